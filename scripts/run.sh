@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# README command 1: install what is missing, build Release, run the default experiment.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/setup.sh
+build/tailsim run configs/default.yaml --out results/default "$@"

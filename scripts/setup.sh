@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs tailsim's Debian 12 packages (only those missing) and builds Release into build/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PKGS="build-essential cmake libmujoco-dev libmujoco-samples libeigen3-dev libyaml-cpp-dev
+  libosmesa6-dev ffmpeg libgtest-dev googletest libbenchmark-dev libboost-dev libcli11-dev
+  gnuplot-nox libtinyxml2-dev nlohmann-json3-dev"
+missing=""
+for p in $PKGS; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "tailsim: installing$missing"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing
+fi
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)"

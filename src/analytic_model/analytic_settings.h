@@ -1,0 +1,25 @@
+// Solver and modelling settings of the analytic ("Simulink") model.
+#pragma once
+
+#include <string>
+
+namespace tailsim {
+
+enum class Coupling {
+  kPaper,  // Eqs. (5)-(13) as printed: tail loads from an inertial base, I_zz phi_ddot = M
+  kExact,  // planar multibody with the base moving (READING-NOTES point 3)
+};
+
+// Settings of the analytic ("Simulink") model.
+struct AnalyticSettings {
+  std::string solver = "adaptive";  // "adaptive" (dense-output Dormand-Prince) or "fixed" (RK4)
+  double rel_tol = 1e-8;            // adaptive: relative error tolerance
+  double abs_tol = 1e-10;           // adaptive: absolute error tolerance
+  double fixed_dt_s = 1e-4;         // fixed: step  [s]
+  double event_tol_s = 1e-12;       // stick/slip event location tolerance in time  [s]
+  double max_step_s = 0.0;          // adaptive: step bound while the tail moves; 0 = dT/50  [s]
+  double v_stop_mps = 1e-7;         // translation: speed below which sliding is declared stopped  [m/s]
+  Coupling coupling = Coupling::kPaper;
+};
+
+}  // namespace tailsim

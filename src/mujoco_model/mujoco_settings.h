@@ -1,0 +1,28 @@
+// Settings of the MuJoCo contact ("ADAMS") model. See README "Friction in MuJoCo".
+#pragma once
+
+#include <array>
+#include <string>
+
+namespace tailsim {
+
+struct MujocoSettings {
+  double timestep_s = 2e-4;             // physics step  [s]
+  std::string integrator = "implicit";  // Euler | RK4 | implicit
+  std::string solver = "Newton";        // Newton | CG | PGS
+  int iterations = 100;                 // constraint solver iterations
+  double tolerance = 1e-10;             // constraint solver tolerance
+  std::string cone = "elliptic";        // pyramidal | elliptic
+  int noslip_iterations = 0;            // MuJoCo noslip post-processing iterations
+  int condim = 3;                       // 1 (frictionless), 3 (sliding), 4 (+torsional), 6
+  double impratio = 1.0;                // frictional-to-normal impedance ratio
+  std::array<double, 2> solref = {0.002, 1.0};                  // contact time constant [s], damping ratio
+  std::array<double, 5> solimp = {0.95, 0.99, 0.001, 0.5, 2.0};  // contact impedance
+  double mu = -1.0;                     // contact friction; < 0: max(mu_s, mu_d)
+  double kp = 0.0;                      // tail position gain [N m/rad]; 0 = chosen from the link inertia
+  double kv = 0.0;                      // tail velocity gain [N m s/rad]; 0 = critically damped
+  bool velocity_feedforward = true;     // add kv * theta_dot_ref
+  bool inverse_dynamics_feedforward = true;  // add MuJoCo's inverse-dynamics joint torque
+};
+
+}  // namespace tailsim

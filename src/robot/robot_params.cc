@@ -1,0 +1,64 @@
+#include "robot/robot_params.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace tailsim {
+
+double RobotParams::tailMass() const {
+  double m = 0.0;
+  for (const TailLink& l : tail) m += l.mass_kg;
+  return m;
+}
+
+TailLink paperTailLink(int n) {
+  // Table 2 (I_zz in kg m^2; the table's "kg/m^2" is a typo).
+  static const double kMass[] = {2.40, 1.20, 0.80, 0.60, 0.48, 0.40};
+  static const double kIzz[] = {2.236e-2, 3.469e-3, 1.268e-3, 6.521e-4, 4.022e-4, 2.743e-4};
+  static const double kLength[] = {0.300, 0.150, 0.100, 0.075, 0.060, 0.050};
+  if (n < 1 || n > 6) throw std::invalid_argument("paper tails have n = 1..6 links, got " + std::to_string(n));
+  return TailLink{kMass[n - 1], kIzz[n - 1], kLength[n - 1], 0.5 * kLength[n - 1]};
+}
+
+namespace {
+void requireFinite(double v, const std::string& what) {
+  if (!std::isfinite(v)) throw std::invalid_argument(what + " must be finite");
+}
+void requirePositive(double v, const std::string& what) {
+  requireFinite(v, what);
+  if (!(v > 0.0)) throw std::invalid_argument(what + " must be > 0, got " + std::to_string(v));
+}
+void requireNonNegative(double v, const std::string& what) {
+  requireFinite(v, what);
+  if (v < 0.0) throw std::invalid_argument(what + " must be >= 0, got " + std::to_string(v));
+}
+}  // namespace
+
+void validate(const RobotParams& p) {
+  const QuadrupedParams& q = p.quadruped;
+  requirePositive(q.mass_kg, "quadruped.mass_kg");
+  requirePositive(q.izz_kgm2, "quadruped.izz_kgm2");
+  requireFinite(q.d_Q2C_m, "quadruped.d_Q2C_m");
+  requireNonNegative(q.d_Q2B_m, "quadruped.d_Q2B_m");
+  requirePositive(q.l_F_m, "quadruped.l_F_m");
+  requirePositive(q.w_F_m, "quadruped.w_F_m");
+  if (p.tail.empty()) throw std::invalid_argument("tail must have at least one link (n >= 1)");
+  for (size_t i = 0; i < p.tail.size(); ++i) {
+    const std::string k = "tail link " + std::to_string(i + 1);
+    requirePositive(p.tail[i].mass_kg, k + " mass_kg");
+    requirePositive(p.tail[i].izz_kgm2, k + " izz_kgm2");
+    requirePositive(p.tail[i].length_m, k + " length_m");
+    requireNonNegative(p.tail[i].com_offset_m, k + " com_offset_m");
+  }
+  const FrictionParams& f = p.friction;
+  requireNonNegative(f.mu_s, "friction.mu_s");
+  requireNonNegative(f.mu_d, "friction.mu_d");
+  requirePositive(f.phidot_s_radps, "friction.phidot_s_radps");
+  requirePositive(f.v_s_mps, "friction.v_s_mps");
+  if (!(f.phidot_d_radps > f.phidot_s_radps))
+    throw std::invalid_argument("friction.phidot_d_radps must exceed friction.phidot_s_radps");
+  if (!(f.v_d_mps > f.v_s_mps)) throw std::invalid_argument("friction.v_d_mps must exceed friction.v_s_mps");
+  requireNonNegative(p.gravity_mps2, "gravity_mps2");
+}
+
+}  // namespace tailsim
