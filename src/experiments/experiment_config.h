@@ -2,9 +2,7 @@
 // turns into. Every model reads its settings from here; nothing else is global.
 #pragma once
 
-#include <array>
 #include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,14 +12,10 @@
 #include "analytic_model/analytic_settings.h"
 #include "mujoco_model/mujoco_settings.h"
 #include "rendering/render_settings.h"
+#include "results/output_settings.h"
 
 namespace tailsim {
 
-struct OutputSettings {
-  double sample_dt_s = 1e-3;  // CSV row spacing (both models share this grid)  [s]
-  double duration_s = 0.0;    // simulated time; 0 = tail end time + settle_s
-  double settle_s = 0.5;      // time after the tail stops  [s]
-};
 
 struct ExperimentCase {
   std::string experiment;   // experiment name
