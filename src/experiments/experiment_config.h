@@ -17,11 +17,21 @@
 namespace tailsim {
 
 
+// kind: pose — evaluate loads at one tail state, no time integration (Figs. 8, 10).
+struct PoseSpec {
+  std::vector<double> theta_rad;         // per joint  [rad]
+  std::vector<double> thetadot_radps;    // per joint  [rad/s]
+  std::vector<double> thetaddot_radps2;  // per joint  [rad/s^2]
+};
+
 struct ExperimentCase {
   std::string experiment;   // experiment name
   std::string name;         // case name: "base" or "key=value,key=value" for sweeps
   std::string source_file;  // the YAML file it came from
   std::map<std::string, std::string> sweep_values;  // swept key -> value as written
+
+  std::string kind = "simulate";  // "simulate" | "pose"
+  PoseSpec pose;                   // kind == "pose"
 
   RobotParams robot;
   std::vector<SplitCycleParams> joints;  // one per tail link
@@ -32,7 +42,9 @@ struct ExperimentCase {
   OutputSettings output;
   RenderSettings render;
 
-  double simDuration() const;  // output.duration_s, or tail end + settle_s
+  TailTrajectory trajectory() const;  // one SplitCycleProfile per joint
+  double simDuration() const;         // output.duration_s, or tail end + settle_s
+
 };
 
 }  // namespace tailsim
