@@ -2,9 +2,12 @@
 # Installs tailsim's Debian 12 packages (only those missing) and builds Release into build/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# libqhull-dev: mujocoConfig.cmake (libmujoco-dev 2.2.2) lists /usr/include/libqhull_r as an include dir;
+# without it CMake generation fails.
 PKGS="build-essential cmake libmujoco-dev libmujoco-samples libeigen3-dev libyaml-cpp-dev
   libosmesa6-dev ffmpeg libgtest-dev googletest libbenchmark-dev libboost-dev libcli11-dev
-  gnuplot-nox libtinyxml2-dev nlohmann-json3-dev"
+  gnuplot-nox libtinyxml2-dev nlohmann-json3-dev
+  libqhull-dev"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
