@@ -23,6 +23,12 @@ struct MujocoSettings {
   double kv = 0.0;                      // tail velocity gain [N m s/rad]; 0 = critically damped
   bool velocity_feedforward = true;     // add kv * theta_dot_ref
   bool inverse_dynamics_feedforward = true;  // add MuJoCo's inverse-dynamics joint torque
+  // Added by the MuJoCo model (docs/mujoco-model.md):
+  double servo_wn_dt = 0.2;             // kp = 0: servo natural frequency * timestep (w_n = servo_wn_dt / timestep_s)
+  double body_height_m = 0.15;          // quadruped COM (= tail plane) height above the ground  [m]
+  double foot_radius_m = 0.01;          // foot spheres  [m]
+  double settle_s = 0.1;                // pre-roll with the tail held at theta(0) so the feet settle; then t = 0  [s]
+  double stop_phidot_radps = 1e-3;      // t_stop: |phi_dot| below this from then on  [rad/s]
 };
 
 }  // namespace tailsim

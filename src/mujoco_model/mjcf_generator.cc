@@ -1,0 +1,379 @@
+#include "mujoco_model/mjcf_generator.h"
+
+#include <tinyxml2.h>
+
+#include <cmath>
+#include <cstdio>
+#include <initializer_list>
+#include <stdexcept>
+
+#include "results/atomic_file.h"
+
+namespace tailsim {
+
+namespace mjcf {
+std::string footGeomName(int k) {
+  static const char* kSuffix[] = {"FL", "FR", "RR", "RL"};
+  if (k < 1 || k > 4) throw std::invalid_argument("foot index must be 1..4");
+  return "foot" + std::to_string(k) + "_" + kSuffix[k - 1];
+}
+std::string tailBodyName(int i) { return "tail_link" + std::to_string(i); }
+std::string tailJointName(int i) { return "tail_joint" + std::to_string(i); }
+std::string tailActuatorName(int i) { return "tail_motor" + std::to_string(i); }
+}  // namespace mjcf
+
+namespace {
+
+constexpr double kBoxHeight = 0.1;       // inertia box of the quadruped (only for Ixx, Iyy)  [m]
+constexpr double kTailGeomRadius = 0.012;  // visual capsule radius of the tail  [m]
+
+// Attribute text for numbers: 15 significant digits (parameters read back to ~1e-15).
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.15g", v == 0.0 ? 0.0 : v);  // no "-0"
+  return buf;
+}
+std::string nums(std::initializer_list<double> vs) {
+  std::string s;
+  for (double v : vs) {
+    if (!s.empty()) s += ' ';
+    s += num(v);
+  }
+  return s;
+}
+
+tinyxml2::XMLElement* child(tinyxml2::XMLElement* parent, const char* tag) {
+  tinyxml2::XMLElement* e = parent->GetDocument()->NewElement(tag);
+  parent->InsertEndChild(e);
+  return e;
+}
+
+void requireOneOf(const std::string& v, std::initializer_list<const char*> allowed, const char* key) {
+  for (const char* a : allowed)
+    if (v == a) return;
+  std::string list;
+  for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+  throw std::invalid_argument(std::string("mujoco.") + key + " must be one of {" + list + "}, got '" + v + "'");
+}
+
+void validateSettings(const MujocoSettings& s) {
+  if (!(s.timestep_s > 0.0) || !std::isfinite(s.timestep_s))
+    throw std::invalid_argument("mujoco.timestep_s must be > 0");
+  requireOneOf(s.integrator, {"Euler", "RK4", "implicit"}, "integrator");
+  requireOneOf(s.solver, {"PGS", "CG", "Newton"}, "solver");
+  requireOneOf(s.cone, {"pyramidal", "elliptic"}, "cone");
+  if (s.condim != 1 && s.condim != 3 && s.condim != 4 && s.condim != 6)
+    throw std::invalid_argument("mujoco.condim must be 1, 3, 4 or 6, got " + std::to_string(s.condim));
+  if (s.iterations < 1) throw std::invalid_argument("mujoco.iterations must be >= 1");
+  if (s.noslip_iterations < 0) throw std::invalid_argument("mujoco.noslip_iterations must be >= 0");
+  if (!(s.tolerance >= 0.0)) throw std::invalid_argument("mujoco.tolerance must be >= 0");
+  if (!(s.impratio > 0.0)) throw std::invalid_argument("mujoco.impratio must be > 0");
+  if (s.kp < 0.0 || s.kv < 0.0) throw std::invalid_argument("mujoco.kp and mujoco.kv must be >= 0");
+  if (s.kp == 0.0 && !(s.servo_wn_dt > 0.0)) throw std::invalid_argument("mujoco.servo_wn_dt must be > 0");
+  if (!(s.foot_radius_m > 0.0)) throw std::invalid_argument("mujoco.foot_radius_m must be > 0");
+  if (!(s.body_height_m > s.foot_radius_m + kTailGeomRadius))
+    throw std::invalid_argument("mujoco.body_height_m must exceed foot_radius_m + tail radius");
+  if (!(s.settle_s >= 0.0)) throw std::invalid_argument("mujoco.settle_s must be >= 0");
+}
+
+}  // namespace
+
+std::array<double, 2> footXY(const QuadrupedParams& q, int k) {
+  // Eq. (17): feet 1, 2 front (+x), 3, 4 rear; 1, 4 left (+y), 2, 3 right.
+  if (k < 1 || k > 4) throw std::invalid_argument("foot index must be 1..4");
+  const double x = (k == 1 || k == 2) ? 0.5 * q.l_F_m : -0.5 * q.l_F_m;
+  const double y = (k == 1 || k == 4) ? 0.5 * q.w_F_m : -0.5 * q.w_F_m;
+  return {q.d_Q2C_m + x, y};
+}
+
+std::array<double, 3> quadrupedDiagInertia(const QuadrupedParams& q) {
+  // Box a x b x c with a:b = l_F:w_F and m (a^2 + b^2) / 12 = I_zz,Q.
+  const double r = q.w_F_m / q.l_F_m;
+  const double a2 = 12.0 * q.izz_kgm2 / (q.mass_kg * (1.0 + r * r));
+  const double b2 = r * r * a2, c2 = kBoxHeight * kBoxHeight;
+  return {q.mass_kg * (b2 + c2) / 12.0, q.mass_kg * (a2 + c2) / 12.0, q.izz_kgm2};
+}
+
+std::array<double, 3> tailLinkDiagInertia(const TailLink& l) { return {0.01 * l.izz_kgm2, l.izz_kgm2, l.izz_kgm2}; }
+
+std::vector<double> tailJointInertias(const RobotParams& p) {
+  const int n = p.numLinks();
+  std::vector<double> I(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    double dist = 0.0;  // joint i -> joint j along the straight tail
+    for (int j = i; j < n; ++j) {
+      const TailLink& l = p.tail[j];
+      const double r = dist + l.com_offset_m;
+      I[i] += l.izz_kgm2 + l.mass_kg * r * r;
+      dist += l.length_m;
+    }
+  }
+  return I;
+}
+
+ServoGains tailServoGains(const RobotParams& p, const MujocoSettings& s) {
+  const std::vector<double> I = tailJointInertias(p);
+  const double wn = s.servo_wn_dt / s.timestep_s;
+  ServoGains g;
+  for (double Ii : I) {
+    g.kp.push_back(s.kp > 0.0 ? s.kp : Ii * wn * wn);
+    g.kv.push_back(s.kv > 0.0 ? s.kv : 2.0 * Ii * (s.kp > 0.0 ? std::sqrt(s.kp / Ii) : wn));
+  }
+  return g;
+}
+
+double footFrictionCoefficient(const RobotParams& p, const MujocoSettings& s, const Effects& e) {
+  switch (e.friction) {
+    case FrictionLaw::kNone: return 0.0;
+    case FrictionLaw::kContinuous: return 0.0;  // mu(0) = 0; updated each step from the slip speed
+    case FrictionLaw::kStiction: break;
+  }
+  return s.mu >= 0.0 ? s.mu : std::max(p.friction.mu_s, p.friction.mu_d);
+}
+
+std::string generateMjcf(const RobotParams& p, const MujocoSettings& s, const Effects& e) {
+  validate(p);
+  validateSettings(s);
+  const int n = p.numLinks();
+  const QuadrupedParams& q = p.quadruped;
+  const double h = s.body_height_m, rf = s.foot_radius_m;
+  const double mu = footFrictionCoefficient(p, s, e);
+  const int condim = e.friction == FrictionLaw::kNone ? 1 : s.condim;
+  const ServoGains gains = tailServoGains(p, s);
+
+  tinyxml2::XMLDocument doc;
+  doc.InsertEndChild(doc.NewComment(
+      " Generated by tailsim (src/mujoco_model/mjcf_generator.cc) from RobotParams + MujocoSettings + Effects. "
+      "Quadruped + planar tail of Rone & Ben-Tzvi 2016; see docs/mujoco-model.md. Do not edit by hand. "));
+  tinyxml2::XMLElement* root = doc.NewElement("mujoco");
+  doc.InsertEndChild(root);
+  root->SetAttribute("model", ("tailsim_quadruped_tail" + std::to_string(n)).c_str());
+
+  tinyxml2::XMLElement* compiler = child(root, "compiler");
+  compiler->SetAttribute("angle", "radian");
+  compiler->SetAttribute("inertiafromgeom", "false");
+
+  tinyxml2::XMLElement* option = child(root, "option");
+  option->SetAttribute("timestep", num(s.timestep_s).c_str());
+  option->SetAttribute("integrator", s.integrator.c_str());
+  option->SetAttribute("solver", s.solver.c_str());
+  option->SetAttribute("iterations", s.iterations);
+  option->SetAttribute("tolerance", num(s.tolerance).c_str());
+  option->SetAttribute("cone", s.cone.c_str());
+  option->SetAttribute("noslip_iterations", s.noslip_iterations);
+  option->SetAttribute("impratio", num(s.impratio).c_str());
+  option->SetAttribute("gravity", nums({0.0, 0.0, e.gravity ? -p.gravity_mps2 : 0.0}).c_str());
+  if (!e.gravity || !e.ground_contact) {
+    tinyxml2::XMLElement* flag = child(option, "flag");
+    if (!e.gravity) flag->SetAttribute("gravity", "disable");
+    if (!e.ground_contact) flag->SetAttribute("contact", "disable");
+  }
+
+  // Default classes: "tailsim" holds everything; visual geoms never collide.
+  tinyxml2::XMLElement* defaults = child(root, "default");
+  tinyxml2::XMLElement* dmain = child(defaults, "default");
+  dmain->SetAttribute("class", "tailsim");
+  {
+    tinyxml2::XMLElement* visual = child(dmain, "default");
+    visual->SetAttribute("class", "visual");
+    tinyxml2::XMLElement* g = child(visual, "geom");
+    g->SetAttribute("contype", 0);
+    g->SetAttribute("conaffinity", 0);
+    g->SetAttribute("group", 2);
+    g->SetAttribute("density", 0);
+
+    tinyxml2::XMLElement* foot = child(dmain, "default");
+    foot->SetAttribute("class", "foot");
+    g = child(foot, "geom");
+    g->SetAttribute("type", "sphere");
+    g->SetAttribute("size", num(rf).c_str());
+    g->SetAttribute("contype", 1);
+    g->SetAttribute("conaffinity", 1);
+    g->SetAttribute("condim", condim);
+    g->SetAttribute("friction", nums({mu, 0.0, 0.0}).c_str());
+    g->SetAttribute("solref", nums({s.solref[0], s.solref[1]}).c_str());
+    g->SetAttribute("solimp", nums({s.solimp[0], s.solimp[1], s.solimp[2], s.solimp[3], s.solimp[4]}).c_str());
+    g->SetAttribute("group", 3);
+
+    tinyxml2::XMLElement* tail = child(dmain, "default");
+    tail->SetAttribute("class", "tail");
+    tinyxml2::XMLElement* j = child(tail, "joint");
+    j->SetAttribute("type", "hinge");
+    j->SetAttribute("axis", "0 0 1");
+    j->SetAttribute("damping", 0);
+    j->SetAttribute("armature", 0);
+    j->SetAttribute("limited", "false");
+    g = child(tail, "geom");
+    g->SetAttribute("type", "capsule");
+    g->SetAttribute("size", num(kTailGeomRadius).c_str());
+    g->SetAttribute("contype", 0);
+    g->SetAttribute("conaffinity", 0);
+    g->SetAttribute("group", 2);
+    g->SetAttribute("density", 0);
+    tinyxml2::XMLElement* a = child(tail, "general");
+    a->SetAttribute("dyntype", "none");
+    a->SetAttribute("gaintype", "fixed");
+    a->SetAttribute("biastype", "affine");
+    a->SetAttribute("ctrllimited", "false");
+    a->SetAttribute("forcelimited", "false");
+  }
+
+  tinyxml2::XMLElement* asset = child(root, "asset");
+  {
+    tinyxml2::XMLElement* t = child(asset, "texture");
+    t->SetAttribute("name", "grid");
+    t->SetAttribute("type", "2d");
+    t->SetAttribute("builtin", "checker");
+    t->SetAttribute("rgb1", "0.2 0.3 0.4");
+    t->SetAttribute("rgb2", "0.1 0.2 0.3");
+    t->SetAttribute("width", 512);
+    t->SetAttribute("height", 512);
+    tinyxml2::XMLElement* mtl = child(asset, "material");
+    mtl->SetAttribute("name", "grid");
+    mtl->SetAttribute("texture", "grid");
+    mtl->SetAttribute("texrepeat", "1 1");
+    mtl->SetAttribute("texuniform", "true");
+    mtl->SetAttribute("reflectance", "0.1");
+  }
+
+  tinyxml2::XMLElement* world = child(root, "worldbody");
+  {
+    tinyxml2::XMLElement* light = child(world, "light");
+    light->SetAttribute("name", "top");
+    light->SetAttribute("pos", "0 0 3");
+    light->SetAttribute("dir", "0 0 -1");
+    light->SetAttribute("directional", "true");
+  }
+  if (e.ground_contact) {
+    // The floor takes its friction and condim from the feet (MuJoCo mixes with max()).
+    tinyxml2::XMLElement* floor = child(world, "geom");
+    floor->SetAttribute("name", mjcf::kFloorGeom);
+    floor->SetAttribute("type", "plane");
+    floor->SetAttribute("size", "5 5 0.05");
+    floor->SetAttribute("material", "grid");
+    floor->SetAttribute("contype", 1);
+    floor->SetAttribute("conaffinity", 1);
+    floor->SetAttribute("condim", 1);
+    floor->SetAttribute("friction", "0 0 0");
+    floor->SetAttribute("solref", nums({s.solref[0], s.solref[1]}).c_str());
+    floor->SetAttribute("solimp", nums({s.solimp[0], s.solimp[1], s.solimp[2], s.solimp[3], s.solimp[4]}).c_str());
+  }
+
+  // Quadruped: body frame origin = quadruped COM at height h, x forward, z up (paper Fig. 2).
+  tinyxml2::XMLElement* body = child(world, "body");
+  body->SetAttribute("name", mjcf::kQuadrupedBody);
+  body->SetAttribute("childclass", "tailsim");
+  body->SetAttribute("pos", nums({0.0, 0.0, h}).c_str());
+  if (e.translation) {
+    tinyxml2::XMLElement* fj = child(body, "freejoint");
+    fj->SetAttribute("name", mjcf::kRootJoint);
+  } else {
+    // x, y locked: the body may still settle (slide z) and tilt on its feet (ball); yaw is free.
+    tinyxml2::XMLElement* jz = child(body, "joint");
+    jz->SetAttribute("name", mjcf::kHeightJoint);
+    jz->SetAttribute("type", "slide");
+    jz->SetAttribute("axis", "0 0 1");
+    jz->SetAttribute("limited", "false");
+    tinyxml2::XMLElement* jb = child(body, "joint");
+    jb->SetAttribute("name", mjcf::kRootJoint);
+    jb->SetAttribute("type", "ball");
+    jb->SetAttribute("limited", "false");
+  }
+  {
+    const std::array<double, 3> I = quadrupedDiagInertia(q);
+    tinyxml2::XMLElement* in = child(body, "inertial");
+    in->SetAttribute("pos", "0 0 0");
+    in->SetAttribute("mass", num(q.mass_kg).c_str());
+    in->SetAttribute("diaginertia", nums({I[0], I[1], I[2]}).c_str());
+  }
+  {
+    tinyxml2::XMLElement* torso = child(body, "geom");
+    torso->SetAttribute("name", "torso");
+    torso->SetAttribute("class", "visual");
+    torso->SetAttribute("type", "box");
+    torso->SetAttribute("pos", nums({q.d_Q2C_m, 0.0, 0.0}).c_str());
+    torso->SetAttribute("size", nums({0.5 * q.l_F_m + 0.04, 0.5 * q.w_F_m - 0.02, 0.04}).c_str());
+    torso->SetAttribute("rgba", "0.7 0.7 0.75 1");
+  }
+  for (int k = 1; k <= 4; ++k) {
+    const std::array<double, 2> xy = footXY(q, k);
+    tinyxml2::XMLElement* leg = child(body, "geom");
+    leg->SetAttribute("name", ("leg" + std::to_string(k)).c_str());
+    leg->SetAttribute("class", "visual");
+    leg->SetAttribute("type", "capsule");
+    leg->SetAttribute("size", "0.012");
+    leg->SetAttribute("fromto", nums({xy[0], xy[1], 0.0, xy[0], xy[1], -(h - rf)}).c_str());
+    leg->SetAttribute("rgba", "0.5 0.5 0.55 1");
+  }
+  for (int k = 1; k <= 4; ++k) {
+    const std::array<double, 2> xy = footXY(q, k);
+    tinyxml2::XMLElement* foot = child(body, "geom");
+    foot->SetAttribute("name", mjcf::footGeomName(k).c_str());
+    foot->SetAttribute("class", "foot");
+    foot->SetAttribute("pos", nums({xy[0], xy[1], -(h - rf)}).c_str());  // sphere bottom at z = 0
+    foot->SetAttribute("rgba", "0.2 0.2 0.2 1");
+  }
+
+  // Tail: base B at -d_Q2B x (Eq. 2), R_B = R_Q R_Z(180 deg) (Eq. 1): quaternion (0, 0, 0, 1).
+  tinyxml2::XMLElement* parent = body;
+  for (int i = 1; i <= n; ++i) {
+    const TailLink& l = p.tail[i - 1];
+    tinyxml2::XMLElement* link = child(parent, "body");
+    link->SetAttribute("name", mjcf::tailBodyName(i).c_str());
+    link->SetAttribute("childclass", "tail");
+    if (i == 1) {
+      link->SetAttribute("pos", nums({-q.d_Q2B_m, 0.0, 0.0}).c_str());
+      link->SetAttribute("quat", "0 0 0 1");
+    } else {
+      link->SetAttribute("pos", nums({p.tail[i - 2].length_m, 0.0, 0.0}).c_str());  // Eq. (3): joint i at end of link i-1
+    }
+    tinyxml2::XMLElement* j = child(link, "joint");
+    j->SetAttribute("name", mjcf::tailJointName(i).c_str());
+    const std::array<double, 3> I = tailLinkDiagInertia(l);
+    tinyxml2::XMLElement* in = child(link, "inertial");
+    in->SetAttribute("pos", nums({l.com_offset_m, 0.0, 0.0}).c_str());
+    in->SetAttribute("mass", num(l.mass_kg).c_str());
+    in->SetAttribute("diaginertia", nums({I[0], I[1], I[2]}).c_str());
+    tinyxml2::XMLElement* g = child(link, "geom");
+    g->SetAttribute("name", ("tail_geom" + std::to_string(i)).c_str());
+    g->SetAttribute("fromto", nums({0.0, 0.0, 0.0, l.length_m, 0.0, 0.0}).c_str());
+    g->SetAttribute("rgba", i % 2 ? "0.85 0.45 0.1 1" : "0.95 0.65 0.2 1");
+    parent = link;
+  }
+
+  // PD position servos: force = kp ctrl - kp theta - kv theta_dot (MuJoCo 2.2 <position> has no kv).
+  tinyxml2::XMLElement* actuator = child(root, "actuator");
+  for (int i = 1; i <= n; ++i) {
+    tinyxml2::XMLElement* a = child(actuator, "general");
+    a->SetAttribute("name", mjcf::tailActuatorName(i).c_str());
+    a->SetAttribute("class", "tail");
+    a->SetAttribute("joint", mjcf::tailJointName(i).c_str());
+    a->SetAttribute("gainprm", num(gains.kp[i - 1]).c_str());
+    a->SetAttribute("biasprm", nums({0.0, -gains.kp[i - 1], -gains.kv[i - 1]}).c_str());
+  }
+
+  tinyxml2::XMLElement* keyframe = child(root, "keyframe");
+  {
+    tinyxml2::XMLElement* key = child(keyframe, "key");
+    key->SetAttribute("name", mjcf::kHomeKey);
+    std::string qpos = e.translation ? nums({0.0, 0.0, h, 1.0, 0.0, 0.0, 0.0}) : nums({0.0, 1.0, 0.0, 0.0, 0.0});
+    for (int i = 0; i < n; ++i) qpos += " 0";
+    key->SetAttribute("qpos", qpos.c_str());
+  }
+
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
+}
+
+RobotParams paperRobot(int links) {
+  RobotParams p;  // Table 1 defaults
+  p.tail.assign(links, paperTailLink(links));
+  return p;
+}
+
+void writeMjcfFile(int links, const std::string& out) {
+  writeFileAtomic(out, generateMjcf(paperRobot(links), MujocoSettings{}, Effects{}));
+}
+
+}  // namespace tailsim

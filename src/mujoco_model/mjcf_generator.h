@@ -1,0 +1,66 @@
+// MJCF generation (tinyxml2) for the MuJoCo contact model: the quadruped on four point-like
+// feet with an n-link planar tail (paper Figs. 1-3, Tables 1-2). See docs/mujoco-model.md.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "mujoco_model/mujoco_settings.h"
+#include "robot/robot_params.h"
+#include "robot/scene_effects.h"
+
+namespace tailsim {
+
+// Element names in the generated model (menagerie style).
+namespace mjcf {
+inline constexpr const char* kQuadrupedBody = "quadruped";
+inline constexpr const char* kRootJoint = "root";   // freejoint (translation) or ball (no translation)
+inline constexpr const char* kHeightJoint = "height";  // slide z, only when translation is off
+inline constexpr const char* kFloorGeom = "floor";
+inline constexpr const char* kHomeKey = "home";
+std::string footGeomName(int k);       // k = 1..4: foot1_FL, foot2_FR, foot3_RR, foot4_RL
+std::string tailBodyName(int i);       // i = 1..n: tail_link<i>
+std::string tailJointName(int i);      // tail_joint<i>
+std::string tailActuatorName(int i);   // tail_motor<i>
+}  // namespace mjcf
+
+// Foot position (k = 1..4) relative to the quadruped COM in the body x-y plane, Eq. (17):
+// (d_Q2C + x_F,k, y_F,k), x_F = +-l_F/2, y_F = +-w_F/2.
+std::array<double, 2> footXY(const QuadrupedParams& q, int k);
+
+// Quadruped principal inertia (Ixx, Iyy, Izz): Izz = I_zz,Q exactly; Ixx, Iyy from the uniform box
+// (height 0.1 m, x:y aspect l_F:w_F) whose Izz equals I_zz,Q. Only Izz matters to the planar paper.
+std::array<double, 3> quadrupedDiagInertia(const QuadrupedParams& q);
+
+// Tail link principal inertia about its COM: (axial, transverse, Izz) = (0.01 Izz, Izz, Izz)
+// (a slender link; Izz exact from Table 2).
+std::array<double, 3> tailLinkDiagInertia(const TailLink& l);
+
+// z inertia about joint i of links i..n with the tail straight (all theta = 0): the servo's load.
+std::vector<double> tailJointInertias(const RobotParams& p);
+
+// PD gains of the tail position servos. kp_i = I_i w_n^2, kv_i = 2 I_i w_n (critically damped),
+// w_n = servo_wn_dt / timestep_s, I_i from tailJointInertias. settings.kp/kv > 0 override.
+struct ServoGains {
+  std::vector<double> kp;  // [N m / rad]
+  std::vector<double> kv;  // [N m s / rad]
+};
+ServoGains tailServoGains(const RobotParams& p, const MujocoSettings& s);
+
+// The foot friction coefficient written into the model: settings.mu, or max(mu_s, mu_d) if mu < 0
+// (READING-NOTES point 1); 0 for FrictionLaw::kNone; 0 at start for kContinuous (mu(0) = 0, the
+// simulation updates it every step).
+double footFrictionCoefficient(const RobotParams& p, const MujocoSettings& s, const Effects& e);
+
+// One self-contained MJCF document (no includes, no assets on disk). Throws std::invalid_argument
+// on bad parameters or settings.
+std::string generateMjcf(const RobotParams& p, const MujocoSettings& s, const Effects& e);
+
+// The paper robot (Table 1 defaults of RobotParams, Table 2 n-link tail).
+RobotParams paperRobot(int links);
+
+// `tailsim mjcf --links N --out FILE`: the paper robot with default settings and effects.
+void writeMjcfFile(int links, const std::string& out);
+
+}  // namespace tailsim

@@ -1,0 +1,52 @@
+// RAII ownership of MuJoCo 2.2 objects and exception-based error reporting.
+//
+// Errors: compile errors come back from mj_loadXML in a caller-owned buffer and are thrown as
+// MujocoError with MuJoCo's text. Run-time trouble (NaN/Inf, singular inertia, full contact
+// buffers) is read from the per-mjData warning counters d->warning[i] (no global state).
+// MuJoCo 2.2's fatal-error hook (mju_user_error) is a process-wide global: we do NOT install a
+// handler, so a genuine mju_error (e.g. out of arena memory) still terminates the process as in
+// stock MuJoCo. mju_user_warning is likewise left alone; the counters carry the information.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include <mujoco/mujoco.h>
+
+namespace tailsim {
+
+class MujocoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct MjModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct MjDataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+using ModelPtr = std::unique_ptr<mjModel, MjModelDeleter>;
+using DataPtr = std::unique_ptr<mjData, MjDataDeleter>;
+
+// Compiles an MJCF document held in memory (through a private mjVFS, no temporary file).
+// Throws MujocoError with MuJoCo's compiler message on failure.
+ModelPtr loadModelFromXml(const std::string& xml);
+// Loads an MJCF file from disk (throws MujocoError naming the file).
+ModelPtr loadModelFromFile(const std::string& path);
+// mj_makeData; throws MujocoError if it returns null.
+DataPtr makeData(const mjModel* m);
+
+// Total of d->warning[i].number over all warning types.
+int warningCount(const mjData* d);
+// "" if no warning occurred, else e.g. "mjWARN_BADQACC x3 (first at t=0.1234 s); ...".
+std::string describeWarnings(const mjData* d);
+
+// Id lookups that throw MujocoError naming the missing element.
+int bodyId(const mjModel* m, const std::string& name);
+int jointId(const mjModel* m, const std::string& name);
+int geomId(const mjModel* m, const std::string& name);
+int actuatorId(const mjModel* m, const std::string& name);
+
+}  // namespace tailsim

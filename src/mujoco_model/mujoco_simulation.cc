@@ -1,0 +1,337 @@
+#include "mujoco_model/mujoco_simulation.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "controllers/tail_controller.h"
+#include "mujoco_model/mjcf_generator.h"
+#include "mujoco_model/mujoco_handles.h"
+#include "robot/friction_law.h"
+
+namespace tailsim {
+
+namespace {
+
+constexpr double kRad2Deg = 180.0 / M_PI;
+
+// Indices into mjModel for the elements the simulation reads.
+struct Layout {
+  int quad_body = -1;
+  int root_dofadr = -1;  // first rotational dof of the quadruped (body-frame angular velocity)
+  int link1_body = -1;
+  std::vector<int> tail_qposadr, tail_dofadr, tail_act;
+  std::array<int, 4> foot_geom{};
+};
+
+Layout makeLayout(const mjModel* m, int n, bool translation) {
+  Layout L;
+  L.quad_body = bodyId(m, mjcf::kQuadrupedBody);
+  const int root = jointId(m, mjcf::kRootJoint);
+  L.root_dofadr = m->jnt_dofadr[root] + (translation ? 3 : 0);  // free: (v, w_local); ball: w_local
+  L.link1_body = bodyId(m, mjcf::tailBodyName(1));
+  for (int i = 1; i <= n; ++i) {
+    const int j = jointId(m, mjcf::tailJointName(i));
+    L.tail_qposadr.push_back(m->jnt_qposadr[j]);
+    L.tail_dofadr.push_back(m->jnt_dofadr[j]);
+    L.tail_act.push_back(actuatorId(m, mjcf::tailActuatorName(i)));
+  }
+  for (int k = 1; k <= 4; ++k) L.foot_geom[k - 1] = geomId(m, mjcf::footGeomName(k));
+  return L;
+}
+
+// Column indices of the output table.
+struct Columns {
+  int t, x, y, phi, phidot, phiddot, mzt, mzf, izz, izz_phiddot, ftx, fty, ffx, ffy;
+  std::vector<int> theta, thetadot, thetaddot, track_err;
+  std::array<int, 4> fn{}, ft{};
+};
+
+Columns makeColumns(TimeSeries& ts, int n) {
+  Columns c;
+  c.t = ts.addColumn("t_s");
+  for (int i = 1; i <= n; ++i) c.theta.push_back(ts.addColumn("theta" + std::to_string(i) + "_deg"));
+  for (int i = 1; i <= n; ++i) c.thetadot.push_back(ts.addColumn("thetadot" + std::to_string(i) + "_dps"));
+  for (int i = 1; i <= n; ++i) c.thetaddot.push_back(ts.addColumn("thetaddot" + std::to_string(i) + "_dps2"));
+  c.x = ts.addColumn("x_m");
+  c.y = ts.addColumn("y_m");
+  c.phi = ts.addColumn("phi_deg");
+  c.phidot = ts.addColumn("phidot_dps");
+  c.phiddot = ts.addColumn("phiddot_dps2");
+  c.mzt = ts.addColumn("MzT_Nm");
+  c.mzf = ts.addColumn("MzF_Nm");
+  c.izz = ts.addColumn("Izz_kgm2");
+  c.izz_phiddot = ts.addColumn("Izz_phiddot_Nm");
+  c.ftx = ts.addColumn("FTx_N");
+  c.fty = ts.addColumn("FTy_N");
+  c.ffx = ts.addColumn("FFx_N");
+  c.ffy = ts.addColumn("FFy_N");
+  for (int k = 1; k <= 4; ++k) {
+    c.fn[k - 1] = ts.addColumn("foot" + std::to_string(k) + "_Fn_N");
+    c.ft[k - 1] = ts.addColumn("foot" + std::to_string(k) + "_Ft_N");
+  }
+  for (int i = 1; i <= n; ++i) c.track_err.push_back(ts.addColumn("track_err" + std::to_string(i) + "_deg"));
+  return c;
+}
+
+double yawOf(const mjData* d, int body) {
+  const mjtNum* R = d->xmat + 9 * body;  // row-major, body -> world
+  return std::atan2(R[3], R[0]);          // heading of the body x axis in the ground plane
+}
+
+double wrapPi(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+// z component (world) of a body-frame vector w of `body`.
+double worldZ(const mjData* d, int body, const mjtNum* w) {
+  const mjtNum* R = d->xmat + 9 * body;
+  return R[6] * w[0] + R[7] * w[1] + R[8] * w[2];
+}
+
+// Fills one output row. Kinematics, contacts, qacc in d belong to the state (qpos, qvel) at time t
+// (the step that started at t has just run, only d->qpos / d->qvel / d->time moved on).
+void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, const TailController& ctrl,
+             const std::vector<mjtNum>& qpos, const std::vector<mjtNum>& qvel, double t_grid, double phi,
+             std::vector<double>& row) {
+  const int n = static_cast<int>(L.tail_qposadr.size());
+  row[c.t] = t_grid;
+  for (int i = 0; i < n; ++i) {
+    row[c.theta[i]] = qpos[L.tail_qposadr[i]] * kRad2Deg;
+    row[c.thetadot[i]] = qvel[L.tail_dofadr[i]] * kRad2Deg;
+    row[c.thetaddot[i]] = d->qacc[L.tail_dofadr[i]] * kRad2Deg;  // actual (MuJoCo's), not the reference
+    row[c.track_err[i]] = ctrl.lastError(i) * kRad2Deg;
+  }
+  row[c.x] = d->xpos[3 * L.quad_body];  // quadruped COM = body origin
+  row[c.y] = d->xpos[3 * L.quad_body + 1];
+  row[c.phi] = phi * kRad2Deg;
+  const double phidot = worldZ(d, L.quad_body, qvel.data() + L.root_dofadr);
+  const double phiddot = worldZ(d, L.quad_body, d->qacc + L.root_dofadr);
+  row[c.phidot] = phidot * kRad2Deg;
+  row[c.phiddot] = phiddot * kRad2Deg;
+
+  // System COM and Izz about it (Eq. 11, full 3-D inertia tensors, tilt included).
+  const mjtNum* com = d->subtree_com + 3 * L.quad_body;
+  double izz = 0.0;
+  for (int b = L.quad_body; b < m->nbody; ++b) {
+    if (m->body_rootid[b] != L.quad_body) continue;
+    const mjtNum* R = d->ximat + 9 * b;
+    const mjtNum* I = m->body_inertia + 3 * b;
+    izz += R[6] * R[6] * I[0] + R[7] * R[7] * I[1] + R[8] * R[8] * I[2];
+    const double dx = d->xipos[3 * b] - com[0], dy = d->xipos[3 * b + 1] - com[1];
+    izz += m->body_mass[b] * (dx * dx + dy * dy);
+  }
+  row[c.izz] = izz;
+  row[c.izz_phiddot] = izz * phiddot;
+
+  // Tail load on the body: minus the interaction force of the tail's first link with its parent.
+  // cfrc_int is (torque, force) at subtree_com of the root body = the system COM, world axes, so
+  // its z torque is already M_z,T about the system COM (Eq. 13). mj_rnePostConstraint reads
+  // d->qvel: give it the velocities of time t.
+  std::vector<mjtNum> qvel_next(d->qvel, d->qvel + m->nv);
+  std::copy(qvel.begin(), qvel.end(), d->qvel);
+  mj_rnePostConstraint(m, d);
+  std::copy(qvel_next.begin(), qvel_next.end(), d->qvel);
+  const mjtNum* fint = d->cfrc_int + 6 * L.link1_body;
+  row[c.mzt] = -fint[2];
+  row[c.ftx] = -fint[3];
+  row[c.fty] = -fint[4];
+
+  // Foot contact forces (world), their friction moment about the system COM.
+  std::array<double, 4> fn{}, ft{};
+  double mzf = 0.0, ffx = 0.0, ffy = 0.0;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& con = d->contact[i];
+    int k = -1;
+    double sign = 1.0;  // mj_contactForce: force of geom1 on geom2 in the contact frame
+    for (int f = 0; f < 4; ++f) {
+      if (con.geom2 == L.foot_geom[f]) k = f;
+      if (con.geom1 == L.foot_geom[f]) k = f, sign = -1.0;
+    }
+    if (k < 0) continue;
+    mjtNum f6[6];
+    mj_contactForce(m, d, i, f6);
+    double F[3];
+    for (int a = 0; a < 3; ++a)
+      F[a] = sign * (f6[0] * con.frame[a] + f6[1] * con.frame[3 + a] + f6[2] * con.frame[6 + a]);
+    fn[k] += f6[0];
+    ft[k] += std::hypot(f6[1], f6[2]);
+    const double rx = con.pos[0] - com[0], ry = con.pos[1] - com[1];
+    mzf += rx * F[1] - ry * F[0];
+    ffx += F[0];
+    ffy += F[1];
+  }
+  row[c.mzf] = mzf;
+  row[c.ffx] = ffx;
+  row[c.ffy] = ffy;
+  for (int k = 0; k < 4; ++k) {
+    row[c.fn[k]] = fn[k];
+    row[c.ft[k]] = ft[k];
+  }
+}
+
+// ADAMS law (Fig. 4): each foot's coefficient from its horizontal slip speed. Uses d->cvel of the
+// last evaluated state (one step old).
+void updateFootFriction(mjModel* m, const mjData* d, const Layout& L, const FrictionParams& fp) {
+  for (int k = 0; k < 4; ++k) {
+    mjtNum v6[6];
+    mj_objectVelocity(m, d, mjOBJ_GEOM, L.foot_geom[k], v6, 0);  // (angular, linear), world axes
+    const double slip = std::hypot(v6[3], v6[4]);
+    m->geom_friction[3 * L.foot_geom[k]] = adamsFrictionCoefficient(slip, fp.v_s_mps, fp.v_d_mps, fp.mu_s, fp.mu_d);
+  }
+}
+
+std::string instabilityMessage(const mjData* d, double t, const MujocoSettings& s, const ServoGains& g) {
+  std::ostringstream os;
+  os << "MuJoCo became unstable at t=" << t << " s (" << describeWarnings(d) << "): timestep_s=" << s.timestep_s
+     << " too large for kp=" << *std::max_element(g.kp.begin(), g.kp.end())
+     << " N m/rad (servo_wn_dt=" << s.servo_wn_dt << ") or contact solref=[" << s.solref[0] << ", " << s.solref[1]
+     << "] with integrator=" << s.integrator;
+  return os.str();
+}
+
+}  // namespace
+
+RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer) {
+  const int n = robot.numLinks();
+  if (static_cast<int>(trajectory.joints.size()) != n)
+    throw std::invalid_argument("trajectory has " + std::to_string(trajectory.joints.size()) +
+                                " joints but the tail has " + std::to_string(n) + " links");
+  if (!(output.sample_dt_s > 0.0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
+  const double duration = output.duration_s > 0.0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  if (!(duration >= 0.0) || !std::isfinite(duration)) throw std::invalid_argument("bad simulation duration");
+
+  const std::string xml = generateMjcf(robot, settings, effects);  // validates robot + settings
+  ModelPtr model = loadModelFromXml(xml);
+  mjModel* m = model.get();
+  DataPtr data = makeData(m);
+  mjData* d = data.get();
+  const Layout L = makeLayout(m, n, effects.translation);
+  const ServoGains gains = tailServoGains(robot, settings);
+  const bool continuous = effects.friction == FrictionLaw::kContinuous && effects.ground_contact;
+  const bool rk4 = settings.integrator == "RK4";
+
+  RunResult result;
+  RunSummary& sum = result.summary;
+  sum.model = "mujoco";
+  TimeSeries& ts = result.series;
+  const Columns cols = makeColumns(ts, n);
+  std::vector<double> row(ts.numColumns(), 0.0);
+
+  // Initial state: home keyframe, tail at theta(0), then settle on the feet.
+  mj_resetDataKeyframe(m, d, mj_name2id(m, mjOBJ_KEY, mjcf::kHomeKey));
+  std::vector<JointState> ref0;
+  trajectory.evaluate(0.0, ref0);
+  for (int i = 0; i < n; ++i) d->qpos[L.tail_qposadr[i]] = ref0[i].theta;
+  TailController ctrl(m, trajectory, L.tail_qposadr, L.tail_dofadr, L.tail_act,
+                      {settings.velocity_feedforward, settings.inverse_dynamics_feedforward});
+  mj_forward(m, d);
+
+  auto fail = [&](const std::string& why) {
+    sum.ok = false;
+    sum.error = why;
+  };
+  auto step = [&](double t_ref, bool record) {
+    if (continuous) updateFootFriction(m, d, L, robot.friction);
+    if (rk4) {
+      mj_forward(m, d);  // M, bias at this state for the feed-forward; ctrl is held over the RK4 step
+      ctrl.apply(m, d, t_ref, record);
+      mj_step(m, d);
+    } else {
+      mj_step1(m, d);
+      ctrl.apply(m, d, t_ref, record);
+      mj_step2(m, d);
+    }
+  };
+
+  while (d->time < settings.settle_s - 0.5 * settings.timestep_s && sum.ok) {
+    step(0.0, false);
+    if (warningCount(d) > 0) fail(instabilityMessage(d, d->time - settings.settle_s, settings, gains) + " (settling)");
+  }
+  if (!sum.ok) return result;
+  d->time = 0.0;
+  for (int v = 0; v < m->nv; ++v) d->qvel[v] = 0.0;
+  mj_forward(m, d);
+
+  // Main loop. Row k is the state at the start of the first step with t >= t_k (exact when the
+  // timestep divides sample_dt; otherwise up to one timestep late, labelled t_k).
+  const double h = settings.timestep_s;
+  const long num_samples = static_cast<long>(std::floor(duration / output.sample_dt_s + 1e-9)) + 1;
+  const double eps = 1e-6 * h;
+  long k = 0;
+  std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv);
+  double phi = yawOf(d, L.quad_body), yaw_prev = phi, phi0 = phi;
+  long steps = 0;
+  const auto wall0 = std::chrono::steady_clock::now();
+  while (k < num_samples) {
+    const double t = d->time;
+    const bool sample = t >= k * output.sample_dt_s - eps;
+    if (sample) {
+      if (observer) observer(k * output.sample_dt_s, m, d);
+      std::copy(d->qpos, d->qpos + m->nq, qpos_t.begin());
+      std::copy(d->qvel, d->qvel + m->nv, qvel_t.begin());
+    }
+    if (rk4 && sample) {
+      // RK4 overwrites the intermediate fields: evaluate the sample state first.
+      if (continuous) updateFootFriction(m, d, L, robot.friction);
+      mj_forward(m, d);
+      ctrl.apply(m, d, t, true);
+      const double yaw = yawOf(d, L.quad_body);
+      phi += wrapPi(yaw - yaw_prev);
+      yaw_prev = yaw;
+      while (k < num_samples && t >= k * output.sample_dt_s - eps) {
+        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, k * output.sample_dt_s, phi, row);
+        ts.appendRow(row);
+        ++k;
+      }
+      mj_step(m, d);
+    } else {
+      step(t, true);
+    }
+    ++steps;
+    if (warningCount(d) > 0 || !std::isfinite(d->qacc[L.root_dofadr])) {
+      fail(instabilityMessage(d, t, settings, gains));
+      break;
+    }
+    if (sample && !rk4) {
+      const double yaw = yawOf(d, L.quad_body);  // xmat of time t
+      phi += wrapPi(yaw - yaw_prev);
+      yaw_prev = yaw;
+      while (k < num_samples && t >= k * output.sample_dt_s - eps) {
+        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, k * output.sample_dt_s, phi, row);
+        ts.appendRow(row);
+        ++k;
+      }
+    }
+  }
+  sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  sum.solver_steps = steps;
+
+  // Summary.
+  const std::vector<double>& phis = ts.values(cols.phi);
+  if (!phis.empty()) sum.phi_net_deg = phis.back() - phi0 * kRad2Deg;
+  const std::vector<double>& tcol = ts.values(cols.t);
+  const std::vector<double>& pd = ts.values(cols.phidot);
+  const double thr = settings.stop_phidot_radps * kRad2Deg;
+  sum.t_stop_s = 0.0;
+  for (size_t r = pd.size(); r-- > 0;) {
+    if (std::abs(pd[r]) >= thr) {
+      sum.t_stop_s = r + 1 < pd.size() ? tcol[r + 1] : tcol[r];
+      break;
+    }
+  }
+  const TrackingStats st = ctrl.stats();
+  for (int i = 0; i < n; ++i) {
+    sum.extra["tracking_max_deg_j" + std::to_string(i + 1)] = st.max_abs_rad[i] * kRad2Deg;
+    sum.extra["tracking_rms_deg_j" + std::to_string(i + 1)] = st.rms_rad[i] * kRad2Deg;
+  }
+  sum.extra["mujoco_warnings"] = warningCount(d);
+  sum.extra["kp_j1"] = gains.kp[0];
+  return result;
+}
+
+}  // namespace tailsim
