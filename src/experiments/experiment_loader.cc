@@ -1,0 +1,903 @@
+// YAML experiment files -> validated ExperimentCases (docs/experiment-format.md).
+//
+// Two passes over an experiment file: (1) find every sweep ({sweep: [...]} / {range: [...]}) and
+// remember it by its dotted key; (2) for every point of the sweep grid, read the whole file again
+// with each sweep replaced by its value at that point, building and validating one ExperimentCase.
+// Every case is built before anything is returned, so a bad value anywhere in the grid is
+// reported before any work starts. Each error names file:line:col and the dotted key.
+#include "experiments/experiment_loader.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+#include <utility>
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kRadPerDeg = M_PI / 180.0;
+
+std::string fmtG(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string joinList(std::initializer_list<const char*> names) {
+  std::string s;
+  for (const char* n : names) s += (s.empty() ? "" : ", ") + std::string(n);
+  return s;
+}
+
+std::string joinKey(const std::string& parent, const std::string& k) {
+  return parent.empty() ? k : parent + "." + k;
+}
+std::string indexKey(const std::string& parent, std::size_t i) { return parent + "[" + std::to_string(i) + "]"; }
+
+// Where a value came from.
+struct Loc {
+  const std::string* file = nullptr;  // points into the loader's long-lived file list
+  YAML::Mark mark = YAML::Mark::null_mark();
+  std::string key;  // dotted key
+};
+
+[[noreturn]] void fail(const Loc& at, const std::string& what) {
+  std::string s = at.file ? *at.file : std::string("<unknown file>");
+  if (!at.mark.is_null()) s += ":" + std::to_string(at.mark.line + 1) + ":" + std::to_string(at.mark.column + 1);
+  s += ": ";
+  if (!at.key.empty()) s += at.key + ": ";
+  throw ConfigError(s + what);
+}
+
+// Re-throws a std::invalid_argument from tailsim::validate() / SplitCycleProfile as a
+// ConfigError at the value its message names: the longest key in `at` that prefixes the message.
+[[noreturn]] void rethrowAt(const std::string& msg, const std::map<std::string, Loc>& at, const Loc& fallback) {
+  const std::pair<const std::string, Loc>* best = nullptr;
+  for (const auto& kv : at)
+    if (msg.compare(0, kv.first.size(), kv.first) == 0 && (!best || kv.first.size() > best->first.size())) best = &kv;
+  if (!best) fail(fallback, msg);
+  std::string rest = msg.substr(best->first.size());
+  while (!rest.empty() && rest.front() == ' ') rest.erase(rest.begin());
+  fail(best->second, rest.empty() ? msg : rest);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sweeps
+
+struct SweepValue {
+  YAML::Node node;          // the sweep element (undefined for a range value)
+  bool from_range = false;  // true: `number` holds the value
+  double number = 0.0;
+  std::string text;         // as written (sweep) or %g (range)
+  YAML::Mark mark;          // sweep element, or the range node
+};
+
+struct Sweep {
+  std::string key;  // dotted key
+  std::vector<SweepValue> values;
+};
+
+using Picks = std::map<std::string, const SweepValue*>;
+
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Null: return "nothing (empty value)";
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Sequence: return "a list";
+    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+    default: return "nothing";
+  }
+}
+
+bool isSweepMap(const YAML::Node& n) { return n.IsMap() && (n["sweep"] || n["range"]); }
+
+// A plain (unquoted) scalar parsed as a finite number; false if it is not one.
+bool parseNumber(const YAML::Node& n, double& out) {
+  if (!n.IsScalar() || n.Tag() == "!") return false;
+  try {
+    out = n.as<double>();
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+  return true;
+}
+
+Sweep parseSweep(const std::string* file, const YAML::Node& n, const std::string& key) {
+  const Loc here{file, n.Mark(), key};
+  if (n.size() != 1) fail(here, "a sweep is {sweep: [v1, v2, ...]} or {range: [start, stop, step]}, with no other keys");
+  Sweep s{key, {}};
+  if (const YAML::Node list = n["sweep"]) {
+    if (!list.IsSequence() || list.size() == 0)
+      fail(Loc{file, list.Mark(), key}, "sweep: needs a non-empty list of values, got " + describe(list));
+    if (list.size() > kMaxSweepValues)
+      fail(Loc{file, list.Mark(), key}, "sweep: more than " + std::to_string(kMaxSweepValues) + " values");
+    std::set<std::string> seen;
+    for (const YAML::Node& v : list) {
+      if (!v.IsScalar()) fail(Loc{file, v.Mark().is_null() ? list.Mark() : v.Mark(), key},
+                              "sweep values must be single values, got " + describe(v));
+      if (!seen.insert(v.Scalar()).second) fail(Loc{file, v.Mark(), key}, "value '" + v.Scalar() + "' appears twice in the sweep");
+      SweepValue sv;
+      sv.node = v;
+      sv.text = v.Scalar();
+      sv.mark = v.Mark();
+      s.values.push_back(sv);
+    }
+    return s;
+  }
+  const YAML::Node r = n["range"];
+  const Loc rl{file, n.Mark(), key};
+  if (!r.IsSequence() || r.size() != 3) fail(rl, "range: needs [start, stop, step], got " + describe(r));
+  double a[3];
+  for (int i = 0; i < 3; ++i) {
+    if (!parseNumber(r[i], a[i])) fail(rl, "range: [start, stop, step] must be numbers, got " + describe(r[i]));
+    if (!std::isfinite(a[i])) fail(rl, "range: values must be finite, got " + r[i].Scalar());
+  }
+  const double start = a[0], stop = a[1], step = a[2];
+  if (step == 0.0) fail(rl, "range: step must not be 0");
+  if ((stop - start) * step < 0.0) fail(rl, "range: step " + fmtG(step) + " moves away from stop " + fmtG(stop));
+  // stop is included within 1e-9 |step|.
+  const double count = std::floor((stop - start) / step + 1e-9) + 1.0;
+  if (count > static_cast<double>(kMaxSweepValues))
+    fail(rl, "range: more than " + std::to_string(kMaxSweepValues) + " values");
+  std::set<std::string> seen;
+  const double tol = 1e-9 * std::abs(step);
+  for (long i = 0; i < static_cast<long>(count); ++i) {
+    double v = start + static_cast<double>(i) * step;  // no accumulated rounding
+    if (std::abs(v - stop) <= tol) v = stop;
+    if (std::abs(v) <= tol) v = 0.0;
+    SweepValue sv;
+    sv.from_range = true;
+    sv.number = v;
+    sv.text = fmtG(v);
+    sv.mark = n.Mark();
+    if (!seen.insert(sv.text).second)
+      fail(rl, "range: values " + sv.text + " are not distinct at %g precision; list them with sweep: [...]");
+    s.values.push_back(sv);
+  }
+  return s;
+}
+
+// Pass 1: every sweep in the document, in file order.
+void collectSweeps(const std::string* file, const YAML::Node& n, const std::string& key, std::vector<Sweep>& out) {
+  if (n.IsMap()) {
+    if (isSweepMap(n)) {
+      out.push_back(parseSweep(file, n, key));
+      return;
+    }
+    for (const auto& kv : n)
+      if (kv.first.IsScalar()) collectSweeps(file, kv.second, joinKey(key, kv.first.Scalar()), out);
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) collectSweeps(file, n[i], indexKey(key, i), out);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading values, with sweeps resolved
+
+struct Item {
+  YAML::Node node;
+  std::string key;  // dotted key
+  YAML::Mark mark;  // of the value (of its key when the value is empty)
+  YAML::Mark key_mark = YAML::Mark::null_mark();  // of its key in the parent map: where a missing child is reported
+};
+
+struct MapView {
+  Item self;
+  std::vector<std::pair<std::string, Item>> fields;  // file order
+  const Item* get(const std::string& k) const {
+    for (const auto& f : fields)
+      if (f.first == k) return &f.second;
+    return nullptr;
+  }
+};
+
+class Reader {
+ public:
+  Reader(const std::string* file, const Picks* picks) : file_(file), picks_(picks) {}
+
+  const std::string* file() const { return file_; }
+  Item root(const YAML::Node& doc) const { return Item{doc, "", doc.Mark()}; }
+
+  const SweepValue* pick(const Item& it) const {
+    if (!picks_) return nullptr;
+    auto f = picks_->find(it.key);
+    return f == picks_->end() ? nullptr : f->second;
+  }
+  Loc loc(const Item& it) const {
+    const SweepValue* sv = pick(it);
+    return Loc{file_, sv ? sv->mark : it.mark, it.key};
+  }
+  // Where a key missing from `parent` is reported: the parent's own key, else the parent.
+  Loc locAt(const Item& parent, const std::string& k) const {
+    return Loc{file_, parent.key_mark.is_null() ? parent.mark : parent.key_mark, joinKey(parent.key, k)};
+  }
+  [[noreturn]] void fail(const Item& it, const std::string& what) const { tailsim::fail(loc(it), what); }
+
+  MapView map(const Item& it, std::initializer_list<const char*> allowed) const {
+    if (pick(it)) fail(it, "a sweep can replace a single value only, not a section or list");
+    if (!it.node.IsMap()) {
+      if (it.key.empty()) fail(it, "the file must be a map of key: value, got " + describe(it.node));
+      fail(it, "expected a map of key: value, got " + describe(it.node));
+    }
+    if (!picks_ && isSweepMap(it.node)) fail(it, "sweeps are allowed in experiment files only");
+    MapView m{it, {}};
+    for (const auto& kv : it.node) {
+      if (!kv.first.IsScalar()) tailsim::fail(Loc{file_, kv.first.Mark(), it.key}, "keys must be plain names");
+      const std::string k = kv.first.Scalar();
+      const Loc keyLoc{file_, kv.first.Mark(), joinKey(it.key, k)};
+      if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }) == allowed.end())
+        tailsim::fail(keyLoc, "unknown key (allowed here: " + joinList(allowed) + ")");
+      if (m.get(k)) tailsim::fail(keyLoc, "duplicate key");
+      const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
+      m.fields.emplace_back(k, Item{kv.second, keyLoc.key, empty ? kv.first.Mark() : kv.second.Mark(), kv.first.Mark()});
+    }
+    return m;
+  }
+
+  const Item& need(const MapView& m, const std::string& k) const {
+    const Item* it = m.get(k);
+    if (!it) tailsim::fail(locAt(m.self, k), "required key is missing");
+    return *it;
+  }
+
+  std::vector<Item> list(const Item& it) const {
+    if (pick(it)) fail(it, "a sweep can replace a single value only, not a section or list");
+    if (!it.node.IsSequence()) fail(it, "expected a list [a, b, ...], got " + describe(it.node));
+    std::vector<Item> out;
+    for (std::size_t i = 0; i < it.node.size(); ++i) {
+      const YAML::Node e = it.node[i];
+      out.push_back(Item{e, indexKey(it.key, i), e.Mark().is_null() || e.IsNull() ? it.mark : e.Mark()});
+    }
+    return out;
+  }
+
+  // One value, or one per joint: a list of exactly n values.
+  std::vector<Item> perJoint(const Item& it, int n) const {
+    if (pick(it) || !it.node.IsSequence()) return std::vector<Item>(static_cast<std::size_t>(n), it);
+    std::vector<Item> v = list(it);
+    if (static_cast<int>(v.size()) != n)
+      fail(it, "has " + std::to_string(v.size()) + " values but the tail has " + std::to_string(n) +
+                   " joints: give one value for all joints or one per joint");
+    return v;
+  }
+
+  double number(const Item& it) const {
+    const SweepValue* sv = pick(it);
+    if (sv && sv->from_range) return sv->number;
+    const YAML::Node& n = sv ? sv->node : it.node;
+    scalarOrFail(it, n, "a number");
+    if (n.Tag() == "!") fail(it, "expected a number, got the string \"" + n.Scalar() + "\"");
+    double v;
+    if (!parseNumber(n, v)) fail(it, "expected a number, got " + describe(n));
+    if (!std::isfinite(v)) fail(it, "must be a finite number, got " + n.Scalar());
+    return v;
+  }
+  double positive(const Item& it) const {
+    const double v = number(it);
+    if (!(v > 0.0)) fail(it, "must be > 0, got " + fmtG(v));
+    return v;
+  }
+  double nonNegative(const Item& it) const {
+    const double v = number(it);
+    if (v < 0.0) fail(it, "must be >= 0, got " + fmtG(v));
+    return v;
+  }
+  int integer(const Item& it, long lo, long hi = std::numeric_limits<int>::max()) const {
+    const double v = number(it);
+    if (v != std::floor(v)) fail(it, "expected an integer, got " + fmtG(v));
+    if (v < static_cast<double>(lo) || v > static_cast<double>(hi))
+      fail(it, hi == std::numeric_limits<int>::max()
+                   ? "must be >= " + std::to_string(lo) + ", got " + fmtG(v)
+                   : "must be in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + fmtG(v));
+    return static_cast<int>(v);
+  }
+  bool boolean(const Item& it) const {
+    const SweepValue* sv = pick(it);
+    if (sv && sv->from_range) fail(it, "expected true or false, got a range value");
+    const YAML::Node& n = sv ? sv->node : it.node;
+    scalarOrFail(it, n, "true or false");
+    bool b = false;
+    bool ok = n.Tag() != "!";
+    if (ok) {
+      try {
+        b = n.as<bool>();
+      } catch (const YAML::Exception&) {
+        ok = false;
+      }
+    }
+    if (!ok) fail(it, "expected true or false, got " + describe(n));
+    return b;
+  }
+  std::string string(const Item& it) const {
+    const SweepValue* sv = pick(it);
+    if (sv && sv->from_range) fail(it, "expected a string, got a range value");
+    const YAML::Node& n = sv ? sv->node : it.node;
+    scalarOrFail(it, n, "a string");
+    return n.Scalar();
+  }
+  std::string choice(const Item& it, std::initializer_list<const char*> allowed) const {
+    const std::string s = string(it);
+    if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; }) == allowed.end())
+      fail(it, "unknown value '" + s + "' (allowed: " + joinList(allowed) + ")");
+    return s;
+  }
+
+ private:
+  void scalarOrFail(const Item& it, const YAML::Node& n, const char* expected) const {
+    if (n.IsScalar()) return;
+    if (!picks_ && isSweepMap(n)) fail(it, "sweeps are allowed in experiment files only");
+    fail(it, std::string("expected ") + expected + ", got " + describe(n));
+  }
+
+  const std::string* file_;
+  const Picks* picks_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Robot files
+
+struct DoubleField {
+  const char* name;
+  double QuadrupedParams::*quad;
+  double FrictionParams::*fric;
+};
+constexpr DoubleField kQuadFields[] = {
+    {"mass_kg", &QuadrupedParams::mass_kg, nullptr}, {"izz_kgm2", &QuadrupedParams::izz_kgm2, nullptr},
+    {"d_Q2C_m", &QuadrupedParams::d_Q2C_m, nullptr}, {"d_Q2B_m", &QuadrupedParams::d_Q2B_m, nullptr},
+    {"l_F_m", &QuadrupedParams::l_F_m, nullptr},     {"w_F_m", &QuadrupedParams::w_F_m, nullptr}};
+constexpr DoubleField kFrictionFields[] = {
+    {"mu_s", nullptr, &FrictionParams::mu_s},
+    {"mu_d", nullptr, &FrictionParams::mu_d},
+    {"phidot_s_radps", nullptr, &FrictionParams::phidot_s_radps},
+    {"phidot_d_radps", nullptr, &FrictionParams::phidot_d_radps},
+    {"v_s_mps", nullptr, &FrictionParams::v_s_mps},
+    {"v_d_mps", nullptr, &FrictionParams::v_d_mps}};
+#define TAILSIM_QUAD_KEYS {"mass_kg", "izz_kgm2", "d_Q2C_m", "d_Q2B_m", "l_F_m", "w_F_m"}
+#define TAILSIM_FRICTION_KEYS {"mu_s", "mu_d", "phidot_s_radps", "phidot_d_radps", "v_s_mps", "v_d_mps"}
+#define TAILSIM_LINK_KEYS {"mass_kg", "izz_kgm2", "length_m", "com_offset_m"}
+
+using Origins = std::map<std::string, Loc>;  // tailsim::validate() field name -> where it was set
+
+// Sets the quadruped / friction fields present in `m` (all of them when `all`).
+void readQuadruped(const Reader& r, const MapView& m, bool all, QuadrupedParams& q, Origins& origin) {
+  for (const DoubleField& f : kQuadFields) {
+    const Item* it = all ? &r.need(m, f.name) : m.get(f.name);
+    if (!it) continue;
+    q.*(f.quad) = r.number(*it);
+    origin[std::string("quadruped.") + f.name] = r.loc(*it);
+  }
+}
+void readFriction(const Reader& r, const MapView& m, bool all, FrictionParams& fp, Origins& origin) {
+  for (const DoubleField& f : kFrictionFields) {
+    const Item* it = all ? &r.need(m, f.name) : m.get(f.name);
+    if (!it) continue;
+    fp.*(f.fric) = r.number(*it);
+    origin[std::string("friction.") + f.name] = r.loc(*it);
+  }
+}
+
+// One tail link {mass_kg, izz_kgm2, length_m, com_offset_m?}; origins under "tail link <i> ".
+TailLink readLink(const Reader& r, const Item& item, int index, Origins& origin) {
+  const MapView m = r.map(item, TAILSIM_LINK_KEYS);
+  TailLink l;
+  const std::string pre = "tail link " + std::to_string(index) + " ";
+  const Item& mass = r.need(m, "mass_kg");
+  const Item& izz = r.need(m, "izz_kgm2");
+  const Item& len = r.need(m, "length_m");
+  l.mass_kg = r.number(mass);
+  l.izz_kgm2 = r.number(izz);
+  l.length_m = r.number(len);
+  origin[pre + "mass_kg"] = r.loc(mass);
+  origin[pre + "izz_kgm2"] = r.loc(izz);
+  origin[pre + "length_m"] = r.loc(len);
+  if (const Item* c = m.get("com_offset_m")) {
+    l.com_offset_m = r.number(*c);
+    origin[pre + "com_offset_m"] = r.loc(*c);
+  } else {
+    l.com_offset_m = 0.5 * l.length_m;  // Table 2: COM at mid-length
+    origin[pre + "com_offset_m"] = r.loc(len);
+  }
+  return l;
+}
+
+void validateRobot(const RobotParams& p, const Origins& origin, const Loc& fallback) {
+  try {
+    validate(p);
+  } catch (const std::invalid_argument& e) {
+    rethrowAt(e.what(), origin, fallback);
+  }
+}
+
+struct RobotFile {
+  std::string file;  // absolute path
+  RobotParams base;  // tail empty
+  Origins origin;    // quadruped.*, friction.*, gravity_mps2
+  std::map<int, TailLink> tails;
+  std::map<int, Origins> tail_origin;  // keys "tail link 1 <field>"
+};
+
+YAML::Node parseYaml(const std::string* file) {
+  std::ifstream in(*file);
+  if (!in) throw ConfigError(*file + ": cannot read file");
+  try {
+    return YAML::Load(in);
+  } catch (const YAML::ParserException& e) {
+    fail(Loc{file, e.mark, ""}, "YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    fail(Loc{file, e.mark, ""}, std::string("YAML error: ") + e.what());
+  }
+}
+
+std::unique_ptr<RobotFile> readRobotFile(const std::string& abs) {
+  auto rf = std::make_unique<RobotFile>();
+  rf->file = abs;
+  const YAML::Node doc = parseYaml(&rf->file);
+  const Reader r(&rf->file, nullptr);
+  const Item root = r.root(doc);
+  const MapView top = r.map(root, {"quadruped", "friction", "gravity_mps2", "tails"});
+  readQuadruped(r, r.map(r.need(top, "quadruped"), TAILSIM_QUAD_KEYS), true, rf->base.quadruped, rf->origin);
+  readFriction(r, r.map(r.need(top, "friction"), TAILSIM_FRICTION_KEYS), true, rf->base.friction, rf->origin);
+  const Item& g = r.need(top, "gravity_mps2");
+  rf->base.gravity_mps2 = r.number(g);
+  rf->origin["gravity_mps2"] = r.loc(g);
+  const Item& tailsItem = r.need(top, "tails");
+  const MapView tails = r.map(tailsItem, {"1", "2", "3", "4", "5", "6"});
+  if (tails.fields.empty()) r.fail(tailsItem, "needs at least one tail (keys 1..6)");
+  for (const auto& [k, item] : tails.fields) {
+    const int n = std::stoi(k);
+    Origins o;
+    const TailLink link = readLink(r, item, 1, o);
+    RobotParams check = rf->base;
+    check.tail = {link};
+    Origins all = rf->origin;
+    all.insert(o.begin(), o.end());
+    validateRobot(check, all, r.loc(item));
+    rf->tails[n] = link;
+    rf->tail_origin[n] = std::move(o);
+  }
+  return rf;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Experiment files
+
+struct Loader {
+  std::vector<std::unique_ptr<std::string>> files;  // stable storage for Loc::file
+  std::map<std::string, std::unique_ptr<RobotFile>> robots;
+
+  const std::string* keep(const std::string& s) {
+    files.push_back(std::make_unique<std::string>(s));
+    return files.back().get();
+  }
+  const RobotFile& robot(const std::string& abs, const Loc& at) {
+    auto f = robots.find(abs);
+    if (f != robots.end()) return *f->second;
+    std::error_code ec;
+    if (!fs::is_regular_file(abs, ec)) fail(at, "robot file not found: " + abs);
+    return *(robots[abs] = readRobotFile(abs));
+  }
+};
+
+std::string absolutePath(const std::string& p) { return fs::absolute(fs::path(p)).lexically_normal().string(); }
+std::string resolveRelative(const std::string& base_file, const std::string& p) {
+  const fs::path q(p);
+  return (q.is_absolute() ? q : fs::path(base_file).parent_path() / q).lexically_normal().string();
+}
+
+struct JointLocs {
+  Loc dT, w_ss;
+};
+
+std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, int n) {
+  const MapView t = r.map(item, {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps", "w_ss", "t0_s", "rule",
+                                 "thetadot_max_dps", "thetadot_max_radps"});
+  std::vector<SplitCycleParams> joints(static_cast<std::size_t>(n));
+  std::vector<JointLocs> locs(static_cast<std::size_t>(n), JointLocs{r.loc(item), r.loc(item)});
+
+  // w_ss, t0_s: both forms. Defaults 0.25 and 0.
+  if (const Item* w = t.get("w_ss")) {
+    const std::vector<Item> v = r.perJoint(*w, n);
+    for (int i = 0; i < n; ++i) {
+      const double x = r.number(v[i]);
+      if (!(x > 0.0 && x < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(x));
+      joints[i].w_ss = x;
+      locs[i].w_ss = r.loc(v[i]);
+    }
+  } else {
+    for (auto& j : joints) j.w_ss = 0.25;
+  }
+  if (const Item* t0 = t.get("t0_s")) {
+    const std::vector<Item> v = r.perJoint(*t0, n);
+    for (int i = 0; i < n; ++i) joints[i].t0_s = r.nonNegative(v[i]);
+  }
+
+  if (const Item* rule = t.get("rule")) {
+    r.choice(*rule, {"eq25"});
+    for (const char* k : {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps"})
+      if (const Item* x = t.get(k)) r.fail(*x, "not allowed with rule: eq25 (Eq. 25 sets it)");
+    const Item* dps = t.get("thetadot_max_dps");
+    const Item* radps = t.get("thetadot_max_radps");
+    if (!dps && !radps) tailsim::fail(r.locAt(t.self, "thetadot_max_dps"), "rule: eq25 needs thetadot_max_dps or thetadot_max_radps");
+    if (dps && radps) r.fail(*radps, "give thetadot_max_dps or thetadot_max_radps, not both");
+    const Item& w = dps ? *dps : *radps;
+    const double wmax = r.positive(w) * (dps ? kRadPerDeg : 1.0);
+    for (int i = 0; i < n; ++i) {
+      try {
+        joints[i] = equalPeakSpeedParams(n, wmax, joints[i].w_ss, joints[i].t0_s);  // Eq. (25)
+      } catch (const std::invalid_argument& e) {
+        r.fail(w, e.what());
+      }
+      locs[i].dT = r.loc(w);
+    }
+  } else {
+    for (const char* k : {"thetadot_max_dps", "thetadot_max_radps"})
+      if (const Item* x = t.get(k)) r.fail(*x, "only used with rule: eq25");
+    if (const Item* th0 = t.get("theta0_deg")) {
+      const std::vector<Item> v = r.perJoint(*th0, n);
+      for (int i = 0; i < n; ++i) joints[i].theta0_rad = r.number(v[i]) * kRadPerDeg;
+    }
+    const std::vector<Item> dth = r.perJoint(r.need(t, "dtheta_deg"), n);
+    for (int i = 0; i < n; ++i) joints[i].dtheta_rad = r.number(dth[i]) * kRadPerDeg;
+    const Item* dT = t.get("dT_s");
+    const Item* peak = t.get("peak_speed_dps");
+    if (!dT && !peak) tailsim::fail(r.locAt(t.self, "dT_s"), "give dT_s or peak_speed_dps");
+    if (dT && peak) r.fail(*peak, "give dT_s or peak_speed_dps, not both");
+    if (dT) {
+      const std::vector<Item> v = r.perJoint(*dT, n);
+      for (int i = 0; i < n; ++i) {
+        joints[i].dT_s = r.number(v[i]);
+        locs[i].dT = r.loc(v[i]);
+      }
+    } else {
+      const std::vector<Item> v = r.perJoint(*peak, n);
+      for (int i = 0; i < n; ++i) {
+        const double pk = r.positive(v[i]) * kRadPerDeg;
+        joints[i].dT_s = 2.0 * std::abs(joints[i].dtheta_rad) / pk;  // peak speed 2 |dtheta| / dT (Eq. 23)
+        if (!(joints[i].dT_s > 0.0)) r.fail(v[i], "dtheta_deg = 0 gives dT_s = 0; give dT_s instead");
+        locs[i].dT = r.loc(v[i]);
+      }
+    }
+  }
+  // SplitCycleProfile's own checks (dT > 0, w_ss in (0, 1), finite), at the right value.
+  for (int i = 0; i < n; ++i) {
+    try {
+      SplitCycleProfile check(joints[i]);
+    } catch (const std::invalid_argument& e) {
+      rethrowAt(e.what(), Origins{{"dT_s", locs[i].dT}, {"w_ss", locs[i].w_ss}}, r.loc(item));
+    }
+  }
+  return joints;
+}
+
+PoseSpec readPose(const Reader& r, const Item& item, int n) {
+  const MapView m = r.map(item, {"theta_deg", "thetadot_radps", "thetaddot_radps2"});
+  PoseSpec p;
+  auto read = [&](const char* key, double scale, std::vector<double>& out) {
+    out.assign(static_cast<std::size_t>(n), 0.0);
+    if (const Item* x = m.get(key)) {
+      const std::vector<Item> v = r.perJoint(*x, n);
+      for (int i = 0; i < n; ++i) out[i] = r.number(v[i]) * scale;
+    }
+  };
+  read("theta_deg", kRadPerDeg, p.theta_rad);
+  read("thetadot_radps", 1.0, p.thetadot_radps);
+  read("thetaddot_radps2", 1.0, p.thetaddot_radps2);
+  return p;
+}
+
+AnalyticSettings readAnalytic(const Reader& r, const Item& item) {
+  const MapView m = r.map(item, {"solver", "rel_tol", "abs_tol", "fixed_dt_s", "event_tol_s", "max_step_s",
+                                 "v_stop_mps", "coupling"});
+  AnalyticSettings s;
+  if (const Item* x = m.get("solver")) s.solver = r.choice(*x, {"adaptive", "fixed"});
+  if (const Item* x = m.get("rel_tol")) s.rel_tol = r.positive(*x);
+  if (const Item* x = m.get("abs_tol")) s.abs_tol = r.positive(*x);
+  if (const Item* x = m.get("fixed_dt_s")) s.fixed_dt_s = r.positive(*x);
+  if (const Item* x = m.get("event_tol_s")) s.event_tol_s = r.positive(*x);
+  if (const Item* x = m.get("max_step_s")) s.max_step_s = r.nonNegative(*x);
+  if (const Item* x = m.get("v_stop_mps")) s.v_stop_mps = r.positive(*x);
+  if (const Item* x = m.get("coupling"))
+    s.coupling = r.choice(*x, {"paper", "exact"}) == "paper" ? Coupling::kPaper : Coupling::kExact;
+  return s;
+}
+
+MujocoSettings readMujoco(const Reader& r, const Item& item) {
+  const MapView m = r.map(item, {"timestep_s", "integrator", "solver", "iterations", "tolerance", "cone",
+                                 "noslip_iterations", "condim", "impratio", "solref", "solimp", "mu", "kp", "kv",
+                                 "velocity_feedforward", "inverse_dynamics_feedforward"});
+  MujocoSettings s;
+  if (const Item* x = m.get("timestep_s")) s.timestep_s = r.positive(*x);
+  if (const Item* x = m.get("integrator")) s.integrator = r.choice(*x, {"Euler", "RK4", "implicit"});
+  if (const Item* x = m.get("solver")) s.solver = r.choice(*x, {"Newton", "CG", "PGS"});
+  if (const Item* x = m.get("iterations")) s.iterations = r.integer(*x, 1);
+  if (const Item* x = m.get("tolerance")) s.tolerance = r.nonNegative(*x);
+  if (const Item* x = m.get("cone")) s.cone = r.choice(*x, {"pyramidal", "elliptic"});
+  if (const Item* x = m.get("noslip_iterations")) s.noslip_iterations = r.integer(*x, 0);
+  if (const Item* x = m.get("condim")) {
+    s.condim = r.integer(*x, 1, 6);
+    if (s.condim == 2 || s.condim == 5) r.fail(*x, "must be one of 1, 3, 4, 6, got " + std::to_string(s.condim));
+  }
+  if (const Item* x = m.get("impratio")) s.impratio = r.positive(*x);
+  if (const Item* x = m.get("solref")) {
+    const std::vector<Item> v = r.list(*x);
+    if (v.size() != 2) r.fail(*x, "needs 2 values [timeconst, dampratio], got " + std::to_string(v.size()));
+    for (int i = 0; i < 2; ++i) s.solref[i] = r.number(v[i]);
+    // MuJoCo: both > 0 (time constant, damping ratio) or direct (-stiffness, -damping).
+    if (s.solref[0] > 0.0 && !(s.solref[1] > 0.0)) r.fail(v[1], "damping ratio must be > 0 when solref[0] > 0");
+    if (s.solref[0] < 0.0 && s.solref[1] > 0.0) r.fail(v[1], "must be <= 0 (-damping) when solref[0] < 0");
+    if (s.solref[0] == 0.0) r.fail(v[0], "must not be 0");
+  }
+  if (const Item* x = m.get("solimp")) {
+    const std::vector<Item> v = r.list(*x);
+    if (v.size() != 5) r.fail(*x, "needs 5 values [dmin, dmax, width, midpoint, power], got " + std::to_string(v.size()));
+    for (int i = 0; i < 5; ++i) s.solimp[i] = r.number(v[i]);
+    for (int i : {0, 1, 3})
+      if (!(s.solimp[i] > 0.0 && s.solimp[i] < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(s.solimp[i]));
+    if (!(s.solimp[2] > 0.0)) r.fail(v[2], "width must be > 0, got " + fmtG(s.solimp[2]));
+    if (!(s.solimp[4] >= 1.0)) r.fail(v[4], "power must be >= 1, got " + fmtG(s.solimp[4]));
+  }
+  if (const Item* x = m.get("mu")) s.mu = r.nonNegative(*x);
+  if (const Item* x = m.get("kp")) s.kp = r.nonNegative(*x);
+  if (const Item* x = m.get("kv")) s.kv = r.nonNegative(*x);
+  if (const Item* x = m.get("velocity_feedforward")) s.velocity_feedforward = r.boolean(*x);
+  if (const Item* x = m.get("inverse_dynamics_feedforward")) s.inverse_dynamics_feedforward = r.boolean(*x);
+  return s;
+}
+
+Effects readEffects(const Reader& r, const Item& item) {
+  const MapView m =
+      r.map(item, {"friction", "translation", "gravity", "ground_contact", "foot_loads", "load_decomposition"});
+  Effects e;
+  if (const Item* x = m.get("friction")) {
+    const std::string f = r.choice(*x, {"none", "stiction", "continuous"});
+    e.friction = f == "none" ? FrictionLaw::kNone : f == "stiction" ? FrictionLaw::kStiction : FrictionLaw::kContinuous;
+  }
+  if (const Item* x = m.get("translation")) e.translation = r.boolean(*x);
+  if (const Item* x = m.get("gravity")) e.gravity = r.boolean(*x);
+  if (const Item* x = m.get("ground_contact")) e.ground_contact = r.boolean(*x);
+  if (const Item* x = m.get("foot_loads"))
+    e.foot_loads = r.choice(*x, {"distributed", "constant"}) == "distributed" ? FootLoadModel::kDistributed
+                                                                              : FootLoadModel::kConstant;
+  if (const Item* x = m.get("load_decomposition")) e.load_decomposition = r.boolean(*x);
+  return e;
+}
+
+OutputSettings readOutput(const Reader& r, const Item& item) {
+  const MapView m = r.map(item, {"sample_dt_s", "duration_s", "settle_s"});
+  OutputSettings o;
+  if (const Item* x = m.get("sample_dt_s")) o.sample_dt_s = r.positive(*x);
+  if (const Item* x = m.get("duration_s")) o.duration_s = r.nonNegative(*x);
+  if (const Item* x = m.get("settle_s")) o.settle_s = r.nonNegative(*x);
+  return o;
+}
+
+RenderSettings readRender(const Reader& r, const Item& item) {
+  RenderSettings s;
+  s.enabled = true;  // the section's presence asks for a video
+  if (item.node.IsNull() && !r.pick(item)) return s;  // `render:` with nothing: all defaults
+  const MapView m = r.map(item, {"width", "height", "fps", "slowmo", "duration_s", "camera", "shadows",
+                                 "reflections", "msaa", "ghost"});
+  if (const Item* x = m.get("width")) s.width = r.integer(*x, 16, 16384);
+  if (const Item* x = m.get("height")) s.height = r.integer(*x, 16, 16384);
+  if (const Item* x = m.get("fps")) s.fps = r.integer(*x, 1, 1000);
+  if (const Item* x = m.get("slowmo")) s.slowmo = r.positive(*x);
+  if (const Item* x = m.get("duration_s")) s.duration_s = r.nonNegative(*x);
+  if (const Item* x = m.get("camera")) s.camera = r.choice(*x, {"top", "perspective"});
+  if (const Item* x = m.get("shadows")) s.shadows = r.boolean(*x);
+  if (const Item* x = m.get("reflections")) s.reflections = r.boolean(*x);
+  if (const Item* x = m.get("msaa")) s.msaa = r.integer(*x, 0, 64);
+  if (const Item* x = m.get("ghost")) s.ghost = r.boolean(*x);
+  return s;
+}
+
+// Pass 2: one case, with the sweeps resolved by `r`.
+ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
+  const Item root = r.root(doc);
+  const MapView top = r.map(root, {"name", "description", "robot", "kind", "tail", "quadruped", "friction",
+                                   "gravity_mps2", "trajectory", "pose", "models", "analytic", "mujoco", "effects",
+                                   "output", "render"});
+  ExperimentCase c;
+  c.source_file = source;
+  const Item& name = r.need(top, "name");
+  c.experiment = r.string(name);
+  if (c.experiment.empty() || c.experiment.find_first_of("/\\") != std::string::npos)
+    r.fail(name, "must be a non-empty name without '/' or '\\'");
+  if (const Item* d = top.get("description")) r.string(*d);
+
+  // Robot file, then the experiment's overrides.
+  const Item& robotItem = r.need(top, "robot");
+  const std::string robotRel = r.string(robotItem);
+  if (robotRel.empty()) r.fail(robotItem, "needs the path of a robot file");
+  const RobotFile& rf = L.robot(resolveRelative(source, robotRel), r.loc(robotItem));
+  c.robot = rf.base;
+  Origins origin = rf.origin;
+
+  if (const Item* k = top.get("kind")) c.kind = r.choice(*k, {"simulate", "pose"});
+
+  if (const Item* t = top.get("tail")) {
+    const MapView tm = r.map(*t, {"links", "custom"});
+    const Item* links = tm.get("links");
+    const Item* custom = tm.get("custom");
+    if (!links && !custom) r.fail(*t, "give links: n (1..6) or custom: [{mass_kg, izz_kgm2, length_m}, ...]");
+    if (links && custom) r.fail(*custom, "give links: n or custom: [...], not both");
+    if (links) {
+      const int n = r.integer(*links, 1, 6);
+      const auto f = rf.tails.find(n);
+      if (f == rf.tails.end()) r.fail(*links, "robot file " + rf.file + " has no tails." + std::to_string(n));
+      c.robot.tail.assign(static_cast<std::size_t>(n), f->second);  // n identical links (Table 2)
+      for (int i = 1; i <= n; ++i)
+        for (const auto& [k, loc] : rf.tail_origin.at(n))  // keys "tail link 1 <field>"
+          origin["tail link " + std::to_string(i) + k.substr(std::string("tail link 1").size())] = loc;
+    } else {
+      const std::vector<Item> v = r.list(*custom);
+      if (v.empty()) r.fail(*custom, "needs at least one link (n >= 1)");
+      for (std::size_t i = 0; i < v.size(); ++i) c.robot.tail.push_back(readLink(r, v[i], static_cast<int>(i + 1), origin));
+    }
+  } else {  // default: tail: {links: 1}
+    const auto f = rf.tails.find(1);
+    if (f == rf.tails.end()) tailsim::fail(r.locAt(root, "tail"), "missing, and robot file " + rf.file + " has no tails.1");
+    c.robot.tail = {f->second};
+    origin.insert(rf.tail_origin.at(1).begin(), rf.tail_origin.at(1).end());
+  }
+  if (const Item* q = top.get("quadruped"))
+    readQuadruped(r, r.map(*q, TAILSIM_QUAD_KEYS), false, c.robot.quadruped, origin);
+  if (const Item* f = top.get("friction")) readFriction(r, r.map(*f, TAILSIM_FRICTION_KEYS), false, c.robot.friction, origin);
+  if (const Item* g = top.get("gravity_mps2")) {
+    c.robot.gravity_mps2 = r.number(*g);
+    origin["gravity_mps2"] = r.loc(*g);
+  }
+  validateRobot(c.robot, origin, r.loc(root));
+  const int n = c.robot.numLinks();
+
+  const Item* traj = top.get("trajectory");
+  const Item* pose = top.get("pose");
+  if (c.kind == "simulate") {
+    if (pose) r.fail(*pose, "only used with kind: pose");
+    if (!traj) tailsim::fail(r.locAt(root, "trajectory"), "required for kind: simulate");
+    c.joints = readTrajectory(r, *traj, n);
+  } else {
+    if (traj) r.fail(*traj, "only used with kind: simulate");
+    c.pose = pose ? readPose(r, *pose, n) : readPose(r, Item{YAML::Node(YAML::NodeType::Map), "pose", root.mark}, n);
+  }
+
+  if (const Item* m = top.get("models")) {
+    const std::vector<Item> v = r.list(*m);
+    if (v.empty()) r.fail(*m, "needs at least one model (analytic, mujoco)");
+    for (const Item& x : v) {
+      const std::string s = r.choice(x, {"analytic", "mujoco"});
+      if (std::find(c.models.begin(), c.models.end(), s) != c.models.end()) r.fail(x, "'" + s + "' is listed twice");
+      c.models.push_back(s);
+    }
+  } else {
+    c.models = {"analytic"};
+  }
+  if (const Item* x = top.get("analytic")) c.analytic = readAnalytic(r, *x);
+  if (const Item* x = top.get("mujoco")) c.mujoco = readMujoco(r, *x);
+  if (const Item* x = top.get("effects")) c.effects = readEffects(r, *x);
+  if (const Item* x = top.get("output")) c.output = readOutput(r, *x);
+  if (const Item* x = top.get("render")) c.render = readRender(r, *x);
+  return c;
+}
+
+bool isSuite(const YAML::Node& doc) { return doc.IsMap() && doc["experiments"]; }
+
+Experiment readExperiment(Loader& L, const std::string* file, const YAML::Node& doc) {
+  Experiment e;
+  e.source_file = *file;
+
+  std::vector<Sweep> sweeps;
+  collectSweeps(file, doc, "", sweeps);
+  for (const Sweep& s : sweeps)
+    if (s.key == "name") fail(Loc{file, s.values.front().mark, s.key}, "the experiment name cannot be swept");
+  double total = 1.0;
+  for (const Sweep& s : sweeps) total *= static_cast<double>(s.values.size());
+  if (total > static_cast<double>(kMaxCases))
+    fail(Loc{file, doc.Mark(), ""}, "the sweeps make " + fmtG(total) + " cases, more than " + std::to_string(kMaxCases));
+
+  // Case-name labels: the leaf key, or the dotted key where two swept leaves share a name.
+  std::vector<std::string> label;
+  for (const Sweep& s : sweeps) {
+    e.swept_keys.push_back(s.key);
+    const std::size_t dot = s.key.rfind('.');
+    label.push_back(dot == std::string::npos ? s.key : s.key.substr(dot + 1));
+  }
+  std::vector<std::string> shown = label;
+  for (std::size_t i = 0; i < label.size(); ++i)
+    if (std::count(label.begin(), label.end(), label[i]) > 1) shown[i] = sweeps[i].key;
+
+  std::vector<std::size_t> idx(sweeps.size(), 0);  // odometer; the last sweep varies fastest
+  for (;;) {
+    Picks picks;
+    std::string caseName;
+    std::map<std::string, std::string> values;
+    for (std::size_t i = 0; i < sweeps.size(); ++i) {
+      const SweepValue& v = sweeps[i].values[idx[i]];
+      picks[sweeps[i].key] = &v;
+      caseName += (i ? "," : "") + shown[i] + "=" + v.text;
+      values[sweeps[i].key] = v.text;
+    }
+    const Reader r(file, &picks);
+    ExperimentCase c = readCase(L, r, doc, *file);
+    c.name = sweeps.empty() ? "base" : caseName;
+    c.sweep_values = std::move(values);
+    e.cases.push_back(std::move(c));
+
+    std::size_t i = sweeps.size();
+    while (i > 0 && ++idx[i - 1] == sweeps[i - 1].values.size()) idx[--i] = 0;
+    if (i == 0) break;
+  }
+  e.name = e.cases.front().experiment;
+  if (doc["description"] && doc["description"].IsScalar()) e.description = doc["description"].Scalar();
+  return e;
+}
+
+void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::vector<std::string>& stack,
+               std::vector<Experiment>& out, std::map<std::string, std::string>& names) {
+  const Reader r(file, nullptr);
+  const MapView m = r.map(r.root(doc), {"experiments", "description"});
+  if (const Item* d = m.get("description")) r.string(*d);
+  const Item& list = r.need(m, "experiments");
+  const std::vector<Item> entries = r.list(list);
+  if (entries.empty()) r.fail(list, "needs at least one experiment file");
+  stack.push_back(*file);
+  for (const Item& entry : entries) {
+    const std::string rel = r.string(entry);
+    const std::string* path = L.keep(resolveRelative(*file, rel));
+    std::error_code ec;
+    if (!fs::is_regular_file(*path, ec)) r.fail(entry, "experiment file not found: " + *path);
+    if (std::find(stack.begin(), stack.end(), *path) != stack.end()) r.fail(entry, "suite includes itself: " + *path);
+    const YAML::Node sub = parseYaml(path);
+    if (isSuite(sub)) {
+      readSuite(L, path, sub, stack, out, names);
+      continue;
+    }
+    Experiment e = readExperiment(L, path, sub);
+    const auto [it, fresh] = names.emplace(e.name, *path);
+    if (!fresh) r.fail(entry, "experiment name '" + e.name + "' is already used by " + it->second);
+    out.push_back(std::move(e));
+  }
+  stack.pop_back();
+}
+
+}  // namespace
+
+Experiment loadExperiment(const std::string& path) {
+  Loader L;
+  const std::string* file = L.keep(absolutePath(path));
+  std::error_code ec;
+  if (!fs::is_regular_file(*file, ec)) throw ConfigError(*file + ": experiment file not found");
+  const YAML::Node doc = parseYaml(file);
+  if (isSuite(doc))
+    fail(Loc{file, doc["experiments"].Mark(), "experiments"}, "this is a suite file; load it with loadExperimentSuite");
+  return readExperiment(L, file, doc);
+}
+
+std::vector<Experiment> loadExperimentSuite(const std::string& path) {
+  Loader L;
+  const std::string* file = L.keep(absolutePath(path));
+  std::error_code ec;
+  if (!fs::is_regular_file(*file, ec)) throw ConfigError(*file + ": experiment file not found");
+  const YAML::Node doc = parseYaml(file);
+  std::vector<Experiment> out;
+  if (!isSuite(doc)) {
+    out.push_back(readExperiment(L, file, doc));
+    return out;
+  }
+  std::vector<std::string> stack;
+  std::map<std::string, std::string> names;
+  readSuite(L, file, doc, stack, out, names);
+  return out;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,39 @@
+// YAML experiment files -> fully validated Experiments, one ExperimentCase per sweep point.
+// The file format is described in docs/experiment-format.md.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_config.h"
+
+namespace tailsim {
+
+// Bad input in an experiment, suite or robot file. what() reads
+// "<file>:<line>:<col>: <dotted.key>: <what is wrong>" (line and column 1-based; the file is the
+// one that holds the bad value, e.g. the robot file for an error inside it).
+struct ConfigError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Experiment {
+  std::string name;
+  std::string description;
+  std::string source_file;              // absolute path of the YAML file
+  std::vector<std::string> swept_keys;  // dotted keys that are swept, in file order ("trajectory.theta0_deg[1]")
+  std::vector<ExperimentCase> cases;    // product of all sweeps, first swept key varying slowest
+};
+
+// Loads and validates every case of one experiment file before returning. Throws ConfigError.
+Experiment loadExperiment(const std::string& path);
+
+// A suite file is `experiments: [fig06.yaml, ...]` (paths relative to the suite file; entries may
+// be suites themselves). A normal experiment file yields a one-element vector. Throws ConfigError.
+std::vector<Experiment> loadExperimentSuite(const std::string& path);
+
+// At most this many values per sweep/range and this many cases per experiment.
+constexpr std::size_t kMaxSweepValues = 10000;
+constexpr std::size_t kMaxCases = 100000;
+
+}  // namespace tailsim

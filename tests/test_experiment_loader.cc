@@ -1,0 +1,640 @@
+// Experiment-file loader: schema, sweeps, validation messages (file:line:col: key: what).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_loader.h"
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = M_PI / 180.0;
+
+const std::string kSourceDir = TAILSIM_SOURCE_DIR;
+
+// A fresh directory with robots/paper_quadruped.yaml copied in; experiments are written beside it.
+class LoaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "tailsim_loader_XXXXXX").string();
+    ASSERT_NE(mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+    fs::create_directories(dir_ / "robots");
+    fs::copy_file(kSourceDir + "/configs/robots/paper_quadruped.yaml", dir_ / "robots/paper_quadruped.yaml");
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string write(const std::string& rel, const std::string& text) {
+    const fs::path p = dir_ / rel;
+    fs::create_directories(p.parent_path());
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  // A valid experiment header (lines 1-3) followed by `rest` (which starts on line 4).
+  static std::string exp(const std::string& rest) {
+    return "name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 1}\n" + rest;
+  }
+  static constexpr const char* kTraj = "trajectory: {dtheta_deg: -90, dT_s: 0.25}\n";
+
+  // Loads `text`; expects a ConfigError "<file>:<line>:<col>: <key>: ..." containing `what`.
+  void expectError(const std::string& text, int line, const std::string& key, const std::string& what = "",
+                   const std::string& file = "exp.yaml", int col = 0) {
+    const std::string path = write("exp.yaml", text);
+    try {
+      loadExperiment(path);
+      ADD_FAILURE() << "no ConfigError for:\n" << text;
+    } catch (const ConfigError& e) {
+      const std::string msg = e.what();
+      const std::string f = (dir_ / file).string();
+      const std::string prefix = f + ":" + std::to_string(line) + ":";
+      EXPECT_EQ(msg.rfind(prefix, 0), 0u) << "message: " << msg << "\nexpected prefix: " << prefix;
+      if (col > 0) {
+        EXPECT_NE(msg.find(prefix + std::to_string(col) + ": "), std::string::npos) << msg;
+      }
+      const std::regex re("^" + std::regex_replace(f, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
+                          R"(:\d+:\d+: )" + std::regex_replace(key, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
+                          ": ");
+      if (!key.empty()) {
+        EXPECT_TRUE(std::regex_search(msg, re)) << "message: " << msg << "\nexpected key: " << key;
+      }
+      EXPECT_NE(msg.find(what), std::string::npos) << "message: " << msg << "\nexpected to contain: " << what;
+    }
+  }
+
+  fs::path dir_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(LoaderTest, DefaultConfigLoadsWithPaperNumbers) {
+  const Experiment e = loadExperiment(kSourceDir + "/configs/default.yaml");
+  EXPECT_EQ(e.name, "fig07_default");
+  EXPECT_EQ(e.source_file, fs::path(kSourceDir + "/configs/default.yaml").lexically_normal().string());
+  EXPECT_TRUE(fs::path(e.source_file).is_absolute());
+  EXPECT_TRUE(e.swept_keys.empty());
+  ASSERT_EQ(e.cases.size(), 1u);
+  const ExperimentCase& c = e.cases[0];
+  EXPECT_EQ(c.name, "base");
+  EXPECT_EQ(c.experiment, "fig07_default");
+  EXPECT_EQ(c.kind, "simulate");
+  // Table 1.
+  EXPECT_DOUBLE_EQ(c.robot.quadruped.mass_kg, 8.458);
+  EXPECT_DOUBLE_EQ(c.robot.quadruped.izz_kgm2, 0.1916);
+  EXPECT_DOUBLE_EQ(c.robot.quadruped.d_Q2C_m, -0.0155);
+  EXPECT_DOUBLE_EQ(c.robot.quadruped.d_Q2B_m, 0.125);
+  EXPECT_DOUBLE_EQ(c.robot.quadruped.l_F_m, 0.30);
+  EXPECT_DOUBLE_EQ(c.robot.quadruped.w_F_m, 0.26);
+  EXPECT_DOUBLE_EQ(c.robot.friction.mu_s, 0.25);
+  EXPECT_DOUBLE_EQ(c.robot.friction.mu_d, 0.30);
+  EXPECT_DOUBLE_EQ(c.robot.gravity_mps2, 9.81);
+  // Table 2, 1-link tail; COM at mid-length by default.
+  ASSERT_EQ(c.robot.numLinks(), 1);
+  EXPECT_DOUBLE_EQ(c.robot.tail[0].mass_kg, 2.40);
+  EXPECT_DOUBLE_EQ(c.robot.tail[0].izz_kgm2, 2.236e-2);
+  EXPECT_DOUBLE_EQ(c.robot.tail[0].length_m, 0.300);
+  EXPECT_DOUBLE_EQ(c.robot.tail[0].com_offset_m, 0.150);
+  // Fig. 7 trajectory, in radians.
+  ASSERT_EQ(c.joints.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.joints[0].theta0_rad, 0.0);
+  EXPECT_DOUBLE_EQ(c.joints[0].dtheta_rad, -M_PI / 2);
+  EXPECT_DOUBLE_EQ(c.joints[0].dT_s, 0.25);
+  EXPECT_DOUBLE_EQ(c.joints[0].w_ss, 0.25);
+  EXPECT_DOUBLE_EQ(c.joints[0].t0_s, 0.0);
+  EXPECT_EQ(c.models, std::vector<std::string>{"analytic"});
+  // Unset sections keep their defaults; no render section, no video.
+  EXPECT_EQ(c.analytic.solver, "adaptive");
+  EXPECT_EQ(c.effects.friction, FrictionLaw::kStiction);
+  EXPECT_DOUBLE_EQ(c.output.sample_dt_s, 1e-3);
+  EXPECT_FALSE(c.render.enabled);
+  // The tail ends at theta0 + dtheta = -90 deg at t0 + dT (trajectory() uses the loaded params).
+  EXPECT_NEAR(c.trajectory().joints[0].at(1.0).theta, -M_PI / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(c.simDuration(), 0.25 + 0.5);
+}
+
+TEST_F(LoaderTest, RobotTailsMatchTable2ForEveryN) {
+  const std::string p = write("exp.yaml", "name: t\nrobot: robots/paper_quadruped.yaml\n"
+                                          "tail: {links: {range: [1, 6, 1]}}\n" + std::string(kTraj));
+  const Experiment e = loadExperiment(p);
+  ASSERT_EQ(e.cases.size(), 6u);
+  EXPECT_EQ(e.swept_keys, std::vector<std::string>{"tail.links"});
+  for (int n = 1; n <= 6; ++n) {
+    const ExperimentCase& c = e.cases[n - 1];
+    EXPECT_EQ(c.name, "links=" + std::to_string(n));
+    const TailLink ref = paperTailLink(n);  // Table 2 as coded in robot_params.cc
+    ASSERT_EQ(c.robot.numLinks(), n);
+    ASSERT_EQ(c.joints.size(), static_cast<size_t>(n));
+    for (const TailLink& l : c.robot.tail) {
+      EXPECT_DOUBLE_EQ(l.mass_kg, ref.mass_kg);
+      EXPECT_DOUBLE_EQ(l.izz_kgm2, ref.izz_kgm2);
+      EXPECT_DOUBLE_EQ(l.length_m, ref.length_m);
+      EXPECT_DOUBLE_EQ(l.com_offset_m, ref.com_offset_m);
+    }
+    EXPECT_NEAR(c.robot.tailMass(), 2.4, 1e-12);  // every paper tail weighs 2.4 kg
+  }
+}
+
+// READING-NOTES "Checks": Eq. (25) with thetadot_max = 10.47 rad/s.
+TEST_F(LoaderTest, Eq25RuleGivesReadingNotesNumbers) {
+  const double dtheta_deg[] = {-180, -120, -90, -72, -60, -51.43};
+  const double dT_s[] = {0.600, 0.400, 0.300, 0.240, 0.200, 0.171};
+  for (const char* speed : {"thetadot_max_radps: 10.47", "thetadot_max_dps: 600"}) {
+    const std::string p = write("exp.yaml", "name: eq25\nrobot: robots/paper_quadruped.yaml\n"
+                                            "tail: {links: {sweep: [1, 2, 3, 4, 5, 6]}}\n"
+                                            "trajectory: {rule: eq25, w_ss: 0.3, " +
+                                                std::string(speed) + "}\n");
+    const Experiment e = loadExperiment(p);
+    ASSERT_EQ(e.cases.size(), 6u);
+    for (int n = 1; n <= 6; ++n) {
+      const ExperimentCase& c = e.cases[n - 1];
+      ASSERT_EQ(c.joints.size(), static_cast<size_t>(n)) << speed;
+      for (const SplitCycleParams& j : c.joints) {
+        EXPECT_NEAR(j.dtheta_rad / kDeg, dtheta_deg[n - 1], 0.005) << speed << " n=" << n;
+        EXPECT_NEAR(j.dT_s, dT_s[n - 1], 0.0006) << speed << " n=" << n;
+        EXPECT_NEAR(j.theta0_rad / kDeg, 180.0 / (n + 1), 1e-9) << "each joint starts at +180/(n+1) deg";
+        EXPECT_DOUBLE_EQ(j.w_ss, 0.3);
+        // The profile's own peak speed (Eq. 20 integrated) is thetadot_max.
+        const SplitCycleProfile prof(j);
+        EXPECT_NEAR(std::abs(prof.at(prof.t1()).theta_dot), 10.47, 0.01);
+      }
+    }
+  }
+}
+
+TEST_F(LoaderTest, TwoDimensionalSweepIsAProductInFileOrder) {
+  const std::string p = write("exp.yaml", exp("trajectory:\n"
+                                              "  theta0_deg: {sweep: [0, 15, 30]}\n"
+                                              "  dtheta_deg: -90\n"
+                                              "  dT_s: 0.25\n"
+                                              "quadruped:\n"
+                                              "  d_Q2B_m: {sweep: [0.05, 0.1405]}\n"));
+  const Experiment e = loadExperiment(p);
+  EXPECT_EQ(e.swept_keys, (std::vector<std::string>{"trajectory.theta0_deg", "quadruped.d_Q2B_m"}));
+  ASSERT_EQ(e.cases.size(), 6u);
+  const double th[] = {0, 15, 30};
+  const double d[] = {0.05, 0.1405};
+  const char* dtext[] = {"0.05", "0.1405"};
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const ExperimentCase& c = e.cases[i * 2 + k];  // first swept key varies slowest
+      EXPECT_EQ(c.name, "theta0_deg=" + std::to_string(static_cast<int>(th[i])) + ",d_Q2B_m=" + dtext[k]);
+      EXPECT_DOUBLE_EQ(c.joints[0].theta0_rad, th[i] * kDeg);
+      EXPECT_DOUBLE_EQ(c.robot.quadruped.d_Q2B_m, d[k]);
+      EXPECT_DOUBLE_EQ(c.robot.quadruped.mass_kg, 8.458);  // not overridden: from the robot file
+      ASSERT_EQ(c.sweep_values.size(), 2u);
+      EXPECT_EQ(c.sweep_values.at("trajectory.theta0_deg"), std::to_string(static_cast<int>(th[i])));
+      EXPECT_EQ(c.sweep_values.at("quadruped.d_Q2B_m"), dtext[k]);
+    }
+}
+
+TEST_F(LoaderTest, RangeIsInclusiveAndRobustToFloatSteps) {
+  const std::string p = write("exp.yaml", exp("quadruped: {d_Q2B_m: {range: [0, 0.15, 0.025]}}\n") + kTraj);
+  const Experiment e = loadExperiment(p);
+  ASSERT_EQ(e.cases.size(), 7u);  // 0.15 / 0.025 = 5.999999999999999 in floating point
+  const char* names[] = {"0", "0.025", "0.05", "0.075", "0.1", "0.125", "0.15"};
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(e.cases[i].name, std::string("d_Q2B_m=") + names[i]);
+    EXPECT_EQ(e.cases[i].sweep_values.at("quadruped.d_Q2B_m"), names[i]);
+    EXPECT_NEAR(e.cases[i].robot.quadruped.d_Q2B_m, 0.025 * i, 1e-15);
+  }
+  EXPECT_EQ(e.cases.back().robot.quadruped.d_Q2B_m, 0.15);  // the stop value exactly
+
+  // Descending ranges, and 0..0.3 by 0.1 (0.3/0.1 = 2.9999999999999996): 4 values.
+  const std::string q = write("exp.yaml", exp("trajectory: {theta0_deg: {range: [90, 0, -30]}, dtheta_deg: "
+                                              "{range: [-0.1, -0.3, -0.1]}, dT_s: 0.25}\n"));
+  const Experiment f = loadExperiment(q);
+  ASSERT_EQ(f.cases.size(), 4u * 3u);
+  EXPECT_EQ(f.cases.front().name, "theta0_deg=90,dtheta_deg=-0.1");
+  EXPECT_EQ(f.cases.back().name, "theta0_deg=0,dtheta_deg=-0.3");
+  EXPECT_DOUBLE_EQ(f.cases.back().joints[0].dtheta_rad, -0.3 * kDeg);
+  const std::string r = write("exp.yaml", exp("output: {sample_dt_s: {range: [0.1, 1.0, 0.1]}}\n") + kTraj);
+  EXPECT_EQ(loadExperiment(r).cases.size(), 10u);
+}
+
+TEST_F(LoaderTest, SweepValuesArePrintedAsWritten) {
+  const std::string p = write("exp.yaml", exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: {sweep: [0.10, 2.5e-1]}}\n"
+                                              "effects: {friction: {sweep: [stiction, continuous]}}\n"));
+  const Experiment e = loadExperiment(p);
+  ASSERT_EQ(e.cases.size(), 4u);
+  EXPECT_EQ(e.cases[0].name, "w_ss=0.10,friction=stiction");
+  EXPECT_EQ(e.cases[3].name, "w_ss=2.5e-1,friction=continuous");
+  EXPECT_DOUBLE_EQ(e.cases[3].joints[0].w_ss, 0.25);
+  EXPECT_EQ(e.cases[3].effects.friction, FrictionLaw::kContinuous);
+}
+
+TEST_F(LoaderTest, SharedLeafNamesUseTheDottedKey) {
+  const std::string p = write("exp.yaml", "name: t\nrobot: robots/paper_quadruped.yaml\n"
+                                          "tail: {custom: [{mass_kg: {sweep: [1, 2]}, izz_kgm2: 0.01, length_m: 0.3}]}\n"
+                                          "quadruped: {mass_kg: {sweep: [8, 9]}}\n"
+                                          "friction: {mu_s: {sweep: [0.2, 0.3]}}\n" +
+                                          std::string(kTraj));
+  const Experiment e = loadExperiment(p);
+  ASSERT_EQ(e.cases.size(), 8u);
+  EXPECT_EQ(e.swept_keys,
+            (std::vector<std::string>{"tail.custom[0].mass_kg", "quadruped.mass_kg", "friction.mu_s"}));
+  EXPECT_EQ(e.cases[5].name, "tail.custom[0].mass_kg=2,quadruped.mass_kg=8,mu_s=0.3");
+  EXPECT_DOUBLE_EQ(e.cases[5].robot.tail[0].mass_kg, 2.0);
+  EXPECT_DOUBLE_EQ(e.cases[5].robot.tail[0].com_offset_m, 0.15);  // 0.5 length_m by default
+  EXPECT_DOUBLE_EQ(e.cases[5].robot.quadruped.mass_kg, 8.0);
+  EXPECT_DOUBLE_EQ(e.cases[5].robot.friction.mu_s, 0.3);
+}
+
+TEST_F(LoaderTest, PerJointListsAndSweptListElements) {
+  const std::string p = write("exp.yaml", "name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 2}\n"
+                                          "trajectory:\n"
+                                          "  theta0_deg: [0, {sweep: [10, 20]}]\n"
+                                          "  dtheta_deg: [-90, -45]\n"
+                                          "  peak_speed_dps: 720\n"
+                                          "  w_ss: [0.25, 0.5]\n"
+                                          "  t0_s: [0, 0.1]\n");
+  const Experiment e = loadExperiment(p);
+  EXPECT_EQ(e.swept_keys, std::vector<std::string>{"trajectory.theta0_deg[1]"});
+  ASSERT_EQ(e.cases.size(), 2u);
+  EXPECT_EQ(e.cases[1].name, "theta0_deg[1]=20");
+  const auto& j = e.cases[1].joints;
+  ASSERT_EQ(j.size(), 2u);
+  EXPECT_DOUBLE_EQ(j[0].theta0_rad, 0.0);
+  EXPECT_DOUBLE_EQ(j[1].theta0_rad, 20 * kDeg);
+  EXPECT_DOUBLE_EQ(j[1].dtheta_rad, -45 * kDeg);
+  EXPECT_DOUBLE_EQ(j[1].w_ss, 0.5);
+  EXPECT_DOUBLE_EQ(j[1].t0_s, 0.1);
+  // peak_speed_dps: the integrated profile really peaks at 720 deg/s, at t1 = t0 + w_ss dT.
+  for (const SplitCycleParams& q : j) {
+    const SplitCycleProfile prof(q);
+    EXPECT_NEAR(std::abs(prof.at(prof.t1()).theta_dot), 720 * kDeg, 1e-9);
+    EXPECT_LT(std::abs(prof.at(prof.t1() - 1e-3).theta_dot), 720 * kDeg);
+  }
+  EXPECT_DOUBLE_EQ(j[0].dT_s, 0.25);   // 2 * 90 / 720
+  EXPECT_DOUBLE_EQ(j[1].dT_s, 0.125);  // 2 * 45 / 720
+}
+
+TEST_F(LoaderTest, PoseKindNeedsNoTrajectory) {
+  const std::string p = write("exp.yaml", "name: fig08\nrobot: robots/paper_quadruped.yaml\nkind: pose\n"
+                                          "tail: {links: 3}\n"
+                                          "pose: {theta_deg: [30, {sweep: [0, 45]}, -30], thetadot_radps: 2, "
+                                          "thetaddot_radps2: [1, 2, 3]}\n");
+  const Experiment e = loadExperiment(p);
+  ASSERT_EQ(e.cases.size(), 2u);
+  const ExperimentCase& c = e.cases[1];
+  EXPECT_EQ(c.kind, "pose");
+  EXPECT_TRUE(c.joints.empty());
+  ASSERT_EQ(c.pose.theta_rad.size(), 3u);
+  EXPECT_DOUBLE_EQ(c.pose.theta_rad[0], 30 * kDeg);
+  EXPECT_DOUBLE_EQ(c.pose.theta_rad[1], 45 * kDeg);
+  EXPECT_DOUBLE_EQ(c.pose.thetadot_radps[2], 2.0);
+  EXPECT_DOUBLE_EQ(c.pose.thetaddot_radps2[2], 3.0);
+  // No pose section: all zero.
+  const std::string q = write("exp.yaml", "name: p\nrobot: robots/paper_quadruped.yaml\nkind: pose\n");
+  const Experiment f = loadExperiment(q);
+  EXPECT_EQ(f.cases[0].pose.theta_rad, std::vector<double>{0.0});
+}
+
+TEST_F(LoaderTest, AllSectionsAreRead) {
+  const std::string p = write(
+      "exp.yaml",
+      exp(std::string(kTraj) +
+          "friction: {mu_s: 0.3, mu_d: 0.25, v_d_mps: 0.6}\n"
+          "gravity_mps2: 9.8\n"
+          "models: [mujoco, analytic]\n"
+          "analytic: {solver: fixed, rel_tol: 1e-6, abs_tol: 1e-9, fixed_dt_s: 1e-5, event_tol_s: 1e-10,\n"
+          "           max_step_s: 0.001, v_stop_mps: 1e-6, coupling: exact}\n"
+          "mujoco: {timestep_s: 1e-4, integrator: RK4, solver: PGS, iterations: 50, tolerance: 1e-8,\n"
+          "         cone: pyramidal, noslip_iterations: 3, condim: 4, impratio: 2, solref: [0.004, 0.9],\n"
+          "         solimp: [0.9, 0.95, 0.002, 0.4, 3], mu: 0.3, kp: 50, kv: 2,\n"
+          "         velocity_feedforward: false, inverse_dynamics_feedforward: no}\n"
+          "effects: {friction: none, translation: false, gravity: false, ground_contact: false,\n"
+          "          foot_loads: constant, load_decomposition: false}\n"
+          "output: {sample_dt_s: 0.002, duration_s: 1.5, settle_s: 0.2}\n"
+          "render: {width: 320, height: 240, fps: 60, slowmo: 2, duration_s: 0.5, camera: perspective,\n"
+          "         shadows: true, reflections: true, msaa: 4, ghost: false}\n"));
+  const ExperimentCase c = loadExperiment(p).cases.at(0);
+  EXPECT_DOUBLE_EQ(c.robot.friction.mu_s, 0.3);
+  EXPECT_DOUBLE_EQ(c.robot.friction.mu_d, 0.25);
+  EXPECT_DOUBLE_EQ(c.robot.friction.v_d_mps, 0.6);
+  EXPECT_DOUBLE_EQ(c.robot.friction.v_s_mps, 0.05);
+  EXPECT_DOUBLE_EQ(c.robot.gravity_mps2, 9.8);
+  EXPECT_EQ(c.models, (std::vector<std::string>{"mujoco", "analytic"}));
+  EXPECT_EQ(c.analytic.solver, "fixed");
+  EXPECT_DOUBLE_EQ(c.analytic.rel_tol, 1e-6);
+  EXPECT_DOUBLE_EQ(c.analytic.abs_tol, 1e-9);
+  EXPECT_DOUBLE_EQ(c.analytic.fixed_dt_s, 1e-5);
+  EXPECT_DOUBLE_EQ(c.analytic.event_tol_s, 1e-10);
+  EXPECT_DOUBLE_EQ(c.analytic.max_step_s, 0.001);
+  EXPECT_DOUBLE_EQ(c.analytic.v_stop_mps, 1e-6);
+  EXPECT_EQ(c.analytic.coupling, Coupling::kExact);
+  EXPECT_DOUBLE_EQ(c.mujoco.timestep_s, 1e-4);
+  EXPECT_EQ(c.mujoco.integrator, "RK4");
+  EXPECT_EQ(c.mujoco.solver, "PGS");
+  EXPECT_EQ(c.mujoco.iterations, 50);
+  EXPECT_DOUBLE_EQ(c.mujoco.tolerance, 1e-8);
+  EXPECT_EQ(c.mujoco.cone, "pyramidal");
+  EXPECT_EQ(c.mujoco.noslip_iterations, 3);
+  EXPECT_EQ(c.mujoco.condim, 4);
+  EXPECT_DOUBLE_EQ(c.mujoco.impratio, 2.0);
+  EXPECT_DOUBLE_EQ(c.mujoco.solref[0], 0.004);
+  EXPECT_DOUBLE_EQ(c.mujoco.solref[1], 0.9);
+  EXPECT_DOUBLE_EQ(c.mujoco.solimp[2], 0.002);
+  EXPECT_DOUBLE_EQ(c.mujoco.solimp[4], 3.0);
+  EXPECT_DOUBLE_EQ(c.mujoco.mu, 0.3);
+  EXPECT_DOUBLE_EQ(c.mujoco.kp, 50.0);
+  EXPECT_DOUBLE_EQ(c.mujoco.kv, 2.0);
+  EXPECT_FALSE(c.mujoco.velocity_feedforward);
+  EXPECT_FALSE(c.mujoco.inverse_dynamics_feedforward);
+  EXPECT_EQ(c.effects.friction, FrictionLaw::kNone);
+  EXPECT_FALSE(c.effects.translation);
+  EXPECT_FALSE(c.effects.gravity);
+  EXPECT_FALSE(c.effects.ground_contact);
+  EXPECT_EQ(c.effects.foot_loads, FootLoadModel::kConstant);
+  EXPECT_FALSE(c.effects.load_decomposition);
+  EXPECT_DOUBLE_EQ(c.output.sample_dt_s, 0.002);
+  EXPECT_DOUBLE_EQ(c.output.duration_s, 1.5);
+  EXPECT_DOUBLE_EQ(c.output.settle_s, 0.2);
+  EXPECT_DOUBLE_EQ(c.simDuration(), 1.5);
+  EXPECT_TRUE(c.render.enabled);
+  EXPECT_EQ(c.render.width, 320);
+  EXPECT_EQ(c.render.height, 240);
+  EXPECT_EQ(c.render.fps, 60);
+  EXPECT_DOUBLE_EQ(c.render.slowmo, 2.0);
+  EXPECT_DOUBLE_EQ(c.render.duration_s, 0.5);
+  EXPECT_EQ(c.render.camera, "perspective");
+  EXPECT_TRUE(c.render.shadows);
+  EXPECT_TRUE(c.render.reflections);
+  EXPECT_EQ(c.render.msaa, 4);
+  EXPECT_FALSE(c.render.ghost);
+
+  const std::string q = write("exp.yaml", exp(std::string(kTraj) + "render: {}\n"));
+  const ExperimentCase d = loadExperiment(q).cases.at(0);
+  EXPECT_TRUE(d.render.enabled);  // presence alone asks for a video
+  EXPECT_EQ(d.render.width, RenderSettings{}.width);
+}
+
+TEST_F(LoaderTest, RobotPathIsRelativeToTheExperimentFile) {
+  const std::string p = write("sub/dir/exp.yaml", "name: t\nrobot: ../../robots/paper_quadruped.yaml\n" +
+                                                      std::string(kTraj));
+  const Experiment e = loadExperiment(p);
+  EXPECT_EQ(e.cases[0].robot.numLinks(), 1);  // tail defaults to {links: 1}
+  EXPECT_EQ(e.source_file, p);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Every kind of bad input: a ConfigError naming file:line, the dotted key and what is wrong.
+
+TEST_F(LoaderTest, UnknownKeys) {
+  expectError(exp(std::string(kTraj) + "colour: red\n"), 5, "colour", "unknown key", "exp.yaml", 1);
+  expectError(exp(std::string(kTraj) + "quadruped:\n  mass: 3\n"), 6, "quadruped.mass", "allowed here: mass_kg");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, dT: 1}\n"), 4, "trajectory.dT", "unknown key", "exp.yaml",
+              43);
+  expectError(exp(std::string(kTraj) + "render: {size: 3}\n"), 5, "render.size", "unknown key");
+  expectError(exp(std::string(kTraj) + "quadruped: {mass_kg: 1, mass_kg: 2}\n"), 5, "quadruped.mass_kg", "duplicate");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 1, lenght: 2}\n" + std::string(kTraj), 3,
+              "tail.lenght", "unknown key");
+}
+
+TEST_F(LoaderTest, WrongTypes) {
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: abc}\n"), 4, "trajectory.dT_s", "expected a number, got 'abc'");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: \"0.25\"}\n"), 4, "trajectory.dT_s", "string");
+  expectError(exp(std::string(kTraj) + "effects:\n  translation: abc\n"), 6, "effects.translation", "true or false");
+  expectError(exp(std::string(kTraj) + "mujoco: {iterations: 2.5}\n"), 5, "mujoco.iterations", "integer");
+  expectError(exp(std::string(kTraj) + "models: analytic\n"), 5, "models", "expected a list");
+  expectError(exp("trajectory: 5\n"), 4, "trajectory", "expected a map");
+  expectError(exp("trajectory:\n  dtheta_deg:\n  dT_s: 0.25\n"), 5, "trajectory.dtheta_deg", "empty");
+  expectError("name: [a]\nrobot: robots/paper_quadruped.yaml\n" + std::string(kTraj), 1, "name", "expected a string");
+}
+
+TEST_F(LoaderTest, NonFiniteNumbers) {
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: .nan}\n"), 4, "trajectory.w_ss", "finite");
+  expectError(exp("trajectory:\n  dtheta_deg: -.inf\n  dT_s: 0.25\n"), 5, "trajectory.dtheta_deg", "finite");
+  expectError(exp(std::string(kTraj) + "quadruped: {izz_kgm2: .inf}\n"), 5, "quadruped.izz_kgm2", "finite");
+}
+
+TEST_F(LoaderTest, BadLinkCountsAndListLengths) {
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 0}\n" + std::string(kTraj), 3, "tail.links",
+              "1..6");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 7}\n" + std::string(kTraj), 3, "tail.links",
+              "1..6");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {custom: []}\n" + std::string(kTraj), 3,
+              "tail.custom", "n >= 1");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 1, custom: []}\n" + std::string(kTraj), 3,
+              "tail.custom", "not both");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 2}\n"
+              "trajectory:\n  theta0_deg: [0, 10, 20]\n  dtheta_deg: -90\n  dT_s: 0.25\n",
+              5, "trajectory.theta0_deg", "3 values but the tail has 2");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\nkind: pose\ntail: {links: 3}\npose: {theta_deg: [1, 2]}\n",
+              5, "pose.theta_deg", "2 values but the tail has 3");
+}
+
+TEST_F(LoaderTest, TrajectoryRanges) {
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: 1.0}\n"), 4, "trajectory.w_ss", "(0, 1)");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: [0]}\n"), 4, "trajectory.w_ss[0]", "(0, 1)");
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n  dT_s: 0\n"), 6, "trajectory.dT_s", "> 0");
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n  dT_s: -0.1\n"), 6, "trajectory.dT_s", "> 0");
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n"), 4, "trajectory.dT_s", "dT_s or peak_speed_dps");
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n  dT_s: 1\n  peak_speed_dps: 100\n"), 7,
+              "trajectory.peak_speed_dps", "not both");
+  expectError(exp("trajectory:\n  dtheta_deg: 0\n  peak_speed_dps: 100\n"), 6, "trajectory.peak_speed_dps", "dT_s = 0");
+  expectError(exp("trajectory:\n  dT_s: 1\n"), 4, "trajectory.dtheta_deg", "required");
+  expectError(exp("trajectory:\n  dT_s: 1\n  dtheta_deg: -90\n  t0_s: -1\n"), 7, "trajectory.t0_s", ">= 0");
+  expectError(exp("trajectory:\n  rule: eq25\n  thetadot_max_dps: 600\n  dtheta_deg: -90\n"), 7,
+              "trajectory.dtheta_deg", "rule: eq25");
+  expectError(exp("trajectory:\n  rule: eq25\n"), 4, "trajectory.thetadot_max_dps", "needs");
+  expectError(exp("trajectory:\n  rule: eq26\n  thetadot_max_dps: 600\n"), 5, "trajectory.rule", "allowed: eq25");
+  expectError(exp("trajectory:\n  rule: eq25\n  thetadot_max_radps: -1\n"), 6, "trajectory.thetadot_max_radps", "> 0");
+  expectError(exp(""), 1, "trajectory", "required for kind: simulate");
+  expectError(exp(std::string(kTraj) + "pose: {theta_deg: 0}\n"), 5, "pose", "kind: pose");
+}
+
+TEST_F(LoaderTest, BadRobotValues) {
+  expectError(exp(std::string(kTraj) + "quadruped:\n  mass_kg: -1\n"), 6, "quadruped.mass_kg", "> 0");
+  expectError(exp(std::string(kTraj) + "quadruped: {izz_kgm2: 0}\n"), 5, "quadruped.izz_kgm2", "> 0");
+  expectError(exp(std::string(kTraj) + "friction:\n  mu_d: 0.3\n  mu_s: -0.1\n"), 7, "friction.mu_s", ">= 0");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\n"
+              "tail:\n  custom:\n    - {mass_kg: 1, izz_kgm2: 0.01, length_m: 0.1}\n"
+              "    - {mass_kg: 1, izz_kgm2: 0, length_m: 0.1}\n" +
+                  std::string(kTraj),
+              6, "tail.custom[1].izz_kgm2", "> 0");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\n"
+              "tail: {custom: [{mass_kg: 1, izz_kgm2: 0.01, length_m: -0.1}]}\n" + std::string(kTraj),
+              3, "tail.custom[0].length_m", "> 0");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\n"
+              "tail: {custom: [{mass_kg: 0, izz_kgm2: 0.01, length_m: 0.1}]}\n" + std::string(kTraj),
+              3, "tail.custom[0].mass_kg", "> 0");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\n"
+              "tail: {custom: [{izz_kgm2: 0.01, length_m: 0.1}]}\n" + std::string(kTraj),
+              3, "tail.custom[0].mass_kg", "required");
+}
+
+TEST_F(LoaderTest, BadSettings) {
+  expectError(exp(std::string(kTraj) + "output:\n  sample_dt_s: 0\n"), 6, "output.sample_dt_s", "> 0");
+  expectError(exp(std::string(kTraj) + "mujoco:\n  timestep_s: -1e-4\n"), 6, "mujoco.timestep_s", "> 0");
+  expectError(exp(std::string(kTraj) + "mujoco: {condim: 2}\n"), 5, "mujoco.condim", "1, 3, 4, 6");
+  expectError(exp(std::string(kTraj) + "mujoco: {solref: [0.002]}\n"), 5, "mujoco.solref", "2 values");
+  expectError(exp(std::string(kTraj) + "mujoco: {solimp: [0.9, 1.5, 0.001, 0.5, 2]}\n"), 5, "mujoco.solimp[1]", "(0, 1)");
+}
+
+TEST_F(LoaderTest, UnknownEnumValuesListTheAllowedOnes) {
+  expectError(exp(std::string(kTraj) + "analytic:\n  solver: rk45\n"), 6, "analytic.solver", "allowed: adaptive, fixed");
+  expectError(exp(std::string(kTraj) + "analytic: {coupling: loose}\n"), 5, "analytic.coupling", "allowed: paper, exact");
+  expectError(exp(std::string(kTraj) + "mujoco: {integrator: RK45}\n"), 5, "mujoco.integrator",
+              "allowed: Euler, RK4, implicit");
+  expectError(exp(std::string(kTraj) + "effects: {friction: coulomb}\n"), 5, "effects.friction",
+              "allowed: none, stiction, continuous");
+  expectError(exp(std::string(kTraj) + "models: [analytic, adams]\n"), 5, "models[1]", "allowed: analytic, mujoco");
+  expectError(exp(std::string(kTraj) + "models: []\n"), 5, "models", "at least one");
+  expectError(exp(std::string(kTraj) + "models: [mujoco, mujoco]\n"), 5, "models[1]", "twice");
+  expectError(exp(std::string(kTraj) + "render: {camera: side}\n"), 5, "render.camera", "allowed: top, perspective");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\nkind: replay\n" + std::string(kTraj), 3, "kind",
+              "allowed: simulate, pose");
+}
+
+TEST_F(LoaderTest, MissingFilesAndRequiredKeys) {
+  expectError("name: t\n\nrobot: robots/nothere.yaml\n" + std::string(kTraj), 3, "robot", "robot file not found",
+              "exp.yaml", 8);
+  expectError("robot: robots/paper_quadruped.yaml\n" + std::string(kTraj), 1, "name", "required");
+  expectError("name: t\n" + std::string(kTraj), 1, "robot", "required");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntrajectory: {dtheta_deg: [-90, dT_s: 0.25}\n", 3, "",
+              "YAML syntax error");
+  EXPECT_THROW(loadExperiment((dir_ / "nothere.yaml").string()), ConfigError);
+}
+
+TEST_F(LoaderTest, ErrorsInsideTheRobotFileNameTheRobotFile) {
+  const std::string good = "quadruped: {mass_kg: 8.458, izz_kgm2: 0.1916, d_Q2C_m: -0.0155, d_Q2B_m: 0.125, "
+                           "l_F_m: 0.3, w_F_m: 0.26}\n"
+                           "friction: {mu_s: 0.25, mu_d: 0.3, phidot_s_radps: 0.05, phidot_d_radps: 0.5, "
+                           "v_s_mps: 0.05, v_d_mps: 0.5}\n"
+                           "gravity_mps2: 9.81\n";
+  const std::string experiment = "name: t\nrobot: robots/r.yaml\n" + std::string(kTraj);
+  write("robots/r.yaml", good + "tails:\n  1: {mass_kg: 2.4, izz_kgm2: -0.02, length_m: 0.3}\n");
+  expectError(experiment, 5, "tails.1.izz_kgm2", "> 0", "robots/r.yaml");
+  write("robots/r.yaml", good + "tails:\n  1: {mass_kg: 2.4, izz_kgm2: 0.02, length_m: 0.3, colour: red}\n");
+  expectError(experiment, 5, "tails.1.colour", "unknown key", "robots/r.yaml");
+  write("robots/r.yaml", good + "tails:\n  7: {mass_kg: 2.4, izz_kgm2: 0.02, length_m: 0.3}\n");
+  expectError(experiment, 5, "tails.7", "unknown key", "robots/r.yaml");
+  write("robots/r.yaml", good);
+  expectError(experiment, 1, "tails", "required", "robots/r.yaml");
+  write("robots/r.yaml", "quadruped: {mass_kg: 8}\n" + good.substr(good.find("friction")) + "tails: {}\n");
+  expectError(experiment, 1, "quadruped.izz_kgm2", "required", "robots/r.yaml");
+  write("robots/r.yaml", good + "gravity: 9\ntails:\n  1: {mass_kg: 2.4, izz_kgm2: 0.02, length_m: 0.3}\n");
+  expectError(experiment, 4, "gravity", "unknown key", "robots/r.yaml");
+  write("robots/r.yaml", good + "tails:\n  1: {mass_kg: {sweep: [1, 2]}, izz_kgm2: 0.02, length_m: 0.3}\n");
+  expectError(experiment, 5, "tails.1.mass_kg", "experiment files only", "robots/r.yaml");
+  // A tail the robot file lacks: the error is at the experiment's links value.
+  write("robots/r.yaml", good + "tails:\n  1: {mass_kg: 2.4, izz_kgm2: 0.02, length_m: 0.3}\n");
+  expectError("name: t\nrobot: robots/r.yaml\ntail: {links: 2}\n" + std::string(kTraj), 3, "tail.links", "no tails.2");
+  // The friction thresholds must be ordered (tailsim::validate), at the robot file's line.
+  write("robots/r.yaml", good.substr(0, good.find("friction")) +
+                             "friction:\n  mu_s: 0.25\n  mu_d: 0.3\n  phidot_s_radps: 0.5\n  phidot_d_radps: 0.05\n"
+                             "  v_s_mps: 0.05\n  v_d_mps: 0.5\ngravity_mps2: 9.81\n"
+                             "tails:\n  1: {mass_kg: 2.4, izz_kgm2: 0.02, length_m: 0.3}\n");
+  expectError(experiment, 6, "friction.phidot_d_radps", "must exceed", "robots/r.yaml");
+  // Overridden in the experiment: the error moves to the experiment file.
+  expectError(exp(std::string(kTraj) + "friction: {phidot_d_radps: 0.01}\n"), 5, "friction.phidot_d_radps",
+              "must exceed");
+}
+
+TEST_F(LoaderTest, BadSweepsAndRanges) {
+  // The bad value is the second sweep element, on its own line: that line is named.
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n  dT_s:\n    sweep:\n      - 0.1\n      - -0.2\n"), 9,
+              "trajectory.dT_s", "> 0", "exp.yaml", 9);
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n  dT_s: 0.1\n  w_ss: {sweep: [0.5, 0.7, abc]}\n"), 7,
+              "trajectory.w_ss", "expected a number, got 'abc'", "exp.yaml", 28);
+  // A range with bad values: the range node is named.
+  expectError(exp("trajectory:\n  dtheta_deg: -90\n  dT_s: 0.1\n  w_ss: {range: [0.5, 1.5, 0.5]}\n"), 7,
+              "trajectory.w_ss", "(0, 1)");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {range: [0, 1, -0.1]}}\n"), 5, "output.settle_s",
+              "moves away");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {range: [0, 1, 0]}}\n"), 5, "output.settle_s", "step");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {range: [0, 1, 1e-5]}}\n"), 5, "output.settle_s",
+              "more than 10000");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {range: [0, 1]}}\n"), 5, "output.settle_s",
+              "[start, stop, step]");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {sweep: []}}\n"), 5, "output.settle_s", "non-empty");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {sweep: [1, 1]}}\n"), 5, "output.settle_s", "twice");
+  expectError(exp(std::string(kTraj) + "output: {settle_s: {sweep: [1], step: 2}}\n"), 5, "output.settle_s",
+              "no other keys");
+  expectError(exp(std::string(kTraj) + "quadruped: {sweep: [1, 2]}\n"), 5, "quadruped", "single value");
+  expectError(exp(std::string(kTraj) + "effects: {gravity: {range: [0, 1, 1]}}\n"), 5, "effects.gravity",
+              "true or false");
+  expectError("name: {sweep: [a, b]}\nrobot: robots/paper_quadruped.yaml\n" + std::string(kTraj), 1, "name",
+              "cannot be swept");
+  // Per-joint lengths are checked per case: links = 2 breaks the 1-element list.
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: {sweep: [1, 2]}}\n"
+              "trajectory: {dtheta_deg: [-90], dT_s: 0.25}\n",
+              4, "trajectory.dtheta_deg", "1 values but the tail has 2");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+TEST_F(LoaderTest, SuiteLoadsEveryExperimentInOrder) {
+  write("paper/fig07.yaml", "name: fig07\nrobot: ../robots/paper_quadruped.yaml\n" + std::string(kTraj));
+  write("paper/more/fig09.yaml", "name: fig09\nrobot: ../../robots/paper_quadruped.yaml\n"
+                                 "trajectory: {theta0_deg: {sweep: [0, 30, 60, 90]}, dtheta_deg: -90, dT_s: 0.25}\n");
+  write("paper/sub.yaml", "experiments: [more/fig09.yaml]\n");
+  const std::string all = write("paper/all.yaml", "description: all figures\nexperiments:\n  - fig07.yaml\n  - sub.yaml\n");
+  const std::vector<Experiment> s = loadExperimentSuite(all);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].name, "fig07");
+  EXPECT_EQ(s[0].cases.size(), 1u);
+  EXPECT_EQ(s[1].name, "fig09");
+  EXPECT_EQ(s[1].cases.size(), 4u);
+  EXPECT_EQ(s[1].source_file, (dir_ / "paper/more/fig09.yaml").string());
+  EXPECT_EQ(s[1].cases[0].source_file, s[1].source_file);
+
+  // A normal experiment file is a suite of one.
+  const std::vector<Experiment> one = loadExperimentSuite((dir_ / "paper/fig07.yaml").string());
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].name, "fig07");
+
+  // loadExperiment refuses a suite file.
+  EXPECT_THROW(loadExperiment(all), ConfigError);
+}
+
+TEST_F(LoaderTest, SuiteErrors) {
+  write("a.yaml", "name: a\nrobot: robots/paper_quadruped.yaml\n" + std::string(kTraj));
+  auto expectSuiteError = [&](const std::string& text, const std::string& file, int line, const std::string& what) {
+    const std::string p = write("all.yaml", text);
+    try {
+      loadExperimentSuite(p);
+      ADD_FAILURE() << "no ConfigError for suite:\n" << text;
+    } catch (const ConfigError& e) {
+      const std::string prefix = (dir_ / file).string() + ":" + std::to_string(line) + ":";
+      EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expectSuiteError("experiments:\n  - a.yaml\n  - b.yaml\n", "all.yaml", 3, "not found");
+  expectSuiteError("experiments:\n  - a.yaml\n  - a.yaml\n", "all.yaml", 3, "already used");
+  expectSuiteError("experiments: []\n", "all.yaml", 1, "at least one");
+  expectSuiteError("experiments: [all.yaml]\n", "all.yaml", 1, "includes itself");
+  expectSuiteError("experiments: [a.yaml]\nname: x\n", "all.yaml", 2, "unknown key");
+  // An error inside a listed experiment names that experiment's file.
+  write("bad.yaml", "name: bad\nrobot: robots/paper_quadruped.yaml\ntrajectory: {dtheta_deg: -90, dT_s: -1}\n");
+  expectSuiteError("experiments: [a.yaml, bad.yaml]\n", "bad.yaml", 3, "trajectory.dT_s");
+}
+
+// Every config shipped in the repository loads.
+TEST(ShippedConfigs, AllLoad) {
+  const fs::path configs = fs::path(kSourceDir) / "configs";
+  int loaded = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(configs)) {
+    if (entry.path().extension() != ".yaml") continue;
+    if (entry.path().parent_path().filename() == "robots") continue;
+    try {
+      loadExperimentSuite(entry.path().string());
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << e.what();
+    }
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 1);
+}
+
+}  // namespace
+}  // namespace tailsim
