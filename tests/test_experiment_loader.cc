@@ -309,7 +309,8 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
           "mujoco: {timestep_s: 1e-4, integrator: RK4, solver: PGS, iterations: 50, tolerance: 1e-8,\n"
           "         cone: pyramidal, noslip_iterations: 3, condim: 4, impratio: 2, solref: [0.004, 0.9],\n"
           "         solimp: [0.9, 0.95, 0.002, 0.4, 3], mu: 0.3, kp: 50, kv: 2,\n"
-          "         velocity_feedforward: false, inverse_dynamics_feedforward: no}\n"
+          "         velocity_feedforward: false, inverse_dynamics_feedforward: no, servo_wn_dt: 0.1,\n"
+          "         body_height_m: 0.2, foot_radius_m: 0.02, settle_s: 0.3, stop_phidot_radps: 1e-4}\n"
           "effects: {friction: none, translation: false, gravity: false, ground_contact: false,\n"
           "          foot_loads: constant, load_decomposition: false}\n"
           "output: {sample_dt_s: 0.002, duration_s: 1.5, settle_s: 0.2}\n"
@@ -348,6 +349,11 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
   EXPECT_DOUBLE_EQ(c.mujoco.kv, 2.0);
   EXPECT_FALSE(c.mujoco.velocity_feedforward);
   EXPECT_FALSE(c.mujoco.inverse_dynamics_feedforward);
+  EXPECT_DOUBLE_EQ(c.mujoco.servo_wn_dt, 0.1);
+  EXPECT_DOUBLE_EQ(c.mujoco.body_height_m, 0.2);
+  EXPECT_DOUBLE_EQ(c.mujoco.foot_radius_m, 0.02);
+  EXPECT_DOUBLE_EQ(c.mujoco.settle_s, 0.3);
+  EXPECT_DOUBLE_EQ(c.mujoco.stop_phidot_radps, 1e-4);
   EXPECT_EQ(c.effects.friction, FrictionLaw::kNone);
   EXPECT_FALSE(c.effects.translation);
   EXPECT_FALSE(c.effects.gravity);
@@ -475,6 +481,7 @@ TEST_F(LoaderTest, BadSettings) {
   expectError(exp(std::string(kTraj) + "output:\n  sample_dt_s: 0\n"), 6, "output.sample_dt_s", "> 0");
   expectError(exp(std::string(kTraj) + "mujoco:\n  timestep_s: -1e-4\n"), 6, "mujoco.timestep_s", "> 0");
   expectError(exp(std::string(kTraj) + "mujoco: {condim: 2}\n"), 5, "mujoco.condim", "1, 3, 4, 6");
+  expectError(exp(std::string(kTraj) + "mujoco: {body_height_m: 0}\n"), 5, "mujoco.body_height_m", "> 0");
   expectError(exp(std::string(kTraj) + "mujoco: {solref: [0.002]}\n"), 5, "mujoco.solref", "2 values");
   expectError(exp(std::string(kTraj) + "mujoco: {solimp: [0.9, 1.5, 0.001, 0.5, 2]}\n"), 5, "mujoco.solimp[1]", "(0, 1)");
 }

@@ -615,7 +615,8 @@ AnalyticSettings readAnalytic(const Reader& r, const Item& item) {
 MujocoSettings readMujoco(const Reader& r, const Item& item) {
   const MapView m = r.map(item, {"timestep_s", "integrator", "solver", "iterations", "tolerance", "cone",
                                  "noslip_iterations", "condim", "impratio", "solref", "solimp", "mu", "kp", "kv",
-                                 "velocity_feedforward", "inverse_dynamics_feedforward"});
+                                 "velocity_feedforward", "inverse_dynamics_feedforward", "servo_wn_dt", "body_height_m",
+                                 "foot_radius_m", "settle_s", "stop_phidot_radps"});
   MujocoSettings s;
   if (const Item* x = m.get("timestep_s")) s.timestep_s = r.positive(*x);
   if (const Item* x = m.get("integrator")) s.integrator = r.choice(*x, {"Euler", "RK4", "implicit"});
@@ -652,6 +653,11 @@ MujocoSettings readMujoco(const Reader& r, const Item& item) {
   if (const Item* x = m.get("kv")) s.kv = r.nonNegative(*x);
   if (const Item* x = m.get("velocity_feedforward")) s.velocity_feedforward = r.boolean(*x);
   if (const Item* x = m.get("inverse_dynamics_feedforward")) s.inverse_dynamics_feedforward = r.boolean(*x);
+  if (const Item* x = m.get("servo_wn_dt")) s.servo_wn_dt = r.positive(*x);
+  if (const Item* x = m.get("body_height_m")) s.body_height_m = r.positive(*x);
+  if (const Item* x = m.get("foot_radius_m")) s.foot_radius_m = r.positive(*x);
+  if (const Item* x = m.get("settle_s")) s.settle_s = r.nonNegative(*x);
+  if (const Item* x = m.get("stop_phidot_radps")) s.stop_phidot_radps = r.positive(*x);
   return s;
 }
 
