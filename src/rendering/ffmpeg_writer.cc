@@ -1,0 +1,265 @@
+#include "rendering/ffmpeg_writer.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+extern char** environ;
+
+namespace tailsim {
+
+namespace {
+
+bool isExecutableFile(const std::string& p) {
+  struct stat st;
+  return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0;
+}
+
+// Temporary name beside the target, keeping the extension: dir/name.tmp.<pid>.<k>.ext
+std::string tempNameFor(const std::string& final_path) {
+  static std::atomic<int> counter{0};  // unique within the process (several sinks at once)
+  const size_t slash = final_path.find_last_of('/');
+  const size_t dot = final_path.find_last_of('.');
+  const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  const std::string stem = has_ext ? final_path.substr(0, dot) : final_path;
+  const std::string ext = has_ext ? final_path.substr(dot) : "";
+  return stem + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ext;
+}
+
+// write() with SIGPIPE blocked in this thread, so a dead reader gives EPIPE instead of killing
+// the process; a SIGPIPE raised meanwhile is consumed before the mask is restored.
+// Returns 0 or the errno of the failed write.
+int writeAll(int fd, const uint8_t* p, size_t n) {
+  sigset_t pipe_set, old_set;
+  sigemptyset(&pipe_set);
+  sigaddset(&pipe_set, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_set, &old_set);
+  int err = 0;
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      err = errno;
+      break;
+    }
+    p += w;
+    n -= static_cast<size_t>(w);
+  }
+  if (err != 0) {
+    const timespec zero{0, 0};
+    while (sigtimedwait(&pipe_set, nullptr, &zero) > 0) {
+    }
+  }
+  pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
+  return err;
+}
+
+}  // namespace
+
+std::string findExecutable(const std::string& name) {
+  if (name.empty()) return "";
+  if (name.find('/') != std::string::npos) return isExecutableFile(name) ? name : "";
+  const char* path = std::getenv("PATH");
+  if (!path) return "";
+  std::stringstream ss(path);
+  std::string dir;
+  while (std::getline(ss, dir, ':')) {
+    if (dir.empty()) dir = ".";
+    const std::string cand = dir + "/" + name;
+    if (isExecutableFile(cand)) return cand;
+  }
+  return "";
+}
+
+namespace {
+// mkstemp in $TMPDIR (or /tmp); returns the fd and sets `path`.
+int makeLogFile(std::string& path) {
+  const char* tmpdir = std::getenv("TMPDIR");
+  std::string tmpl_s = std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/tailsim-ffmpeg-XXXXXX";
+  std::vector<char> tmpl(tmpl_s.begin(), tmpl_s.end());
+  tmpl.push_back('\0');
+  const int fd = ::mkstemp(tmpl.data());
+  if (fd < 0) throw std::runtime_error(std::string("cannot create an ffmpeg log file: ") + std::strerror(errno));
+  path = tmpl.data();
+  return fd;
+}
+
+std::string readLog(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string s = ss.str();
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  if (s.size() > 2000) s = "..." + s.substr(s.size() - 2000);
+  return s.empty() ? "(no message)" : s;
+}
+}  // namespace
+
+std::string probeFfmpeg(const std::string& ffmpeg_exe) {
+  std::string log_path;
+  const int log_fd = makeLogFile(log_path);
+  std::vector<std::string> args = {ffmpeg_exe, "-hide_banner", "-loglevel", "error", "-nostdin",
+                                   "-f", "lavfi", "-i", "testsrc=size=64x48:rate=1:duration=1",
+                                   "-frames:v", "1", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-f", "null", "-"};
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_adddup2(&fa, log_fd, 2);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, ffmpeg_exe.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  ::close(log_fd);
+  std::string result;
+  if (rc != 0) {
+    result = std::string("cannot start it: ") + std::strerror(rc);
+  } else {
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+      result = "a test encode with libx264 failed: " + readLog(log_path);
+  }
+  std::remove(log_path.c_str());
+  return result;
+}
+
+FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, Kind kind, int width, int height, int fps,
+                       int crf, const std::string& preset, const std::string& final_path)
+    : final_path_(final_path), frame_bytes_(static_cast<size_t>(width) * height * 3) {
+  tmp_path_ = tempNameFor(final_path);
+  const int log_fd = makeLogFile(log_path_);
+
+  const std::string size = std::to_string(width) + "x" + std::to_string(height);
+  std::vector<std::string> args = {ffmpeg_exe, "-hide_banner", "-loglevel", "error", "-y",
+                                   "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", size,
+                                   "-r", std::to_string(fps), "-i", "-", "-an"};
+  if (kind == Kind::kMp4) {
+    for (const char* a : {"-c:v", "libx264", "-preset"}) args.push_back(a);
+    args.push_back(preset);
+    args.push_back("-crf");
+    args.push_back(std::to_string(crf));
+    for (const char* a : {"-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"}) args.push_back(a);
+  } else {
+    for (const char* a : {"-frames:v", "1", "-update", "1", "-c:v", "png", "-f", "image2"}) args.push_back(a);
+  }
+  args.push_back(tmp_path_);
+
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
+    ::close(log_fd);
+    std::remove(log_path_.c_str());
+    throw std::runtime_error(std::string("cannot create a pipe to ffmpeg: ") + std::strerror(errno));
+  }
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_adddup2(&fa, fds[0], 0);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_adddup2(&fa, log_fd, 2);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const int rc = posix_spawn(&pid_, ffmpeg_exe.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  ::close(fds[0]);
+  ::close(log_fd);
+  if (rc != 0) {
+    ::close(fds[1]);
+    std::remove(log_path_.c_str());
+    pid_ = -1;
+    throw std::runtime_error("cannot start ffmpeg (" + ffmpeg_exe + "): " + std::strerror(rc));
+  }
+  stdin_fd_ = fds[1];
+  ::fcntl(stdin_fd_, F_SETPIPE_SZ, 1 << 20);  // best effort: fewer blocking writes
+}
+
+FfmpegSink::~FfmpegSink() { abort(); }
+
+std::string FfmpegSink::errorLog() const { return readLog(log_path_); }
+
+void FfmpegSink::writeFrame(const uint8_t* rgb) {
+  if (stdin_fd_ < 0) throw std::logic_error("FfmpegSink::writeFrame after finish");
+  if (const int err = writeAll(stdin_fd_, rgb, frame_bytes_)) {
+    ::close(stdin_fd_);
+    stdin_fd_ = -1;
+    int status = 0;
+    if (pid_ > 0) ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+    const std::string msg = "ffmpeg stopped reading frames for " + final_path_ + " (" + std::strerror(err) +
+                            "): " + errorLog();
+    abort();
+    throw std::runtime_error(msg);
+  }
+  ++frames_;
+}
+
+void FfmpegSink::finish() {
+  if (pid_ < 0) throw std::logic_error("FfmpegSink::finish called twice");
+  ::close(stdin_fd_);
+  stdin_fd_ = -1;
+  int status = 0;
+  while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+  }
+  pid_ = -1;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    const std::string msg = "ffmpeg failed writing " + final_path_ +
+                            (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
+                                               : std::string(" (killed by a signal)")) +
+                            ": " + errorLog();
+    abort();
+    throw std::runtime_error(msg);
+  }
+  finished_ = true;
+}
+
+void FfmpegSink::commit() {
+  if (!finished_ || tmp_path_.empty()) throw std::logic_error("FfmpegSink::commit before finish");
+  if (std::rename(tmp_path_.c_str(), final_path_.c_str()) != 0) {
+    const std::string msg = "cannot move " + tmp_path_ + " to " + final_path_ + ": " + std::strerror(errno);
+    abort();
+    throw std::runtime_error(msg);
+  }
+  tmp_path_.clear();
+  std::remove(log_path_.c_str());
+  log_path_.clear();
+}
+
+void FfmpegSink::abort() noexcept {
+  if (stdin_fd_ >= 0) {
+    ::close(stdin_fd_);
+    stdin_fd_ = -1;
+  }
+  if (pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    int status;
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid_ = -1;
+  }
+  if (!tmp_path_.empty()) {
+    std::remove(tmp_path_.c_str());
+    tmp_path_.clear();
+  }
+  if (!log_path_.empty()) {
+    std::remove(log_path_.c_str());
+    log_path_.clear();
+  }
+}
+
+}  // namespace tailsim

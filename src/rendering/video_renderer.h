@@ -1,0 +1,49 @@
+// Headless videos of a case (issue 5): OSMesa off-screen MuJoCo rendering piped into ffmpeg.
+// Rendering replays the models' time series; it runs no physics. See docs/rendering.md.
+#pragma once
+
+#include <string>
+
+#include "rendering/render_settings.h"
+#include "results/time_series.h"
+#include "robot/robot_params.h"
+#include "trajectory/split_cycle_profile.h"
+
+namespace tailsim {
+
+// Checks everything that can be checked before any simulation or rendering, in this order:
+// settings in range (even width/height for yuv420p, fps, slowmo, camera name), ffmpeg found
+// (settings.ffmpeg on PATH, or the path itself), out_dir exists (created if missing) and is
+// writable, an OSMesa context of the requested size can be made. Throws std::runtime_error
+// with a message saying what is wrong and how to fix it.
+void checkRenderPrerequisites(const RenderSettings& settings, const std::string& out_dir);
+
+struct RenderInputs {
+  const RobotParams* robot = nullptr;
+  const TailTrajectory* trajectory = nullptr;  // for the tail-phase text
+  const TimeSeries* mujoco = nullptr;          // poses the MuJoCo model (required)
+  const TimeSeries* analytic = nullptr;        // poses the translucent ghost (nullable)
+  std::string mjcf_xml;                        // the case's model (generateMjcf)
+  std::string title;                           // optional first overlay line (case name)
+};
+
+struct RenderStats {
+  long frames = 0;
+  double seconds = 0.0;      // wall time of the whole pipeline (setup excluded)
+  double fps = 0.0;          // frames / seconds
+  double sim_start_s = 0.0, sim_end_s = 0.0;  // simulated time shown
+  int width = 0, height = 0;
+  double poster_time_s = 0.0;  // simulated time of the poster frame
+};
+
+// Renders the case to `mp4_path` (H.264, yuv420p, settings.fps) and a PNG poster frame to
+// `png_path` ("" = none). Video frame k shows simulated time t_start + k / (fps * slowmo).
+// Both files appear whole under their final names or not at all (even on exceptions).
+RenderStats renderVideo(const RenderInputs& in, const RenderSettings& settings, const std::string& mp4_path,
+                        const std::string& png_path);
+
+// The bare render loop for comparison: same model, scene, camera and settings, the scene
+// posed once; each frame only mjr_render + mjr_readPixels. Returns frames per second.
+double benchBareRenderLoop(const RenderInputs& in, const RenderSettings& settings, int frames);
+
+}  // namespace tailsim

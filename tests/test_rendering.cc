@@ -1,0 +1,468 @@
+// Issue 5: headless video renders. Checks the replay kinematics against MuJoCo's own
+// kinematics, the encoded files against ffprobe, and the error paths (no file under the final
+// name on any failure).
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mujoco_model/mjcf_generator.h"
+#include "mujoco_model/mujoco_handles.h"
+#include "rendering/ffmpeg_writer.h"
+#include "rendering/replay.h"
+#include "rendering/video_renderer.h"
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = M_PI / 180.0;
+
+// A fresh, empty folder under the build tree's temp area, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::string tmpl = (fs::temp_directory_path() / "tailsim-render-test-XXXXXX").string();
+    std::vector<char> buf(tmpl.begin(), tmpl.end());
+    buf.push_back('\0');
+    if (!::mkdtemp(buf.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = buf.data();
+  }
+  ~TempDir() {
+    if (std::getenv("TAILSIM_KEEP_TEST_DIRS")) return;
+    std::error_code ec;
+    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(path_, ec);
+  }
+  std::string operator/(const std::string& name) const { return (fs::path(path_) / name).string(); }
+  const std::string& str() const { return path_; }
+  std::vector<std::string> files() const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(path_)) out.push_back(e.path().filename().string());
+    return out;
+  }
+
+ private:
+  std::string path_;
+};
+
+std::string run(const std::string& cmd) {
+  std::unique_ptr<FILE, int (*)(FILE*)> p(popen(cmd.c_str(), "r"), pclose);
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), p.get())) > 0) out.append(buf, n);
+  return out;
+}
+
+// A synthetic replay: the tail follows its trajectory exactly, the body yaws and drifts along
+// smooth curves. The renderer replays series and runs no physics, so any series will do.
+TimeSeries syntheticSeries(const TailTrajectory& traj, int n, double duration, double dt, double phi_scale_deg,
+                           double x_drift_m) {
+  TimeSeries ts;
+  ts.addColumn("t_s");
+  ts.addColumn("x_m");
+  ts.addColumn("y_m");
+  ts.addColumn("phi_deg");
+  for (int i = 1; i <= n; ++i) ts.addColumn("theta" + std::to_string(i) + "_deg");
+  std::vector<JointState> js;
+  for (int k = 0; k * dt <= duration + 1e-12; ++k) {
+    const double t = k * dt, u = t / duration;
+    traj.evaluate(t, js);
+    std::vector<double> row = {t, x_drift_m * u, 0.3 * x_drift_m * u * u, phi_scale_deg * (3 * u * u - 2 * u * u * u)};
+    for (const JointState& j : js) row.push_back(j.theta / kDeg);
+    ts.appendRow(row);
+  }
+  return ts;
+}
+
+struct Case {
+  RobotParams robot;
+  TailTrajectory traj;
+  TimeSeries mujoco, analytic;
+  std::string xml;
+};
+
+// Paper Fig. 7 trajectory (Sec. 4.3) on an n-link tail, split by Eq. 25 for n > 1.
+Case makeCase(int n, double duration = 0.4) {
+  Case c;
+  c.robot = paperRobot(n);
+  for (int i = 0; i < n; ++i) {
+    SplitCycleParams p;
+    p.theta0_rad = n == 1 ? 0.0 : 180.0 / (n + 1) * kDeg;
+    p.dtheta_rad = n == 1 ? -90 * kDeg : -360.0 / (n + 1) * kDeg;
+    p.dT_s = 0.25;
+    p.w_ss = 0.25;
+    c.traj.joints.emplace_back(p);
+  }
+  c.mujoco = syntheticSeries(c.traj, n, duration, 1e-3, 20.0, 0.05);
+  c.analytic = syntheticSeries(c.traj, n, duration, 1e-3, 60.0, -0.05);
+  c.xml = generateMjcf(c.robot, MujocoSettings{}, Effects{});
+  return c;
+}
+
+RenderSettings smallSettings() {
+  RenderSettings s;
+  s.enabled = true;
+  s.width = 320;
+  s.height = 240;
+  s.fps = 10;
+  s.slowmo = 1.0;
+  s.msaa = 0;
+  return s;
+}
+
+// Decodes an image or video frame to raw RGB with ffmpeg (independent of our encoder path).
+std::vector<uint8_t> decodeRgb(const std::string& path, int frame = 0) {
+  const std::string cmd = "ffmpeg -v error -i '" + path + "' -vf 'select=eq(n\\," + std::to_string(frame) +
+                          ")' -frames:v 1 -f rawvideo -pix_fmt rgb24 - 2>/dev/null";
+  const std::string s = run(cmd);
+  return std::vector<uint8_t>(s.begin(), s.end());
+}
+
+void expectNoMujocoWarnings(const mjData* d) {
+  for (int i = 0; i < mjNWARNING; ++i) EXPECT_EQ(d->warning[i].number, 0) << "MuJoCo warning " << i;
+}
+
+// ---------------------------------------------------------------- kinematics
+
+TEST(PlanarTailPose, OneLinkClosedForm) {
+  RobotParams r = paperRobot(1);
+  PlanarState s{0.3, -0.2, 40 * kDeg, {25 * kDeg}};
+  const PlanarTailPose p = planarTailPose(r, s);
+  ASSERT_EQ(p.joints.size(), 2u);
+  // Eq. (2) and Eq. (24)'s geometry: base behind the COM, link at phi + 180 deg + theta.
+  const double bx = 0.3 - 0.125 * std::cos(40 * kDeg), by = -0.2 - 0.125 * std::sin(40 * kDeg);
+  EXPECT_NEAR(p.joints[0][0], bx, 1e-12);
+  EXPECT_NEAR(p.joints[0][1], by, 1e-12);
+  EXPECT_NEAR(p.joints[1][0], bx + 0.3 * std::cos(245 * kDeg), 1e-12);
+  EXPECT_NEAR(p.joints[1][1], by + 0.3 * std::sin(245 * kDeg), 1e-12);
+}
+
+TEST(PlanarTailPose, StraightTailLiesBehindTheBody) {
+  RobotParams r = paperRobot(6);
+  PlanarState s{0, 0, 90 * kDeg, std::vector<double>(6, 0.0)};
+  const PlanarTailPose p = planarTailPose(r, s);
+  // Body x along world +y: the straight tail points to -y, tip at d_Q2B + 6 * 0.05 m.
+  EXPECT_NEAR(p.joints.back()[0], 0.0, 1e-12);
+  EXPECT_NEAR(p.joints.back()[1], -(0.125 + 0.3), 1e-12);
+}
+
+// The ghost's paper kinematics and the MuJoCo model posed by setReplayQpos must agree: MuJoCo's
+// own forward kinematics is the independent check of both the qpos mapping and Eqs. (1)-(3).
+void checkReplayMatchesMujoco(int n, bool translation) {
+  RobotParams robot = paperRobot(n);
+  Effects e;
+  e.translation = translation;
+  ModelPtr m = loadModelFromXml(generateMjcf(robot, MujocoSettings{}, e));
+  DataPtr d = makeData(m.get());
+  const MujocoReplayLayout L = findReplayLayout(m.get(), n);
+  EXPECT_EQ(L.free_root, translation);
+  PlanarState s{translation ? 0.42 : 0.0, translation ? -0.17 : 0.0, -130 * kDeg, {}};
+  for (int i = 0; i < n; ++i) s.theta.push_back((35.0 - 17.0 * i) * kDeg);
+  setReplayQpos(m.get(), L, s, d->qpos);
+  mj_kinematics(m.get(), d.get());
+  expectNoMujocoWarnings(d.get());
+  const int qb = bodyId(m.get(), mjcf::kQuadrupedBody);
+  EXPECT_NEAR(d->xipos[3 * qb], s.x, 1e-9);
+  EXPECT_NEAR(d->xipos[3 * qb + 1], s.y, 1e-9);
+  EXPECT_NEAR(std::atan2(d->xmat[9 * qb + 3], d->xmat[9 * qb]), s.phi, 1e-9);
+  const PlanarTailPose p = planarTailPose(robot, s);
+  for (int i = 1; i <= n; ++i) {
+    const int b = bodyId(m.get(), mjcf::tailBodyName(i));
+    EXPECT_NEAR(d->xpos[3 * b], p.joints[i - 1][0], 1e-9) << "joint " << i;
+    EXPECT_NEAR(d->xpos[3 * b + 1], p.joints[i - 1][1], 1e-9) << "joint " << i;
+    EXPECT_NEAR(std::atan2(d->xmat[9 * b + 3], d->xmat[9 * b]), std::remainder(p.link_yaw[i - 1], 2 * M_PI), 1e-9);
+  }
+}
+
+TEST(Replay, QposMatchesPaperKinematicsFreeRoot1Link) { checkReplayMatchesMujoco(1, true); }
+TEST(Replay, QposMatchesPaperKinematicsFreeRoot4Links) { checkReplayMatchesMujoco(4, true); }
+TEST(Replay, QposMatchesPaperKinematicsBallRoot3Links) { checkReplayMatchesMujoco(3, false); }
+
+TEST(Replay, SamplerInterpolatesLinearlyAndClamps) {
+  TimeSeries ts;
+  for (const char* c : {"t_s", "x_m", "y_m", "phi_deg", "theta1_deg"}) ts.addColumn(c);
+  ts.appendRow({0.0, 0.0, 1.0, 0.0, 10.0});
+  ts.appendRow({0.1, 1.0, 1.0, 90.0, 20.0});
+  ts.appendRow({0.3, 3.0, 0.0, 90.0, 20.0});
+  PlanarStateSampler s(ts, 1, "test");
+  PlanarState a = s.at(0.05);
+  EXPECT_NEAR(a.x, 0.5, 1e-12);
+  EXPECT_NEAR(a.phi, 45 * kDeg, 1e-12);
+  EXPECT_NEAR(a.theta[0], 15 * kDeg, 1e-12);
+  a = s.at(0.2);
+  EXPECT_NEAR(a.x, 2.0, 1e-12);
+  EXPECT_NEAR(a.y, 0.5, 1e-12);
+  EXPECT_NEAR(s.at(-1).x, 0.0, 0);
+  EXPECT_NEAR(s.at(9).x, 3.0, 0);
+  EXPECT_THROW(PlanarStateSampler(ts, 2, "test"), std::invalid_argument);  // no theta2_deg
+}
+
+TEST(Replay, TailPhaseFollowsSplitCycleBreakpoints) {
+  SplitCycleParams p;
+  p.t0_s = 0.1;
+  p.dT_s = 0.2;
+  p.w_ss = 0.25;  // t1 = 0.15, t2 = 0.3
+  TailTrajectory tr;
+  tr.joints.emplace_back(p);
+  EXPECT_EQ(tailPhase(tr, 0.05), TailPhase::kAtRest);
+  EXPECT_EQ(tailPhase(tr, 0.1), TailPhase::kAccelerating);
+  EXPECT_EQ(tailPhase(tr, 0.15), TailPhase::kAccelerating);
+  EXPECT_EQ(tailPhase(tr, 0.1501), TailPhase::kDecelerating);
+  EXPECT_EQ(tailPhase(tr, 0.3), TailPhase::kDecelerating);
+  EXPECT_EQ(tailPhase(tr, 0.3001), TailPhase::kAtRest);
+}
+
+// ---------------------------------------------------------------- videos
+
+struct Probe {
+  int frames = -1, width = -1, height = -1;
+  std::string codec, pix_fmt;
+};
+
+Probe ffprobe(const std::string& path) {
+  const std::string out = run("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                              "stream=codec_name,width,height,pix_fmt,nb_read_frames -of default=nw=1 '" +
+                              path + "'");
+  Probe p;
+  std::istringstream in(out);
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    const std::string k = line.substr(0, eq), v = line.substr(eq + 1);
+    if (k == "codec_name") p.codec = v;
+    if (k == "width") p.width = std::stoi(v);
+    if (k == "height") p.height = std::stoi(v);
+    if (k == "pix_fmt") p.pix_fmt = v;
+    if (k == "nb_read_frames") p.frames = std::stoi(v);
+  }
+  return p;
+}
+
+// Robot-coloured pixels: the generated floor is a blue checker (b - r ~ 0.2 of full scale, lit),
+// the robot grey (b - r = 0.05) and orange (r > b).
+bool robotColoured(const uint8_t* p) { return int(p[2]) - int(p[0]) < 30; }
+
+// Fraction of robot pixels in a box around the image centre (+-w/10, +-h/10): the tracking top
+// camera looks at the quadruped COM, so the torso fills it.
+double robotFractionInCentre(const std::vector<uint8_t>& rgb, int w, int h) {
+  int robot = 0, total = 0;
+  for (int y = h / 2 - h / 10; y < h / 2 + h / 10; ++y)
+    for (int x = w / 2 - w / 10; x < w / 2 + w / 10; ++x, ++total) robot += robotColoured(&rgb[3 * (y * w + x)]);
+  return double(robot) / total;
+}
+
+// Same in two strips the robot cannot reach and the text does not cover: the left eighth of the
+// lower half, the right eighth of the upper half (floor only).
+double robotFractionInBorder(const std::vector<uint8_t>& rgb, int w, int h) {
+  int robot = 0, total = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const bool strip = (y >= h / 2 && x < w / 8) || (y < h / 2 && x >= w - w / 8);
+      if (!strip) continue;
+      robot += robotColoured(&rgb[3 * (y * w + x)]);
+      ++total;
+    }
+  return double(robot) / total;
+}
+
+TEST(RenderVideo, Mp4AndPosterAreReadableAndShowTheRobot) {
+  TempDir dir;
+  Case c = makeCase(3, 0.4);
+  RenderSettings s = smallSettings();
+  ASSERT_NO_THROW(checkRenderPrerequisites(s, dir.str()));
+  RenderInputs in{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, "test case"};
+  const RenderStats st = renderVideo(in, s, dir / "case.mp4", dir / "case.png");
+  // 0.4 s at 10 fps, slowmo 1: frames at t = 0, 0.1, .., 0.4.
+  EXPECT_EQ(st.frames, 5);
+  EXPECT_NEAR(st.sim_end_s, 0.4, 1e-9);
+  const Probe p = ffprobe(dir / "case.mp4");
+  EXPECT_EQ(p.frames, 5);
+  EXPECT_EQ(p.width, 320);
+  EXPECT_EQ(p.height, 240);
+  EXPECT_EQ(p.codec, "h264");
+  EXPECT_EQ(p.pix_fmt, "yuv420p");
+  // Only the two final files: no temporaries or probes left behind.
+  std::vector<std::string> files = dir.files();
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(files, (std::vector<std::string>{"case.mp4", "case.png"}));
+
+  const std::vector<uint8_t> poster = decodeRgb(dir / "case.png");
+  ASSERT_EQ(poster.size(), 320u * 240u * 3u);
+  // The tracking top camera centres the robot: robot-coloured pixels dominate the centre and
+  // are rare at the border (floor).
+  EXPECT_GT(robotFractionInCentre(poster, 320, 240), 0.9);
+  EXPECT_LT(robotFractionInBorder(poster, 320, 240), 0.02);
+  // Not blank: the picture has contrast.
+  double mean = 0, var = 0;
+  for (uint8_t v : poster) mean += v;
+  mean /= poster.size();
+  for (uint8_t v : poster) var += (v - mean) * (v - mean);
+  EXPECT_GT(std::sqrt(var / poster.size()), 15.0);
+  // The video's frames are not blank either.
+  const std::vector<uint8_t> last = decodeRgb(dir / "case.mp4", 4);
+  ASSERT_EQ(last.size(), 320u * 240u * 3u);
+  EXPECT_GT(robotFractionInCentre(last, 320, 240), 0.9);
+  EXPECT_LT(robotFractionInBorder(last, 320, 240), 0.02);
+}
+
+TEST(RenderVideo, GhostAndCameraChangeThePicture) {
+  TempDir dir;
+  Case c = makeCase(1, 0.3);
+  RenderSettings s = smallSettings();
+  s.fps = 10;
+  RenderInputs with{&c.robot, &c.traj, &c.mujoco, &c.analytic, c.xml, ""};
+  RenderInputs without{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, ""};
+  renderVideo(with, s, dir / "a.mp4", dir / "a.png");
+  renderVideo(without, s, dir / "b.mp4", dir / "b.png");
+  s.camera = "perspective";
+  renderVideo(with, s, dir / "c.mp4", dir / "c.png");
+  const auto a = decodeRgb(dir / "a.png"), b = decodeRgb(dir / "b.png"), cp = decodeRgb(dir / "c.png");
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), cp.size());
+  auto differing = [](const std::vector<uint8_t>& x, const std::vector<uint8_t>& y) {
+    int n = 0;
+    for (size_t i = 0; i < x.size(); i += 3)
+      n += std::abs(x[i] - y[i]) + std::abs(x[i + 1] - y[i + 1]) + std::abs(x[i + 2] - y[i + 2]) > 30;
+    return n;
+  };
+  // The analytic ghost (phi 3x the MuJoCo one) sits elsewhere: a visible set of pixels changes.
+  EXPECT_GT(differing(a, b), 800);
+  EXPECT_GT(differing(a, cp), 8000);
+}
+
+// ---------------------------------------------------------------- errors
+
+TEST(RenderErrors, MissingFfmpegIsReportedBeforeWork) {
+  TempDir dir;
+  Case c = makeCase(1, 0.2);
+  RenderSettings s = smallSettings();
+  s.ffmpeg = "tailsim-no-such-ffmpeg";
+  try {
+    checkRenderPrerequisites(s, dir.str());
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not found on PATH"), std::string::npos) << e.what();
+  }
+  RenderInputs in{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, ""};
+  EXPECT_THROW(renderVideo(in, s, dir / "x.mp4", dir / "x.png"), std::runtime_error);
+  EXPECT_TRUE(dir.files().empty());
+
+  // The same through PATH: the default name "ffmpeg" on an empty PATH.
+  const std::string old_path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  ::setenv("PATH", dir.str().c_str(), 1);
+  RenderSettings d = smallSettings();
+  EXPECT_THROW(checkRenderPrerequisites(d, dir.str()), std::runtime_error);
+  ::setenv("PATH", old_path.c_str(), 1);
+  s.ffmpeg = dir / "missing/ffmpeg";
+  try {
+    checkRenderPrerequisites(s, dir.str());
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not found at"), std::string::npos) << e.what();
+  }
+}
+
+TEST(RenderErrors, UnwritableOutputFolderIsReported) {
+  TempDir dir;
+  {
+    std::ofstream f(dir / "plain_file");
+    f << "x";
+  }
+  // A folder below a regular file can never be created (even as root).
+  try {
+    checkRenderPrerequisites(smallSettings(), dir / "plain_file/videos");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("output folder"), std::string::npos) << e.what();
+  }
+  if (::geteuid() != 0) {  // permission bits do not stop root
+    fs::create_directory(dir / "ro");
+    fs::permissions(dir / "ro", fs::perms::owner_read | fs::perms::owner_exec);
+    EXPECT_THROW(checkRenderPrerequisites(smallSettings(), dir / "ro"), std::runtime_error);
+  }
+  Case c = makeCase(1, 0.2);
+  RenderInputs in{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, ""};
+  EXPECT_THROW(renderVideo(in, smallSettings(), dir / "plain_file/x.mp4", ""), std::runtime_error);
+  EXPECT_FALSE(fs::exists(dir / "plain_file/x.mp4"));
+}
+
+TEST(RenderErrors, BadSettingsAreReported) {
+  TempDir dir;
+  RenderSettings s = smallSettings();
+  s.width = 161;
+  EXPECT_THROW(checkRenderPrerequisites(s, dir.str()), std::runtime_error);
+  s = smallSettings();
+  s.camera = "side";
+  EXPECT_THROW(checkRenderPrerequisites(s, dir.str()), std::runtime_error);
+  s = smallSettings();
+  s.slowmo = 0;
+  EXPECT_THROW(checkRenderPrerequisites(s, dir.str()), std::runtime_error);
+}
+
+// An encoder that dies mid-video: the error carries its message and nothing appears under the
+// final names (the temporary file is removed too).
+TEST(RenderErrors, EncoderFailureLeavesNoFile) {
+  TempDir dir;
+  const std::string fake = dir / "fake-ffmpeg";
+  {
+    std::ofstream f(fake);
+    f << "#!/bin/sh\n"
+         "case \"$*\" in *testsrc*) exit 0;; esac\n"  // pass the prerequisite probe
+         "head -c 100000 >/dev/null\necho 'fake encoder gave up' >&2\nexit 3\n";
+  }
+  fs::permissions(fake, fs::perms::owner_all);
+  RenderSettings s = smallSettings();
+  s.ffmpeg = fake;
+  ASSERT_NO_THROW(checkRenderPrerequisites(s, dir.str()));
+  Case c = makeCase(1, 0.4);
+  RenderInputs in{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, ""};
+  fs::create_directory(dir / "out");
+  try {
+    renderVideo(in, s, dir / "out/v.mp4", dir / "out/v.png");
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("fake encoder gave up"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_empty(dir / "out"));
+}
+
+// RAII: a sink dropped without finish() (an exception between frames) kills ffmpeg and leaves
+// neither the final nor the temporary file.
+TEST(RenderErrors, AbandonedSinkRemovesItsTemporary) {
+  TempDir dir;
+  const std::string exe = findExecutable("ffmpeg");
+  ASSERT_FALSE(exe.empty());
+  std::vector<uint8_t> frame(64 * 48 * 3, 128);
+  std::string tmp;
+  {
+    FfmpegSink sink(exe, FfmpegSink::Kind::kMp4, 64, 48, 10, 23, "veryfast", dir / "v.mp4");
+    tmp = sink.tempPath();
+    for (int k = 0; k < 20; ++k) sink.writeFrame(frame.data());
+  }
+  EXPECT_FALSE(fs::exists(dir / "v.mp4"));
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_TRUE(dir.files().empty());
+  // finish() without commit() publishes nothing either.
+  {
+    FfmpegSink sink(exe, FfmpegSink::Kind::kMp4, 64, 48, 10, 23, "veryfast", dir / "w.mp4");
+    for (int k = 0; k < 3; ++k) sink.writeFrame(frame.data());
+    sink.finish();
+  }
+  EXPECT_TRUE(dir.files().empty());
+}
+
+}  // namespace
+}  // namespace tailsim
