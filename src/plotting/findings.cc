@@ -1,0 +1,563 @@
+#include "plotting/findings.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <sstream>
+
+namespace tailsim {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kPi = 3.14159265358979323846;
+const std::vector<std::string> kModels = {"analytic", "mujoco"};
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+std::string signedDeg(double v) { return fmt("%+.3f", v) + " deg"; }
+
+ModelVerdict na(const std::string& model, const std::string& why) { return {model, Verdict::kNotAvailable, why}; }
+
+// Models of a finding: analytic and mujoco always (n/a when not run), plus any others present.
+std::vector<std::string> modelsOf(const ExperimentResults* r) {
+  std::vector<std::string> m = kModels;
+  if (r)
+    for (const std::string& x : r->models)
+      if (std::find(m.begin(), m.end(), x) == m.end()) m.push_back(x);
+  return m;
+}
+
+std::string notRun(const ExperimentResults& r, const std::string& model) {
+  return "not run (" + r.name + " has no " + model + " runs)";
+}
+
+// phi_net along `axis` (in the given value order) with the other keys fixed.
+std::vector<double> phiAlong(const ExperimentResults& r, const SweepAxis& axis, const std::vector<size_t>& order,
+                             const std::string& model, std::map<std::string, std::string> fixed = {}) {
+  std::vector<double> y;
+  for (size_t i : order) {
+    fixed[axis.key] = axis.values[i];
+    const CaseRecord* c = r.find(fixed);
+    y.push_back(c ? r.phiNet(*c, model) : kNaN);
+  }
+  return y;
+}
+
+std::vector<size_t> ascending(const SweepAxis& a) {
+  std::vector<size_t> o(a.values.size());
+  std::iota(o.begin(), o.end(), 0);
+  return o;
+}
+
+std::vector<size_t> byMagnitude(const SweepAxis& a) {
+  std::vector<size_t> o = ascending(a);
+  std::stable_sort(o.begin(), o.end(), [&](size_t x, size_t y) { return std::fabs(a.number(x)) < std::fabs(a.number(y)); });
+  return o;
+}
+
+std::string listValues(const std::vector<double>& y, const char* f = "%.2f") {
+  std::string s;
+  for (size_t i = 0; i < y.size(); ++i) s += (i ? ", " : "") + (std::isfinite(y[i]) ? fmt(f, y[i]) : "NaN");
+  return s;
+}
+
+// A 1-D monotonicity finding over one axis of one experiment (Figs. 11, 13, 14).
+void oneAxisTrend(Finding& f, const ExperimentResults* r, const std::string& leaf, bool by_magnitude, int direction,
+                  const std::string& what) {
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "experiment not in the results")); continue; }
+    const SweepAxis* a = findAxis(*r, leaf);
+    if (!a) { f.verdicts.push_back(na(m, r->name + " has no sweep over " + leaf)); continue; }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    const std::vector<size_t> order = by_magnitude ? byMagnitude(*a) : ascending(*a);
+    const std::vector<double> y = phiAlong(*r, *a, order, m);
+    const Trend t = checkTrend(y, direction);
+    std::string xs;
+    for (size_t k = 0; k < order.size(); ++k) xs += (k ? ", " : "") + a->values[order[k]];
+    std::string d = "phi_net = [" + listValues(y) + "] deg at " + leaf + " = [" + xs + "]";
+    if (!t.complete) {
+      f.verdicts.push_back({m, Verdict::kNo, "incomplete (failed or missing runs): " + d});
+      continue;
+    }
+    if (t.holds)
+      d = "smallest step " + fmt("%.3f", t.min_step) + " deg (" + a->values[order[t.worst]] + " -> " +
+          a->values[order[t.worst + 1]] + "); " + d;
+    else
+      d = what + " fails between " + leaf + " = " + a->values[order[t.worst]] + " and " + a->values[order[t.worst + 1]] +
+          " (phi_net " + fmt("%.3f", y[t.worst]) + " -> " + fmt("%.3f", y[t.worst + 1]) + " deg); " + d;
+    f.verdicts.push_back({m, t.holds ? Verdict::kYes : Verdict::kNo, d});
+  }
+}
+
+// A 2-D finding: along axis `along` the trend must hold for every value of axis `across`.
+void twoAxisTrend(Finding& f, const ExperimentResults* r, const std::string& along_leaf, bool by_magnitude,
+                  int direction, const std::string& across_leaf) {
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "experiment not in the results")); continue; }
+    const SweepAxis* along = findAxis(*r, along_leaf);
+    const SweepAxis* across = findAxis(*r, across_leaf);
+    if (!along || !across) {
+      f.verdicts.push_back(na(m, r->name + " does not sweep both " + along_leaf + " and " + across_leaf));
+      continue;
+    }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    const std::vector<size_t> order = by_magnitude ? byMagnitude(*along) : ascending(*along);
+    int held = 0, incomplete = 0;
+    double min_step = std::numeric_limits<double>::infinity();
+    std::string where_min, failures;
+    for (size_t j = 0; j < across->values.size(); ++j) {
+      const std::vector<double> y = phiAlong(*r, *along, order, m, {{across->key, across->values[j]}});
+      const Trend t = checkTrend(y, direction);
+      if (!t.complete) { ++incomplete; continue; }
+      const std::string at = across_leaf + "=" + across->values[j] + ", " + along_leaf + " " +
+                             along->values[order[t.worst]] + " -> " + along->values[order[t.worst + 1]];
+      if (t.holds) ++held;
+      else failures += (failures.empty() ? "" : "; ") + at + " (" + fmt("%+.3f", y[t.worst + 1] - y[t.worst]) + " deg)";
+      if (t.min_step < min_step) min_step = t.min_step, where_min = at;
+    }
+    const int n = static_cast<int>(across->values.size());
+    std::string d = "holds at " + std::to_string(held) + " of " + std::to_string(n) + " values of " + across_leaf;
+    if (incomplete) d += " (" + std::to_string(incomplete) + " incomplete: failed or missing runs)";
+    if (std::isfinite(min_step)) d += "; smallest step in the claimed direction " + fmt("%.3f", min_step) + " deg at " + where_min;
+    if (!failures.empty()) d += "; fails at: " + failures;
+    f.verdicts.push_back({m, held == n ? Verdict::kYes : Verdict::kNo, d});
+  }
+}
+
+std::optional<double> yamlNumber(const ExperimentResults& r, const std::string& section, const std::string& key) {
+  try {
+    const YAML::Node n = YAML::LoadFile((fs::path(r.dir) / "experiment.yaml").string());
+    const YAML::Node s = section.empty() ? n[key] : n[section][key];
+    if (s && s.IsScalar()) return s.as<double>();
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+// Index of a column's max |value| and that value; -1 if absent.
+std::pair<long, double> peakAbs(const TimeSeries& s, const std::string& col) {
+  if (!s.has(col)) return {-1, kNaN};
+  const auto& v = s.values(col);
+  long best = -1;
+  double b = -1;
+  for (size_t i = 0; i < v.size(); ++i)
+    if (std::isfinite(v[i]) && std::fabs(v[i]) > b) b = std::fabs(v[i]), best = static_cast<long>(i);
+  return {best, b};
+}
+
+// ---- individual findings --------------------------------------------------------------------
+
+Finding splitCycle(const std::vector<ExperimentResults>& all) {
+  Finding f{"split_cycle_peak", "Sec. 3.3, Eqs. (20)-(23)",
+            "peak joint speed is 2|dtheta|/dT, reached at t = t0 + w_ss dT; theta goes from theta0 to theta0 + dtheta "
+            "(fig07 case, joint 1, measured from each model's joint angles)",
+            {}};
+  const ExperimentResults* r = findExperiment(all, "fig07");
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "fig07 not in the results")); continue; }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    const auto dT = yamlNumber(*r, "trajectory", "dT_s"), dth = yamlNumber(*r, "trajectory", "dtheta_deg"),
+               w = yamlNumber(*r, "trajectory", "w_ss"), th0 = yamlNumber(*r, "trajectory", "theta0_deg");
+    const double t0 = yamlNumber(*r, "trajectory", "t0_s").value_or(0.0);
+    if (!dT || !dth || !w || !th0) {
+      f.verdicts.push_back(na(m, "experiment.yaml lacks scalar trajectory dT_s, dtheta_deg, w_ss, theta0_deg"));
+      continue;
+    }
+    TimeSeries s;
+    try {
+      s = r->series(r->cases.front(), m);
+    } catch (const std::exception& e) {
+      f.verdicts.push_back(na(m, e.what()));
+      continue;
+    }
+    if (!s.has("t_s") || !s.has("thetadot1_dps") || !s.has("theta1_deg") || s.numRows() < 3) {
+      f.verdicts.push_back(na(m, "CSV lacks t_s, theta1_deg, thetadot1_dps"));
+      continue;
+    }
+    const auto& t = s.values("t_s");
+    const double dt = t[1] - t[0];
+    const auto [ip, peak] = peakAbs(s, "thetadot1_dps");
+    const double want_peak = 2.0 * std::fabs(*dth) / *dT, want_t = t0 + *w * *dT;
+    const double th_start = s.values("theta1_deg").front(), th_end = s.values("theta1_deg").back();
+    const double peak_err = std::fabs(peak - want_peak) / want_peak, t_err = std::fabs(t[ip] - want_t);
+    const double th_err = std::max(std::fabs(th_start - *th0), std::fabs(th_end - (*th0 + *dth)));
+    const bool ok = peak_err <= 0.01 && t_err <= std::max(2.0 * dt, 0.02 * *dT) && th_err <= 0.5;
+    f.verdicts.push_back({m, ok ? Verdict::kYes : Verdict::kNo,
+                          "peak " + fmt("%.1f", peak) + " deg/s at t = " + fmt("%.4f", t[ip]) + " s (expected " +
+                              fmt("%.1f", want_peak) + " deg/s at " + fmt("%.4f", want_t) + " s; tolerance 1 %, " +
+                              fmt("%.4f", std::max(2.0 * dt, 0.02 * *dT)) + " s); theta " + fmt("%.2f", th_start) +
+                              " -> " + fmt("%.2f", th_end) + " deg (expected " + fmt("%.2f", *th0) + " -> " +
+                              fmt("%.2f", *th0 + *dth) + ", tolerance 0.5 deg)"});
+  }
+  return f;
+}
+
+Finding eq25(const std::vector<ExperimentResults>& all) {
+  Finding f{"eq25_table", "Sec. 4.7, Eq. (25)",
+            "with thetadot_max = 600 deg/s, n = 1..6 gives dtheta = -180, -120, -90, -72, -60, -51.43 deg and "
+            "dT = 0.600, 0.400, 0.300, 0.240, 0.200, 0.171 s (measured on every joint: start/end angle and peak "
+            "speed; dT implied = 2|dtheta|/peak)",
+            {}};
+  const ExperimentResults* r = findExperiment(all, "fig14");
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "fig14 not in the results")); continue; }
+    const SweepAxis* a = findAxis(*r, "links");
+    if (!a) { f.verdicts.push_back(na(m, "fig14 has no sweep over links")); continue; }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    const double vmax = yamlNumber(*r, "trajectory", "thetadot_max_dps").value_or(600.0);
+    bool ok = true;
+    double worst_angle = 0, worst_speed = 0;
+    std::string d;
+    for (size_t i = 0; i < a->values.size(); ++i) {
+      const int n = static_cast<int>(std::lround(a->number(i)));
+      const CaseRecord* c = r->find({{a->key, a->values[i]}});
+      TimeSeries s;
+      try {
+        if (!c) throw std::runtime_error("missing case");
+        s = r->series(*c, m);
+      } catch (const std::exception&) {
+        ok = false;
+        d += (d.empty() ? "" : "; ") + ("n=" + a->values[i] + ": no data");
+        continue;
+      }
+      const double want = 360.0 / (n + 1);  // |dtheta|; theta goes +want/2 -> -want/2
+      double dth1 = kNaN, peak1 = kNaN;
+      for (int j = 1; j <= n; ++j) {
+        const std::string th = "theta" + std::to_string(j) + "_deg", thd = "thetadot" + std::to_string(j) + "_dps";
+        if (!s.has(th) || !s.has(thd) || s.numRows() == 0) { ok = false; continue; }
+        const double a0 = s.values(th).front(), a1 = s.values(th).back();
+        const double pk = peakAbs(s, thd).second;
+        worst_angle = std::max({worst_angle, std::fabs(a0 - want / 2), std::fabs(a1 + want / 2)});
+        worst_speed = std::max(worst_speed, std::fabs(pk - vmax) / vmax);
+        if (j == 1) dth1 = a1 - a0, peak1 = pk;
+      }
+      d += (d.empty() ? "" : "; ") + ("n=" + std::to_string(n) + ": dtheta " + fmt("%.2f", dth1) + " deg, dT " +
+                                      fmt("%.3f", 2.0 * std::fabs(dth1) / peak1) + " s");
+    }
+    ok = ok && worst_angle <= 0.5 && worst_speed <= 0.01;
+    f.verdicts.push_back({m, ok ? Verdict::kYes : Verdict::kNo,
+                          d + " (worst joint angle error " + fmt("%.3f", worst_angle) + " deg, worst peak-speed error " +
+                              fmt("%.2f", 100 * worst_speed) + " %; tolerance 0.5 deg, 1 %)"});
+  }
+  return f;
+}
+
+// Robot numbers for Eq. (24): m_Q, one-link tail m_L, L_L, I_zz,L from the robot file named by
+// the experiment, d_Q2B from the experiment (or the robot file).
+struct OneLinkParams {
+  double mQ, mL, L, IzzL, d;
+};
+std::optional<OneLinkParams> oneLinkParams(const ExperimentResults& r) {
+  try {
+    const YAML::Node e = YAML::LoadFile((fs::path(r.dir) / "experiment.yaml").string());
+    fs::path robot = e["robot"].as<std::string>();
+    if (robot.is_relative()) {
+      if (r.source.empty()) return std::nullopt;
+      robot = fs::path(r.source).parent_path() / robot;
+    }
+    const YAML::Node rb = YAML::LoadFile(robot.string());
+    OneLinkParams p;
+    p.mQ = rb["quadruped"]["mass_kg"].as<double>();
+    p.mL = rb["tails"][1]["mass_kg"].as<double>();
+    p.L = rb["tails"][1]["length_m"].as<double>();
+    p.IzzL = rb["tails"][1]["izz_kgm2"].as<double>();
+    p.d = rb["quadruped"]["d_Q2B_m"].as<double>();
+    if (e["quadruped"] && e["quadruped"]["d_Q2B_m"] && e["quadruped"]["d_Q2B_m"].IsScalar())
+      p.d = e["quadruped"]["d_Q2B_m"].as<double>();
+    return p;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
+  Finding eq{"eq24_closed_form", "Sec. 4.4, Eq. (24)",
+             "for the 1-link tail the general recursion reduces to M_zT = -(I_zz,L + 0.25 m_L L_L^2 m_Q/m) thetaddot "
+             "- I_eff thetaddot cos(theta) + I_eff thetadot^2 sin(theta), I_eff = m_Q m_L L_L d_Q2B / (2 m) "
+             "(fig08 poses)",
+             {}};
+  Finding peaks{"fig08_peaks", "Sec. 4.4, Fig. 8",
+                "|M_zT,tan| is largest at theta = 0 and |M_zT,cen| at theta = +-90 deg", {}};
+  const ExperimentResults* r = findExperiment(all, "fig08");
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) {
+      eq.verdicts.push_back(na(m, "fig08 not in the results"));
+      peaks.verdicts.push_back(na(m, "fig08 not in the results"));
+      continue;
+    }
+    const SweepAxis* a = findAxis(*r, "theta_deg");
+    if (!a) a = findAxis(*r, "theta_deg[1]");
+    if (!a || !r->hasModel(m)) {
+      const std::string why = !a ? "fig08 has no sweep over theta_deg" : notRun(*r, m);
+      eq.verdicts.push_back(na(m, why));
+      peaks.verdicts.push_back(na(m, why));
+      continue;
+    }
+    const double thd = yamlNumber(*r, "pose", "thetadot_radps").value_or(kNaN);
+    const double thdd = yamlNumber(*r, "pose", "thetaddot_radps2").value_or(kNaN);
+    const auto p = oneLinkParams(*r);
+    std::vector<double> th, tan, cen, tot;
+    bool cols = true;
+    for (size_t i = 0; i < a->values.size(); ++i) {
+      const CaseRecord* c = r->find({{a->key, a->values[i]}});
+      try {
+        if (!c) throw std::runtime_error("missing");
+        const TimeSeries s = r->series(*c, m);
+        if (!s.has("MzT_tan_Nm") || !s.has("MzT_cen_Nm") || s.numRows() == 0) { cols = false; break; }
+        th.push_back(a->number(i) * kPi / 180);
+        tan.push_back(s.values("MzT_tan_Nm")[0]);
+        cen.push_back(s.values("MzT_cen_Nm")[0]);
+        tot.push_back(s.has("MzT_Nm") ? s.values("MzT_Nm")[0] : kNaN);
+      } catch (const std::exception&) {
+        cols = false;
+        break;
+      }
+    }
+    if (!cols || th.empty()) {
+      eq.verdicts.push_back(na(m, "pose CSVs missing or without MzT_tan_Nm / MzT_cen_Nm"));
+      peaks.verdicts.push_back(na(m, "pose CSVs missing or without MzT_tan_Nm / MzT_cen_Nm"));
+      continue;
+    }
+    // Peaks of |tan| and |cen| over theta.
+    auto argmaxAbs = [](const std::vector<double>& v) {
+      size_t b = 0;
+      for (size_t i = 1; i < v.size(); ++i)
+        if (std::fabs(v[i]) > std::fabs(v[b])) b = i;
+      return b;
+    };
+    const size_t it = argmaxAbs(tan), ic = argmaxAbs(cen);
+    const double th_t = th[it] * 180 / kPi, th_c = th[ic] * 180 / kPi;
+    // |cen| is symmetric: both ends count; tolerate ties within 1e-9 relative.
+    const bool cen_ok = std::fabs(std::fabs(th_c) - 90) < 1e-6 ||
+                        std::fabs(std::fabs(cen[ic]) - std::max(std::fabs(cen.front()), std::fabs(cen.back()))) <=
+                            1e-9 * std::fabs(cen[ic]);
+    const bool tan_ok = std::fabs(th_t) < 1e-6;
+    peaks.verdicts.push_back({m, tan_ok && cen_ok ? Verdict::kYes : Verdict::kNo,
+                              "max |M_zT,tan| = " + fmt("%.4g", std::fabs(tan[it])) + " N m at theta = " +
+                                  fmt("%.1f", th_t) + " deg; max |M_zT,cen| = " + fmt("%.4g", std::fabs(cen[ic])) +
+                                  " N m at theta = " + fmt("%.1f", th_c) + " deg (grid " + a->values.front() + " .. " +
+                                  a->values.back() + " deg)"});
+    if (!p || !std::isfinite(thd) || !std::isfinite(thdd)) {
+      eq.verdicts.push_back(na(m, "robot parameters or pose rates not readable from experiment.yaml / robot file"));
+      continue;
+    }
+    const double mtot = p->mQ + p->mL;
+    const double Ieff = p->mQ * p->mL / (2 * mtot) * p->L * p->d;
+    const double rot = -(p->IzzL + 0.25 * p->mL * p->L * p->L * p->mQ / mtot) * thdd;
+    double err = 0, scale = 1e-12;
+    bool have_total = true;
+    for (size_t i = 0; i < th.size(); ++i) {
+      const double wt = -Ieff * thdd * std::cos(th[i]), wc = Ieff * thd * thd * std::sin(th[i]);
+      err = std::max({err, std::fabs(tan[i] - wt), std::fabs(cen[i] - wc)});
+      scale = std::max({scale, std::fabs(wt), std::fabs(wc), std::fabs(rot)});
+      if (std::isfinite(tot[i])) err = std::max(err, std::fabs(tot[i] - (rot + wt + wc)));
+      else have_total = false;
+    }
+    const double rel = err / scale;
+    eq.verdicts.push_back({m, rel <= 1e-6 ? Verdict::kYes : Verdict::kNo,
+                           "max deviation from Eq. (24) " + fmt("%.3g", err) + " N m = " + fmt("%.2g", rel) +
+                               " of the largest term (I_eff = " + fmt("%.5g", Ieff) + " kg m^2, d_Q2B = " +
+                               fmt("%.4g", p->d) + " m; " + std::to_string(th.size()) + " poses" +
+                               (have_total ? ", tangential, centripetal and total" : ", tangential and centripetal") +
+                               "; tolerance 1e-6)"});
+  }
+  return {eq, peaks};
+}
+
+Finding modelComparison(const std::vector<ExperimentResults>& all) {
+  Finding f{"fig06_contact_rotates_more", "Sec. 4.2, Fig. 6",
+            "the contact model (ADAMS there, MuJoCo here) rotates more than the stiction model, for the 1- and the "
+            "6-link tail",
+            {}};
+  std::string d;
+  int yes = 0, have = 0, panels = 0;
+  for (const char* prefix : {"fig06a", "fig06b"}) {
+    const ExperimentResults* r = findExperiment(all, prefix);
+    if (!r) continue;
+    ++panels;
+    const double a = r->cases.empty() ? kNaN : r->phiNet(r->cases.front(), "analytic");
+    const double mj = r->cases.empty() ? kNaN : r->phiNet(r->cases.front(), "mujoco");
+    d += (d.empty() ? "" : "; ") + r->name + ": analytic " +
+         (std::isfinite(a) ? signedDeg(a) : std::string("n/a")) + ", MuJoCo " +
+         (std::isfinite(mj) ? signedDeg(mj) : std::string("n/a"));
+    if (std::isfinite(a) && std::isfinite(mj)) {
+      ++have;
+      if (std::fabs(mj) > std::fabs(a)) ++yes;
+    }
+  }
+  if (!panels) f.verdicts.push_back(na("mujoco vs analytic", "fig06a/fig06b not in the results"));
+  else if (!have) f.verdicts.push_back(na("mujoco vs analytic", "no panel has both models: " + d));
+  else
+    f.verdicts.push_back({"mujoco vs analytic", yes == have ? Verdict::kYes : Verdict::kNo,
+                          "|phi_net| larger for MuJoCo in " + std::to_string(yes) + " of " + std::to_string(have) +
+                              " panels (" + d + ")"});
+  return f;
+}
+
+Finding argmax60(const std::vector<ExperimentResults>& all) {
+  Finding f{"fig09_max_at_60", "Sec. 4.4, Fig. 9",
+            "over theta0 in [0, 90] deg the maximum phi_net sits mostly at theta0 = 60 deg (counted over d_Q2B > 0)",
+            {}};
+  const ExperimentResults* r = findExperiment(all, "fig09");
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "fig09 not in the results")); continue; }
+    const SweepAxis* th = findAxis(*r, "theta0_deg");
+    const SweepAxis* d = findAxis(*r, "d_Q2B_m");
+    if (!th || !d) { f.verdicts.push_back(na(m, "fig09 does not sweep theta0_deg and d_Q2B_m")); continue; }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    int at60 = 0, counted = 0;
+    std::string list;
+    for (size_t j = 0; j < d->values.size(); ++j) {
+      if (d->number(j) <= 0) continue;
+      const std::vector<double> y = phiAlong(*r, *th, ascending(*th), m, {{d->key, d->values[j]}});
+      size_t b = 0;
+      bool finite = std::isfinite(y[0]);
+      for (size_t i = 1; i < y.size(); ++i) {
+        finite = finite && std::isfinite(y[i]);
+        if (y[i] > y[b]) b = i;
+      }
+      if (!finite) continue;
+      ++counted;
+      if (std::fabs(th->number(b) - 60) < 1e-9) ++at60;
+      list += (list.empty() ? "" : ", ") + ("d_Q2B " + d->values[j] + ": " + th->values[b] + " deg (" +
+                                            fmt("%.2f", y[b]) + ")");
+    }
+    if (!counted) { f.verdicts.push_back({m, Verdict::kNo, "no complete theta0 row"}); continue; }
+    f.verdicts.push_back({m, 2 * at60 > counted ? Verdict::kYes : Verdict::kNo,
+                          "argmax at 60 deg for " + std::to_string(at60) + " of " + std::to_string(counted) +
+                              " d_Q2B values; argmax theta0 (phi_net deg): " + list});
+  }
+  return f;
+}
+
+Finding lfVariation(const std::vector<ExperimentResults>& all) {
+  Finding f{"fig10_LF_variation", "Sec. 4.4, Fig. 10",
+            "L_F varies less than 3 % from its median over theta and d_Q2B (max |L_F - median| / median)", {}};
+  const ExperimentResults* r = findExperiment(all, "fig10");
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "fig10 not in the results")); continue; }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    std::vector<std::pair<double, const CaseRecord*>> lf;
+    for (const CaseRecord& c : r->cases) {
+      try {
+        const TimeSeries s = r->series(c, m);
+        if (s.has("LF_m") && s.numRows() > 0 && std::isfinite(s.values("LF_m")[0]))
+          lf.emplace_back(s.values("LF_m")[0], &c);
+      } catch (const std::exception&) {
+      }
+    }
+    if (lf.empty()) { f.verdicts.push_back(na(m, "no L_F values (LF_m column) in the pose CSVs")); continue; }
+    std::vector<double> v;
+    for (const auto& x : lf) v.push_back(x.first);
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    double worst = 0;
+    const CaseRecord* wc = nullptr;
+    for (const auto& [x, c] : lf)
+      if (std::fabs(x - median) / median >= worst) worst = std::fabs(x - median) / median, wc = c;
+    f.verdicts.push_back({m, worst < 0.03 ? Verdict::kYes : Verdict::kNo,
+                          "max variation " + fmt("%.2f", 100 * worst) + " % (at " + (wc ? wc->name : "?") +
+                              "); median L_F " + fmt("%.2f", 1e3 * median) + " mm, range " + fmt("%.2f", 1e3 * v.front()) +
+                              " .. " + fmt("%.2f", 1e3 * v.back()) + " mm over " + std::to_string(n) + " poses" +
+                              (n < r->cases.size() ? " (" + std::to_string(r->cases.size() - n) + " missing)" : "")});
+  }
+  return f;
+}
+
+}  // namespace
+
+const char* verdictText(Verdict v) {
+  switch (v) {
+    case Verdict::kYes: return "YES";
+    case Verdict::kNo: return "NO";
+    default: return "n/a";
+  }
+}
+
+const ModelVerdict* Finding::verdictFor(const std::string& model) const {
+  for (const ModelVerdict& v : verdicts)
+    if (v.model == model) return &v;
+  return nullptr;
+}
+
+Trend checkTrend(const std::vector<double>& y, int direction, double tol) {
+  Trend t;
+  t.complete = !y.empty() && std::all_of(y.begin(), y.end(), [](double v) { return std::isfinite(v); });
+  if (!t.complete || y.size() < 2) {
+    t.holds = false;
+    return t;
+  }
+  t.min_step = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i + 1 < y.size(); ++i) {
+    const double step = direction * (y[i + 1] - y[i]);
+    if (step < t.min_step) t.min_step = step, t.worst = i;
+  }
+  t.holds = t.min_step > tol;
+  return t;
+}
+
+const ExperimentResults* findExperiment(const std::vector<ExperimentResults>& results, const std::string& prefix) {
+  for (const ExperimentResults& r : results)
+    if (r.name.compare(0, prefix.size(), prefix) == 0) return &r;
+  return nullptr;
+}
+
+const SweepAxis* findAxis(const ExperimentResults& r, const std::string& leaf) {
+  for (const SweepAxis& a : r.axes)
+    if (leafKey(a.key) == leaf) return &a;
+  return nullptr;
+}
+
+std::vector<Finding> computeFindings(const std::vector<ExperimentResults>& all) {
+  std::vector<Finding> out;
+  out.push_back(splitCycle(all));
+  out.push_back(eq25(all));
+  for (Finding& f : fig08Findings(all)) out.push_back(std::move(f));
+  out.push_back(modelComparison(all));
+
+  Finding rises{"fig09_dQ2B_rises", "Sec. 4.4, Fig. 9", "phi_net rises with d_Q2B at every theta0", {}};
+  twoAxisTrend(rises, findExperiment(all, "fig09"), "d_Q2B_m", false, +1, "theta0_deg");
+  out.push_back(rises);
+  out.push_back(argmax60(all));
+  out.push_back(lfVariation(all));
+
+  Finding wss{"fig11_wss_falls", "Sec. 4.5, Fig. 11", "phi_net falls as w_ss rises from 0.1 to 0.9", {}};
+  oneAxisTrend(wss, findExperiment(all, "fig11"), "w_ss", false, -1, "falling");
+  out.push_back(wss);
+
+  Finding dth{"fig12_dtheta_rises", "Sec. 4.6, Fig. 12", "phi_net rises with |dtheta| (at every dT)", {}};
+  twoAxisTrend(dth, findExperiment(all, "fig12"), "dtheta_deg", true, +1, "dT_s");
+  out.push_back(dth);
+  Finding dT{"fig12_dT_falls", "Sec. 4.6, Fig. 12", "phi_net rises with 1/dT, i.e. falls as dT grows (at every dtheta)",
+             {}};
+  twoAxisTrend(dT, findExperiment(all, "fig12"), "dT_s", false, -1, "dtheta_deg");
+  out.push_back(dT);
+
+  Finding f13{"fig13_larger_dtheta_wins", "Sec. 4.6, Fig. 13",
+              "at a fixed peak joint speed of 600 deg/s the larger |dtheta| (with the longer dT) gives the larger "
+              "phi_net",
+              {}};
+  oneAxisTrend(f13, findExperiment(all, "fig13"), "dtheta_deg", true, +1, "rising");
+  out.push_back(f13);
+
+  Finding f14{"fig14_links_rises", "Sec. 4.7, Fig. 14", "phi_net rises with the number of tail links n", {}};
+  oneAxisTrend(f14, findExperiment(all, "fig14"), "links", false, +1, "rising");
+  out.push_back(f14);
+  return out;
+}
+
+}  // namespace tailsim

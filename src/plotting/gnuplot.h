@@ -1,0 +1,29 @@
+// Running gnuplot on a generated script: every figure is written as PNG (pngcairo) and SVG from
+// the same plot commands, with its script and data files kept beside it (DIR/plots/).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace tailsim {
+
+struct GnuplotFigure {
+  std::string stem;        // file name without extension: <experiment>_<what>
+  std::string body;        // plot commands (no terminal/output); starts from a `reset` state
+  int width_px = 1000;     // PNG size; the SVG gets the same size in points
+  int height_px = 700;
+};
+
+// Writes <plots_dir>/<stem>.gp, runs gnuplot in plots_dir, checks <stem>.png and .svg exist and
+// are not empty. Throws std::runtime_error with gnuplot's stderr on failure.
+// Returns the PNG path.
+std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig);
+
+// A whitespace-separated data file for gnuplot (NaN for missing values), written atomically.
+void writeDataFile(const std::string& path, const std::vector<std::string>& header,
+                   const std::vector<std::vector<double>>& rows);
+
+// Quotes a string for a gnuplot single-quoted literal.
+std::string gpQuote(const std::string& s);
+
+}  // namespace tailsim

@@ -1,0 +1,38 @@
+// gnuplot figures of a result folder (`tailsim plot DIR`). Which figures are drawn follows the
+// data's structure, not the experiment's name:
+//   simulate, no sweep      -> phi(t) of every model overlaid; M_zT, M_zF, I_zz phi_ddot over time
+//                              (one panel per model)                                  (Figs. 6, 7)
+//   simulate, 1 swept key   -> phi_net over the key, one curve per model (bars side by side when
+//                              the key is the number of tail links); phi(t) of every case when
+//                              there are at most 12                              (Figs. 11, 13, 14)
+//   simulate, 2 swept keys  -> heat map of phi_net with the values in the cells, one per model
+//                              side by side; phi_net over the faster key, one curve per value of
+//                              the slower one                                        (Figs. 9, 12)
+//   simulate, 3+ swept keys -> phi_net over the case index
+//   pose, 1 swept key       -> M_zT,tan/I_zz and M_zT,cen/I_zz (else the acceleration-/speed-driven
+//                              parts) over the key; L_F over the key                      (Fig. 8)
+//   pose, 2 swept keys      -> heat map of L_F                                           (Fig. 10)
+// Every figure is DIR/plots/<experiment>_<what>.png and .svg, with its .gp script and .dat files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "plotting/result_folder.h"
+
+namespace tailsim {
+
+struct PlotFile {
+  std::string png;      // absolute or DIR-relative path as built from the result folder; .svg beside it
+  std::string caption;  // one line saying what the figure shows
+};
+
+// Draws the figures of one experiment into r.dir/plots/. Throws std::runtime_error if gnuplot
+// fails; a model whose CSV is missing is left out of the figures that need it.
+std::vector<PlotFile> plotExperiment(const ExperimentResults& r);
+
+// DIR is one result folder or a suite folder (one result folder per experiment under it).
+// Returns every figure written.
+std::vector<PlotFile> plotResults(const std::string& dir);
+
+}  // namespace tailsim

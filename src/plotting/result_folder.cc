@@ -1,0 +1,240 @@
+#include "plotting/result_folder.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "results/atomic_file.h"
+
+namespace tailsim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::optional<double> parseNumber(const std::string& s) {
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str()) return std::nullopt;
+  while (*end == ' ') ++end;
+  if (*end != '\0') return std::nullopt;
+  return v;
+}
+
+double SweepAxis::number(size_t i) const {
+  if (!numeric) return static_cast<double>(i);
+  return *parseNumber(values.at(i));
+}
+
+int SweepAxis::indexOf(const std::string& value) const {
+  for (size_t i = 0; i < values.size(); ++i)
+    if (values[i] == value) return static_cast<int>(i);
+  return -1;
+}
+
+std::string leafKey(const std::string& key) {
+  const size_t dot = key.rfind('.');
+  return dot == std::string::npos ? key : key.substr(dot + 1);
+}
+
+std::string axisLabel(const std::string& key) {
+  std::string leaf = leafKey(key);
+  std::string index;
+  if (const size_t b = leaf.find('['); b != std::string::npos) {
+    index = " (joint " + leaf.substr(b + 1, leaf.size() - b - 2) + ")";
+    leaf = leaf.substr(0, b);
+  }
+  static const std::map<std::string, std::string> known = {
+      {"theta0_deg", "θ0 [deg]"},       {"dtheta_deg", "Δθ [deg]"},
+      {"dT_s", "ΔT [s]"},               {"w_ss", "w_ss"},
+      {"d_Q2B_m", "d_Q2B [m]"},         {"links", "tail links n"},
+      {"theta_deg", "θ [deg]"},         {"peak_speed_dps", "peak joint speed [deg/s]"},
+      {"thetadot_max_dps", "θ̇_max [deg/s]"}, {"mu_s", "μ_s"},
+      {"mu_d", "μ_d"},                  {"t0_s", "t0 [s]"}};
+  if (auto it = known.find(leaf); it != known.end()) return it->second + index;
+  static const std::vector<std::pair<std::string, std::string>> units = {
+      {"_dps2", "deg/s²"}, {"_dps", "deg/s"}, {"_deg", "deg"}, {"_radps2", "rad/s²"},
+      {"_radps", "rad/s"}, {"_rad", "rad"},   {"_kgm2", "kg m²"}, {"_kg", "kg"},
+      {"_Nm", "N m"},      {"_N", "N"},       {"_mps", "m/s"},  {"_m", "m"}, {"_s", "s"}};
+  for (const auto& [suffix, unit] : units)
+    if (leaf.size() > suffix.size() && leaf.compare(leaf.size() - suffix.size(), suffix.size(), suffix) == 0)
+      return leaf.substr(0, leaf.size() - suffix.size()) + " [" + unit + "]" + index;
+  return leaf + index;
+}
+
+namespace {
+
+std::string valueText(const json& v) {
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_number()) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.12g", v.get<double>());
+    return buf;
+  }
+  return v.dump();
+}
+
+double numberOr(const json& j, const char* key, double fallback) {
+  auto it = j.find(key);
+  return (it != j.end() && it->is_number()) ? it->get<double>() : fallback;
+}
+
+CaseRecord parseCase(const json& c) {
+  CaseRecord r;
+  r.name = c.value("name", std::string("base"));
+  r.dir = c.value("dir", r.name);
+  if (auto s = c.find("sweep"); s != c.end() && s->is_object())
+    for (auto it = s->begin(); it != s->end(); ++it) r.sweep[it.key()] = valueText(it.value());
+  if (auto runs = c.find("runs"); runs != c.end() && runs->is_object()) {
+    for (auto it = runs->begin(); it != runs->end(); ++it) {
+      const json& j = it.value();
+      RunRecord run;
+      run.ok = j.value("ok", true);
+      run.phi_net_deg = numberOr(j, "phi_net_deg", NAN);
+      run.t_stop_s = numberOr(j, "t_stop_s", NAN);
+      run.wall_time_s = numberOr(j, "wall_time_s", NAN);
+      run.stick_slip_events = static_cast<int>(numberOr(j, "stick_slip_events", 0));
+      if (j.contains("error") && j["error"].is_string()) run.error = j["error"].get<std::string>();
+      r.runs[it.key()] = run;
+    }
+  }
+  return r;
+}
+
+json readJson(const fs::path& p) {
+  std::ifstream in(p);
+  if (!in) throw std::runtime_error("cannot read " + p.string());
+  try {
+    return json::parse(in);
+  } catch (const json::exception& e) {
+    throw std::runtime_error(p.string() + ": " + e.what());
+  }
+}
+
+// Top-level `kind:` (and `description:` / `name:`) of the copied experiment file, if readable.
+void readExperimentYaml(const fs::path& p, ExperimentResults& r) {
+  if (!fs::exists(p)) return;
+  try {
+    const YAML::Node n = YAML::LoadFile(p.string());
+    if (n["kind"]) r.kind = n["kind"].as<std::string>();
+    if (r.description.empty() && n["description"]) r.description = n["description"].as<std::string>();
+    if (r.name.empty() && n["name"]) r.name = n["name"].as<std::string>();
+  } catch (const YAML::Exception&) {
+    // a copy we cannot parse only costs the defaults
+  }
+}
+
+}  // namespace
+
+std::string ExperimentResults::csvPath(const CaseRecord& c, const std::string& model) const {
+  return (fs::path(dir) / "cases" / c.dir / (model + ".csv")).string();
+}
+
+TimeSeries ExperimentResults::series(const CaseRecord& c, const std::string& model) const {
+  return readCsv(csvPath(c, model));
+}
+
+double ExperimentResults::phiNet(const CaseRecord& c, const std::string& model) const {
+  auto it = c.runs.find(model);
+  if (it == c.runs.end() || !it->second.ok) return NAN;
+  return it->second.phi_net_deg;
+}
+
+bool ExperimentResults::hasModel(const std::string& model) const {
+  return std::find(models.begin(), models.end(), model) != models.end();
+}
+
+const CaseRecord* ExperimentResults::find(const std::map<std::string, std::string>& sweep) const {
+  for (const CaseRecord& c : cases) {
+    bool all = true;
+    for (const auto& [k, v] : sweep) {
+      auto it = c.sweep.find(k);
+      if (it == c.sweep.end() || it->second != v) { all = false; break; }
+    }
+    if (all) return &c;
+  }
+  return nullptr;
+}
+
+ExperimentResults loadResults(const std::string& dir) {
+  ExperimentResults r;
+  r.dir = dir;
+  const fs::path root(dir);
+  std::vector<std::string> keys;
+  if (fs::exists(root / "summary.json")) {
+    const json s = readJson(root / "summary.json");
+    r.name = s.value("experiment", std::string());
+    r.source = s.value("source", std::string());
+    r.description = s.value("description", std::string());
+    r.kind = s.value("kind", std::string());
+    if (auto k = s.find("swept_keys"); k != s.end() && k->is_array())
+      for (const json& key : *k) keys.push_back(key.get<std::string>());
+    if (auto cs = s.find("cases"); cs != s.end() && cs->is_array())
+      for (const json& c : *cs) r.cases.push_back(parseCase(c));
+  } else if (fs::is_directory(root / "cases")) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(root / "cases"))
+      if (fs::exists(e.path() / "result.json")) files.push_back(e.path() / "result.json");
+    std::sort(files.begin(), files.end());
+    for (const fs::path& f : files) r.cases.push_back(parseCase(readJson(f)));
+  } else {
+    throw std::runtime_error(dir + " is not a result folder (no summary.json, no cases/)");
+  }
+  const bool kind_given = !r.kind.empty();
+  if (!kind_given) r.kind = "simulate";
+  ExperimentResults fromYaml;
+  fromYaml.kind = r.kind;
+  readExperimentYaml(root / "experiment.yaml", fromYaml);
+  if (!kind_given) r.kind = fromYaml.kind;
+  if (r.description.empty()) r.description = fromYaml.description;
+  if (r.name.empty()) r.name = fromYaml.name.empty() ? root.filename().string() : fromYaml.name;
+
+  // Keys: summary order first, then any others found in the cases.
+  for (const CaseRecord& c : r.cases)
+    for (const auto& [k, v] : c.sweep)
+      if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
+  for (const std::string& k : keys) {
+    SweepAxis a;
+    a.key = k;
+    for (const CaseRecord& c : r.cases) {
+      auto it = c.sweep.find(k);
+      if (it != c.sweep.end() && a.indexOf(it->second) < 0) a.values.push_back(it->second);
+    }
+    if (a.values.size() < 2) continue;
+    for (const std::string& v : a.values) a.numeric = a.numeric && parseNumber(v).has_value();
+    if (a.numeric)
+      std::stable_sort(a.values.begin(), a.values.end(),
+                       [](const std::string& x, const std::string& y) { return *parseNumber(x) < *parseNumber(y); });
+    r.axes.push_back(a);
+  }
+  for (const CaseRecord& c : r.cases)
+    for (const auto& [m, run] : c.runs)
+      if (!r.hasModel(m)) r.models.push_back(m);
+  std::stable_sort(r.models.begin(), r.models.end(), [](const std::string& a, const std::string& b) {
+    auto rank = [](const std::string& m) { return m == "analytic" ? 0 : m == "mujoco" ? 1 : 2; };
+    return rank(a) < rank(b);
+  });
+  return r;
+}
+
+std::vector<ExperimentResults> loadResultTree(const std::string& dir) {
+  const fs::path root(dir);
+  if (fs::exists(root / "summary.json")) return {loadResults(dir)};
+  std::vector<fs::path> subs;
+  if (fs::is_directory(root))
+    for (const auto& e : fs::directory_iterator(root))
+      if (e.is_directory() && (fs::exists(e.path() / "summary.json") || fs::is_directory(e.path() / "cases")))
+        subs.push_back(e.path());
+  std::sort(subs.begin(), subs.end());
+  if (subs.empty()) throw std::runtime_error(dir + " holds no result folder (no summary.json in it or its subfolders)");
+  std::vector<ExperimentResults> out;
+  for (const fs::path& p : subs) out.push_back(loadResults(p.string()));
+  return out;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,76 @@
+// Reading a result folder (docs/ARCHITECTURE.md "Result folder") back for plots and reports:
+// DIR/summary.json, DIR/cases/<dir>/<model>.csv, DIR/experiment.yaml. A suite folder holds one
+// such folder per experiment (DIR/<experiment>/summary.json).
+#pragma once
+
+#include <cmath>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "results/time_series.h"
+
+namespace tailsim {
+
+// One model run of one case, as summary.json records it (RunSummary).
+struct RunRecord {
+  bool ok = false;
+  double phi_net_deg = NAN;
+  double t_stop_s = NAN;
+  double wall_time_s = NAN;
+  int stick_slip_events = 0;
+  std::string error;
+};
+
+struct CaseRecord {
+  std::string name;                           // "base" or "key=value,..."
+  std::string dir;                            // folder under DIR/cases/
+  std::map<std::string, std::string> sweep;   // swept key -> value as written
+  std::map<std::string, RunRecord> runs;      // model -> run
+};
+
+// One swept key with its distinct values in increasing order (numeric when all values parse).
+struct SweepAxis {
+  std::string key;                  // as in summary.json ("trajectory.theta0_deg")
+  std::vector<std::string> values;  // distinct values as written, sorted
+  bool numeric = true;
+  double number(size_t i) const;    // numeric value of values[i] (index i when not numeric)
+  int indexOf(const std::string& value) const;  // -1 if absent
+};
+
+struct ExperimentResults {
+  std::string dir;          // the result folder
+  std::string name;         // experiment name
+  std::string description;
+  std::string source;       // YAML file it was run from
+  std::string kind = "simulate";  // "simulate" | "pose"
+  std::vector<std::string> models;  // every model that has a run, "analytic" first
+  std::vector<SweepAxis> axes;      // swept keys with more than one value, in summary order
+  std::vector<CaseRecord> cases;
+
+  // DIR/cases/<case.dir>/<model>.csv; throws std::runtime_error if unreadable.
+  std::string csvPath(const CaseRecord& c, const std::string& model) const;
+  TimeSeries series(const CaseRecord& c, const std::string& model) const;
+  // phi_net of a run, NaN if the model did not run or failed.
+  double phiNet(const CaseRecord& c, const std::string& model) const;
+  bool hasModel(const std::string& model) const;
+  // The case with these axis values (value strings as in SweepAxis::values), or nullptr.
+  const CaseRecord* find(const std::map<std::string, std::string>& sweep) const;
+};
+
+// Reads DIR/summary.json (falling back to DIR/cases/*/result.json for an interrupted run).
+// Throws std::runtime_error if DIR holds neither.
+ExperimentResults loadResults(const std::string& dir);
+
+// DIR itself if it holds summary.json, else every direct subfolder that does (sorted by name).
+std::vector<ExperimentResults> loadResultTree(const std::string& dir);
+
+// "trajectory.theta0_deg" -> "theta0_deg"; "trajectory.dtheta_deg[2]" -> "dtheta_deg[2]".
+std::string leafKey(const std::string& key);
+// Axis label with unit for a key: "theta0_deg" -> "θ0 [deg]", "d_Q2B_m" -> "d_Q2B [m]".
+std::string axisLabel(const std::string& key);
+// Parses a value as written ("0.25", "-90"); nullopt if it is not a number.
+std::optional<double> parseNumber(const std::string& s);
+
+}  // namespace tailsim

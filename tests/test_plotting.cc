@@ -1,0 +1,378 @@
+// Plots and the reproduction report from synthetic result folders whose answers are known:
+// monotone sweeps must give YES, broken ones NO naming the failing step, closed-form pose data
+// must match Eq. (24), and every figure must exist as a non-trivial PNG and SVG.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "plotting/findings.h"
+#include "plotting/plots.h"
+#include "plotting/report.h"
+#include "results/atomic_file.h"
+#include "trajectory/split_cycle_profile.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace tailsim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+struct SynthCase {
+  std::map<std::string, json> sweep;
+  std::map<std::string, double> phi;             // model -> phi_net_deg
+  std::map<std::string, TimeSeries> csv;         // model -> CSV
+};
+
+// Writes DIR/summary.json, experiment.yaml, cases/<name>/<model>.csv in the documented layout.
+void writeExperiment(const fs::path& dir, const std::string& name, const std::vector<std::string>& swept_keys,
+                     const std::vector<SynthCase>& cases, const std::string& yaml) {
+  fs::create_directories(dir / "cases");
+  json s;
+  s["experiment"] = name;
+  s["source"] = (dir / "source.yaml").string();
+  s["swept_keys"] = swept_keys;
+  s["cases"] = json::array();
+  for (const SynthCase& c : cases) {
+    std::string cname;
+    for (const auto& [k, v] : c.sweep) {
+      const std::string leaf = k.substr(k.rfind('.') + 1);
+      cname += (cname.empty() ? "" : ",") + leaf + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
+    }
+    if (cname.empty()) cname = "base";
+    json j;
+    j["name"] = cname;
+    j["dir"] = cname;
+    j["sweep"] = json::object();
+    for (const auto& [k, v] : c.sweep) j["sweep"][k] = v;
+    for (const auto& [m, phi] : c.phi) {
+      j["runs"][m] = {{"model", m}, {"phi_net_deg", phi}, {"ok", true}, {"t_stop_s", 0.4}, {"wall_time_s", 0.01}};
+    }
+    fs::create_directories(dir / "cases" / cname);
+    for (const auto& [m, ts] : c.csv) writeCsvAtomic((dir / "cases" / cname / (m + ".csv")).string(), ts);
+    s["cases"].push_back(j);
+  }
+  writeFileAtomic((dir / "summary.json").string(), s.dump(2));
+  writeFileAtomic((dir / "experiment.yaml").string(), yaml);
+  writeFileAtomic((dir / "source.yaml").string(), yaml);
+}
+
+// A simulate CSV driven by split-cycle profiles (joint columns), with a made-up phi(t) and
+// moments. `lag_s` shifts the joint motion (a badly tracking model).
+TimeSeries simCsv(const std::vector<SplitCycleParams>& joints, double phi_net, double lag_s = 0.0) {
+  TimeSeries ts;
+  ts.addColumn("t_s");
+  const int n = static_cast<int>(joints.size());
+  for (int j = 1; j <= n; ++j) {
+    ts.addColumn("theta" + std::to_string(j) + "_deg");
+    ts.addColumn("thetadot" + std::to_string(j) + "_dps");
+  }
+  for (const char* c : {"phi_deg", "MzT_Nm", "MzF_Nm", "Izz_phiddot_Nm"}) ts.addColumn(c);
+  double end = 0;
+  for (const auto& p : joints) end = std::max(end, p.t0_s + p.dT_s);
+  const double dur = end + 0.3, dt = 1e-3;
+  for (int k = 0; k * dt <= dur + 1e-12; ++k) {
+    const double t = k * dt;
+    std::vector<double> row = {t};
+    for (const auto& p : joints) {
+      const JointState st = SplitCycleProfile(p).at(t - lag_s);
+      row.push_back(st.theta / kDeg);
+      row.push_back(st.theta_dot / kDeg);
+    }
+    const double x = std::min(t / end, 1.0);
+    const double mzt = 5 * std::sin(2 * kPi * x) * (t < end);
+    row.push_back(phi_net * x * x * (3 - 2 * x));
+    row.push_back(mzt);
+    row.push_back(-0.5 * mzt);
+    row.push_back(0.5 * mzt);
+    ts.appendRow(row);
+  }
+  return ts;
+}
+
+TimeSeries poseCsv(const std::map<std::string, double>& values) {
+  TimeSeries ts;
+  std::vector<double> row;
+  for (const auto& [k, v] : values) {
+    ts.addColumn(k);
+    row.push_back(v);
+  }
+  ts.appendRow(row);
+  return ts;
+}
+
+const std::string kRobotYaml = R"(quadruped: {mass_kg: 8.458, izz_kgm2: 0.1916, d_Q2C_m: -0.0155, d_Q2B_m: 0.125, l_F_m: 0.30, w_F_m: 0.26}
+tails:
+  1: {mass_kg: 2.40, izz_kgm2: 2.236e-2, length_m: 0.300}
+)";
+
+class SyntheticSuite : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = fs::path(TAILSIM_BINARY_DIR) / "test_plotting_suite";
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    writeFileAtomic((root_ / "robot.yaml").string(), kRobotYaml);
+
+    // fig06a: no sweep, MuJoCo rotates more.
+    {
+      SplitCycleParams p{0.0, -90 * kDeg, 0.25, 0.25, 0.0};
+      writeExperiment(root_ / "fig06a_model_comparison_1dof", "fig06a_model_comparison_1dof", {},
+                      {{{}, {{"analytic", 10.0}, {"mujoco", 14.0}},
+                        {{"analytic", simCsv({p}, 10.0)}, {"mujoco", simCsv({p}, 14.0)}}}},
+                      "name: fig06a_model_comparison_1dof\nkind: simulate\n");
+    }
+    // fig07: exact profile for analytic; MuJoCo lags 20 ms (peak time off by more than tolerance).
+    {
+      SplitCycleParams p{0.0, -90 * kDeg, 0.25, 0.25, 0.0};
+      writeExperiment(root_ / "fig07_loading", "fig07_loading", {},
+                      {{{}, {{"analytic", 8.0}, {"mujoco", 9.0}},
+                        {{"analytic", simCsv({p}, 8.0)}, {"mujoco", simCsv({p}, 9.0, 0.02)}}}},
+                      "name: fig07_loading\nkind: simulate\ntrajectory: {theta0_deg: 0, dtheta_deg: -90, dT_s: 0.25, "
+                      "w_ss: 0.25}\n");
+    }
+    // fig08: pose over theta, Eq. (24) closed form with thetadot = thetaddot = 1.
+    {
+      const double mQ = 8.458, mL = 2.4, L = 0.3, IzzL = 2.236e-2, d = 0.125, m = mQ + mL;
+      const double Ieff = mQ * mL / (2 * m) * L * d, rot = -(IzzL + 0.25 * mL * L * L * mQ / m);
+      std::vector<SynthCase> cs;
+      for (int th = -90; th <= 90; th += 15) {
+        const double tan = -Ieff * std::cos(th * kDeg), cen = Ieff * std::sin(th * kDeg);
+        cs.push_back({{{"pose.theta_deg", th}},
+                      {{"analytic", 0.0}},
+                      {{"analytic", poseCsv({{"MzT_tan_Nm", tan}, {"MzT_cen_Nm", cen}, {"MzT_Nm", rot + tan + cen},
+                                             {"Izz_kgm2", 0.3}, {"LF_m", 0.2}})}}});
+      }
+      writeExperiment(root_ / "fig08_moment_contributions", "fig08_moment_contributions", {"pose.theta_deg"}, cs,
+                      "name: fig08_moment_contributions\nkind: pose\nrobot: ../robot.yaml\ntail: {links: 1}\n"
+                      "quadruped: {d_Q2B_m: 0.125}\npose: {theta_deg: {range: [-90, 90, 15]}, thetadot_radps: 1, "
+                      "thetaddot_radps2: 1}\n");
+    }
+    // fig09: phi_net = 100 d + g(theta0), g peaks at 60 except for d = 0.15 (peak at 75);
+    // analytic only. Rises with d everywhere.
+    {
+      std::vector<SynthCase> cs;
+      for (int i = 0; i <= 6; ++i)
+        for (int th = 0; th <= 90; th += 15) {
+          const double d = 0.025 * i;
+          double g = -std::pow((th - 60) / 30.0, 2);
+          if (i == 6) g = -std::pow((th - 75) / 30.0, 2);
+          char dv[16];
+          std::snprintf(dv, sizeof dv, "%g", d);
+          cs.push_back({{{"quadruped.d_Q2B_m", std::string(dv)}, {"trajectory.theta0_deg", th}},
+                        {{"analytic", 100 * d + g}},
+                        {}});
+        }
+      writeExperiment(root_ / "fig09_theta0_dQ2B", "fig09_theta0_dQ2B",
+                      {"quadruped.d_Q2B_m", "trajectory.theta0_deg"}, cs, "name: fig09_theta0_dQ2B\n");
+    }
+    // fig10: L_F = 0.2 (1 + 0.02 sin theta * d / 0.15): max variation 2 % from the median 0.2.
+    {
+      std::vector<SynthCase> cs;
+      for (int i = 0; i <= 6; ++i)
+        for (int th = -90; th <= 90; th += 30) {
+          const double d = 0.025 * i;
+          cs.push_back({{{"quadruped.d_Q2B_m", d}, {"pose.theta_deg", th}},
+                        {{"analytic", 0.0}},
+                        {{"analytic", poseCsv({{"LF_m", 0.2 * (1 + 0.02 * std::sin(th * kDeg) * d / 0.15)}})}}});
+        }
+      writeExperiment(root_ / "fig10_LF", "fig10_LF", {"quadruped.d_Q2B_m", "pose.theta_deg"}, cs,
+                      "name: fig10_LF\nkind: pose\n");
+    }
+    // fig11: analytic falls with w_ss; MuJoCo has a bump between 0.5 and 0.6.
+    {
+      std::vector<SynthCase> cs;
+      for (int i = 1; i <= 9; ++i) {
+        const double w = 0.1 * i;
+        const double mj = 20 - 10 * w + (i == 6 ? 2.0 : 0.0);
+        SplitCycleParams p{45 * kDeg, -90 * kDeg, 0.25, w, 0.0};
+        cs.push_back({{{"trajectory.w_ss", w}},
+                      {{"analytic", 15 - 10 * w}, {"mujoco", mj}},
+                      {{"analytic", simCsv({p}, 15 - 10 * w)}, {"mujoco", simCsv({p}, mj)}}});
+      }
+      writeExperiment(root_ / "fig11_wss", "fig11_wss", {"trajectory.w_ss"}, cs, "name: fig11_wss\n");
+    }
+    // fig14: Eq. (25) trajectories, phi_net rising with n.
+    {
+      std::vector<SynthCase> cs;
+      for (int n = 1; n <= 6; ++n) {
+        const SplitCycleParams p = equalPeakSpeedParams(n, 600 * kDeg, 0.25);
+        const std::vector<SplitCycleParams> joints(n, p);
+        cs.push_back({{{"tail.links", n}},
+                      {{"analytic", 5.0 + n}, {"mujoco", 6.0 + n}},
+                      {{"analytic", simCsv(joints, 5.0 + n)}, {"mujoco", simCsv(joints, 6.0 + n)}}});
+      }
+      writeExperiment(root_ / "fig14_tail_dof", "fig14_tail_dof", {"tail.links"}, cs,
+                      "name: fig14_tail_dof\ntrajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\n");
+    }
+  }
+
+  static std::vector<ExperimentResults> load() { return loadResultTree(root_.string()); }
+  static const Finding& finding(const std::vector<Finding>& fs, const std::string& id) {
+    for (const Finding& f : fs)
+      if (f.id == id) return f;
+    throw std::runtime_error("no finding " + id);
+  }
+  static Verdict verdict(const std::vector<Finding>& fs, const std::string& id, const std::string& model) {
+    const ModelVerdict* v = finding(fs, id).verdictFor(model);
+    if (!v) throw std::runtime_error("no verdict for " + model + " in " + id);
+    return v->verdict;
+  }
+  static fs::path root_;
+};
+fs::path SyntheticSuite::root_;
+
+TEST(CheckTrend, StrictMonotonicity) {
+  EXPECT_TRUE(checkTrend({1, 2, 3}, +1).holds);
+  EXPECT_FALSE(checkTrend({1, 2, 3}, -1).holds);
+  EXPECT_TRUE(checkTrend({3, 2, 1}, -1).holds);
+  const Trend flat = checkTrend({1, 2, 2, 3}, +1);
+  EXPECT_TRUE(flat.complete);
+  EXPECT_FALSE(flat.holds);  // a flat step is no rise
+  EXPECT_EQ(flat.worst, 1u);
+  const Trend dip = checkTrend({1, 3, 2.5, 4}, +1);
+  EXPECT_FALSE(dip.holds);
+  EXPECT_EQ(dip.worst, 1u);
+  EXPECT_DOUBLE_EQ(dip.min_step, -0.5);
+  EXPECT_FALSE(checkTrend({1, NAN, 3}, +1).complete);
+}
+
+TEST_F(SyntheticSuite, LoadsAxesSortedAndTyped) {
+  const auto rs = load();
+  ASSERT_EQ(rs.size(), 7u);
+  const ExperimentResults* f09 = findExperiment(rs, "fig09");
+  ASSERT_NE(f09, nullptr);
+  ASSERT_EQ(f09->axes.size(), 2u);
+  EXPECT_EQ(f09->axes[0].values.size(), 7u);  // string-valued d_Q2B parsed as numbers
+  EXPECT_TRUE(f09->axes[0].numeric);
+  EXPECT_DOUBLE_EQ(f09->axes[0].number(6), 0.15);
+  EXPECT_EQ(f09->models, std::vector<std::string>{"analytic"});
+  const ExperimentResults* f08 = findExperiment(rs, "fig08");
+  ASSERT_NE(f08, nullptr);
+  EXPECT_EQ(f08->kind, "pose");  // from experiment.yaml
+  EXPECT_DOUBLE_EQ(f08->axes[0].number(0), -90);
+  const ExperimentResults* f11 = findExperiment(rs, "fig11");
+  ASSERT_NE(f11, nullptr);
+  EXPECT_EQ(f11->models, (std::vector<std::string>{"analytic", "mujoco"}));
+}
+
+TEST_F(SyntheticSuite, FindingsMatchTheKnownAnswers) {
+  const auto fs_ = computeFindings(load());
+  // Monotone sweeps -> YES, the MuJoCo bump in fig11 -> NO naming the step.
+  EXPECT_EQ(verdict(fs_, "fig11_wss_falls", "analytic"), Verdict::kYes);
+  EXPECT_EQ(verdict(fs_, "fig11_wss_falls", "mujoco"), Verdict::kNo);
+  EXPECT_NE(finding(fs_, "fig11_wss_falls").verdictFor("mujoco")->detail.find("0.5 and 0.6"), std::string::npos)
+      << finding(fs_, "fig11_wss_falls").verdictFor("mujoco")->detail;
+  EXPECT_EQ(verdict(fs_, "fig09_dQ2B_rises", "analytic"), Verdict::kYes);
+  EXPECT_EQ(verdict(fs_, "fig09_dQ2B_rises", "mujoco"), Verdict::kNotAvailable);
+  // Argmax at 60 for d = 0.025 .. 0.125 (5 of 6 values > 0), at 75 for 0.15.
+  EXPECT_EQ(verdict(fs_, "fig09_max_at_60", "analytic"), Verdict::kYes);
+  EXPECT_NE(finding(fs_, "fig09_max_at_60").verdictFor("analytic")->detail.find("5 of 6"), std::string::npos);
+  EXPECT_EQ(verdict(fs_, "fig10_LF_variation", "analytic"), Verdict::kYes);
+  EXPECT_NE(finding(fs_, "fig10_LF_variation").verdictFor("analytic")->detail.find("2.00 %"), std::string::npos)
+      << finding(fs_, "fig10_LF_variation").verdictFor("analytic")->detail;
+  EXPECT_EQ(verdict(fs_, "fig14_links_rises", "analytic"), Verdict::kYes);
+  EXPECT_EQ(verdict(fs_, "fig14_links_rises", "mujoco"), Verdict::kYes);
+  // Trajectories built from the real profiles satisfy Eqs. (20)-(23) and (25); a 20 ms lag does not.
+  EXPECT_EQ(verdict(fs_, "split_cycle_peak", "analytic"), Verdict::kYes)
+      << finding(fs_, "split_cycle_peak").verdictFor("analytic")->detail;
+  EXPECT_EQ(verdict(fs_, "split_cycle_peak", "mujoco"), Verdict::kNo);
+  EXPECT_EQ(verdict(fs_, "eq25_table", "analytic"), Verdict::kYes)
+      << finding(fs_, "eq25_table").verdictFor("analytic")->detail;
+  // Closed-form pose data matches Eq. (24) with the robot file's numbers; peaks at 0 and +-90.
+  EXPECT_EQ(verdict(fs_, "eq24_closed_form", "analytic"), Verdict::kYes)
+      << finding(fs_, "eq24_closed_form").verdictFor("analytic")->detail;
+  EXPECT_EQ(verdict(fs_, "fig08_peaks", "analytic"), Verdict::kYes);
+  EXPECT_EQ(verdict(fs_, "fig06_contact_rotates_more", "mujoco vs analytic"), Verdict::kYes);
+  // Missing experiments are listed as n/a, not dropped.
+  EXPECT_EQ(verdict(fs_, "fig12_dT_falls", "analytic"), Verdict::kNotAvailable);
+  EXPECT_EQ(verdict(fs_, "fig13_larger_dtheta_wins", "analytic"), Verdict::kNotAvailable);
+}
+
+TEST_F(SyntheticSuite, WrongEq24DataIsRejected) {
+  auto rs = load();
+  // Same folder but with a d_Q2B the data was not made with: I_eff off by 20 %.
+  const fs::path dir = root_ / "fig08_moment_contributions";
+  std::string yaml;
+  {
+    std::ifstream in(dir / "experiment.yaml");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    yaml = ss.str();
+  }
+  const std::string bad = std::regex_replace(yaml, std::regex("d_Q2B_m: 0.125"), "d_Q2B_m: 0.15");
+  writeFileAtomic((dir / "experiment.yaml").string(), bad);
+  const auto fs_ = computeFindings(loadResultTree(root_.string()));
+  writeFileAtomic((dir / "experiment.yaml").string(), yaml);
+  EXPECT_EQ(verdict(fs_, "eq24_closed_form", "analytic"), Verdict::kNo);
+}
+
+TEST_F(SyntheticSuite, PlotsAndReportAreWritten) {
+  const std::vector<PlotFile> plots = plotResults(root_.string());
+  std::set<std::string> stems;
+  for (const PlotFile& p : plots) {
+    const fs::path png(p.png), svg = fs::path(p.png).replace_extension(".svg");
+    ASSERT_TRUE(fs::exists(png)) << p.png;
+    ASSERT_TRUE(fs::exists(svg)) << svg;
+    EXPECT_GT(fs::file_size(png), 5000u) << p.png;
+    EXPECT_GT(fs::file_size(svg), 3000u) << svg;
+    EXPECT_TRUE(fs::exists(fs::path(p.png).replace_extension(".gp")));
+    stems.insert(png.stem().string());
+  }
+  for (const char* s : {"fig06a_model_comparison_1dof_phi", "fig06a_model_comparison_1dof_moments",
+                        "fig07_loading_phi", "fig08_moment_contributions_contributions",
+                        "fig08_moment_contributions_LF", "fig09_theta0_dQ2B_phi_net_map",
+                        "fig09_theta0_dQ2B_phi_net_lines", "fig10_LF_LF_map", "fig11_wss_phi_net", "fig11_wss_phi_t",
+                        "fig14_tail_dof_phi_net"})
+    EXPECT_TRUE(stems.count(s)) << "missing figure " << s;
+
+  const std::string path = writeReport(root_.string(), /*draw_plots=*/false);
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string md = ss.str();
+  EXPECT_NE(md.find("## Paper claims, model by model"), std::string::npos);
+  EXPECT_NE(md.find("](fig09_theta0_dQ2B/plots/fig09_theta0_dQ2B_phi_net_map.png)"), std::string::npos);
+  EXPECT_NE(md.find("mujoco: Sec. 4.5, Fig. 11"), std::string::npos);  // listed under "Not reproduced"
+  EXPECT_NE(md.find("| fig06a_model_comparison_1dof | mujoco | +14.000 |"), std::string::npos);
+}
+
+TEST(ResultFolder, FallsBackToCaseResultFiles) {
+  const fs::path dir = fs::path(TAILSIM_BINARY_DIR) / "test_plotting_partial";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "cases" / "w_ss=0.1");
+  fs::create_directories(dir / "cases" / "w_ss=0.2");
+  writeFileAtomic((dir / "experiment.yaml").string(), "name: partial\nkind: simulate\n");
+  for (const char* w : {"0.1", "0.2"}) {
+    json j = {{"name", std::string("w_ss=") + w},
+              {"dir", std::string("w_ss=") + w},
+              {"sweep", {{"trajectory.w_ss", w}}},
+              {"runs", {{"analytic", {{"phi_net_deg", 3.0}, {"ok", true}}}}}};
+    writeFileAtomic((dir / "cases" / (std::string("w_ss=") + w) / "result.json").string(), j.dump());
+  }
+  const ExperimentResults r = loadResults(dir.string());
+  EXPECT_EQ(r.name, "partial");
+  ASSERT_EQ(r.axes.size(), 1u);
+  EXPECT_EQ(r.axes[0].values, (std::vector<std::string>{"0.1", "0.2"}));
+  EXPECT_DOUBLE_EQ(r.phiNet(r.cases[1], "analytic"), 3.0);
+  EXPECT_THROW(loadResults((dir / "nothing").string()), std::runtime_error);
+}
+
+TEST(AxisLabel, UnitsFromNames) {
+  EXPECT_EQ(axisLabel("trajectory.theta0_deg"), "θ0 [deg]");
+  EXPECT_EQ(axisLabel("quadruped.d_Q2B_m"), "d_Q2B [m]");
+  EXPECT_EQ(axisLabel("trajectory.dtheta_deg[2]"), "Δθ [deg] (joint 2)");
+  EXPECT_EQ(axisLabel("foo.bar_Nm"), "bar [N m]");
+  EXPECT_EQ(leafKey("a.b.c_s"), "c_s");
+}
+
+}  // namespace
+}  // namespace tailsim
