@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "experiments/experiment_loader.h"
 #include "plotting/findings.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
@@ -364,6 +365,48 @@ TEST(ResultFolder, FallsBackToCaseResultFiles) {
   EXPECT_EQ(r.axes[0].values, (std::vector<std::string>{"0.1", "0.2"}));
   EXPECT_DOUBLE_EQ(r.phiNet(r.cases[1], "analytic"), 3.0);
   EXPECT_THROW(loadResults((dir / "nothing").string()), std::runtime_error);
+}
+
+// configs/paper/all.yaml: every figure's experiment loads, with the grids the paper states.
+TEST(PaperConfigs, SuiteLoadsWithThePaperGrids) {
+  const std::vector<Experiment> ex = loadExperimentSuite(std::string(TAILSIM_SOURCE_DIR) + "/configs/paper/all.yaml");
+  std::map<std::string, const Experiment*> by;
+  for (const Experiment& e : ex) by[e.name] = &e;
+  const std::map<std::string, size_t> cases = {
+      {"fig06a_model_comparison_1dof", 1}, {"fig06b_model_comparison_6dof", 1}, {"fig07_loading", 1},
+      {"fig08_moment_contributions", 37},  {"fig09_theta0_dQ2B", 49},          {"fig10_LF", 91},
+      {"fig11_wss", 9},                    {"fig12_dT_dtheta", 55},            {"fig13_equal_peak_speed", 5},
+      {"fig14_tail_dof", 6},               {"mu_swapped", 1}};
+  ASSERT_EQ(ex.size(), cases.size());
+  for (const auto& [name, n] : cases) {
+    ASSERT_TRUE(by.count(name)) << name;
+    EXPECT_EQ(by[name]->cases.size(), n) << name;
+  }
+  // Fig. 6(b): six links of -30 deg each at d_Q2B = 0.1405 m.
+  const ExperimentCase& b = by["fig06b_model_comparison_6dof"]->cases[0];
+  ASSERT_EQ(b.joints.size(), 6u);
+  for (const auto& j : b.joints) EXPECT_NEAR(j.dtheta_rad, -30 * kDeg, 1e-12);
+  EXPECT_DOUBLE_EQ(b.robot.quadruped.d_Q2B_m, 0.1405);
+  // Fig. 13: peak 600 deg/s -> dT = |dtheta| / 300 deg/s, a Fig. 12 grid point (0.2 .. 0.6 s).
+  for (const ExperimentCase& c : by["fig13_equal_peak_speed"]->cases) {
+    const auto& j = c.joints[0];
+    EXPECT_NEAR(j.dT_s, std::fabs(j.dtheta_rad) / (300 * kDeg), 1e-12) << c.name;
+    EXPECT_NEAR(j.theta0_rad, 90 * kDeg, 1e-12);
+  }
+  // Fig. 14: Eq. (25) per n; mu_swapped: the Fig. 7 case with mu_s and mu_d exchanged.
+  for (const ExperimentCase& c : by["fig14_tail_dof"]->cases) {
+    const int n = c.robot.numLinks();
+    const SplitCycleParams want = equalPeakSpeedParams(n, 600 * kDeg, 0.25);
+    for (const auto& j : c.joints) {
+      EXPECT_NEAR(j.dtheta_rad, want.dtheta_rad, 1e-12);
+      EXPECT_NEAR(j.dT_s, want.dT_s, 1e-12);
+    }
+  }
+  const ExperimentCase& mu = by["mu_swapped"]->cases[0];
+  const ExperimentCase& f7 = by["fig07_loading"]->cases[0];
+  EXPECT_DOUBLE_EQ(mu.robot.friction.mu_s, f7.robot.friction.mu_d);
+  EXPECT_DOUBLE_EQ(mu.robot.friction.mu_d, f7.robot.friction.mu_s);
+  EXPECT_EQ(by["fig10_LF"]->cases[0].kind, "pose");
 }
 
 TEST(AxisLabel, UnitsFromNames) {
