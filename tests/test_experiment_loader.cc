@@ -315,7 +315,8 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
           "          foot_loads: constant, load_decomposition: false}\n"
           "output: {sample_dt_s: 0.002, duration_s: 1.5, settle_s: 0.2}\n"
           "render: {width: 320, height: 240, fps: 60, slowmo: 2, duration_s: 0.5, camera: perspective,\n"
-          "         shadows: true, reflections: true, msaa: 4, ghost: false}\n"));
+          "         shadows: true, reflections: true, msaa: 4, ghost: false, ffmpeg: /usr/bin/ffmpeg,\n"
+          "         crf: 30, preset: slow}\n"));
   const ExperimentCase c = loadExperiment(p).cases.at(0);
   EXPECT_DOUBLE_EQ(c.robot.friction.mu_s, 0.3);
   EXPECT_DOUBLE_EQ(c.robot.friction.mu_d, 0.25);
@@ -375,6 +376,9 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
   EXPECT_TRUE(c.render.reflections);
   EXPECT_EQ(c.render.msaa, 4);
   EXPECT_FALSE(c.render.ghost);
+  EXPECT_EQ(c.render.ffmpeg, "/usr/bin/ffmpeg");
+  EXPECT_EQ(c.render.crf, 30);
+  EXPECT_EQ(c.render.preset, "slow");
 
   const std::string q = write("exp.yaml", exp(std::string(kTraj) + "render: {}\n"));
   const ExperimentCase d = loadExperiment(q).cases.at(0);
@@ -497,6 +501,7 @@ TEST_F(LoaderTest, UnknownEnumValuesListTheAllowedOnes) {
   expectError(exp(std::string(kTraj) + "models: []\n"), 5, "models", "at least one");
   expectError(exp(std::string(kTraj) + "models: [mujoco, mujoco]\n"), 5, "models[1]", "twice");
   expectError(exp(std::string(kTraj) + "render: {camera: side}\n"), 5, "render.camera", "allowed: top, perspective");
+  expectError(exp(std::string(kTraj) + "render: {preset: quick}\n"), 5, "render.preset", "allowed: ultrafast");
   expectError("name: t\nrobot: robots/paper_quadruped.yaml\nkind: replay\n" + std::string(kTraj), 3, "kind",
               "allowed: simulate, pose");
 }

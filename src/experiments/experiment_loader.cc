@@ -693,7 +693,7 @@ RenderSettings readRender(const Reader& r, const Item& item) {
   s.enabled = true;  // the section's presence asks for a video
   if (item.node.IsNull() && !r.pick(item)) return s;  // `render:` with nothing: all defaults
   const MapView m = r.map(item, {"width", "height", "fps", "slowmo", "duration_s", "camera", "shadows",
-                                 "reflections", "msaa", "ghost"});
+                                 "reflections", "msaa", "ghost", "ffmpeg", "crf", "preset"});
   if (const Item* x = m.get("width")) s.width = r.integer(*x, 16, 16384);
   if (const Item* x = m.get("height")) s.height = r.integer(*x, 16, 16384);
   if (const Item* x = m.get("fps")) s.fps = r.integer(*x, 1, 1000);
@@ -704,6 +704,14 @@ RenderSettings readRender(const Reader& r, const Item& item) {
   if (const Item* x = m.get("reflections")) s.reflections = r.boolean(*x);
   if (const Item* x = m.get("msaa")) s.msaa = r.integer(*x, 0, 64);
   if (const Item* x = m.get("ghost")) s.ghost = r.boolean(*x);
+  if (const Item* x = m.get("ffmpeg")) {
+    s.ffmpeg = r.string(*x);
+    if (s.ffmpeg.empty()) r.fail(*x, "needs the ffmpeg executable (name or path)");
+  }
+  if (const Item* x = m.get("crf")) s.crf = r.integer(*x, 0, 51);  // libx264 range
+  if (const Item* x = m.get("preset"))
+    s.preset = r.choice(*x, {"ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
+                             "veryslow", "placebo"});
   return s;
 }
 
