@@ -1,0 +1,31 @@
+// The paper's analytic ("Simulink") model in time: planar quadruped dynamics (Eq. 9) driven by
+// the tail (Eq. 13) against foot friction (Eqs. 14-16 stiction, or the ADAMS law), integrated
+// with event-located stick/slip switching.
+#pragma once
+
+#include <vector>
+
+#include "analytic_model/analytic_settings.h"
+#include "analytic_model/foot_loads.h"
+#include "analytic_model/system_loads.h"
+#include "results/output_settings.h"
+#include "results/time_series.h"
+#include "robot/scene_effects.h"
+
+namespace tailsim {
+
+// Integrates from t = 0 (tail at rest at theta_0, body at rest) to the output duration.
+// Never throws for physics failures: summary.ok = false with the reason (e.g. tipping).
+// Throws std::invalid_argument for settings it cannot run with (e.g. a negative tolerance).
+RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& trajectory,
+                           const AnalyticSettings& settings, const Effects& effects,
+                           const OutputSettings& output);
+
+// kind: pose — loads, mass properties and L_F at one tail state; one row, no integration.
+RunResult evaluatePose(const RobotParams& robot, const std::vector<JointState>& joints, const Effects& effects);
+
+// Breakaway uses the larger of mu_s and mu_d (READING-NOTES point 1): with mu_s < mu_d, a body
+// that broke away at mu_s would feel mu_d > load and re-stick at once, forever.
+inline double breakawayCoefficient(const FrictionParams& f) { return f.mu_s > f.mu_d ? f.mu_s : f.mu_d; }
+
+}  // namespace tailsim

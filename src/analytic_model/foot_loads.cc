@@ -1,0 +1,52 @@
+#include "analytic_model/foot_loads.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace tailsim {
+
+FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
+  const double l = q.l_F_m, w = q.w_F_m;
+  // Eq. (A2), typo fixed: the centroid offset is body-fixed, so subtract it in Q.
+  const Vec2 p_CC = p_QC - Vec2(q.d_Q2C_m, 0.0);  // foot centroid -> system COM
+  const double xe = p_CC.x(), ye = p_CC.y();       // Eq. (A3)
+  const double slack = 1e-12 * (l + w);  // a COM on an edge (up to round-off) still stands
+  if (std::abs(xe) > 0.5 * l + slack || std::abs(ye) > 0.5 * w + slack) {
+    std::ostringstream os;
+    os << "system COM at (" << xe << ", " << ye << ") m from the foot centroid is outside the support "
+       << "rectangle (+-" << 0.5 * l << ", +-" << 0.5 * w << ") m: the robot tips over";
+    throw TippingError(os.str());
+  }
+  // Eq. (A3) solved (READING-NOTES point 5): ellipse with a/b = l_F/w_F.
+  const double xs = xe * w / l;
+  const double b = std::hypot(xs, ye);
+  const double xi = std::atan2(ye, xs);
+  // Eqs. (A4)-(A5).
+  const double A = 0.25, B = b * std::sqrt(2.0) / (2.0 * w);
+  static const double kC[4] = {M_PI / 4, 3 * M_PI / 4, 5 * M_PI / 4, 7 * M_PI / 4};
+  FootLoads out;
+  for (int i = 0; i < 4; ++i) out.f_C[i] = A + B * std::sin(xi + kC[i]);
+  // Every solution of Eq. (A1) is f + lambda (1, -1, 1, -1). (A4) gives lambda = 0; when a load
+  // is negative (possible for b > w_F/(2 sqrt 2) off the axes), choose the lambda closest to 0
+  // that makes all loads >= 0: this zeroes the negative load and solves (A1) for the other three.
+  // Feasible lambda: [max(-f1, -f3), min(f2, f4)], non-empty exactly when the COM is inside.
+  const auto& f = out.f_C;
+  const double lo = std::max(-f[0], -f[2]), hi = std::min(f[1], f[3]);
+  const double lambda = std::clamp(0.0, lo, std::max(lo, hi));
+  if (lambda != 0.0) {
+    out.clipped = true;
+    out.f_C[0] += lambda; out.f_C[1] -= lambda; out.f_C[2] += lambda; out.f_C[3] -= lambda;
+    for (double& v : out.f_C) v = std::max(v, 0.0);  // round-off at exactly zero
+  }
+  // Eq. (17): foot positions relative to the system COM, in Q; Eq. (19): L_F.
+  static const double kX[4] = {0.5, 0.5, -0.5, -0.5}, kY[4] = {0.5, -0.5, -0.5, 0.5};
+  const Vec2 p_Q2Centroid(q.d_Q2C_m, 0.0);
+  for (int i = 0; i < 4; ++i) {
+    out.p_F[i] = p_Q2Centroid + Vec2(kX[i] * l, kY[i] * w) - p_QC;
+    out.L_F += out.f_C[i] * out.p_F[i].norm();
+  }
+  return out;
+}
+
+}  // namespace tailsim

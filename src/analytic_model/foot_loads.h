@@ -1,0 +1,28 @@
+// Foot-load distribution and friction moment arm L_F (paper Eqs. 17-19, Appendix A1-A5).
+#pragma once
+
+#include <array>
+#include <stdexcept>
+
+#include "analytic_model/tail_dynamics.h"
+
+namespace tailsim {
+
+// The system COM left the feet's support rectangle: the robot tips; no friction arm exists.
+struct TippingError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Feet: 1 front-left (+x,+y), 2 front-right (+x,-y), 3 rear-right (-x,-y), 4 rear-left (-x,+y).
+struct FootLoads {
+  std::array<double, 4> f_C{};  // f_C,i: fraction of the weight on foot i (sum 1, each >= 0)
+  std::array<Vec2, 4> p_F{};    // p_F,i: foot i relative to the system COM, in Q  [m] (Eq. 17)
+  double L_F = 0;               // Eq. (19)  [m]
+  bool clipped = false;         // the (A4) fit gave a negative load that was zeroed (b > 0.5 w_F fallback)
+};
+
+// p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
+// support rectangle (a COM exactly on an edge is allowed).
+FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);
+
+}  // namespace tailsim

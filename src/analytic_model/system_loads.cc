@@ -1,0 +1,68 @@
+#include "analytic_model/system_loads.h"
+
+#include <stdexcept>
+
+namespace tailsim {
+
+std::vector<Vec2> tailLinkComsInQ(const QuadrupedParams& q, const TailKinematics& kin) {
+  const Vec2 p_QB(-q.d_Q2B_m, 0.0);  // Eq. (2): p_B = p_Q - d_Q2B R_Q x
+  std::vector<Vec2> out(kin.p_L.size());
+  for (size_t i = 0; i < out.size(); ++i) out[i] = p_QB - kin.p_L[i];  // R_Z(180 deg) v = -v
+  return out;
+}
+
+void systemMassProperties(const RobotParams& robot, const TailKinematics& kin, SystemLoads& s) {
+  const QuadrupedParams& q = robot.quadruped;
+  const std::vector<Vec2> p_QL = tailLinkComsInQ(q, kin);
+  s.mass_kg = robot.systemMass();  // Eq. (10)
+  Vec2 sum = Vec2::Zero();
+  for (size_t i = 0; i < p_QL.size(); ++i) sum += robot.tail[i].mass_kg * p_QL[i];
+  s.p_QC = sum / s.mass_kg;  // Eq. (10), quadruped COM at the origin of Q
+  s.p_QB = Vec2(-q.d_Q2B_m, 0.0);
+  double I = q.izz_kgm2 + q.mass_kg * s.p_QC.squaredNorm();  // Eqs. (11)-(12)
+  for (size_t i = 0; i < p_QL.size(); ++i)
+    I += robot.tail[i].izz_kgm2 + robot.tail[i].mass_kg * (p_QL[i] - s.p_QC).squaredNorm();
+  s.Izz_kgm2 = I;
+}
+
+namespace {
+// Eq. (8) and (13) from a base-frame load: F_B in Q, and M_z,T about the system COM.
+void netTailLoad(const TailLoad& l, const Vec2& p_CB, Vec2& F_Q, double& MzT) {
+  F_Q = -(-l.F_J1_B);  // F_B = -R_B F_J,1 with R_B = R_Q R_Z(180 deg): in Q, -R_Z(180) F = F
+  const double MzB = -l.M_J1;  // M_B = -R_B M_J,1; a z rotation keeps the z component
+  MzT = MzB + cross2(p_CB, F_Q);  // Eq. (13)
+}
+}  // namespace
+
+SystemLoads systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose) {
+  const TailKinematics kin = tailKinematics(robot.tail, joints);
+  SystemLoads s;
+  systemMassProperties(robot, kin, s);
+  const Vec2 p_CB = s.p_QB - s.p_QC;  // p_B - p_COM
+  netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, s.F_T_Q, s.MzT);
+  if (decompose) {
+    std::vector<JointState> acc = joints, speed = joints;
+    for (auto& j : acc) j.theta_dot = 0.0;
+    for (auto& j : speed) j.theta_ddot = 0.0;
+    Vec2 F_acc, F_speed;
+    netTailLoad(tailBaseLoad(robot.tail, acc), p_CB, F_acc, s.MzT_acc);
+    netTailLoad(tailBaseLoad(robot.tail, speed), p_CB, F_speed, s.MzT_speed);
+    const double mQ_over_m = robot.quadruped.mass_kg / s.mass_kg;
+    // p_B - p_COM = (m_Q/m)(p_B - p_Q) + sum (m_i/m)(p_B - p_L,i): the first part carries d_Q2B.
+    s.MzT_tan = mQ_over_m * cross2(s.p_QB, F_acc);
+    s.MzT_cen = mQ_over_m * cross2(s.p_QB, F_speed);
+  }
+  return s;
+}
+
+Eq24Terms eq24OneLinkMoment(const RobotParams& robot, double theta, double theta_dot, double theta_ddot) {
+  if (robot.tail.size() != 1) throw std::invalid_argument("Eq. (24) is for a one-link tail");
+  const TailLink& l = robot.tail[0];
+  const double mQ = robot.quadruped.mass_kg, m = robot.systemMass();
+  const double L = l.length_m;
+  const double Ieff = mQ * l.mass_kg / (2.0 * m) * L * robot.quadruped.d_Q2B_m;
+  return {-(l.izz_kgm2 + 0.25 * l.mass_kg * L * L * mQ / m) * theta_ddot,
+          -Ieff * theta_ddot * std::cos(theta), Ieff * theta_dot * theta_dot * std::sin(theta)};
+}
+
+}  // namespace tailsim

@@ -1,0 +1,2 @@
+// tailsim command line (placeholder until the commands are wired).
+int main() { return 0; }

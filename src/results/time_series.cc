@@ -1,0 +1,33 @@
+#include "results/time_series.h"
+
+#include <limits>
+#include <stdexcept>
+
+namespace tailsim {
+
+int TimeSeries::addColumn(const std::string& name) {
+  if (column(name) >= 0) throw std::logic_error("duplicate time-series column " + name);
+  const size_t rows = data_.empty() ? 0 : data_[0].size();
+  names_.push_back(name);
+  data_.emplace_back(rows, std::numeric_limits<double>::quiet_NaN());
+  return static_cast<int>(names_.size()) - 1;
+}
+
+int TimeSeries::column(const std::string& name) const {
+  for (size_t i = 0; i < names_.size(); ++i)
+    if (names_[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+void TimeSeries::appendRow(const std::vector<double>& row) {
+  if (row.size() != names_.size()) throw std::logic_error("time-series row has the wrong width");
+  for (size_t i = 0; i < row.size(); ++i) data_[i].push_back(row[i]);
+}
+
+const std::vector<double>& TimeSeries::values(const std::string& name) const {
+  const int c = column(name);
+  if (c < 0) throw std::out_of_range("no time-series column " + name);
+  return data_[c];
+}
+
+}  // namespace tailsim

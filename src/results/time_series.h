@@ -1,0 +1,50 @@
+// What a model run produces: a time series sampled on the output grid, plus summary figures.
+// Both models fill the same column names where the quantity exists in both.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace tailsim {
+
+// Column-oriented table; every column has one value per row. Names carry their unit as a
+// suffix (t_s, phi_deg, MzT_Nm), which is also the CSV header.
+class TimeSeries {
+ public:
+  // Adds a column (all previous rows get NaN) and returns its index.
+  int addColumn(const std::string& name);
+  int column(const std::string& name) const;  // -1 if absent
+  bool has(const std::string& name) const { return column(name) >= 0; }
+  void appendRow(const std::vector<double>& row);  // row.size() == numColumns()
+  const std::vector<std::string>& names() const { return names_; }
+  size_t numColumns() const { return names_.size(); }
+  size_t numRows() const { return names_.empty() ? 0 : data_[0].size(); }
+  const std::vector<double>& values(int col) const { return data_[col]; }
+  const std::vector<double>& values(const std::string& name) const;  // throws if absent
+  double at(size_t row, int col) const { return data_[col][row]; }
+
+ private:
+  std::vector<std::string> names_;
+  std::vector<std::vector<double>> data_;
+};
+
+// Summary of one model run of one case (goes into summary.json).
+struct RunSummary {
+  std::string model;          // "analytic" | "mujoco"
+  double phi_net_deg = 0.0;   // phi at the end of the run minus phi at t = 0
+  double t_stop_s = 0.0;      // last time the body came to rest in yaw (or the run's end if it never did)
+  int stick_slip_events = 0;  // all located stick/slip switches (rotation + translation)
+  double wall_time_s = 0.0;   // wall-clock time of the simulation itself
+  long solver_steps = 0;      // accepted integrator steps (MuJoCo: mj_step calls)
+  bool ok = true;             // false: the run failed (error holds why)
+  std::string error;
+  std::map<std::string, double> extra;  // model-specific figures (e.g. tracking_rms_deg_j1)
+};
+
+struct RunResult {
+  RunSummary summary;
+  TimeSeries series;
+};
+
+}  // namespace tailsim

@@ -1,0 +1,179 @@
+// The analytic model in time: stiction law (Eqs. 14-16) with event-located switching.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "analytic_test_util.h"
+
+using namespace tailsim;
+using namespace tailsim::testing;
+
+// Measured 2026-11-22 (rel_tol 1e-8): the spin the paper's Eqs. (9)-(13) leave at t = dT with mu = 0.
+static constexpr double kPinnedResidualSpinDps = -28.684772;
+
+static const std::vector<double>& col(const RunResult& r, const char* c) { return r.series.values(c); }
+
+TEST(AnalyticSimulation, Fig7RotatesAndComesToRestExactly) {
+  const RunResult r = runFig7();
+  ASSERT_TRUE(r.summary.ok) << r.summary.error;
+  EXPECT_GT(std::abs(r.summary.phi_net_deg), 0.1);
+  EXPECT_GE(r.summary.stick_slip_events, 2);
+  const auto& t = col(r, "t_s");
+  const auto& phidot = col(r, "phidot_dps");
+  const auto& phi = col(r, "phi_deg");
+  // After the last stop phi_dot is exactly zero and phi constant: no chatter, no sign flip.
+  for (size_t i = 0; i < t.size(); ++i)
+    if (t[i] > r.summary.t_stop_s + 1e-9) {
+      EXPECT_EQ(phidot[i], 0.0) << t[i];
+      EXPECT_EQ(phi[i], phi.back()) << t[i];
+    }
+  EXPECT_LT(r.summary.t_stop_s, 0.5);
+  std::printf("Fig. 7: phi_net = %.6f deg, stop at %.6f s, %d switches, %ld steps\n", r.summary.phi_net_deg,
+              r.summary.t_stop_s, r.summary.stick_slip_events, r.summary.solver_steps);
+}
+
+TEST(AnalyticSimulation, MomentBelowStaticFrictionMovesNothing) {
+  RobotParams robot = paperRobot(1);
+  robot.friction.mu_s = robot.friction.mu_d = 2.0;
+  const RunResult r = simulateAnalytic(robot, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  ASSERT_TRUE(r.summary.ok);
+  for (double v : col(r, "phi_deg")) EXPECT_EQ(v, 0.0);
+  for (double v : col(r, "x_m")) EXPECT_EQ(v, 0.0);
+  for (double v : col(r, "y_m")) EXPECT_EQ(v, 0.0);
+  EXPECT_EQ(r.summary.stick_slip_events, 0);
+  // While stuck the friction moment balances the tail exactly (Eq. 16, first case).
+  const auto& mzt = col(r, "MzT_Nm");
+  const auto& mzf = col(r, "MzF_Nm");
+  for (size_t i = 0; i < mzt.size(); ++i) EXPECT_EQ(mzt[i] + mzf[i], 0.0);
+}
+
+// Largest ratio |M_z,T| / (m g L_F) over the Fig. 7 move: the mu at which breakaway just happens.
+static double criticalMu() {
+  const RobotParams robot = paperRobot(1);
+  const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);
+  double best = 0;
+  std::vector<JointState> js;
+  for (int i = 0; i <= 200000; ++i) {
+    tr.evaluate(0.25 * i / 200000.0, js);
+    const SystemLoads s = systemLoads(robot, js, false);
+    best = std::max(best, std::abs(s.MzT) / (robot.systemMass() * 9.81 * footLoads(robot.quadruped, s.p_QC).L_F));
+  }
+  return best;
+}
+
+TEST(AnalyticSimulation, ShortLoadPeakAboveStaticFrictionIsNotMissed) {
+  // READING-NOTES point 4: the load exceeds static friction only for a fraction of a millisecond.
+  const double mu_c = criticalMu();
+  RobotParams robot = paperRobot(1);
+  robot.friction.mu_s = robot.friction.mu_d = mu_c * (1 - 1e-5);
+  const RunResult hit = simulateAnalytic(robot, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  ASSERT_TRUE(hit.summary.ok);
+  EXPECT_GE(hit.summary.stick_slip_events, 2);  // broke away and stuck again
+  EXPECT_GT(hit.summary.extra.at("ever_rotated"), 0.0);
+  EXPECT_NE(hit.summary.phi_net_deg, 0.0);
+  robot.friction.mu_s = robot.friction.mu_d = mu_c * (1 + 1e-5);
+  const RunResult miss = simulateAnalytic(robot, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  EXPECT_EQ(miss.summary.stick_slip_events, 0);
+  EXPECT_EQ(miss.summary.phi_net_deg, 0.0);
+}
+
+TEST(AnalyticSimulation, FrictionlessPaperModelLeavesResidualSpin) {
+  // READING-NOTES point 3: the paper's equations do not conserve angular momentum. This pins the
+  // spin left after the Fig. 7 move with mu = 0, so it cannot drift unnoticed.
+  Effects e;
+  e.friction = FrictionLaw::kNone;
+  OutputSettings o;
+  o.duration_s = 0.25;  // the instant the tail stops
+  const RunResult r = runFig7({}, e, o);
+  ASSERT_TRUE(r.summary.ok);
+  const double spin = r.summary.extra.at("final_phidot_dps");
+  std::printf("mu = 0, paper coupling: phi(0.25 s) = %.6f deg, residual phi_dot = %.6f deg/s\n", r.summary.phi_net_deg,
+              spin);
+  EXPECT_NEAR(spin, kPinnedResidualSpinDps, 1e-6 * std::abs(kPinnedResidualSpinDps));
+}
+
+TEST(AnalyticSimulation, FrictionlessExactCouplingConservesMomentum) {
+  // The exact planar multibody starts at rest with no external load: when the tail stops, the
+  // whole system must be at rest again (zero angular and linear momentum).
+  Effects e;
+  e.friction = FrictionLaw::kNone;
+  AnalyticSettings s;
+  s.coupling = Coupling::kExact;
+  s.rel_tol = 1e-11;
+  s.abs_tol = 1e-13;
+  OutputSettings o;
+  o.duration_s = 0.3;
+  const RunResult r = runFig7(s, e, o);
+  ASSERT_TRUE(r.summary.ok);
+  EXPECT_NEAR(r.summary.extra.at("final_phidot_dps"), 0.0, 1e-7);
+  const auto& phi = col(r, "phi_deg");
+  EXPECT_NEAR(phi.back(), phi[phi.size() - 20], 1e-8);  // no drift after the tail stopped
+  EXPECT_GT(std::abs(phi.back()), 1.0);                   // but it did turn
+}
+
+TEST(AnalyticSimulation, ComLeavingSupportPolygonIsReported) {
+  RobotParams robot = paperRobot(1, 0.6);  // tail base far behind: COM behind the rear feet
+  robot.tail[0].mass_kg = 20;
+  const RunResult r = simulateAnalytic(robot, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  EXPECT_FALSE(r.summary.ok);
+  EXPECT_NE(r.summary.error.find("support"), std::string::npos) << r.summary.error;
+}
+
+TEST(AnalyticSimulation, AdaptiveToleranceConverges) {
+  double prev_err = 1e9;
+  AnalyticSettings ref;
+  ref.rel_tol = 1e-12;
+  ref.abs_tol = 1e-14;
+  const double phi_ref = runFig7(ref).summary.phi_net_deg;
+  for (double tol : {1e-4, 1e-6, 1e-8, 1e-10}) {
+    AnalyticSettings s;
+    s.rel_tol = tol;
+    s.abs_tol = tol * 1e-2;
+    const RunResult r = runFig7(s);
+    const double err = std::abs(r.summary.phi_net_deg - phi_ref);
+    std::printf("rel_tol %.0e: phi_net %.10f deg, err %.2e, steps %ld\n", tol, r.summary.phi_net_deg, err,
+                r.summary.solver_steps);
+    EXPECT_LE(err, std::max(prev_err, 1e-9));
+    prev_err = err;
+  }
+  EXPECT_LT(prev_err, 1e-6);
+}
+
+TEST(AnalyticSimulation, FixedStepConvergesToEventLocatedResult) {
+  const double phi_ref = runFig7().summary.phi_net_deg;
+  double prev = 1e9;
+  for (double h : {1e-3, 1e-4, 1e-5}) {
+    AnalyticSettings s;
+    s.solver = "fixed";
+    s.fixed_dt_s = h;
+    const double err = std::abs(runFig7(s).summary.phi_net_deg - phi_ref);
+    std::printf("fixed h %.0e: err %.3e deg\n", h, err);
+    EXPECT_LT(err, prev);
+    prev = err;
+  }
+  EXPECT_LT(prev, 1e-3);
+}
+
+TEST(AnalyticSimulation, ContinuousLawRunsAndStops) {
+  Effects e;
+  e.friction = FrictionLaw::kContinuous;
+  const RunResult r = runFig7({}, e);
+  ASSERT_TRUE(r.summary.ok) << r.summary.error;
+  EXPECT_TRUE(std::isfinite(r.summary.phi_net_deg));
+  EXPECT_LT(std::abs(r.summary.extra.at("final_phidot_dps")), 1.0);
+}
+
+TEST(AnalyticSimulation, SwappedFrictionBreaksAwayAtTheLargerCoefficient) {
+  // READING-NOTES point 1: breakaway at max(mu_s, mu_d). Printed (0.25 / 0.30) and
+  // mu_s = mu_d = 0.30 behave identically; swapping (0.30 / 0.25) slides further.
+  RobotParams printed = paperRobot(1), same = paperRobot(1), swapped = paperRobot(1);
+  same.friction.mu_s = 0.30;
+  swapped.friction.mu_s = 0.30;
+  swapped.friction.mu_d = 0.25;
+  const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);
+  const double a = simulateAnalytic(printed, tr, {}, {}, {}).summary.phi_net_deg;
+  const double b = simulateAnalytic(same, tr, {}, {}, {}).summary.phi_net_deg;
+  const double c = simulateAnalytic(swapped, tr, {}, {}, {}).summary.phi_net_deg;
+  EXPECT_EQ(a, b);
+  EXPECT_GT(std::abs(c), std::abs(a));
+}
