@@ -1,2 +1,150 @@
-// tailsim command line (placeholder until the commands are wired).
-int main() { return 0; }
+// tailsim: how much can a planar robotic tail turn a standing quadruped?
+//   tailsim run EXPERIMENT.yaml --out DIR      both models as the experiment lists, results in DIR
+//   tailsim plot DIR | tailsim report DIR      figures / Markdown report from saved results
+//   tailsim render EXPERIMENT.yaml --out DIR   headless MP4 + PNG of each case
+//   tailsim mjcf --links N --out FILE          the MuJoCo model of the paper robot
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "experiments/experiment_loader.h"
+#include "experiments/experiment_runner.h"
+#include "experiments/render_case.h"
+#include "mujoco_model/mjcf_generator.h"
+#include "plotting/plots.h"
+#include "plotting/report.h"
+
+using namespace tailsim;
+namespace fs = std::filesystem;
+
+namespace {
+
+void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite) {
+  // A short table of phi_net per case and model, read back from the result folders.
+  for (const Experiment& e : suite) {
+    const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
+    std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
+    if (e.cases.size() > 12) {
+      std::printf("  %zu cases (see %s/summary.json)\n", e.cases.size(), dir.c_str());
+      continue;
+    }
+    for (const ExperimentCase& c : e.cases) {
+      std::printf("  %-40s", c.name.c_str());
+      std::ifstream in(dir / "cases" / caseDirName(c.name) / "result.json");
+      if (!in) { std::printf(" (not run)\n"); continue; }
+      const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+      if (j.is_discarded() || !j.contains("runs")) { std::printf(" (unreadable)\n"); continue; }
+      for (const auto& [model, r] : j["runs"].items()) {
+        if (!r.value("ok", false)) std::printf(" %s: FAILED (%s)", model.c_str(), r.value("error", std::string()).c_str());
+        else if (r["phi_net_deg"].is_number())
+          std::printf(" %s: phi_net %+.3f deg (%.2f ms)", model.c_str(), r["phi_net_deg"].get<double>(),
+                      1e3 * r.value("wall_time_s", 0.0));
+        else std::printf(" %s: ok", model.c_str());
+      }
+      std::printf("\n");
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tailsim: quadruped yaw turning with a planar robotic tail (Rone & Ben-Tzvi 2016)"};
+  app.require_subcommand(1);
+
+  std::string exp_path, out_dir, case_name;
+  int threads = 0;
+  bool no_render = false, fresh = false, quiet = false, plots = false;
+  auto* run = app.add_subcommand("run", "run an experiment (or a suite such as configs/paper/all.yaml)");
+  run->add_option("experiment", exp_path, "experiment YAML")->required()->check(CLI::ExistingFile);
+  run->add_option("--out", out_dir, "result folder")->required();
+  run->add_option("--threads", threads, "worker threads (default: all cores)");
+  run->add_option("--case", case_name, "run only this case");
+  run->add_flag("--no-render", no_render, "skip the render section");
+  run->add_flag("--fresh", fresh, "recompute finished cases instead of resuming");
+  run->add_flag("--quiet", quiet, "no progress line");
+  run->add_flag("--plot", plots, "draw the plots and the report afterwards");
+
+  int links = 1;
+  std::string mjcf_out;
+  auto* mjcf = app.add_subcommand("mjcf", "write the MuJoCo model (MJCF) of the paper robot");
+  mjcf->add_option("--links", links, "tail links n (1..6)")->check(CLI::Range(1, 6));
+  mjcf->add_option("--out", mjcf_out, "output .xml")->required();
+
+  std::string render_out = "renders";
+  auto* render = app.add_subcommand("render", "render each case of an experiment to MP4 + PNG (headless)");
+  render->add_option("experiment", exp_path, "experiment YAML")->required()->check(CLI::ExistingFile);
+  render->add_option("--case", case_name, "render only this case");
+  render->add_option("--out", render_out, "output folder (default: renders/)");
+
+  std::string result_dir;
+  auto* plot = app.add_subcommand("plot", "redraw the figures of a result folder (no simulation)");
+  plot->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
+  auto* report = app.add_subcommand("report", "write DIR/report.md: plots and the paper's findings checked");
+  report->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
+
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (*run) {
+      const std::vector<Experiment> suite = loadExperimentSuite(exp_path);  // all errors before any work
+      RunOptions o;
+      o.out_dir = out_dir;
+      o.threads = threads;
+      o.render = !no_render;
+      o.resume = !fresh;
+      o.progress = !quiet;
+      o.only_case = case_name;
+      const RunStats s = runSuite(suite, o);
+      std::printf("%d cases: %d run, %d resumed, %d failed model runs, %.3f s wall\n", s.total, s.ran, s.resumed,
+                  s.failed, s.wall_time_s);
+      printCases(suite, out_dir, suite.size() > 1);
+      if (plots) std::printf("report: %s\n", writeReport(out_dir).c_str());
+      return s.failed ? 2 : 0;
+    }
+    if (*mjcf) {
+      writeMjcfFile(links, mjcf_out);
+      std::printf("wrote %s\n", mjcf_out.c_str());
+      return 0;
+    }
+    if (*render) {
+      const std::vector<Experiment> suite = loadExperimentSuite(exp_path);
+      for (const Experiment& e : suite) {
+        const fs::path dir = fs::path(render_out) / e.name;
+        for (ExperimentCase c : e.cases) {
+          if (!case_name.empty() && c.name != case_name) continue;
+          if (!c.render.enabled) c.render.enabled = true;  // defaults when the file has no render section
+          checkRenderPrerequisites(c.render, dir.string());  // before simulating
+          if (c.kind != "simulate") throw std::runtime_error("only kind: simulate experiments can be rendered");
+          c.models = {"analytic", "mujoco"};
+          const std::vector<RunResult> runs = runCase(c);
+          for (const RunResult& r : runs)
+            if (!r.summary.ok) std::fprintf(stderr, "warning: %s run failed: %s\n", r.summary.model.c_str(), r.summary.error.c_str());
+          const RenderStats st = renderCase(c, runs, dir.string());
+          std::printf("%s/%s.mp4: %ld frames %dx%d, %.1f frames/s\n", dir.c_str(), caseDirName(c.name).c_str(),
+                      st.frames, st.width, st.height, st.fps);
+        }
+      }
+      return 0;
+    }
+    if (*plot) {
+      const auto files = plotResults(result_dir);
+      for (const auto& f : files) std::printf("%s\n", f.png.c_str());
+      return 0;
+    }
+    if (*report) {
+      std::printf("%s\n", writeReport(result_dir).c_str());
+      return 0;
+    }
+  } catch (const ConfigError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -28,6 +28,7 @@ struct ExperimentCase {
   std::string experiment;   // experiment name
   std::string name;         // case name: "base" or "key=value,key=value" for sweeps
   std::string source_file;  // the YAML file it came from
+  std::string robot_file;   // the robot file it names (absolute)
   std::map<std::string, std::string> sweep_values;  // swept key -> value as written
 
   std::string kind = "simulate";  // "simulate" | "pose"

@@ -733,7 +733,8 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   const Item& robotItem = r.need(top, "robot");
   const std::string robotRel = r.string(robotItem);
   if (robotRel.empty()) r.fail(robotItem, "needs the path of a robot file");
-  const RobotFile& rf = L.robot(resolveRelative(source, robotRel), r.loc(robotItem));
+  c.robot_file = resolveRelative(source, robotRel);
+  const RobotFile& rf = L.robot(c.robot_file, r.loc(robotItem));
   c.robot = rf.base;
   Origins origin = rf.origin;
 

@@ -1,0 +1,233 @@
+#include "experiments/experiment_runner.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "analytic_model/analytic_simulation.h"
+#include "experiments/render_case.h"
+#include "mujoco_model/mujoco_simulation.h"
+#include "results/atomic_file.h"
+
+namespace tailsim {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// Identifies the configuration a finished case was computed from: a resumed case must come
+// from the same experiment text (and robot file), else it is recomputed.
+std::string fingerprint(const Experiment& e) {
+  std::string text = readText(e.source_file);
+  if (!e.cases.empty()) text += readText(e.cases.front().robot_file);
+  return std::to_string(std::hash<std::string>{}(text));
+}
+
+json summaryJson(const RunSummary& s) {
+  json j;
+  j["ok"] = s.ok;
+  j["phi_net_deg"] = std::isfinite(s.phi_net_deg) ? json(s.phi_net_deg) : json(nullptr);
+  j["t_stop_s"] = s.t_stop_s;
+  j["stick_slip_events"] = s.stick_slip_events;
+  j["wall_time_s"] = s.wall_time_s;
+  j["solver_steps"] = s.solver_steps;
+  if (!s.error.empty()) j["error"] = s.error;
+  for (const auto& [k, v] : s.extra) j["extra"][k] = std::isfinite(v) ? json(v) : json(nullptr);
+  return j;
+}
+
+std::string fmtSeconds(double s) {
+  char b[32];
+  if (s < 60) std::snprintf(b, sizeof b, "%.1f s", s);
+  else std::snprintf(b, sizeof b, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  return b;
+}
+
+}  // namespace
+
+std::string caseDirName(const std::string& name) {
+  std::string d;
+  for (char ch : name) d += (std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '-' || ch == '=' ||
+                             ch == ',' || ch == '_') ? ch : '_';
+  return d.empty() ? "base" : d;
+}
+
+std::vector<RunResult> runCase(const ExperimentCase& c) {
+  std::vector<RunResult> out;
+  if (c.kind == "pose") {
+    std::vector<JointState> js(c.robot.numLinks());
+    for (size_t i = 0; i < js.size(); ++i)
+      js[i] = {c.pose.theta_rad.at(i), c.pose.thetadot_radps.at(i), c.pose.thetaddot_radps2.at(i)};
+    out.push_back(evaluatePose(c.robot, js, c.effects));
+    return out;
+  }
+  const TailTrajectory traj = c.trajectory();
+  for (const std::string& m : c.models) {
+    if (m == "analytic") {
+      out.push_back(simulateAnalytic(c.robot, traj, c.analytic, c.effects, c.output));
+    } else if (m == "mujoco") {
+      try {
+        out.push_back(simulateMujoco(c.robot, traj, c.mujoco, c.effects, c.output));
+      } catch (const std::exception& e) {
+        RunResult r;
+        r.summary.model = "mujoco";
+        r.summary.ok = false;
+        r.summary.error = e.what();
+        out.push_back(std::move(r));
+      }
+    }
+  }
+  return out;
+}
+
+RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  RunStats stats;
+  std::vector<size_t> todo_all;
+  for (size_t i = 0; i < e.cases.size(); ++i)
+    if (opt.only_case.empty() || e.cases[i].name == opt.only_case) todo_all.push_back(i);
+  if (todo_all.empty()) throw std::runtime_error("experiment " + e.name + " has no case named '" + opt.only_case + "'");
+  stats.total = static_cast<int>(todo_all.size());
+
+  const fs::path root(opt.out_dir);
+  fs::create_directories(root / "cases");
+  writeFileAtomic((root / "experiment.yaml").string(), readText(e.source_file));
+  const std::string fp = fingerprint(e);
+
+  // Render prerequisites are checked before anything runs (issue 5).
+  const bool render = opt.render && !e.cases.empty() && e.cases.front().render.enabled;
+  if (render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
+
+  // Finished cases (resume).
+  std::vector<json> entries(e.cases.size());
+  std::vector<size_t> todo;
+  for (size_t i : todo_all) {
+    const fs::path rj = root / "cases" / caseDirName(e.cases[i].name) / "result.json";
+    if (opt.resume && fs::exists(rj)) {
+      try {
+        std::ifstream in(rj);
+        json j = json::parse(in);
+        if (j.value("fingerprint", std::string()) == fp && j.value("name", std::string()) == e.cases[i].name) {
+          entries[i] = std::move(j);
+          ++stats.resumed;
+          continue;
+        }
+      } catch (const std::exception&) {
+        // unreadable: recompute
+      }
+    }
+    todo.push_back(i);
+  }
+  if (opt.max_new_cases >= 0 && static_cast<long>(todo.size()) > opt.max_new_cases) todo.resize(opt.max_new_cases);
+
+  std::atomic<size_t> next{0};
+  std::atomic<int> done{0}, failed{0};
+  std::mutex mu;
+  std::condition_variable cv;
+  std::string first_error;
+  auto worker = [&]() {
+    for (;;) {
+      const size_t k = next.fetch_add(1);
+      if (k >= todo.size()) return;
+      const size_t i = todo[k];
+      const ExperimentCase& c = e.cases[i];
+      try {
+        const std::vector<RunResult> runs = runCase(c);
+        const fs::path dir = root / "cases" / caseDirName(c.name);
+        fs::create_directories(dir);
+        json j;
+        j["name"] = c.name;
+        j["dir"] = caseDirName(c.name);
+        j["fingerprint"] = fp;
+        j["sweep"] = json::object();
+        for (const auto& [key, v] : c.sweep_values) j["sweep"][key] = v;
+        j["runs"] = json::object();
+        for (const RunResult& r : runs) {
+          writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), r.series);
+          j["runs"][r.summary.model] = summaryJson(r.summary);
+          if (!r.summary.ok) ++failed;
+        }
+        if (render) renderCase(c, runs, (root / "renders").string());
+        writeFileAtomic((dir / "result.json").string(), j.dump(1));  // last: marks the case finished
+        entries[i] = std::move(j);
+      } catch (const std::exception& ex) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (first_error.empty()) first_error = "case " + c.name + ": " + ex.what();
+      }
+      ++done;
+      cv.notify_all();
+    }
+  };
+  const int n_threads = std::max(1, std::min<int>(opt.threads > 0 ? opt.threads : std::thread::hardware_concurrency(),
+                                                  static_cast<int>(todo.size())));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < n_threads && !todo.empty(); ++t) pool.emplace_back(worker);
+  if (opt.progress && !todo.empty()) {
+    std::unique_lock<std::mutex> lock(mu);
+    int shown = -1;
+    while (done.load() < static_cast<int>(todo.size())) {
+      cv.wait_for(lock, std::chrono::milliseconds(500));
+      const int d = done.load();
+      if (d == shown) continue;
+      shown = d;
+      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+      const double eta = d > 0 ? el / d * (todo.size() - d) : 0.0;
+      std::fprintf(stderr, "\r[%s] %d/%zu cases (%d resumed), %s elapsed, ETA %s   ", e.name.c_str(),
+                   d + stats.resumed, todo_all.size(), stats.resumed, fmtSeconds(el).c_str(), fmtSeconds(eta).c_str());
+    }
+    std::fprintf(stderr, "\n");
+  }
+  for (auto& th : pool) th.join();
+  if (!first_error.empty()) throw std::runtime_error(first_error);
+  stats.ran = static_cast<int>(todo.size());
+  stats.failed = failed.load();
+
+  // summary.json: every finished case in experiment order.
+  json s;
+  s["experiment"] = e.name;
+  s["description"] = e.description;
+  s["source"] = e.source_file;
+  s["kind"] = e.cases.empty() ? "simulate" : e.cases.front().kind;
+  s["swept_keys"] = e.swept_keys;
+  s["cases"] = json::array();
+  for (size_t i = 0; i < e.cases.size(); ++i)
+    if (!entries[i].is_null()) s["cases"].push_back(entries[i]);
+  writeFileAtomic((root / "summary.json").string(), s.dump(1));
+  stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return stats;
+}
+
+RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& opt) {
+  if (suite.size() == 1) return runExperiment(suite.front(), opt);
+  RunStats total;
+  const auto wall0 = std::chrono::steady_clock::now();
+  for (const Experiment& e : suite) {
+    RunOptions o = opt;
+    o.out_dir = (fs::path(opt.out_dir) / e.name).string();
+    const RunStats s = runExperiment(e, o);
+    total.total += s.total;
+    total.ran += s.ran;
+    total.resumed += s.resumed;
+    total.failed += s.failed;
+  }
+  total.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return total;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,42 @@
+// Runs the cases of an experiment on worker threads and writes its result folder
+// (docs/ARCHITECTURE.md): one folder per case, written the moment the case finishes, so an
+// interrupted sweep run again resumes without redoing or losing finished cases.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_config.h"
+#include "experiments/experiment_loader.h"
+#include "results/time_series.h"
+
+namespace tailsim {
+
+struct RunOptions {
+  std::string out_dir;           // result folder (a suite writes out_dir/<experiment>/)
+  int threads = 0;               // worker threads; 0 = all cores
+  bool progress = true;          // done/total, elapsed and ETA on stderr
+  bool render = true;            // render cases whose experiment has a render section
+  bool resume = true;            // skip cases whose result.json matches this configuration
+  std::string only_case;         // run just this case ("" = all)
+  long max_new_cases = -1;       // stop after this many newly run cases (tests of resuming)
+};
+
+struct RunStats {
+  int total = 0;     // cases in the experiment(s)
+  int ran = 0;       // cases run now
+  int resumed = 0;   // cases found finished and skipped
+  int failed = 0;    // model runs with ok == false
+  double wall_time_s = 0;
+};
+
+// All models of one case (no files written). Pose cases evaluate the analytic model only.
+std::vector<RunResult> runCase(const ExperimentCase& c);
+
+// The folder name of a case under DIR/cases/.
+std::string caseDirName(const std::string& case_name);
+
+RunStats runExperiment(const Experiment& e, const RunOptions& options);
+RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& options);
+
+}  // namespace tailsim

@@ -1,0 +1,31 @@
+#include "experiments/render_case.h"
+
+#include <filesystem>
+
+#include "experiments/experiment_runner.h"
+#include "mujoco_model/mjcf_generator.h"
+
+namespace tailsim {
+
+RenderStats renderCase(const ExperimentCase& c, const std::vector<RunResult>& runs, const std::string& out_dir) {
+  const RunResult* mj = nullptr;
+  const RunResult* an = nullptr;
+  for (const RunResult& r : runs) {
+    if (r.summary.model == "mujoco") mj = &r;
+    if (r.summary.model == "analytic") an = &r;
+  }
+  if (!mj && !an) throw std::runtime_error("case " + c.name + ": nothing to render (no model ran)");
+  const TailTrajectory traj = c.trajectory();
+  RenderInputs in;
+  in.robot = &c.robot;
+  in.trajectory = &traj;
+  in.mujoco = mj ? &mj->series : &an->series;
+  in.analytic = (mj && an && c.render.ghost) ? &an->series : nullptr;
+  in.mjcf_xml = generateMjcf(c.robot, c.mujoco, c.effects);
+  in.title = c.experiment + (c.name == "base" ? "" : " " + c.name);
+  std::filesystem::create_directories(out_dir);
+  const std::string stem = (std::filesystem::path(out_dir) / caseDirName(c.name)).string();
+  return renderVideo(in, c.render, stem + ".mp4", stem + ".png");
+}
+
+}  // namespace tailsim

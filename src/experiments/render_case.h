@@ -1,0 +1,16 @@
+// Video of one experiment case (issue 5): the MuJoCo model with the analytic model as a ghost.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_config.h"
+#include "rendering/video_renderer.h"
+
+namespace tailsim {
+
+// Renders <out_dir>/<case dir>.mp4 and .png from the case's runs (MuJoCo poses the model, the
+// analytic run the ghost; without a MuJoCo run the analytic run poses the model, no ghost).
+RenderStats renderCase(const ExperimentCase& c, const std::vector<RunResult>& runs, const std::string& out_dir);
+
+}  // namespace tailsim
