@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mujoco_model/mjcf_generator.h"
@@ -341,6 +343,40 @@ TEST(RenderVideo, GhostAndCameraChangeThePicture) {
   // The analytic ghost (phi 3x the MuJoCo one) sits elsewhere: a visible set of pixels changes.
   EXPECT_GT(differing(a, b), 800);
   EXPECT_GT(differing(a, cp), 8000);
+}
+
+// Cases render on the experiment runner's worker threads: two renders at once, each in its
+// own OSMesa context, give the same pictures as one at a time.
+TEST(RenderVideo, ConcurrentRendersOnTwoThreads) {
+  TempDir dir;
+  Case c1 = makeCase(1, 0.3), c2 = makeCase(2, 0.3);
+  RenderSettings s = smallSettings();
+  RenderInputs in1{&c1.robot, &c1.traj, &c1.mujoco, &c1.analytic, c1.xml, ""};
+  RenderInputs in2{&c2.robot, &c2.traj, &c2.mujoco, &c2.analytic, c2.xml, ""};
+  renderVideo(in1, s, dir / "ref1.mp4", dir / "ref1.png");
+  renderVideo(in2, s, dir / "ref2.mp4", dir / "ref2.png");
+  std::string err1, err2;
+  std::thread t1([&] {
+    try {
+      renderVideo(in1, s, dir / "a1.mp4", dir / "a1.png");
+    } catch (const std::exception& e) {
+      err1 = e.what();
+    }
+  });
+  std::thread t2([&] {
+    try {
+      renderVideo(in2, s, dir / "a2.mp4", dir / "a2.png");
+    } catch (const std::exception& e) {
+      err2 = e.what();
+    }
+  });
+  t1.join();
+  t2.join();
+  EXPECT_EQ(err1, "");
+  EXPECT_EQ(err2, "");
+  EXPECT_EQ(decodeRgb(dir / "a1.png"), decodeRgb(dir / "ref1.png"));
+  EXPECT_EQ(decodeRgb(dir / "a2.png"), decodeRgb(dir / "ref2.png"));
+  EXPECT_EQ(ffprobe(dir / "a2.mp4").frames, 4);
 }
 
 // ---------------------------------------------------------------- errors

@@ -3,13 +3,25 @@
 #include <GL/osmesa.h>
 
 #include <algorithm>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
 namespace tailsim {
 
+namespace {
+// Context creation and MuJoCo's GL setup (mjr_makeContext loads GL entry points into MuJoCo's
+// process-wide function table) are serialized: cases render on several worker threads. Frames
+// themselves render concurrently, each thread in its own OSMesa context.
+std::mutex& glSetupMutex() {
+  static std::mutex m;
+  return m;
+}
+}  // namespace
+
 OsMesaContext::OsMesaContext(int width, int height) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("OSMesa context needs a positive size");
+  std::lock_guard<std::mutex> lock(glSetupMutex());
   OSMesaContext ctx = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 0, nullptr);
   if (!ctx)
     throw std::runtime_error(
@@ -25,11 +37,13 @@ OsMesaContext::OsMesaContext(int width, int height) {
 }
 
 OsMesaContext::~OsMesaContext() {
+  std::lock_guard<std::mutex> lock(glSetupMutex());
   if (ctx_) OSMesaDestroyContext(static_cast<OSMesaContext>(ctx_));
 }
 
 MjOffscreen::MjOffscreen(mjModel* m, int width, int height, int msaa, int maxgeom)
     : gl_(width, height), width_(width), height_(height) {
+  std::lock_guard<std::mutex> lock(glSetupMutex());
   m->vis.global.offwidth = std::max(m->vis.global.offwidth, width);
   m->vis.global.offheight = std::max(m->vis.global.offheight, height);
   m->vis.quality.offsamples = msaa;
@@ -47,6 +61,7 @@ MjOffscreen::MjOffscreen(mjModel* m, int width, int height, int msaa, int maxgeo
 }
 
 MjOffscreen::~MjOffscreen() {
+  std::lock_guard<std::mutex> lock(glSetupMutex());
   mjr_freeContext(&con_);
   mjv_freeScene(&scn_);
 }

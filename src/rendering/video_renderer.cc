@@ -4,6 +4,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -172,7 +178,7 @@ struct RenderRig {
   mjvCamera cam;
   GhostShape ghost;
   double look_z = 0.1;
-  std::vector<uint8_t> pixels, flipped;
+  std::vector<uint8_t> pixels;
 };
 
 void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
@@ -219,11 +225,20 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
     r.cam.distance = 1.35 * radius / std::tan(half_fov);
   }
   r.pixels.resize(static_cast<size_t>(s.width) * s.height * 3);
-  r.flipped.resize(r.pixels.size());
+}
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point& t0) {
+  const Clock::time_point t1 = Clock::now();
+  const double s = std::chrono::duration<double>(t1 - t0).count();
+  t0 = t1;
+  return s;
 }
 
 // Poses the model (and ghost) for simulated time t and renders into the off-screen buffer.
-void renderFrame(RenderRig& r, const RenderInputs& in, const RenderSettings& s, double t) {
+void renderFrame(RenderRig& r, const RenderInputs& in, const RenderSettings& s, double t,
+                 RenderStats* stats = nullptr) {
+  Clock::time_point tic = Clock::now();
   const mjModel* m = r.model.get();
   mjData* d = r.data.get();
   const PlanarState st = r.mujoco->at(t);
@@ -241,6 +256,7 @@ void renderFrame(RenderRig& r, const RenderInputs& in, const RenderSettings& s, 
     ghost = r.analytic->at(t);
     addGhost(scn, r.ghost, *in.robot, *ghost);
   }
+  if (stats) stats->pose_s += since(tic);
   const mjrRect vp = r.gl->viewport();
   mjr_render(vp, &scn, &r.gl->context());
 
@@ -267,15 +283,7 @@ void renderFrame(RenderRig& r, const RenderInputs& in, const RenderSettings& s, 
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, vp, l.c_str(), v.c_str(), &r.gl->context());
   std::snprintf(left, sizeof(left), "%gx slow motion", s.slowmo);
   mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMRIGHT, vp, left, nullptr, &r.gl->context());
-}
-
-// mjr_readPixels returns rows bottom to top; video wants top to bottom.
-const uint8_t* readFrame(RenderRig& r, const RenderSettings& s) {
-  mjr_readPixels(r.pixels.data(), nullptr, r.gl->viewport(), &r.gl->context());
-  const size_t row = static_cast<size_t>(s.width) * 3;
-  for (int y = 0; y < s.height; ++y)
-    std::memcpy(r.flipped.data() + row * y, r.pixels.data() + row * (s.height - 1 - y), row);
-  return r.flipped.data();
+  if (stats) stats->render_s += since(tic);
 }
 
 void checkMujocoWarnings(const mjData* d) {
@@ -297,6 +305,90 @@ FrameTimes frameTimes(const RenderRig& r, const RenderSettings& s) {
   f.frames = static_cast<long>(std::floor((f.t_end - f.t_start) * s.fps * s.slowmo + 1e-9)) + 1;
   return f;
 }
+
+// Hands frames from the GL thread to a writer thread (which feeds ffmpeg), so rendering frame
+// k+1 overlaps encoding frame k. A fixed set of buffers bounds the memory; the writer's first
+// exception is rethrown to the GL thread. The destructor stops and joins the writer (no frame
+// is written after an exception).
+class FramePipeline {
+ public:
+  using Consumer = std::function<void(long frame, const uint8_t* rows_bottom_up)>;
+  FramePipeline(size_t frame_bytes, int buffers, Consumer consume) : consume_(std::move(consume)) {
+    for (int i = 0; i < buffers; ++i) {
+      store_.emplace_back(frame_bytes);
+      free_.push_back(store_.back().data());
+    }
+    writer_ = std::thread([this] { writerLoop(); });
+  }
+  ~FramePipeline() {
+    {
+      std::lock_guard<std::mutex> lk(mu_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    writer_.join();
+  }
+  FramePipeline(const FramePipeline&) = delete;
+  FramePipeline& operator=(const FramePipeline&) = delete;
+
+  // A free buffer (blocks while the writer is behind).
+  uint8_t* acquire() {
+    std::unique_lock<std::mutex> lk(mu_);
+    cv_.wait(lk, [this] { return !free_.empty() || error_; });
+    if (error_) std::rethrow_exception(error_);
+    uint8_t* b = free_.front();
+    free_.pop_front();
+    return b;
+  }
+  void submit(long frame, uint8_t* buffer) {
+    {
+      std::lock_guard<std::mutex> lk(mu_);
+      ready_.push_back({frame, buffer});
+    }
+    cv_.notify_all();
+  }
+  // Waits until every submitted frame is consumed; rethrows the writer's exception.
+  void drain() {
+    std::unique_lock<std::mutex> lk(mu_);
+    cv_.wait(lk, [this] { return (ready_.empty() && !busy_) || error_; });
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  void writerLoop() {
+    std::unique_lock<std::mutex> lk(mu_);
+    for (;;) {
+      cv_.wait(lk, [this] { return !ready_.empty() || stop_; });
+      if (stop_ || error_) return;
+      const auto [frame, buf] = ready_.front();
+      ready_.pop_front();
+      busy_ = true;
+      lk.unlock();
+      std::exception_ptr err;
+      try {
+        consume_(frame, buf);
+      } catch (...) {
+        err = std::current_exception();
+      }
+      lk.lock();
+      busy_ = false;
+      free_.push_back(buf);
+      if (err) error_ = err;
+      cv_.notify_all();
+      if (error_) return;
+    }
+  }
+
+  Consumer consume_;
+  std::vector<std::vector<uint8_t>> store_;
+  std::deque<uint8_t*> free_;
+  std::deque<std::pair<long, uint8_t*>> ready_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  bool stop_ = false, busy_ = false;
+  std::exception_ptr error_;
+  std::thread writer_;
+};
 
 }  // namespace
 
@@ -331,30 +423,51 @@ RenderStats renderVideo(const RenderInputs& in, const RenderSettings& settings, 
   st.height = settings.height;
   st.sim_start_s = ft.t_start;
   st.poster_time_s = ft.t_start + poster * dt_frame;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   FfmpegSink video(exe, FfmpegSink::Kind::kMp4, settings.width, settings.height, settings.fps, settings.crf,
                    settings.preset, mp4_path);
   std::optional<FfmpegSink> png;
-  for (long k = 0; k < ft.frames; ++k) {
-    const double t = ft.t_start + k * dt_frame;
-    renderFrame(rig, in, settings, t);
-    const uint8_t* rgb = readFrame(rig, settings);
-    video.writeFrame(rgb);
-    if (k == poster && !png_path.empty()) {
-      png.emplace(exe, FfmpegSink::Kind::kPng, settings.width, settings.height, 1, 0, "", png_path);
-      png->writeFrame(rgb);
-      png->finish();
+  const int w = settings.width, h = settings.height;
+  std::vector<uint8_t> flipped(static_cast<size_t>(w) * h * 3);
+  double encode_s = 0.0;  // writer thread only, read after drain()
+  {
+    // Writer thread: flip rows (mjr_readPixels is bottom-up), feed ffmpeg, the poster too.
+    FramePipeline pipe(flipped.size(), 3, [&](long k, const uint8_t* bottom_up) {
+      Clock::time_point tic = Clock::now();
+      const size_t row = static_cast<size_t>(w) * 3;
+      for (int y = 0; y < h; ++y) std::memcpy(flipped.data() + row * y, bottom_up + row * (h - 1 - y), row);
+      video.writeFrame(flipped.data());
+      if (k == poster && !png_path.empty()) {
+        png.emplace(exe, FfmpegSink::Kind::kPng, w, h, 1, 0, "", png_path);
+        png->writeFrame(flipped.data());
+        png->finish();
+      }
+      encode_s += since(tic);
+    });
+    for (long k = 0; k < ft.frames; ++k) {
+      const double t = ft.t_start + k * dt_frame;
+      renderFrame(rig, in, settings, t, &st);
+      Clock::time_point tic = Clock::now();
+      uint8_t* buf = pipe.acquire();
+      st.encode_s += since(tic);  // GL thread blocked because the encoder is behind
+      mjr_readPixels(buf, nullptr, rig.gl->viewport(), &rig.gl->context());
+      st.read_s += since(tic);
+      pipe.submit(k, buf);
+      st.sim_end_s = t;
     }
-    st.sim_end_s = t;
+    checkMujocoWarnings(rig.data.get());
+    if (mjr_getError()) throw std::runtime_error("rendering: OpenGL error while rendering");
+    Clock::time_point tic = Clock::now();
+    pipe.drain();
+    video.finish();
+    st.encode_s += since(tic);
   }
-  checkMujocoWarnings(rig.data.get());
-  if (mjr_getError()) throw std::runtime_error("rendering: OpenGL error while rendering");
-  video.finish();
+  st.writer_s = encode_s;
   // Both files complete: publish them (any failure above leaves neither under its final name).
   video.commit();
   if (png) png->commit();
   st.frames = ft.frames;
-  st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  st.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   st.fps = st.frames / st.seconds;
   return st;
 }

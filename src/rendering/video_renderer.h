@@ -34,6 +34,13 @@ struct RenderStats {
   double sim_start_s = 0.0, sim_end_s = 0.0;  // simulated time shown
   int width = 0, height = 0;
   double poster_time_s = 0.0;  // simulated time of the poster frame
+  // Where the wall time went (seconds, summed over frames). GL thread:
+  double pose_s = 0.0;    // series interpolation, kinematics, mjv_updateScene, ghost
+  double render_s = 0.0;  // mjr_render + mjr_overlay (GL commands; llvmpipe rasterizes lazily)
+  double read_s = 0.0;    // mjr_readPixels (waits for the rasterizer)
+  double encode_s = 0.0;  // blocked waiting for the writer thread (encoder behind) + final flush
+  // Writer thread (runs concurrently): vertical flip + pipe writes to ffmpeg + poster.
+  double writer_s = 0.0;
 };
 
 // Renders the case to `mp4_path` (H.264, yuv420p, settings.fps) and a PNG poster frame to
