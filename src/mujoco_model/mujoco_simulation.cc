@@ -95,21 +95,21 @@ double worldZ(const mjData* d, int body, const mjtNum* w) {
 // Fills one output row. Kinematics, contacts, qacc in d belong to the state (qpos, qvel) at time t
 // (the step that started at t has just run, only d->qpos / d->qvel / d->time moved on).
 void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, const TailController& ctrl,
-             const std::vector<mjtNum>& qpos, const std::vector<mjtNum>& qvel, double t_grid, double phi,
-             std::vector<double>& row) {
+             const std::vector<mjtNum>& qpos, const std::vector<mjtNum>& qvel, const std::vector<mjtNum>& qacc,
+             double t_grid, double phi, std::vector<mjtNum>& scratch, std::vector<double>& row) {
   const int n = static_cast<int>(L.tail_qposadr.size());
   row[c.t] = t_grid;
   for (int i = 0; i < n; ++i) {
     row[c.theta[i]] = qpos[L.tail_qposadr[i]] * kRad2Deg;
     row[c.thetadot[i]] = qvel[L.tail_dofadr[i]] * kRad2Deg;
-    row[c.thetaddot[i]] = d->qacc[L.tail_dofadr[i]] * kRad2Deg;  // actual (MuJoCo's), not the reference
+    row[c.thetaddot[i]] = qacc[L.tail_dofadr[i]] * kRad2Deg;  // actual, not the reference
     row[c.track_err[i]] = ctrl.lastError(i) * kRad2Deg;
   }
   row[c.x] = d->xpos[3 * L.quad_body];  // quadruped COM = body origin
   row[c.y] = d->xpos[3 * L.quad_body + 1];
   row[c.phi] = phi * kRad2Deg;
   const double phidot = worldZ(d, L.quad_body, qvel.data() + L.root_dofadr);
-  const double phiddot = worldZ(d, L.quad_body, d->qacc + L.root_dofadr);
+  const double phiddot = worldZ(d, L.quad_body, qacc.data() + L.root_dofadr);
   row[c.phidot] = phidot * kRad2Deg;
   row[c.phiddot] = phiddot * kRad2Deg;
 
@@ -130,11 +130,16 @@ void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, con
   // Tail load on the body: minus the interaction force of the tail's first link with its parent.
   // cfrc_int is (torque, force) at subtree_com of the root body = the system COM, world axes, so
   // its z torque is already M_z,T about the system COM (Eq. 13). mj_rnePostConstraint reads
-  // d->qvel: give it the velocities of time t.
-  std::vector<mjtNum> qvel_next(d->qvel, d->qvel + m->nv);
+  // d->qvel and d->qacc: give it the velocities of time t and the accelerations the integrator
+  // actually applied over the step.
+  scratch.resize(2 * m->nv);
+  std::copy(d->qvel, d->qvel + m->nv, scratch.begin());
+  std::copy(d->qacc, d->qacc + m->nv, scratch.begin() + m->nv);
   std::copy(qvel.begin(), qvel.end(), d->qvel);
+  std::copy(qacc.begin(), qacc.end(), d->qacc);
   mj_rnePostConstraint(m, d);
-  std::copy(qvel_next.begin(), qvel_next.end(), d->qvel);
+  std::copy(scratch.begin(), scratch.begin() + m->nv, d->qvel);
+  std::copy(scratch.begin() + m->nv, scratch.end(), d->qacc);
   const mjtNum* fint = d->cfrc_int + 6 * L.link1_body;
   row[c.mzt] = -fint[2];
   row[c.ftx] = -fint[3];
@@ -263,7 +268,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   const long num_samples = static_cast<long>(std::floor(duration / output.sample_dt_s + 1e-9)) + 1;
   const double eps = 1e-6 * h;
   long k = 0;
-  std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv);
+  std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv), qacc_t(m->nv), scratch;
   double phi = yawOf(d, L.quad_body), yaw_prev = phi, phi0 = phi;
   long steps = 0;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -283,8 +288,9 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       const double yaw = yawOf(d, L.quad_body);
       phi += wrapPi(yaw - yaw_prev);
       yaw_prev = yaw;
+      std::copy(d->qacc, d->qacc + m->nv, qacc_t.begin());
       while (k < num_samples && t >= k * output.sample_dt_s - eps) {
-        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, k * output.sample_dt_s, phi, row);
+        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, qacc_t, k * output.sample_dt_s, phi, scratch, row);
         ts.appendRow(row);
         ++k;
       }
@@ -301,8 +307,10 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       const double yaw = yawOf(d, L.quad_body);  // xmat of time t
       phi += wrapPi(yaw - yaw_prev);
       yaw_prev = yaw;
+      // The acceleration the integrator applied (implicit: (M - h D)^-1 f, not d->qacc's explicit one).
+      for (int v = 0; v < m->nv; ++v) qacc_t[v] = (d->qvel[v] - qvel_t[v]) / h;
       while (k < num_samples && t >= k * output.sample_dt_s - eps) {
-        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, k * output.sample_dt_s, phi, row);
+        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, qacc_t, k * output.sample_dt_s, phi, scratch, row);
         ts.appendRow(row);
         ++k;
       }

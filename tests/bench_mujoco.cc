@@ -1,0 +1,65 @@
+// Speed of the MuJoCo contact model: the simulation loop of simulateMujoco (controller with
+// feed-forward, warning checks, 1 ms logging) against a bare mj_step loop on the same model, in
+// one run. Target: loop >= 90 % of bare steps/s. Compare with
+//   mujoco-testspeed mjcf/tail_n6.xml 10000 1 0
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "mujoco_model/mjcf_generator.h"
+#include "mujoco_model/mujoco_handles.h"
+#include "mujoco_model/mujoco_simulation.h"
+
+using namespace tailsim;
+
+namespace {
+
+TailTrajectory eq25(int n) {
+  TailTrajectory t;
+  for (int i = 0; i < n; ++i) t.joints.emplace_back(equalPeakSpeedParams(n, 10.47, 0.25));
+  return t;
+}
+
+// Bare loop: same MJCF, same initial state, constant ctrl, `steps` mj_step calls.
+double bareStepsPerSecond(const RobotParams& p, const MujocoSettings& s, const Effects& e, long steps) {
+  ModelPtr m = loadModelFromXml(generateMjcf(p, s, e));
+  DataPtr d = makeData(m.get());
+  mj_resetDataKeyframe(m.get(), d.get(), mj_name2id(m.get(), mjOBJ_KEY, mjcf::kHomeKey));
+  for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 0.3;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (long k = 0; k < steps; ++k) mj_step(m.get(), d.get());
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return steps / wall;
+}
+
+void BM_LoopVsBareStep(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const Effects e = [&] {
+    Effects x;
+    x.friction = state.range(1) ? FrictionLaw::kContinuous : FrictionLaw::kStiction;
+    return x;
+  }();
+  const RobotParams p = paperRobot(n);
+  const MujocoSettings s;
+  double sim_rate = 0, bare_rate = 0;
+  long iters = 0;
+  for (auto _ : state) {
+    const RunResult r = simulateMujoco(p, eq25(n), s, e, OutputSettings{});
+    if (!r.summary.ok) state.SkipWithError(r.summary.error.c_str());
+    state.SetIterationTime(r.summary.wall_time_s);
+    sim_rate += r.summary.solver_steps / r.summary.wall_time_s;
+    bare_rate += bareStepsPerSecond(p, s, e, r.summary.solver_steps);
+    ++iters;
+  }
+  state.counters["sim_steps_per_s"] = sim_rate / iters;
+  state.counters["bare_steps_per_s"] = bare_rate / iters;
+  state.counters["ratio"] = sim_rate / bare_rate;
+}
+
+}  // namespace
+
+// Args: links, friction law (0 stiction = constant mu, 1 continuous ADAMS law).
+BENCHMARK(BM_LoopVsBareStep)->Args({1, 0})->Args({6, 0})->Args({6, 1})->UseManualTime()->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,250 @@
+// The MuJoCo contact model's runs: tracking, stability on the hard cases, conservation of
+// angular momentum without friction, and Newton-Euler consistency of the logged loads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "mujoco_model/mjcf_generator.h"
+#include "mujoco_model/mujoco_handles.h"
+#include "mujoco_model/mujoco_simulation.h"
+
+using namespace tailsim;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+TailTrajectory sameForAllJoints(int n, const SplitCycleParams& sp) {
+  TailTrajectory t;
+  for (int i = 0; i < n; ++i) t.joints.emplace_back(sp);
+  return t;
+}
+
+// Fig. 6 cases (Sec. 4.2): dT = 0.25 s, theta_0 = 0, w_ss = 0.25, d_Q2B = 0.1405 m.
+SplitCycleParams fig6(double dtheta_deg) {
+  SplitCycleParams sp;
+  sp.theta0_rad = 0.0;
+  sp.dtheta_rad = dtheta_deg * kDeg;
+  sp.dT_s = 0.25;
+  sp.w_ss = 0.25;
+  return sp;
+}
+
+void expectCleanRun(const RunResult& r) {
+  ASSERT_TRUE(r.summary.ok) << r.summary.error;
+  EXPECT_EQ(r.summary.extra.at("mujoco_warnings"), 0.0);
+  for (const std::string& name : r.series.names())
+    for (double v : r.series.values(name)) ASSERT_TRUE(std::isfinite(v)) << name;
+}
+
+}  // namespace
+
+class Fig6Tracking : public ::testing::TestWithParam<std::pair<int, double>> {};
+
+TEST_P(Fig6Tracking, RmsBelowOnePercentOfStroke) {
+  const auto [n, dtheta_deg] = GetParam();
+  RobotParams p = paperRobot(n);
+  p.quadruped.d_Q2B_m = 0.1405;
+  OutputSettings out;
+  const RunResult r = simulateMujoco(p, sameForAllJoints(n, fig6(dtheta_deg)), MujocoSettings{}, Effects{}, out);
+  expectCleanRun(r);
+  for (int i = 1; i <= n; ++i) {
+    const double rms = r.summary.extra.at("tracking_rms_deg_j" + std::to_string(i));
+    EXPECT_LT(rms, 0.01 * std::abs(dtheta_deg)) << "joint " << i;
+    // The logged error column agrees with the controller's own statistics.
+    double mx = 0.0;
+    for (double e : r.series.values("track_err" + std::to_string(i) + "_deg")) mx = std::max(mx, std::abs(e));
+    EXPECT_LE(mx, r.summary.extra.at("tracking_max_deg_j" + std::to_string(i)) + 1e-12);
+  }
+  // Output grid: t_k = k * sample_dt exactly, through trajectory end + settle.
+  const std::vector<double>& t = r.series.values("t_s");
+  ASSERT_EQ(t.size(), static_cast<size_t>(std::lround((0.25 + out.settle_s) / out.sample_dt_s)) + 1);
+  for (size_t k = 0; k < t.size(); ++k) EXPECT_EQ(t[k], k * out.sample_dt_s);
+  // The tail ends where the trajectory ends.
+  for (int i = 1; i <= n; ++i)
+    EXPECT_NEAR(r.series.values("theta" + std::to_string(i) + "_deg").back(), dtheta_deg, 0.01 * std::abs(dtheta_deg));
+  // The body turned (Sec. 4.2: the contact model rotates) and came to rest before the end.
+  EXPECT_GT(std::abs(r.summary.phi_net_deg), 1.0);
+  EXPECT_LT(r.summary.t_stop_s, t.back());
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperCases, Fig6Tracking,
+                         ::testing::Values(std::make_pair(1, -90.0), std::make_pair(6, -30.0)));
+
+TEST(MujocoSimulation, HardCasesRunWithoutWarnings) {
+  // 6 links on the Eq. 25 trajectory (peak 10.47 rad/s) and the 1-link tail swinging 180 deg in 0.1 s.
+  {
+    const SplitCycleParams sp = equalPeakSpeedParams(6, 10.47, 0.25);
+    const RunResult r = simulateMujoco(paperRobot(6), sameForAllJoints(6, sp), MujocoSettings{}, Effects{}, {});
+    expectCleanRun(r);
+  }
+  for (FrictionLaw f : {FrictionLaw::kStiction, FrictionLaw::kContinuous, FrictionLaw::kNone}) {
+    SplitCycleParams sp;
+    sp.dtheta_rad = -M_PI;
+    sp.dT_s = 0.1;
+    sp.w_ss = 0.25;
+    Effects e;
+    e.friction = f;
+    const RunResult r = simulateMujoco(paperRobot(1), sameForAllJoints(1, sp), MujocoSettings{}, e, {});
+    expectCleanRun(r);
+  }
+}
+
+TEST(MujocoSimulation, InstabilityIsReportedNamingTheSetting) {
+  MujocoSettings s;
+  s.integrator = "Euler";  // explicit servo damping on a 6-link chain: unstable (docs/mujoco-model.md)
+  const SplitCycleParams sp = equalPeakSpeedParams(6, 10.47, 0.25);
+  const RunResult r = simulateMujoco(paperRobot(6), sameForAllJoints(6, sp), s, Effects{}, {});
+  ASSERT_FALSE(r.summary.ok);
+  EXPECT_NE(r.summary.error.find("timestep_s="), std::string::npos) << r.summary.error;
+  EXPECT_NE(r.summary.error.find("unstable"), std::string::npos) << r.summary.error;
+}
+
+TEST(MujocoSimulation, RestingRobotCarriesItsWeightOnItsFeet) {
+  // At t = 0 (after settling) the normal forces carry m g, the friction is zero, the tail load is
+  // zero and Izz is Eq. (11) for the initial pose.
+  const RobotParams p = paperRobot(1);
+  const RunResult r = simulateMujoco(p, sameForAllJoints(1, fig6(-90)), MujocoSettings{}, Effects{}, {});
+  expectCleanRun(r);
+  double fn = 0.0;
+  for (int k = 1; k <= 4; ++k) fn += r.series.values("foot" + std::to_string(k) + "_Fn_N")[0];
+  EXPECT_NEAR(fn, p.systemMass() * p.gravity_mps2, 1e-6 * fn);
+  EXPECT_NEAR(r.series.values("MzT_Nm")[0], 0.0, 1e-8);
+  EXPECT_NEAR(r.series.values("MzF_Nm")[0], 0.0, 1e-8);
+  // Symmetric pose: left and right feet carry the same load; rear feet more (tail behind).
+  EXPECT_NEAR(r.series.values("foot1_Fn_N")[0], r.series.values("foot2_Fn_N")[0], 1e-6);
+  EXPECT_GT(r.series.values("foot3_Fn_N")[0], r.series.values("foot2_Fn_N")[0]);
+}
+
+// Without friction the only external forces (gravity, frictionless normals) are vertical, so the
+// system's angular momentum about the vertical through its COM stays zero. Measured with MuJoCo's
+// own momentum (mj_subtreeVel) on each sampled state; the integrator (semi-implicit) leaves an
+// O(h) drift, so the test also checks that halving the step halves it.
+TEST(MujocoSimulation, FrictionlessRunConservesAngularMomentum) {
+  const int n = 6;
+  const SplitCycleParams sp = equalPeakSpeedParams(n, 10.47, 0.25);
+  Effects e;
+  e.friction = FrictionLaw::kNone;
+  std::vector<double> drift;
+  for (double h : {2e-4, 1e-4}) {
+    MujocoSettings s;
+    s.timestep_s = h;
+    s.servo_wn_dt = 1000.0 * h;  // the same servo in both runs
+    ModelPtr scratch_model;
+    DataPtr scratch;
+    double lz_max = 0.0, body_scale = 0.0;
+    const RunResult r = simulateMujoco(
+        paperRobot(n), sameForAllJoints(n, sp), s, e, {},
+        [&](double, const mjModel* m, const mjData* d) {
+          if (!scratch) scratch = makeData(m);
+          mj_copyData(scratch.get(), m, d);
+          mj_forward(m, scratch.get());
+          mj_subtreeVel(m, scratch.get());
+          const int q = mj_name2id(m, mjOBJ_BODY, "quadruped");
+          lz_max = std::max(lz_max, std::abs(scratch->subtree_angmom[3 * q + 2]));
+          // Scale: the angular momentum of the quadruped body alone about its own COM.
+          const double wz = scratch->cvel[6 * q + 2];
+          body_scale = std::max(body_scale, std::abs(m->body_inertia[3 * q + 2] * wz));
+        });
+    expectCleanRun(r);
+    ASSERT_GT(body_scale, 0.1);  // the body really spins (about 0.2 kg m^2/s at the peak)
+    drift.push_back(lz_max / body_scale);
+  }
+  EXPECT_LT(drift[0], 0.03);
+  EXPECT_LT(drift[1], 0.015);
+  EXPECT_NEAR(drift[0] / drift[1], 2.0, 0.3);  // first-order integrator error, not a model error
+}
+
+// The logged tail loads obey Newton-Euler for the quadruped body alone, with the system COM from
+// the planar kinematics of Eqs. (2)-(3), (10): m_Q a_Q = F_T + F_F and
+// I_zz,Q phi_ddot = M_z,T + M_z,F + ((p_COM - p_Q) x (F_T + F_F))_z. Run without friction: the
+// foot forces are then smooth and vertical (F_F = 0, M_z,F = 0); with friction they chatter
+// (docs/mujoco-model.md) and a 1 ms sample of them does not represent the step-to-step impulses.
+TEST(MujocoSimulation, LoggedTailLoadsSatisfyNewtonEulerOfTheBody) {
+  const int n = 2;
+  RobotParams p = paperRobot(n);
+  SplitCycleParams sp = fig6(-60);
+  sp.theta0_rad = 20 * kDeg;
+  Effects e;
+  e.friction = FrictionLaw::kNone;
+  const RunResult r = simulateMujoco(p, sameForAllJoints(n, sp), MujocoSettings{}, e, {});
+  expectCleanRun(r);
+  const TimeSeries& ts = r.series;
+  const auto& t = ts.values("t_s");
+  const auto& x = ts.values("x_m");
+  const auto& y = ts.values("y_m");
+  const auto& phi = ts.values("phi_deg");
+  const auto& phidd = ts.values("phiddot_dps2");
+  const auto& mzt = ts.values("MzT_Nm");
+  const auto& mzf = ts.values("MzF_Nm");
+  const auto& ftx = ts.values("FTx_N");
+  const auto& fty = ts.values("FTy_N");
+  const auto& ffx = ts.values("FFx_N");
+  const auto& ffy = ts.values("FFy_N");
+  const double dt = t[1] - t[0];
+  double peak_f = 0, peak_m = 0, err_f = 0, err_m = 0;
+  for (size_t k = 1; k + 1 < t.size(); ++k) {
+    const double ax = (x[k + 1] - 2 * x[k] + x[k - 1]) / (dt * dt);
+    const double ay = (y[k + 1] - 2 * y[k] + y[k - 1]) / (dt * dt);
+    const double Fx = ftx[k] + ffx[k], Fy = fty[k] + ffy[k];
+    peak_f = std::max(peak_f, std::hypot(ftx[k], fty[k]));
+    err_f = std::max(err_f, std::hypot(p.quadruped.mass_kg * ax - Fx, p.quadruped.mass_kg * ay - Fy));
+    // System COM relative to p_Q in world axes (planar, Eqs. 2, 3, 10).
+    const double ph = phi[k] * kDeg;
+    double cx = 0, cy = 0, ang = ph + M_PI;  // R_B = R_Q R_Z(180 deg)
+    double jx = -p.quadruped.d_Q2B_m * std::cos(ph), jy = -p.quadruped.d_Q2B_m * std::sin(ph);
+    for (int i = 1; i <= n; ++i) {
+      const TailLink& l = p.tail[i - 1];
+      ang += ts.values("theta" + std::to_string(i) + "_deg")[k] * kDeg;
+      cx += l.mass_kg * (jx + l.com_offset_m * std::cos(ang));
+      cy += l.mass_kg * (jy + l.com_offset_m * std::sin(ang));
+      jx += l.length_m * std::cos(ang);
+      jy += l.length_m * std::sin(ang);
+    }
+    cx /= p.systemMass();
+    cy /= p.systemMass();
+    const double mq = mzt[k] + mzf[k] + (cx * Fy - cy * Fx);
+    peak_m = std::max(peak_m, std::abs(mzt[k]));
+    err_m = std::max(err_m, std::abs(p.quadruped.izz_kgm2 * phidd[k] * kDeg - mq));
+    EXPECT_EQ(mzf[k], 0.0);
+  }
+  ASSERT_GT(peak_f, 10.0);
+  ASSERT_GT(peak_m, 1.0);
+  EXPECT_LT(err_f, 0.02 * peak_f) << "peak |F_T| " << peak_f;
+  EXPECT_LT(err_m, 0.02 * peak_m) << "peak |M_zT| " << peak_m;
+}
+
+// Foot friction dissipates: its moment works against the yaw rate, sum of M_zF * phi_dot < 0,
+// and the frictionless body turns further.
+TEST(MujocoSimulation, FootFrictionOpposesTheYawRate) {
+  RobotParams p = paperRobot(1);
+  Effects e;
+  const RunResult r = simulateMujoco(p, sameForAllJoints(1, fig6(-90)), MujocoSettings{}, e, {});
+  expectCleanRun(r);
+  const auto& mzf = r.series.values("MzF_Nm");
+  const auto& pd = r.series.values("phidot_dps");
+  double power = 0.0, scale = 0.0;
+  for (size_t k = 0; k < pd.size(); ++k) {
+    power += mzf[k] * pd[k];
+    scale += std::abs(mzf[k] * pd[k]);
+  }
+  EXPECT_LT(power, -0.5 * scale);
+  e.friction = FrictionLaw::kNone;
+  const RunResult f = simulateMujoco(p, sameForAllJoints(1, fig6(-90)), MujocoSettings{}, e, {});
+  EXPECT_GT(std::abs(f.summary.phi_net_deg), 2.0 * std::abs(r.summary.phi_net_deg));
+}
+
+TEST(MujocoSimulation, ContinuousFrictionLawStopsLaterThanStiction) {
+  // mu(0) = 0 in the ADAMS law: the body coasts longer before it comes to rest (Sec. 4.2).
+  RobotParams p = paperRobot(1);
+  p.quadruped.d_Q2B_m = 0.1405;
+  Effects e;
+  const RunResult a = simulateMujoco(p, sameForAllJoints(1, fig6(-90)), MujocoSettings{}, e, {});
+  e.friction = FrictionLaw::kContinuous;
+  const RunResult b = simulateMujoco(p, sameForAllJoints(1, fig6(-90)), MujocoSettings{}, e, {});
+  expectCleanRun(a);
+  expectCleanRun(b);
+  EXPECT_GT(b.summary.t_stop_s, a.summary.t_stop_s);
+  EXPECT_GT(std::abs(b.summary.phi_net_deg), std::abs(a.summary.phi_net_deg));
+}
