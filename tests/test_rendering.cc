@@ -257,12 +257,12 @@ Probe ffprobe(const std::string& path) {
 // the robot grey (b - r = 0.05) and orange (r > b).
 bool robotColoured(const uint8_t* p) { return int(p[2]) - int(p[0]) < 30; }
 
-// Fraction of robot pixels in a box around the image centre (+-w/10, +-h/10): the tracking top
-// camera looks at the quadruped COM, so the torso fills it.
+// Fraction of robot pixels in a square around the image centre (+-h/20): the tracking top
+// camera looks at the quadruped COM, so the torso (half width 0.11 m ~ h/5 here) fills it.
 double robotFractionInCentre(const std::vector<uint8_t>& rgb, int w, int h) {
   int robot = 0, total = 0;
-  for (int y = h / 2 - h / 10; y < h / 2 + h / 10; ++y)
-    for (int x = w / 2 - w / 10; x < w / 2 + w / 10; ++x, ++total) robot += robotColoured(&rgb[3 * (y * w + x)]);
+  for (int y = h / 2 - h / 20; y < h / 2 + h / 20; ++y)
+    for (int x = w / 2 - h / 20; x < w / 2 + h / 20; ++x, ++total) robot += robotColoured(&rgb[3 * (y * w + x)]);
   return double(robot) / total;
 }
 
@@ -313,6 +313,13 @@ TEST(RenderVideo, Mp4AndPosterAreReadableAndShowTheRobot) {
   mean /= poster.size();
   for (uint8_t v : poster) var += (v - mean) * (v - mean);
   EXPECT_GT(std::sqrt(var / poster.size()), 15.0);
+  // The poster is the video's frame at the tail's peak speed t1 = 0.0625 s -> frame 1 (10 fps).
+  EXPECT_NEAR(st.poster_time_s, 0.1, 1e-12);
+  const std::vector<uint8_t> frame1 = decodeRgb(dir / "case.mp4", 1);
+  ASSERT_EQ(frame1.size(), poster.size());
+  double mad = 0;
+  for (size_t i = 0; i < poster.size(); ++i) mad += std::abs(int(poster[i]) - int(frame1[i]));
+  EXPECT_LT(mad / poster.size(), 3.0);  // H.264 at crf 20 vs lossless PNG of the same frame
   // The video's frames are not blank either.
   const std::vector<uint8_t> last = decodeRgb(dir / "case.mp4", 4);
   ASSERT_EQ(last.size(), 320u * 240u * 3u);
@@ -484,8 +491,9 @@ TEST(RenderErrors, AbandonedSinkRemovesItsTemporary) {
   std::vector<uint8_t> frame(64 * 48 * 3, 128);
   std::string tmp;
   {
-    FfmpegSink sink(exe, FfmpegSink::Kind::kMp4, 64, 48, 10, 23, "veryfast", dir / "v.mp4");
-    tmp = sink.tempPath();
+    FfmpegSink sink(exe, 64, 48, VideoEncoding{}, {{FfmpegOutput::Kind::kMp4, dir / "v.mp4", 0},
+                                                   {FfmpegOutput::Kind::kPng, dir / "v.png", 2}});
+    tmp = sink.tempPaths()[0];
     for (int k = 0; k < 20; ++k) sink.writeFrame(frame.data());
   }
   EXPECT_FALSE(fs::exists(dir / "v.mp4"));
@@ -493,9 +501,17 @@ TEST(RenderErrors, AbandonedSinkRemovesItsTemporary) {
   EXPECT_TRUE(dir.files().empty());
   // finish() without commit() publishes nothing either.
   {
-    FfmpegSink sink(exe, FfmpegSink::Kind::kMp4, 64, 48, 10, 23, "veryfast", dir / "w.mp4");
+    FfmpegSink sink(exe, 64, 48, VideoEncoding{}, {{FfmpegOutput::Kind::kMp4, dir / "w.mp4", 0}});
     for (int k = 0; k < 3; ++k) sink.writeFrame(frame.data());
     sink.finish();
+  }
+  EXPECT_TRUE(dir.files().empty());
+  // A poster frame beyond the end of the stream is an error, and nothing is published.
+  {
+    FfmpegSink sink(exe, 64, 48, VideoEncoding{}, {{FfmpegOutput::Kind::kMp4, dir / "x.mp4", 0},
+                                                   {FfmpegOutput::Kind::kPng, dir / "x.png", 5}});
+    for (int k = 0; k < 3; ++k) sink.writeFrame(frame.data());
+    EXPECT_THROW(sink.finish(), std::runtime_error);
   }
   EXPECT_TRUE(dir.files().empty());
 }

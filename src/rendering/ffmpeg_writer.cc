@@ -140,26 +140,30 @@ std::string probeFfmpeg(const std::string& ffmpeg_exe) {
   return result;
 }
 
-FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, Kind kind, int width, int height, int fps,
-                       int crf, const std::string& preset, const std::string& final_path)
-    : final_path_(final_path), frame_bytes_(static_cast<size_t>(width) * height * 3) {
-  tmp_path_ = tempNameFor(final_path);
+FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, const VideoEncoding& enc,
+                       const std::vector<FfmpegOutput>& outputs)
+    : outputs_(outputs), frame_bytes_(static_cast<size_t>(width) * height * 3) {
+  if (outputs.empty()) throw std::invalid_argument("FfmpegSink needs at least one output");
+  for (const FfmpegOutput& o : outputs) tmp_paths_.push_back(tempNameFor(o.path));
   const int log_fd = makeLogFile(log_path_);
 
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   std::vector<std::string> args = {ffmpeg_exe, "-hide_banner", "-loglevel", "error", "-y",
                                    "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", size,
-                                   "-r", std::to_string(fps), "-i", "-", "-an"};
-  if (kind == Kind::kMp4) {
-    for (const char* a : {"-c:v", "libx264", "-preset"}) args.push_back(a);
-    args.push_back(preset);
-    args.push_back("-crf");
-    args.push_back(std::to_string(crf));
-    for (const char* a : {"-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"}) args.push_back(a);
-  } else {
-    for (const char* a : {"-frames:v", "1", "-update", "1", "-c:v", "png", "-f", "image2"}) args.push_back(a);
+                                   "-r", std::to_string(enc.fps), "-i", "-"};
+  auto add = [&](std::initializer_list<std::string> a) { args.insert(args.end(), a); };
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    add({"-map", "0:v", "-an"});
+    if (outputs[i].kind == FfmpegOutput::Kind::kMp4) {
+      // zerolatency: no lookahead or frame threads, so little is left to encode at the end.
+      add({"-c:v", "libx264", "-preset", enc.preset, "-tune", "zerolatency", "-crf", std::to_string(enc.crf),
+           "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"});
+    } else {
+      add({"-vf", "select=eq(n\\," + std::to_string(outputs[i].png_frame) + ")", "-fps_mode", "passthrough",
+           "-frames:v", "1", "-update", "1", "-c:v", "png", "-f", "image2"});
+    }
+    args.push_back(tmp_paths_[i]);
   }
-  args.push_back(tmp_path_);
 
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) {
@@ -201,7 +205,7 @@ void FfmpegSink::writeFrame(const uint8_t* rgb) {
     int status = 0;
     if (pid_ > 0) ::waitpid(pid_, &status, 0);
     pid_ = -1;
-    const std::string msg = "ffmpeg stopped reading frames for " + final_path_ + " (" + std::strerror(err) +
+    const std::string msg = "ffmpeg stopped reading frames for " + outputs_[0].path + " (" + std::strerror(err) +
                             "): " + errorLog();
     abort();
     throw std::runtime_error(msg);
@@ -217,11 +221,24 @@ void FfmpegSink::finish() {
   while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
   }
   pid_ = -1;
+  std::string msg;
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    const std::string msg = "ffmpeg failed writing " + final_path_ +
-                            (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
-                                               : std::string(" (killed by a signal)")) +
-                            ": " + errorLog();
+    msg = "ffmpeg failed writing " + outputs_[0].path +
+          (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
+                             : std::string(" (killed by a signal)")) +
+          ": " + errorLog();
+  } else {
+    for (size_t i = 0; i < tmp_paths_.size() && msg.empty(); ++i) {
+      struct stat st;
+      if (::stat(tmp_paths_[i].c_str(), &st) != 0 || st.st_size == 0)
+        msg = "ffmpeg exited cleanly but wrote nothing for " + outputs_[i].path +
+              (outputs_[i].kind == FfmpegOutput::Kind::kPng
+                   ? " (frame " + std::to_string(outputs_[i].png_frame) + " of " + std::to_string(frames_) + ")"
+                   : std::string()) +
+              ": " + errorLog();
+    }
+  }
+  if (!msg.empty()) {
     abort();
     throw std::runtime_error(msg);
   }
@@ -229,13 +246,17 @@ void FfmpegSink::finish() {
 }
 
 void FfmpegSink::commit() {
-  if (!finished_ || tmp_path_.empty()) throw std::logic_error("FfmpegSink::commit before finish");
-  if (std::rename(tmp_path_.c_str(), final_path_.c_str()) != 0) {
-    const std::string msg = "cannot move " + tmp_path_ + " to " + final_path_ + ": " + std::strerror(errno);
-    abort();
-    throw std::runtime_error(msg);
+  if (!finished_) throw std::logic_error("FfmpegSink::commit before finish");
+  for (size_t i = 0; i < tmp_paths_.size(); ++i) {
+    if (tmp_paths_[i].empty()) continue;
+    if (std::rename(tmp_paths_[i].c_str(), outputs_[i].path.c_str()) != 0) {
+      const std::string msg =
+          "cannot move " + tmp_paths_[i] + " to " + outputs_[i].path + ": " + std::strerror(errno);
+      abort();
+      throw std::runtime_error(msg);
+    }
+    tmp_paths_[i].clear();
   }
-  tmp_path_.clear();
   std::remove(log_path_.c_str());
   log_path_.clear();
 }
@@ -252,9 +273,9 @@ void FfmpegSink::abort() noexcept {
     }
     pid_ = -1;
   }
-  if (!tmp_path_.empty()) {
-    std::remove(tmp_path_.c_str());
-    tmp_path_.clear();
+  for (std::string& t : tmp_paths_) {
+    if (!t.empty()) std::remove(t.c_str());
+    t.clear();
   }
   if (!log_path_.empty()) {
     std::remove(log_path_.c_str());

@@ -20,14 +20,28 @@ std::string findExecutable(const std::string& name);
 // else ffmpeg's message.
 std::string probeFfmpeg(const std::string& ffmpeg_exe);
 
-// One ffmpeg process encoding rgb24 frames of a fixed size into one output file.
+// What ffmpeg writes from the one stream of frames.
+struct FfmpegOutput {
+  enum class Kind { kMp4, kPng };
+  Kind kind = Kind::kMp4;
+  std::string path;    // final path (written under a temporary name until commit())
+  long png_frame = 0;  // kPng: index of the frame written (ffmpeg's select filter)
+};
+
+struct VideoEncoding {
+  int fps = 30;
+  int crf = 20;                     // libx264 constant rate factor
+  std::string preset = "veryfast";  // libx264 preset
+};
+
+// One ffmpeg process reading rgb24 frames of a fixed size on stdin and writing one or more
+// outputs (an H.264 MP4 and a PNG still from the same stream: one process start, not two).
 class FfmpegSink {
  public:
-  enum class Kind { kMp4, kPng };
-  // Starts `ffmpeg_exe` (a full path). For kPng exactly one frame is expected.
-  FfmpegSink(const std::string& ffmpeg_exe, Kind kind, int width, int height, int fps, int crf,
-             const std::string& preset, const std::string& final_path);
-  ~FfmpegSink();  // not finished: kill the child, remove the temporary file
+  // Starts `ffmpeg_exe` (a full path).
+  FfmpegSink(const std::string& ffmpeg_exe, int width, int height, const VideoEncoding& enc,
+             const std::vector<FfmpegOutput>& outputs);
+  ~FfmpegSink();  // not committed: kill the child, remove the temporary files
   FfmpegSink(const FfmpegSink&) = delete;
   FfmpegSink& operator=(const FfmpegSink&) = delete;
 
@@ -35,13 +49,12 @@ class FfmpegSink {
   // ffmpeg's own message) when ffmpeg has died.
   void writeFrame(const uint8_t* rgb);
   // Closes stdin and waits for ffmpeg. Throws std::runtime_error with ffmpeg's message on
-  // failure (and removes the temporary file).
+  // failure (and removes the temporary files), also when an output was not produced.
   void finish();
-  // After finish(): renames the temporary file to the final name.
+  // After finish(): renames the temporary files to the final names, in output order.
   void commit();
 
-  const std::string& tempPath() const { return tmp_path_; }
-  const std::string& finalPath() const { return final_path_; }
+  const std::vector<std::string>& tempPaths() const { return tmp_paths_; }
   long framesWritten() const { return frames_; }
 
  private:
@@ -50,7 +63,9 @@ class FfmpegSink {
 
   pid_t pid_ = -1;
   int stdin_fd_ = -1;
-  std::string tmp_path_, final_path_, log_path_;
+  std::vector<FfmpegOutput> outputs_;
+  std::vector<std::string> tmp_paths_;
+  std::string log_path_;
   size_t frame_bytes_ = 0;
   long frames_ = 0;
   bool finished_ = false;

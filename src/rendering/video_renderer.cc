@@ -424,24 +424,19 @@ RenderStats renderVideo(const RenderInputs& in, const RenderSettings& settings, 
   st.sim_start_s = ft.t_start;
   st.poster_time_s = ft.t_start + poster * dt_frame;
   const auto t0 = Clock::now();
-  FfmpegSink video(exe, FfmpegSink::Kind::kMp4, settings.width, settings.height, settings.fps, settings.crf,
-                   settings.preset, mp4_path);
-  std::optional<FfmpegSink> png;
+  std::vector<FfmpegOutput> outputs = {{FfmpegOutput::Kind::kMp4, mp4_path, 0}};
+  if (!png_path.empty()) outputs.push_back({FfmpegOutput::Kind::kPng, png_path, poster});
+  FfmpegSink video(exe, settings.width, settings.height, {settings.fps, settings.crf, settings.preset}, outputs);
   const int w = settings.width, h = settings.height;
   std::vector<uint8_t> flipped(static_cast<size_t>(w) * h * 3);
   double encode_s = 0.0;  // writer thread only, read after drain()
   {
-    // Writer thread: flip rows (mjr_readPixels is bottom-up), feed ffmpeg, the poster too.
-    FramePipeline pipe(flipped.size(), 3, [&](long k, const uint8_t* bottom_up) {
+    // Writer thread: flip rows (mjr_readPixels is bottom-up), feed ffmpeg.
+    FramePipeline pipe(flipped.size(), 3, [&](long, const uint8_t* bottom_up) {
       Clock::time_point tic = Clock::now();
       const size_t row = static_cast<size_t>(w) * 3;
       for (int y = 0; y < h; ++y) std::memcpy(flipped.data() + row * y, bottom_up + row * (h - 1 - y), row);
       video.writeFrame(flipped.data());
-      if (k == poster && !png_path.empty()) {
-        png.emplace(exe, FfmpegSink::Kind::kPng, w, h, 1, 0, "", png_path);
-        png->writeFrame(flipped.data());
-        png->finish();
-      }
       encode_s += since(tic);
     });
     for (long k = 0; k < ft.frames; ++k) {
@@ -465,7 +460,6 @@ RenderStats renderVideo(const RenderInputs& in, const RenderSettings& settings, 
   st.writer_s = encode_s;
   // Both files complete: publish them (any failure above leaves neither under its final name).
   video.commit();
-  if (png) png->commit();
   st.frames = ft.frames;
   st.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   st.fps = st.frames / st.seconds;
