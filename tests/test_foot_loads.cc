@@ -65,3 +65,18 @@ TEST(FootLoads, FrictionArmVariesLessThan3PercentFig10) {
   RecordProperty("LF_max_rel_variation", std::to_string(worst));
   std::printf("L_F median %.5f m, max variation from median %.3f %%\n", median, 100 * worst);
 }
+
+TEST(FootLoads, ClosedFormEqualsEqA4AsPrinted) {
+  // Inside the region where (A4) needs no clipping, compare with the literal (A3)-(A5).
+  QuadrupedParams q;
+  const double l = q.l_F_m, w = q.w_F_m;
+  for (int i = -20; i <= 20; ++i)
+    for (int j = -20; j <= 20; ++j) {
+      const double xe = 0.5 * l * i / 40.0, ye = 0.5 * w * j / 40.0;  // b <= w_F / (2 sqrt 2)
+      const double xi = std::atan2(ye, xe * w / l), b = std::hypot(xe * w / l, ye);
+      const double B = b * std::sqrt(2.0) / (2 * w);
+      const FootLoads f = footLoads(q, Vec2(q.d_Q2C_m + xe, ye));
+      ASSERT_FALSE(f.clipped);
+      for (int k = 0; k < 4; ++k) EXPECT_NEAR(f.f_C[k], 0.25 + B * std::sin(xi + M_PI / 4 + k * M_PI / 2), 1e-15);
+    }
+}

@@ -71,11 +71,13 @@ class Model {
 
   void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
 
-  Eval evaluate(double t, const State& y, const Modes& m) const {
+  // `decompose`: also the acceleration-/speed-driven parts of M_zT (two more recursions; only
+  // the output rows need them, never the dynamics).
+  Eval evaluate(double t, const State& y, const Modes& m, bool decompose = false) const {
     Eval ev;
-    std::vector<JointState> js;
+    std::vector<JointState>& js = scratch_joints_;
     traj_.evaluate(t, js);
-    ev.loads = systemLoads(robot_, js, e_.load_decomposition);
+    systemLoads(robot_, js, decompose, ev.loads, scratch_);
     if (needsArm())
       ev.L_F = e_.foot_loads == FootLoadModel::kConstant ? L_F_const_
                                                          : footLoads(robot_.quadruped, ev.loads.p_QC).L_F;
@@ -117,6 +119,11 @@ class Model {
     }
     const bool free_dof[3] = {translation() && !m.stuck[kTrans], translation() && !m.stuck[kTrans], !m.stuck[kRot]};
     const double f_known[3] = {FF.x(), FF.y(), MzF};
+    if (s_.coupling == Coupling::kPaper) {  // diagonal: solve each DOF on its own
+      double u[3];
+      for (int j = 0; j < 3; ++j) u[j] = free_dof[j] ? (r0[j] + f_known[j]) / A(j, j) : -r0[j];
+      return finish(ev, free_dof, u, FF, MzF);
+    }
     Eigen::Matrix3d K;
     Eigen::Vector3d rhs = r0;
     for (int j = 0; j < 3; ++j) {
@@ -127,7 +134,13 @@ class Model {
         K.col(j) = -E.col(j);
       }
     }
-    const Eigen::Vector3d u = K.partialPivLu().solve(rhs);
+    const Eigen::Vector3d sol = K.partialPivLu().solve(rhs);
+    const double u[3] = {sol[0], sol[1], sol[2]};
+    return finish(ev, free_dof, u, FF, MzF);
+  }
+
+  // Unpacks the solve: accelerations of the sliding DOFs, friction loads of the stuck ones.
+  Eval finish(Eval& ev, const bool free_dof[3], const double u[3], const Vec2& FF, double MzF) const {
     ev.a_Q = Vec2(free_dof[0] ? u[0] : 0.0, free_dof[1] ? u[1] : 0.0);
     ev.phi_ddot = free_dof[2] ? u[2] : 0.0;
     ev.FF_W = free_dof[0] ? FF : Vec2(u[0], u[1]);
@@ -155,7 +168,8 @@ class Model {
   // Friction: F_F acts at the system COM (no moment about it, as in Eq. 9) plus the pure M_z,F.
   void exactCoupling(const std::vector<JointState>& js, double phi, double w, Eval& ev, Eigen::Matrix3d& A,
                      Eigen::Matrix3d& E, Eigen::Vector3d& r0) const {
-    const TailKinematics kin = tailKinematics(robot_.tail, js);
+    TailKinematics& kin = exact_kin_;
+    tailKinematics(robot_.tail, js, kin);
     const Vec2 p_QB(-robot_.quadruped.d_Q2B_m, 0.0);
     Vec2 S = Vec2::Zero(), lin = Vec2::Zero();
     double J = robot_.quadruped.izz_kgm2, ang = 0.0;
@@ -185,6 +199,10 @@ class Model {
   AnalyticSettings s_;
   Effects e_;
   double weight_ = 0, mu_break_ = 0, L_F_const_ = kNaN;
+  // Reused buffers (one Model per run, never shared between threads).
+  mutable std::vector<JointState> scratch_joints_;
+  mutable LoadScratch scratch_;
+  mutable TailKinematics exact_kin_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -213,7 +231,7 @@ class Recorder {
   bool done() const { return next_ >= n_samples_; }
 
   void record(double t, const State& y, const Modes& m) {
-    const Eval ev = model_.evaluate(t, y, m);
+    const Eval ev = model_.evaluate(t, y, m, model_.effects().load_decomposition);
     std::vector<JointState> js;
     model_.joints(t, js);
     row_.clear();

@@ -18,15 +18,15 @@ FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
        << "rectangle (+-" << 0.5 * l << ", +-" << 0.5 * w << ") m: the robot tips over";
     throw TippingError(os.str());
   }
-  // Eq. (A3) solved (READING-NOTES point 5): ellipse with a/b = l_F/w_F.
-  const double xs = xe * w / l;
-  const double b = std::hypot(xs, ye);
-  const double xi = std::atan2(ye, xs);
-  // Eqs. (A4)-(A5).
-  const double A = 0.25, B = b * std::sqrt(2.0) / (2.0 * w);
-  static const double kC[4] = {M_PI / 4, 3 * M_PI / 4, 5 * M_PI / 4, 7 * M_PI / 4};
+  // Eq. (A3) solved (READING-NOTES point 5): ellipse with a/b = l_F/w_F,
+  //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).
+  // Eqs. (A4)-(A5), f_i = 1/4 + B sin(xi + C_i) with B = b sqrt(2) / (2 w_F), expanded with
+  // b sin(xi) = y_e, b cos(xi) = x_e w_F / l_F and C_i = 45, 135, 225, 315 deg: no trigonometry.
+  //   f_1,2 = 1/4 + x_e/(2 l_F) +- y_e/(2 w_F),  f_3,4 = 1/4 - x_e/(2 l_F) -+ y_e/(2 w_F).
+  // (tests/test_foot_loads.cc checks this against (A4) as printed.)
+  const double ax = xe / (2.0 * l), ay = ye / (2.0 * w);
   FootLoads out;
-  for (int i = 0; i < 4; ++i) out.f_C[i] = A + B * std::sin(xi + kC[i]);
+  out.f_C = {0.25 + ax + ay, 0.25 + ax - ay, 0.25 - ax - ay, 0.25 - ax + ay};
   // Every solution of Eq. (A1) is f + lambda (1, -1, 1, -1). (A4) gives lambda = 0; when a load
   // is negative (possible for b > w_F/(2 sqrt 2) off the axes), choose the lambda closest to 0
   // that makes all loads >= 0: this zeroes the negative load and solves (A1) for the other three.

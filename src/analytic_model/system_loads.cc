@@ -4,24 +4,17 @@
 
 namespace tailsim {
 
-std::vector<Vec2> tailLinkComsInQ(const QuadrupedParams& q, const TailKinematics& kin) {
-  const Vec2 p_QB(-q.d_Q2B_m, 0.0);  // Eq. (2): p_B = p_Q - d_Q2B R_Q x
-  std::vector<Vec2> out(kin.p_L.size());
-  for (size_t i = 0; i < out.size(); ++i) out[i] = p_QB - kin.p_L[i];  // R_Z(180 deg) v = -v
-  return out;
-}
-
 void systemMassProperties(const RobotParams& robot, const TailKinematics& kin, SystemLoads& s) {
   const QuadrupedParams& q = robot.quadruped;
-  const std::vector<Vec2> p_QL = tailLinkComsInQ(q, kin);
+  const Vec2 p_QB(-q.d_Q2B_m, 0.0);
   s.mass_kg = robot.systemMass();  // Eq. (10)
   Vec2 sum = Vec2::Zero();
-  for (size_t i = 0; i < p_QL.size(); ++i) sum += robot.tail[i].mass_kg * p_QL[i];
-  s.p_QC = sum / s.mass_kg;  // Eq. (10), quadruped COM at the origin of Q
-  s.p_QB = Vec2(-q.d_Q2B_m, 0.0);
+  for (size_t i = 0; i < kin.p_L.size(); ++i) sum += robot.tail[i].mass_kg * (p_QB - kin.p_L[i]);
+  s.p_QC = sum / s.mass_kg;  // Eq. (10), quadruped COM at the origin of Q; R_Z(180 deg) v = -v
+  s.p_QB = p_QB;
   double I = q.izz_kgm2 + q.mass_kg * s.p_QC.squaredNorm();  // Eqs. (11)-(12)
-  for (size_t i = 0; i < p_QL.size(); ++i)
-    I += robot.tail[i].izz_kgm2 + robot.tail[i].mass_kg * (p_QL[i] - s.p_QC).squaredNorm();
+  for (size_t i = 0; i < kin.p_L.size(); ++i)
+    I += robot.tail[i].izz_kgm2 + robot.tail[i].mass_kg * (p_QB - kin.p_L[i] - s.p_QC).squaredNorm();
   s.Izz_kgm2 = I;
 }
 
@@ -35,24 +28,35 @@ void netTailLoad(const TailLoad& l, const Vec2& p_CB, Vec2& F_Q, double& MzT) {
 }  // namespace
 
 SystemLoads systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose) {
-  const TailKinematics kin = tailKinematics(robot.tail, joints);
   SystemLoads s;
+  LoadScratch scratch;
+  systemLoads(robot, joints, decompose, s, scratch);
+  return s;
+}
+
+void systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose, SystemLoads& s,
+                 LoadScratch& scratch) {
+  TailKinematics& kin = scratch.kin;
+  tailKinematics(robot.tail, joints, kin);
   systemMassProperties(robot, kin, s);
   const Vec2 p_CB = s.p_QB - s.p_QC;  // p_B - p_COM
   netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, s.F_T_Q, s.MzT);
   if (decompose) {
-    std::vector<JointState> acc = joints, speed = joints;
-    for (auto& j : acc) j.theta_dot = 0.0;
-    for (auto& j : speed) j.theta_ddot = 0.0;
     Vec2 F_acc, F_speed;
-    netTailLoad(tailBaseLoad(robot.tail, acc), p_CB, F_acc, s.MzT_acc);
-    netTailLoad(tailBaseLoad(robot.tail, speed), p_CB, F_speed, s.MzT_speed);
+    std::vector<JointState>& part = scratch.joints;
+    part = joints;
+    for (auto& j : part) j.theta_dot = 0.0;  // acceleration-driven
+    tailKinematics(robot.tail, part, kin);
+    netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, F_acc, s.MzT_acc);
+    part = joints;
+    for (auto& j : part) j.theta_ddot = 0.0;  // speed-driven
+    tailKinematics(robot.tail, part, kin);
+    netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, F_speed, s.MzT_speed);
     const double mQ_over_m = robot.quadruped.mass_kg / s.mass_kg;
     // p_B - p_COM = (m_Q/m)(p_B - p_Q) + sum (m_i/m)(p_B - p_L,i): the first part carries d_Q2B.
     s.MzT_tan = mQ_over_m * cross2(s.p_QB, F_acc);
     s.MzT_cen = mQ_over_m * cross2(s.p_QB, F_speed);
   }
-  return s;
 }
 
 Eq24Terms eq24OneLinkMoment(const RobotParams& robot, double theta, double theta_dot, double theta_ddot) {

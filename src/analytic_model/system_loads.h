@@ -21,14 +21,19 @@ struct SystemLoads {
   double MzT_cen = 0;     // (m_Q/m) p_QB x F_B,speed: Eq. (24)'s centripetal term, for any n  [N m]
 };
 
-// Tail link COM positions in Q (p_B + R_Z(180) p_L,i^B), for the mass properties.
-std::vector<Vec2> tailLinkComsInQ(const QuadrupedParams& q, const TailKinematics& kin);
-
 // Mass properties only (Eqs. 10-12): no velocities needed.
 void systemMassProperties(const RobotParams& robot, const TailKinematics& kin, SystemLoads& out);
 
 // Eqs. (10)-(13). With `decompose`, also the acceleration- and speed-driven parts.
 SystemLoads systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose = true);
+
+// The same, reusing `scratch` between calls (no allocation in a hot loop).
+struct LoadScratch {
+  TailKinematics kin;
+  std::vector<JointState> joints;
+};
+void systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose, SystemLoads& out,
+                 LoadScratch& scratch);
 
 // Eq. (24), the paper's closed form for n = 1 (used to test the recursion).
 struct Eq24Terms {

@@ -5,8 +5,13 @@
 namespace tailsim {
 
 TailKinematics tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints) {
-  const size_t n = links.size();
   TailKinematics k;
+  tailKinematics(links, joints, k);
+  return k;
+}
+
+void tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& k) {
+  const size_t n = links.size();
   k.psi.resize(n); k.omega.resize(n); k.alpha.resize(n);
   k.p_J.resize(n); k.p_L.resize(n); k.v_L.resize(n); k.a_L.resize(n);
   double psi = 0, omega = 0, alpha = 0;
@@ -29,7 +34,6 @@ TailKinematics tailKinematics(const std::vector<TailLink>& links, const std::vec
     a_J += alpha * perp(l) - omega * omega * l;
     v_J += omega * perp(l);
   }
-  return k;
 }
 
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& k) {

@@ -30,6 +30,8 @@ struct TailKinematics {
 };
 
 TailKinematics tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
+// The same into `out`, reusing its storage (no allocation once sized): for hot loops.
+void tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& out);
 
 // Load of link 1 on the base, as the paper writes it: F_J,1 and M_J,1 (Eqs. 5-6) in B.
 // The quadruped feels F_B = -R_B F_J,1, M_B = -M_J,1 (Eq. 8).
