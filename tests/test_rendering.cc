@@ -19,7 +19,9 @@
 #include <vector>
 
 #include "mujoco_model/mjcf_generator.h"
+#include "analytic_model/analytic_simulation.h"
 #include "mujoco_model/mujoco_handles.h"
+#include "mujoco_model/mujoco_simulation.h"
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/replay.h"
 #include "rendering/video_renderer.h"
@@ -350,6 +352,29 @@ TEST(RenderVideo, GhostAndCameraChangeThePicture) {
   // The analytic ghost (phi 3x the MuJoCo one) sits elsewhere: a visible set of pixels changes.
   EXPECT_GT(differing(a, b), 800);
   EXPECT_GT(differing(a, cp), 8000);
+}
+
+// End to end with the real models: the columns both simulations write are what the renderer
+// replays (paper Fig. 7 case, both models, the analytic one as the ghost).
+TEST(RenderVideo, ReplaysBothModelsOfFig7) {
+  TempDir dir;
+  Case c = makeCase(1);
+  OutputSettings out;
+  out.sample_dt_s = 2e-3;
+  out.duration_s = 0.5;
+  const RunResult mj = simulateMujoco(c.robot, c.traj, MujocoSettings{}, Effects{}, out);
+  const RunResult an = simulateAnalytic(c.robot, c.traj, AnalyticSettings{}, Effects{}, out);
+  ASSERT_TRUE(mj.summary.ok) << mj.summary.error;
+  ASSERT_TRUE(an.summary.ok) << an.summary.error;
+  RenderSettings s = smallSettings();
+  s.fps = 20;
+  RenderInputs in{&c.robot, &c.traj, &mj.series, &an.series, c.xml, "fig07"};
+  const RenderStats st = renderVideo(in, s, dir / "fig7.mp4", dir / "fig7.png");
+  EXPECT_EQ(st.frames, 11);
+  EXPECT_EQ(ffprobe(dir / "fig7.mp4").frames, 11);
+  const std::vector<uint8_t> last = decodeRgb(dir / "fig7.mp4", 10);
+  ASSERT_EQ(last.size(), 320u * 240u * 3u);
+  EXPECT_LT(robotFractionInBorder(last, 320, 240), 0.02);
 }
 
 // Cases render on the experiment runner's worker threads: two renders at once, each in its

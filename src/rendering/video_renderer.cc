@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_handles.h"
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/gl_context.h"
@@ -145,8 +146,11 @@ void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, cons
     ++scn.ngeom;
   };
   const double c = std::cos(s.phi), sn = std::sin(s.phi);
+  // The ghost is a shell kGrow larger than the model's geoms: where both models agree it wraps
+  // the model instead of z-fighting with it.
+  constexpr double kGrow = 0.006;  // [m]
   if (scn.ngeom < scn.maxgeom) {  // body box: centre p_Q + R_Q offset
-    const mjtNum size[3] = {g.body_half[0], g.body_half[1], g.body_half[2]};
+    const mjtNum size[3] = {g.body_half[0] + kGrow, g.body_half[1] + kGrow, g.body_half[2] + kGrow};
     const mjtNum pos[3] = {s.x + c * g.body_offset[0] - sn * g.body_offset[1],
                            s.y + sn * g.body_offset[0] + c * g.body_offset[1], g.body_z};
     const mjtNum mat[9] = {c, -sn, 0, sn, c, 0, 0, 0, 1};
@@ -158,13 +162,30 @@ void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, cons
   for (size_t i = 0; i + 1 < tail.joints.size() && scn.ngeom < scn.maxgeom; ++i) {
     mjvGeom* geom = scn.geoms + scn.ngeom;
     mjv_initGeom(geom, mjGEOM_CAPSULE, nullptr, nullptr, nullptr, kRgba);
-    mjv_makeConnector(geom, mjGEOM_CAPSULE, g.tail_radius, tail.joints[i][0], tail.joints[i][1], g.tail_z,
+    mjv_makeConnector(geom, mjGEOM_CAPSULE, g.tail_radius + kGrow, tail.joints[i][0], tail.joints[i][1], g.tail_z,
                       tail.joints[i + 1][0], tail.joints[i + 1][1], g.tail_z);
     finish(geom);
   }
 }
 
 // ---------------------------------------------------------------- scene
+
+// Visual-only changes to the renderer's own compiled copy of the model (physics untouched):
+// softer lights so the grey torso and the translucent ghost do not saturate to white, and a
+// floor checker of 0.1 m squares so that translation shows under the tracking camera.
+void adjustVisuals(mjModel* m) {
+  m->vis.headlight.ambient[0] = m->vis.headlight.ambient[1] = m->vis.headlight.ambient[2] = 0.25f;
+  m->vis.headlight.diffuse[0] = m->vis.headlight.diffuse[1] = m->vis.headlight.diffuse[2] = 0.3f;
+  m->vis.headlight.specular[0] = m->vis.headlight.specular[1] = m->vis.headlight.specular[2] = 0.1f;
+  for (int i = 0; i < m->nlight; ++i)
+    for (int k = 0; k < 3; ++k) m->light_diffuse[3 * i + k] = std::min(m->light_diffuse[3 * i + k], 0.45f);
+  const int floor = mj_name2id(m, mjOBJ_GEOM, mjcf::kFloorGeom);
+  if (floor >= 0 && m->geom_matid[floor] >= 0) {
+    const int mat = m->geom_matid[floor];
+    // builtin checker: 2 x 2 squares per texture repeat; texuniform: repeats per metre.
+    if (m->mat_texuniform[mat]) m->mat_texrepeat[2 * mat] = m->mat_texrepeat[2 * mat + 1] = 5.0f;
+  }
+}
 
 // Everything one render needs, set up before the first frame. Members are destroyed in
 // reverse order: the GL objects before the model.
@@ -189,6 +210,7 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
   if (in.mjcf_xml.empty()) throw std::invalid_argument("rendering: RenderInputs.mjcf_xml is empty");
   r.model = loadModelFromXml(in.mjcf_xml);
   r.data = makeData(r.model.get());
+  adjustVisuals(r.model.get());
   r.layout = findReplayLayout(r.model.get(), n);
   r.gl.emplace(r.model.get(), s.width, s.height, s.msaa, r.model->ngeom + 64 + 8 * n);
   mjvScene& scn = r.gl->scene();
