@@ -319,10 +319,12 @@ struct FrameTimes {
   long frames;
 };
 
-FrameTimes frameTimes(const RenderRig& r, const RenderSettings& s) {
+FrameTimes frameTimes(const TimeSeries& mujoco, const RenderSettings& s) {
+  if (!mujoco.has("t_s") || mujoco.numRows() == 0)
+    throw std::invalid_argument("rendering: the MuJoCo time series has no t_s rows");
   FrameTimes f;
-  f.t_start = r.mujoco->startTime();
-  f.t_end = r.mujoco->endTime();
+  f.t_start = mujoco.values("t_s").front();
+  f.t_end = mujoco.values("t_s").back();
   if (s.duration_s > 0.0) f.t_end = std::min(f.t_end, f.t_start + s.duration_s);
   f.frames = static_cast<long>(std::floor((f.t_end - f.t_start) * s.fps * s.slowmo + 1e-9)) + 1;
   return f;
@@ -425,11 +427,11 @@ void checkRenderPrerequisites(const RenderSettings& settings, const std::string&
 
 RenderStats renderVideo(const RenderInputs& in, const RenderSettings& settings, const std::string& mp4_path,
                         const std::string& png_path) {
+  const auto t_call = Clock::now();
   checkSettings(settings);
   const std::string exe = requireFfmpeg(settings);
-  RenderRig rig;
-  setupRig(rig, in, settings);
-  const FrameTimes ft = frameTimes(rig, settings);
+  if (!in.robot || !in.mujoco) throw std::invalid_argument("rendering: RenderInputs needs robot and mujoco");
+  const FrameTimes ft = frameTimes(*in.mujoco, settings);
   const double dt_frame = 1.0 / (settings.fps * settings.slowmo);  // simulated seconds per frame
 
   // Poster: the frame at joint 1's peak speed (t1, mid-swing), else the middle of the video.
@@ -445,10 +447,15 @@ RenderStats renderVideo(const RenderInputs& in, const RenderSettings& settings, 
   st.height = settings.height;
   st.sim_start_s = ft.t_start;
   st.poster_time_s = ft.t_start + poster * dt_frame;
-  const auto t0 = Clock::now();
+  // ffmpeg first: its start-up (~0.2 s of loading libraries) overlaps the model compile and
+  // the GL setup. On any exception below its destructor kills it and removes the temporaries.
   std::vector<FfmpegOutput> outputs = {{FfmpegOutput::Kind::kMp4, mp4_path, 0}};
   if (!png_path.empty()) outputs.push_back({FfmpegOutput::Kind::kPng, png_path, poster});
   FfmpegSink video(exe, settings.width, settings.height, {settings.fps, settings.crf, settings.preset}, outputs);
+  RenderRig rig;
+  setupRig(rig, in, settings);
+  const auto t0 = Clock::now();
+  st.setup_s = std::chrono::duration<double>(t0 - t_call).count();
   const int w = settings.width, h = settings.height;
   std::vector<uint8_t> flipped(static_cast<size_t>(w) * h * 3);
   double encode_s = 0.0;  // writer thread only, read after drain()
@@ -492,7 +499,7 @@ double benchBareRenderLoop(const RenderInputs& in, const RenderSettings& setting
   checkSettings(settings);
   RenderRig rig;
   setupRig(rig, in, settings);
-  const FrameTimes ft = frameTimes(rig, settings);
+  const FrameTimes ft = frameTimes(*in.mujoco, settings);
   renderFrame(rig, in, settings, 0.5 * (ft.t_start + ft.t_end));  // pose the scene once
   mjvScene& scn = rig.gl->scene();
   const mjrRect vp = rig.gl->viewport();

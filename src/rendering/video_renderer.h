@@ -29,7 +29,8 @@ struct RenderInputs {
 
 struct RenderStats {
   long frames = 0;
-  double seconds = 0.0;      // wall time of the whole pipeline (setup excluded)
+  double setup_s = 0.0;      // wall time before the first frame: checks, ffmpeg start, model compile, GL setup
+  double seconds = 0.0;      // wall time from the first frame to both files committed (encoder flush included)
   double fps = 0.0;          // frames / seconds
   double sim_start_s = 0.0, sim_end_s = 0.0;  // simulated time shown
   int width = 0, height = 0;
