@@ -4,6 +4,7 @@
 //   tailsim render EXPERIMENT.yaml --out DIR   headless MP4 + PNG of each case
 //   tailsim mjcf --links N --out FILE          the MuJoCo model of the paper robot
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -67,6 +68,9 @@ int main(int argc, char** argv) {
   run->add_flag("--fresh", fresh, "recompute finished cases instead of resuming");
   run->add_flag("--quiet", quiet, "no progress line");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
+  std::vector<std::string> only_models;
+  run->add_option("--models", only_models, "run only these models (analytic, mujoco) of each case")
+      ->check(CLI::IsMember({"analytic", "mujoco"}));
 
   int links = 1;
   std::string mjcf_out;
@@ -90,7 +94,15 @@ int main(int argc, char** argv) {
 
   try {
     if (*run) {
-      const std::vector<Experiment> suite = loadExperimentSuite(exp_path);  // all errors before any work
+      std::vector<Experiment> suite = loadExperimentSuite(exp_path);  // all errors before any work
+      if (!only_models.empty())
+        for (Experiment& e : suite)
+          for (ExperimentCase& c : e.cases) {
+            std::vector<std::string> keep;
+            for (const std::string& m : c.models)
+              if (std::find(only_models.begin(), only_models.end(), m) != only_models.end()) keep.push_back(m);
+            c.models = keep;
+          }
       RunOptions o;
       o.out_dir = out_dir;
       o.threads = threads;
