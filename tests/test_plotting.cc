@@ -244,6 +244,14 @@ TEST(CheckTrend, StrictMonotonicity) {
   EXPECT_EQ(dip.worst, 1u);
   EXPECT_DOUBLE_EQ(dip.min_step, -0.5);
   EXPECT_FALSE(checkTrend({1, NAN, 3}, +1).complete);
+  // Zero plateaus (static friction never broken) are skipped only when asked, and only at zero.
+  EXPECT_FALSE(checkTrend({0, 0, 1, 2}, +1).holds);
+  const Trend z = checkTrend({0, 0, 1, 2}, +1, 1e-9, true);
+  EXPECT_TRUE(z.holds);
+  EXPECT_EQ(z.zero_plateaus, 1);
+  EXPECT_FALSE(checkTrend({1, 1, 2}, +1, 1e-9, true).holds);
+  EXPECT_FALSE(checkTrend({0, 0, 0}, +1, 1e-9, true).holds);
+  EXPECT_FALSE(checkTrend({0, 0, -1}, +1, 1e-9, true).holds);
 }
 
 TEST_F(SyntheticSuite, LoadsAxesSortedAndTyped) {

@@ -84,7 +84,7 @@ void oneAxisTrend(Finding& f, const ExperimentResults* r, const std::string& lea
     if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
     const std::vector<size_t> order = by_magnitude ? byMagnitude(*a) : ascending(*a);
     const std::vector<double> y = phiAlong(*r, *a, order, m);
-    const Trend t = checkTrend(y, direction);
+    const Trend t = checkTrend(y, direction, 1e-9, true);
     std::string xs;
     for (size_t k = 0; k < order.size(); ++k) xs += (k ? ", " : "") + a->values[order[k]];
     std::string d = "phi_net = [" + listValues(y) + "] deg at " + leaf + " = [" + xs + "]";
@@ -92,6 +92,8 @@ void oneAxisTrend(Finding& f, const ExperimentResults* r, const std::string& lea
       f.verdicts.push_back({m, Verdict::kNo, "incomplete (failed or missing runs): " + d});
       continue;
     }
+    if (t.zero_plateaus)
+      d += "; " + std::to_string(t.zero_plateaus) + " step(s) skipped where phi_net = 0 on both sides";
     if (t.holds)
       d = "smallest step " + fmt("%.3f", t.min_step) + " deg (" + a->values[order[t.worst]] + " -> " +
           a->values[order[t.worst + 1]] + "); " + d;
@@ -115,23 +117,29 @@ void twoAxisTrend(Finding& f, const ExperimentResults* r, const std::string& alo
     }
     if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
     const std::vector<size_t> order = by_magnitude ? byMagnitude(*along) : ascending(*along);
-    int held = 0, incomplete = 0;
+    int held = 0, incomplete = 0, plateaus = 0;
     double min_step = std::numeric_limits<double>::infinity();
     std::string where_min, failures;
     for (size_t j = 0; j < across->values.size(); ++j) {
       const std::vector<double> y = phiAlong(*r, *along, order, m, {{across->key, across->values[j]}});
-      const Trend t = checkTrend(y, direction);
+      const Trend t = checkTrend(y, direction, 1e-9, true);
       if (!t.complete) { ++incomplete; continue; }
       const std::string at = across_leaf + "=" + across->values[j] + ", " + along_leaf + " " +
                              along->values[order[t.worst]] + " -> " + along->values[order[t.worst + 1]];
+      plateaus += t.zero_plateaus;
       if (t.holds) ++held;
-      else failures += (failures.empty() ? "" : "; ") + at + " (" + fmt("%+.3f", y[t.worst + 1] - y[t.worst]) + " deg)";
+      else
+        failures += (failures.empty() ? "" : "; ") + at + " (phi_net " + fmt("%.3f", y[t.worst]) + " -> " +
+                    fmt("%.3f", y[t.worst + 1]) + " deg)";
       if (t.min_step < min_step) min_step = t.min_step, where_min = at;
     }
     const int n = static_cast<int>(across->values.size());
     std::string d = "holds at " + std::to_string(held) + " of " + std::to_string(n) + " values of " + across_leaf;
     if (incomplete) d += " (" + std::to_string(incomplete) + " incomplete: failed or missing runs)";
     if (std::isfinite(min_step)) d += "; smallest step in the claimed direction " + fmt("%.3f", min_step) + " deg at " + where_min;
+    if (plateaus)
+      d += "; " + std::to_string(plateaus) + " step(s) skipped where phi_net = 0 on both sides (static friction never "
+           "broken)";
     if (!failures.empty()) d += "; fails at: " + failures;
     f.verdicts.push_back({m, held == n ? Verdict::kYes : Verdict::kNo, d});
   }
@@ -494,7 +502,7 @@ const ModelVerdict* Finding::verdictFor(const std::string& model) const {
   return nullptr;
 }
 
-Trend checkTrend(const std::vector<double>& y, int direction, double tol) {
+Trend checkTrend(const std::vector<double>& y, int direction, double tol, bool zero_plateaus_ok) {
   Trend t;
   t.complete = !y.empty() && std::all_of(y.begin(), y.end(), [](double v) { return std::isfinite(v); });
   if (!t.complete || y.size() < 2) {
@@ -502,11 +510,18 @@ Trend checkTrend(const std::vector<double>& y, int direction, double tol) {
     return t;
   }
   t.min_step = std::numeric_limits<double>::infinity();
+  bool any = false;
   for (size_t i = 0; i + 1 < y.size(); ++i) {
+    if (zero_plateaus_ok && std::fabs(y[i]) <= tol && std::fabs(y[i + 1]) <= tol) {
+      ++t.zero_plateaus;
+      continue;
+    }
+    any = true;
     const double step = direction * (y[i + 1] - y[i]);
     if (step < t.min_step) t.min_step = step, t.worst = i;
   }
-  t.holds = t.min_step > tol;
+  if (!any) t.min_step = 0.0;  // all flat at zero: nothing rises
+  t.holds = any && t.min_step > tol;
   return t;
 }
 

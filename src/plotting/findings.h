@@ -38,8 +38,11 @@ struct Trend {
   bool holds = false;      // complete and every step has the wanted sign (|step| > tol)
   double min_step = 0.0;   // smallest step in the wanted direction (direction * (y[i+1]-y[i]))
   size_t worst = 0;        // index i of that step (y[i] -> y[i+1])
+  int zero_plateaus = 0;   // steps skipped because both ends are 0 (zero_plateaus_ok)
 };
-Trend checkTrend(const std::vector<double>& y, int direction, double tol = 1e-9);
+// With zero_plateaus_ok, a flat step between two values with |y| <= tol (the body never broke
+// static friction in either case) is neither a rise nor a reversal: it is skipped and counted.
+Trend checkTrend(const std::vector<double>& y, int direction, double tol = 1e-9, bool zero_plateaus_ok = false);
 
 // Every finding the given experiments allow (a finding whose experiment is missing is listed
 // with n/a verdicts, so the report always has the full list).

@@ -197,10 +197,10 @@ void heatMap(Ctx& ctx, const std::string& stem, const std::string& what, const s
       << "plot " << gpQuote(dstem + ".dat")
       << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
       << "     '' using 1:2:(sprintf(" << gpQuote(cellfmt) << ", $3)) with labels font 'Sans,"
-      << (ax.values.size() > 9 ? 10 : 12) << "' notitle\n";
+      << (ax.values.size() > 9 ? 11 : 12) << "' notitle\n";
   }
   b << "unset multiplot\n";
-  const int w = std::max(800, static_cast<int>(60 * ax.values.size() + 300)) * static_cast<int>(values.size());
+  const int w = std::max(800, static_cast<int>(80 * ax.values.size() + 320)) * static_cast<int>(values.size());
   const int h = std::max(600, static_cast<int>(50 * ay.values.size() + 250));
   ctx.render(stem, b.str(), ctx.r.name + ": " + what + " over " + leafKey(ax.key) + " and " + leafKey(ay.key), w, h);
 }

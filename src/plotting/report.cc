@@ -115,7 +115,9 @@ void muSwapTable(std::ostringstream& o, const std::vector<ExperimentResults>& re
     const double b = sw->cases.empty() ? NAN : sw->phiNet(sw->cases.front(), m);
     o << "| " << m << " | " << num(a) << " | " << num(b) << " | " << num(b - a) << " |\n";
   }
-  o << "\n";
+  o << "\nThe analytic model breaks away at max(mu_s, mu_d) and slides at mu_d, so the swap changes its sliding "
+       "friction only. MuJoCo's contact has one coefficient, max(mu_s, mu_d) unless `mujoco.mu` is set "
+       "(mujoco_settings.h), so the swap leaves it unchanged by construction.\n\n";
 }
 
 void experimentSection(std::ostringstream& o, const ExperimentResults& r, const std::vector<PlotFile>& plots,
@@ -139,7 +141,7 @@ void experimentSection(std::ostringstream& o, const ExperimentResults& r, const 
         if (std::isfinite(it->second.wall_time_s)) wall += it->second.wall_time_s;
       }
     o << " " << m << " (" << ok << " ok" << (failed ? ", " + std::to_string(failed) + " FAILED" : "") << ", "
-      << fmt("%.2f", wall) << " s simulated wall time)";
+      << fmt("%.2f", wall) << " s wall time in the simulations)";
   }
   o << ".\n\n";
   for (const CaseRecord& c : r.cases)
