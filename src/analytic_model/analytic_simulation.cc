@@ -232,7 +232,7 @@ class Recorder {
 
   void record(double t, const State& y, const Modes& m) {
     const Eval ev = model_.evaluate(t, y, m, model_.effects().load_decomposition);
-    std::vector<JointState> js;
+    std::vector<JointState>& js = js_;
     model_.joints(t, js);
     row_.clear();
     row_.push_back(t);
@@ -261,6 +261,7 @@ class Recorder {
   long n_samples_ = 0, next_ = 0;
   TimeSeries ts_;
   std::vector<double> row_;
+  std::vector<JointState> js_;
 };
 
 // ---------------------------------------------------------------------------------------------
