@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -572,6 +573,23 @@ std::vector<Finding> computeFindings(const std::vector<ExperimentResults>& all) 
   Finding f14{"fig14_links_rises", "Sec. 4.7, Fig. 14", "phi_net rises with the number of tail links n", {}};
   oneAxisTrend(f14, findExperiment(all, "fig14"), "links", false, +1, "rising");
   out.push_back(f14);
+
+  static const std::map<std::string, std::string> briefs = {
+      {"split_cycle_peak", "split-cycle peak speed 2|dtheta|/dT at t0 + w_ss dT"},
+      {"eq25_table", "Eq. (25) dtheta and dT for n = 1..6"},
+      {"eq24_closed_form", "recursion reduces to Eq. (24) for n = 1"},
+      {"fig08_peaks", "|M_tan| peaks at theta = 0, |M_cen| at +-90 deg"},
+      {"fig06_contact_rotates_more", "contact model rotates more than stiction model"},
+      {"fig09_dQ2B_rises", "phi_net rises with d_Q2B at every theta0"},
+      {"fig09_max_at_60", "max phi_net mostly at theta0 = 60 deg"},
+      {"fig10_LF_variation", "L_F within 3 % of its median"},
+      {"fig11_wss_falls", "phi_net falls as w_ss rises"},
+      {"fig12_dtheta_rises", "phi_net rises with |dtheta|"},
+      {"fig12_dT_falls", "phi_net rises as dT falls"},
+      {"fig13_larger_dtheta_wins", "at 600 deg/s peak speed, larger |dtheta| wins"},
+      {"fig14_links_rises", "phi_net rises with tail links n"}};
+  for (Finding& f : out)
+    if (auto it = briefs.find(f.id); it != briefs.end()) f.brief = it->second;
   return out;
 }
 

@@ -64,7 +64,8 @@ void findingsSection(std::ostringstream& o, const std::vector<Finding>& findings
     };
     std::string a = v("analytic"), mj = v("mujoco");
     if (const ModelVerdict* cmp = f.verdictFor("mujoco vs analytic")) a = mj = std::string(verdictText(cmp->verdict)) + " (comparison)";
-    o << "| " << cell(f.where) << " | " << cell(f.claim) << " | " << a << " | " << mj << " |\n";
+    o << "| " << cell(f.where) << " | " << cell(f.brief.empty() ? f.claim : f.brief) << " | " << a << " | " << mj
+      << " |\n";
   }
   o << "\n### Details\n\n";
   for (const Finding& f : findings) {
