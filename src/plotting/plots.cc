@@ -100,7 +100,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   // phi(t), all models overlaid (Figs. 6, 7a).
   std::ostringstream body;
   body << header(r.name + ": body yaw φ(t)", "t [s]", "φ [deg]");
-  body << "plot ";
+  body << "set key bottom right box opaque\nplot ";  // phi rises from 0 and settles: bottom right is free
   for (size_t i = 0; i < models.size(); ++i) {
     const std::string& m = models[i];
     const TimeSeries& s = ts[m];
