@@ -76,7 +76,7 @@ TimeSeries simCsv(const std::vector<SplitCycleParams>& joints, double phi_net, d
     ts.addColumn("theta" + std::to_string(j) + "_deg");
     ts.addColumn("thetadot" + std::to_string(j) + "_dps");
   }
-  for (const char* c : {"phi_deg", "MzT_Nm", "MzF_Nm", "Izz_phiddot_Nm"}) ts.addColumn(c);
+  for (const char* c : {"phi_deg", "phidot_dps", "MzT_Nm", "MzF_Nm", "Izz_phiddot_Nm"}) ts.addColumn(c);
   double end = 0;
   for (const auto& p : joints) end = std::max(end, p.t0_s + p.dT_s);
   const double dur = end + 0.3, dt = 1e-3;
@@ -91,6 +91,7 @@ TimeSeries simCsv(const std::vector<SplitCycleParams>& joints, double phi_net, d
     const double x = std::min(t / end, 1.0);
     const double mzt = 5 * std::sin(2 * kPi * x) * (t < end);
     row.push_back(phi_net * x * x * (3 - 2 * x));
+    row.push_back(t < end ? phi_net * 6 * x * (1 - x) / end : 0.0);  // never turns back
     row.push_back(mzt);
     row.push_back(-0.5 * mzt);
     row.push_back(0.5 * mzt);
@@ -294,6 +295,9 @@ TEST_F(SyntheticSuite, FindingsMatchTheKnownAnswers) {
   EXPECT_EQ(verdict(fs_, "split_cycle_peak", "analytic"), Verdict::kYes)
       << finding(fs_, "split_cycle_peak").verdictFor("analytic")->detail;
   EXPECT_EQ(verdict(fs_, "split_cycle_peak", "mujoco"), Verdict::kNo);
+  // The synthetic phi(t) rises monotonically: no phase B-C (turning back), so Fig. 7's phases fail.
+  EXPECT_EQ(verdict(fs_, "fig07_phases", "analytic"), Verdict::kNo);
+  EXPECT_NE(finding(fs_, "fig07_phases").verdictFor("analytic")->detail.find("B-C no"), std::string::npos);
   EXPECT_EQ(verdict(fs_, "eq25_table", "analytic"), Verdict::kYes)
       << finding(fs_, "eq25_table").verdictFor("analytic")->detail;
   // Closed-form pose data matches Eq. (24) with the robot file's numbers; peaks at 0 and +-90.

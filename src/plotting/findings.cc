@@ -214,6 +214,54 @@ Finding splitCycle(const std::vector<ExperimentResults>& all) {
   return f;
 }
 
+Finding fig07Phases(const std::vector<ExperimentResults>& all) {
+  Finding f{"fig07_phases", "Sec. 4.3, Fig. 7",
+            "phases A-D: (A) M_zT > 0 from the start and the body turns positive; (B, C) phidot then changes sign, "
+            "the body turns back; (D) after the tail stops the body comes to rest (|phidot| < 0.01 deg/s at the end)",
+            {}};
+  const ExperimentResults* r = findExperiment(all, "fig07");
+  for (const std::string& m : modelsOf(r)) {
+    if (!r) { f.verdicts.push_back(na(m, "fig07 not in the results")); continue; }
+    if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
+    TimeSeries s;
+    try {
+      s = r->series(r->cases.front(), m);
+    } catch (const std::exception& e) {
+      f.verdicts.push_back(na(m, e.what()));
+      continue;
+    }
+    if (!s.has("t_s") || !s.has("phidot_dps") || !s.has("MzT_Nm") || s.numRows() < 3) {
+      f.verdicts.push_back(na(m, "CSV lacks t_s, phidot_dps, MzT_Nm"));
+      continue;
+    }
+    const auto& t = s.values("t_s");
+    const auto& w = s.values("phidot_dps");
+    const auto& mz = s.values("MzT_Nm");
+    size_t imax = 0, imin = 0, first_neg_mz = mz.size();
+    for (size_t i = 0; i < w.size(); ++i) {
+      if (w[i] > w[imax]) imax = i;
+      if (first_neg_mz == mz.size() && mz[i] < 0) first_neg_mz = i;
+    }
+    for (size_t i = imax; i < w.size(); ++i)
+      if (w[i] < w[imin] || imin < imax) imin = i;
+    // A: M_zT positive from the first sample that is not zero until it first turns negative,
+    // and the body's speed peaks positive inside that stretch or right after.
+    size_t first_pos_mz = 0;
+    while (first_pos_mz < mz.size() && std::fabs(mz[first_pos_mz]) < 1e-12) ++first_pos_mz;
+    const bool a = first_pos_mz < mz.size() && mz[first_pos_mz] > 0 && w[imax] > 0;
+    const bool bc = w[imin] < 0 && imin > imax;
+    const bool d = std::fabs(w.back()) < 0.01;
+    const std::string tneg = first_neg_mz < mz.size() ? fmt("%.3f", t[first_neg_mz]) + " s" : std::string("never");
+    f.verdicts.push_back({m, a && bc && d ? Verdict::kYes : Verdict::kNo,
+                          std::string("A ") + (a ? "yes" : "no") + " (M_zT > 0 until " + tneg + ", phidot peaks at " +
+                              fmt("%+.1f", w[imax]) + " deg/s at " + fmt("%.3f", t[imax]) + " s); B-C " +
+                              (bc ? "yes" : "no") + " (phidot reaches " + fmt("%+.1f", w[imin]) + " deg/s at " +
+                              fmt("%.3f", t[imin]) + " s); D " + (d ? "yes" : "no") + " (phidot at the end " +
+                              fmt("%+.2g", w.back()) + " deg/s, t = " + fmt("%.3f", t.back()) + " s)"});
+  }
+  return f;
+}
+
 Finding eq25(const std::vector<ExperimentResults>& all) {
   Finding f{"eq25_table", "Sec. 4.7, Eq. (25)",
             "with thetadot_max = 600 deg/s, n = 1..6 gives dtheta = -180, -120, -90, -72, -60, -51.43 deg and "
@@ -542,6 +590,7 @@ std::vector<Finding> computeFindings(const std::vector<ExperimentResults>& all) 
   std::vector<Finding> out;
   out.push_back(splitCycle(all));
   out.push_back(eq25(all));
+  out.push_back(fig07Phases(all));
   for (Finding& f : fig08Findings(all)) out.push_back(std::move(f));
   out.push_back(modelComparison(all));
 
@@ -577,6 +626,7 @@ std::vector<Finding> computeFindings(const std::vector<ExperimentResults>& all) 
   static const std::map<std::string, std::string> briefs = {
       {"split_cycle_peak", "split-cycle peak speed 2|dtheta|/dT at t0 + w_ss dT"},
       {"eq25_table", "Eq. (25) dtheta and dT for n = 1..6"},
+      {"fig07_phases", "phases A-D: turn, turn back, come to rest"},
       {"eq24_closed_form", "recursion reduces to Eq. (24) for n = 1"},
       {"fig08_peaks", "|M_tan| peaks at theta = 0, |M_cen| at +-90 deg"},
       {"fig06_contact_rotates_more", "contact model rotates more than stiction model"},
