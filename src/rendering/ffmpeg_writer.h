@@ -31,7 +31,7 @@ struct FfmpegOutput {
 struct VideoEncoding {
   int fps = 30;
   int crf = 20;                     // libx264 constant rate factor
-  std::string preset = "veryfast";  // libx264 preset
+  std::string preset = "ultrafast";  // libx264 preset
 };
 
 // One ffmpeg process reading rgb24 frames of a fixed size on stdin and writing one or more

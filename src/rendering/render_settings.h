@@ -19,7 +19,7 @@ struct RenderSettings {
   // Added for issue 5 (rendering): the encoder.
   std::string ffmpeg = "ffmpeg";  // executable: looked up on PATH unless it contains a '/'
   int crf = 20;                   // libx264 constant rate factor (lower = better, bigger)
-  std::string preset = "veryfast";  // libx264 preset
+  std::string preset = "ultrafast";  // libx264 preset (ultrafast: least CPU next to llvmpipe)
 };
 
 }  // namespace tailsim

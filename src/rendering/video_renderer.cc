@@ -134,7 +134,8 @@ GhostShape ghostShape(const mjModel* m, mjData* d, const MujocoReplayLayout& L, 
 }
 
 void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, const PlanarState& s) {
-  static constexpr float kRgba[4] = {0.15f, 0.75f, 1.0f, 0.35f};
+  static constexpr float kRgba[4] = {0.15f, 0.75f, 1.0f, 0.4f};      // tail: distinct cyan
+  static constexpr float kBodyRgba[4] = {0.15f, 0.75f, 1.0f, 0.3f};  // body: the torso shows through
   const mjtNum cam[3] = {0.5 * (scn.camera[0].pos[0] + scn.camera[1].pos[0]),
                          0.5 * (scn.camera[0].pos[1] + scn.camera[1].pos[1]),
                          0.5 * (scn.camera[0].pos[2] + scn.camera[1].pos[2])};
@@ -146,8 +147,9 @@ void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, cons
     ++scn.ngeom;
   };
   const double c = std::cos(s.phi), sn = std::sin(s.phi);
-  // The ghost is a shell kGrow larger than the model's geoms: where both models agree it wraps
-  // the model instead of z-fighting with it.
+  // The ghost body is a shell kGrow larger than the model's torso: where both models agree it
+  // wraps the model instead of z-fighting with it. The ghost tail is half as thick as the
+  // model's and rides on top of it, so the model's orange tail stays visible around it.
   constexpr double kGrow = 0.006;  // [m]
   if (scn.ngeom < scn.maxgeom) {  // body box: centre p_Q + R_Q offset
     const mjtNum size[3] = {g.body_half[0] + kGrow, g.body_half[1] + kGrow, g.body_half[2] + kGrow};
@@ -155,15 +157,16 @@ void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, cons
                            s.y + sn * g.body_offset[0] + c * g.body_offset[1], g.body_z};
     const mjtNum mat[9] = {c, -sn, 0, sn, c, 0, 0, 0, 1};
     mjvGeom* geom = scn.geoms + scn.ngeom;
-    mjv_initGeom(geom, mjGEOM_BOX, size, pos, mat, kRgba);
+    mjv_initGeom(geom, mjGEOM_BOX, size, pos, mat, kBodyRgba);
     finish(geom);
   }
   const PlanarTailPose tail = planarTailPose(robot, s);
   for (size_t i = 0; i + 1 < tail.joints.size() && scn.ngeom < scn.maxgeom; ++i) {
     mjvGeom* geom = scn.geoms + scn.ngeom;
     mjv_initGeom(geom, mjGEOM_CAPSULE, nullptr, nullptr, nullptr, kRgba);
-    mjv_makeConnector(geom, mjGEOM_CAPSULE, g.tail_radius + kGrow, tail.joints[i][0], tail.joints[i][1], g.tail_z,
-                      tail.joints[i + 1][0], tail.joints[i + 1][1], g.tail_z);
+    const double z = g.tail_z + g.tail_radius;
+    mjv_makeConnector(geom, mjGEOM_CAPSULE, 0.5 * g.tail_radius, tail.joints[i][0], tail.joints[i][1], z,
+                      tail.joints[i + 1][0], tail.joints[i + 1][1], z);
     finish(geom);
   }
 }
