@@ -96,45 +96,115 @@ std::vector<RunResult> runCase(const ExperimentCase& c) {
   return out;
 }
 
-RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  RunStats stats;
+namespace {
+
+// One experiment's share of a run: its folder, what is finished, what is left.
+struct Job {
+  const Experiment* e = nullptr;
+  fs::path root;
+  std::string fp;
+  bool render = false;
+  std::vector<json> entries;  // per case; null = not finished
+  std::vector<size_t> todo;   // case indices to run now
+  int total = 0, resumed = 0;
+};
+
+Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root) {
+  Job job;
+  job.e = &e;
+  job.root = root;
   std::vector<size_t> todo_all;
   for (size_t i = 0; i < e.cases.size(); ++i)
     if (opt.only_case.empty() || e.cases[i].name == opt.only_case) todo_all.push_back(i);
-  if (todo_all.empty()) throw std::runtime_error("experiment " + e.name + " has no case named '" + opt.only_case + "'");
-  stats.total = static_cast<int>(todo_all.size());
-
-  const fs::path root(opt.out_dir);
+  job.total = static_cast<int>(todo_all.size());
   fs::create_directories(root / "cases");
   writeFileAtomic((root / "experiment.yaml").string(), readText(e.source_file));
-  const std::string fp = fingerprint(e);
-
+  job.fp = fingerprint(e);
   // Render prerequisites are checked before anything runs (issue 5).
-  const bool render = opt.render && !e.cases.empty() && e.cases.front().render.enabled;
-  if (render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
-
-  // Finished cases (resume).
-  std::vector<json> entries(e.cases.size());
-  std::vector<size_t> todo;
-  for (size_t i : todo_all) {
+  job.render = opt.render && !e.cases.empty() && e.cases.front().render.enabled;
+  if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
+  job.entries.resize(e.cases.size());
+  for (size_t i : todo_all) {  // finished cases of an earlier, interrupted run
     const fs::path rj = root / "cases" / caseDirName(e.cases[i].name) / "result.json";
     if (opt.resume && fs::exists(rj)) {
       try {
         std::ifstream in(rj);
         json j = json::parse(in);
-        if (j.value("fingerprint", std::string()) == fp && j.value("name", std::string()) == e.cases[i].name) {
-          entries[i] = std::move(j);
-          ++stats.resumed;
+        if (j.value("fingerprint", std::string()) == job.fp && j.value("name", std::string()) == e.cases[i].name) {
+          job.entries[i] = std::move(j);
+          ++job.resumed;
           continue;
         }
       } catch (const std::exception&) {
         // unreadable: recompute
       }
     }
-    todo.push_back(i);
+    job.todo.push_back(i);
   }
-  if (opt.max_new_cases >= 0 && static_cast<long>(todo.size()) > opt.max_new_cases) todo.resize(opt.max_new_cases);
+  return job;
+}
+
+// Runs one case and writes its folder; result.json last, as the "finished" marker.
+json runAndWrite(const Job& job, size_t i, int& failed_runs) {
+  const ExperimentCase& c = job.e->cases[i];
+  const std::vector<RunResult> runs = runCase(c);
+  const fs::path dir = job.root / "cases" / caseDirName(c.name);
+  fs::create_directories(dir);
+  json j;
+  j["name"] = c.name;
+  j["dir"] = caseDirName(c.name);
+  j["fingerprint"] = job.fp;
+  j["sweep"] = json::object();
+  for (const auto& [key, v] : c.sweep_values) j["sweep"][key] = v;
+  j["runs"] = json::object();
+  for (const RunResult& r : runs) {
+    writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), r.series);
+    j["runs"][r.summary.model] = summaryJson(r.summary);
+    if (!r.summary.ok) ++failed_runs;
+  }
+  if (job.render) renderCase(c, runs, (job.root / "renders").string());
+  writeFileAtomic((dir / "result.json").string(), j.dump(1));
+  return j;
+}
+
+void writeSummary(const Job& job) {
+  const Experiment& e = *job.e;
+  json s;
+  s["experiment"] = e.name;
+  s["description"] = e.description;
+  s["source"] = e.source_file;
+  s["kind"] = e.cases.empty() ? "simulate" : e.cases.front().kind;
+  s["swept_keys"] = e.swept_keys;
+  s["cases"] = json::array();
+  for (const json& entry : job.entries)
+    if (!entry.is_null()) s["cases"].push_back(entry);
+  writeFileAtomic((job.root / "summary.json").string(), s.dump(1));
+}
+
+// All cases of all experiments share one pool of workers (workers share nothing mutable but
+// the task counter; each writes only its own case folder and entry).
+RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::string& label) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  RunStats stats;
+  struct Task {
+    Job* job;
+    size_t i;
+  };
+  std::vector<Task> tasks;
+  for (Job& job : jobs) {
+    stats.total += job.total;
+    stats.resumed += job.resumed;
+    for (size_t i : job.todo) tasks.push_back({&job, i});
+  }
+  if (opt.max_new_cases >= 0 && static_cast<long>(tasks.size()) > opt.max_new_cases) tasks.resize(opt.max_new_cases);
+  // MuJoCo cases first: the long tasks start early, the short ones fill the gaps at the end.
+  std::stable_sort(tasks.begin(), tasks.end(), [](const Task& a, const Task& b) {
+    auto heavy = [](const Task& t) {
+      const auto& m = t.job->e->cases[t.i].models;
+      return std::find(m.begin(), m.end(), "mujoco") != m.end();
+    };
+    return heavy(a) && !heavy(b);
+  });
 
   std::atomic<size_t> next{0};
   std::atomic<int> done{0}, failed{0};
@@ -144,90 +214,62 @@ RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
   auto worker = [&]() {
     for (;;) {
       const size_t k = next.fetch_add(1);
-      if (k >= todo.size()) return;
-      const size_t i = todo[k];
-      const ExperimentCase& c = e.cases[i];
+      if (k >= tasks.size()) return;
+      const Task& t = tasks[k];
       try {
-        const std::vector<RunResult> runs = runCase(c);
-        const fs::path dir = root / "cases" / caseDirName(c.name);
-        fs::create_directories(dir);
-        json j;
-        j["name"] = c.name;
-        j["dir"] = caseDirName(c.name);
-        j["fingerprint"] = fp;
-        j["sweep"] = json::object();
-        for (const auto& [key, v] : c.sweep_values) j["sweep"][key] = v;
-        j["runs"] = json::object();
-        for (const RunResult& r : runs) {
-          writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), r.series);
-          j["runs"][r.summary.model] = summaryJson(r.summary);
-          if (!r.summary.ok) ++failed;
-        }
-        if (render) renderCase(c, runs, (root / "renders").string());
-        writeFileAtomic((dir / "result.json").string(), j.dump(1));  // last: marks the case finished
-        entries[i] = std::move(j);
+        int f = 0;
+        json j = runAndWrite(*t.job, t.i, f);
+        failed += f;
+        t.job->entries[t.i] = std::move(j);  // distinct element per task: no lock needed
       } catch (const std::exception& ex) {
         std::lock_guard<std::mutex> lock(mu);
-        if (first_error.empty()) first_error = "case " + c.name + ": " + ex.what();
+        if (first_error.empty()) first_error = "case " + t.job->e->cases[t.i].name + ": " + ex.what();
       }
       ++done;
       cv.notify_all();
     }
   };
   const int n_threads = std::max(1, std::min<int>(opt.threads > 0 ? opt.threads : std::thread::hardware_concurrency(),
-                                                  static_cast<int>(todo.size())));
+                                                  static_cast<int>(tasks.size())));
   std::vector<std::thread> pool;
-  for (int t = 0; t < n_threads && !todo.empty(); ++t) pool.emplace_back(worker);
-  if (opt.progress && !todo.empty()) {
+  for (int t = 0; t < n_threads && !tasks.empty(); ++t) pool.emplace_back(worker);
+  if (opt.progress && !tasks.empty()) {
     std::unique_lock<std::mutex> lock(mu);
     int shown = -1;
-    while (done.load() < static_cast<int>(todo.size())) {
+    while (done.load() < static_cast<int>(tasks.size())) {
       cv.wait_for(lock, std::chrono::milliseconds(500));
       const int d = done.load();
       if (d == shown) continue;
       shown = d;
       const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-      const double eta = d > 0 ? el / d * (todo.size() - d) : 0.0;
-      std::fprintf(stderr, "\r[%s] %d/%zu cases (%d resumed), %s elapsed, ETA %s   ", e.name.c_str(),
-                   d + stats.resumed, todo_all.size(), stats.resumed, fmtSeconds(el).c_str(), fmtSeconds(eta).c_str());
+      const double eta = d > 0 ? el / d * (tasks.size() - d) : 0.0;
+      std::fprintf(stderr, "\r[%s] %d/%d cases (%d resumed), %s elapsed, ETA %s   ", label.c_str(),
+                   d + stats.resumed, stats.total, stats.resumed, fmtSeconds(el).c_str(), fmtSeconds(eta).c_str());
     }
     std::fprintf(stderr, "\n");
   }
   for (auto& th : pool) th.join();
+  for (const Job& job : jobs) writeSummary(job);  // also after a failure: finished cases count
   if (!first_error.empty()) throw std::runtime_error(first_error);
-  stats.ran = static_cast<int>(todo.size());
+  stats.ran = static_cast<int>(tasks.size());
   stats.failed = failed.load();
-
-  // summary.json: every finished case in experiment order.
-  json s;
-  s["experiment"] = e.name;
-  s["description"] = e.description;
-  s["source"] = e.source_file;
-  s["kind"] = e.cases.empty() ? "simulate" : e.cases.front().kind;
-  s["swept_keys"] = e.swept_keys;
-  s["cases"] = json::array();
-  for (size_t i = 0; i < e.cases.size(); ++i)
-    if (!entries[i].is_null()) s["cases"].push_back(entries[i]);
-  writeFileAtomic((root / "summary.json").string(), s.dump(1));
   stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return stats;
 }
 
+}  // namespace
+
+RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
+  std::vector<Job> jobs{prepare(e, opt, opt.out_dir)};
+  if (jobs.front().total == 0) throw std::runtime_error("experiment " + e.name + " has no case named '" + opt.only_case + "'");
+  return runJobs(jobs, opt, e.name);
+}
+
 RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& opt) {
   if (suite.size() == 1) return runExperiment(suite.front(), opt);
-  RunStats total;
-  const auto wall0 = std::chrono::steady_clock::now();
-  for (const Experiment& e : suite) {
-    RunOptions o = opt;
-    o.out_dir = (fs::path(opt.out_dir) / e.name).string();
-    const RunStats s = runExperiment(e, o);
-    total.total += s.total;
-    total.ran += s.ran;
-    total.resumed += s.resumed;
-    total.failed += s.failed;
-  }
-  total.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  return total;
+  std::vector<Job> jobs;
+  for (const Experiment& e : suite) jobs.push_back(prepare(e, opt, fs::path(opt.out_dir) / e.name));
+  return runJobs(jobs, opt, fs::path(opt.out_dir).filename().string());
 }
 
 }  // namespace tailsim
