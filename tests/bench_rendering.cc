@@ -69,7 +69,7 @@ const BenchCase& fig7Case(int links) {
   return b;
 }
 
-const char* kPresets[] = {"veryfast", "ultrafast", "medium"};
+const char* kPresets[] = {"ultrafast", "veryfast"};  // 0: the default
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -128,16 +128,16 @@ void BM_PipelineVsBareLoop(benchmark::State& state) {
 
 BENCHMARK(BM_PipelineVsBareLoop)
     ->ArgNames({"w", "h", "shadow", "refl", "msaa", "links", "preset"})
-    // 640x480: quality settings one at a time, then all together.
+    // 640x480, x264 ultrafast (the defaults): quality settings one at a time, then together.
     ->Args({640, 480, 0, 0, 0, 1, 0})
-    ->Args({640, 480, 0, 0, 0, 1, 1})
-    ->Args({640, 480, 0, 0, 4, 1, 0})
-    ->Args({640, 480, 0, 0, 4, 1, 1})
+    ->Args({640, 480, 0, 0, 4, 1, 0})  // the defaults
     ->Args({640, 480, 0, 0, 8, 1, 0})
     ->Args({640, 480, 0, 1, 4, 1, 0})
     ->Args({640, 480, 1, 0, 4, 1, 0})
     ->Args({640, 480, 1, 1, 4, 1, 0})
-    ->Args({640, 480, 0, 0, 4, 6, 0})
+    ->Args({640, 480, 0, 0, 4, 6, 0})  // 6-link tail
+    ->Args({640, 480, 0, 0, 0, 1, 1})  // x264 veryfast
+    ->Args({640, 480, 0, 0, 4, 1, 1})
     ->Args({1280, 720, 0, 0, 4, 1, 0})
     ->Args({1280, 720, 0, 0, 4, 1, 1})
     ->Iterations(1)
