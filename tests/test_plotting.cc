@@ -2,6 +2,7 @@
 // monotone sweeps must give YES, broken ones NO naming the failing step, closed-form pose data
 // must match Eq. (24), and every figure must exist as a non-trivial PNG and SVG.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -118,8 +119,10 @@ tails:
 
 class SyntheticSuite : public ::testing::Test {
  protected:
+  static void TearDownTestSuite() { fs::remove_all(root_); }
   static void SetUpTestSuite() {
-    root_ = fs::path(TAILSIM_BINARY_DIR) / "test_plotting_suite";
+    // One folder per process: CTest runs the tests of this suite as parallel processes.
+    root_ = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_suite_" + std::to_string(::getpid()));
     fs::remove_all(root_);
     fs::create_directories(root_);
     writeFileAtomic((root_ / "robot.yaml").string(), kRobotYaml);
