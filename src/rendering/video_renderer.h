@@ -32,6 +32,7 @@ struct RenderStats {
   double setup_s = 0.0;      // wall time before the first frame: checks, ffmpeg start, model compile, GL setup
   double seconds = 0.0;      // wall time from the first frame to both files committed (encoder flush included)
   double fps = 0.0;          // frames / seconds
+  double first_frame_s = 0.0;  // wall time of frame 0 (llvmpipe compiles its shaders here)
   double sim_start_s = 0.0, sim_end_s = 0.0;  // simulated time shown
   int width = 0, height = 0;
   double poster_time_s = 0.0;  // simulated time of the poster frame
