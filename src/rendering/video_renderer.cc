@@ -246,7 +246,7 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
     r.cam.distance = 1.15 * radius / std::tan(half_fov) + r.look_z;
   } else {
     r.cam.elevation = -35.0;
-    r.cam.azimuth = 135.0;
+    r.cam.azimuth = 45.0;  // from behind and to the right (-x, -y): the tail is in front of the body
     r.cam.distance = 1.35 * radius / std::tan(half_fov);
   }
   r.pixels.resize(static_cast<size_t>(s.width) * s.height * 3);
