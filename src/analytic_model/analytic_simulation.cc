@@ -97,7 +97,11 @@ class Model {
         MzF = -fp.mu_d * weight_ * ev.L_F * dir;  // Eq. (16), sliding
         // Eq. (15), sliding; inside |v| < v_stop the direction is regularized (friction ~ v), so a
         // body creeping at a load just above the static limit does not chatter in direction.
-        FF = -fp.mu_d * weight_ * v / std::max(v.norm(), s_.v_stop_mps);
+        // The fixed-step solver keeps plain Coulomb friction (its per-step reversal check stops the
+        // body); the ball's stiffness mu W / (m v_stop) would make coarse explicit steps unstable.
+        const double v_reg = s_.solver == "fixed" ? 0.0 : s_.v_stop_mps;
+        const double speed = v.norm();
+        if (speed > 0.0) FF = -fp.mu_d * weight_ * v / std::max(speed, v_reg);
       } else {  // the ADAMS law: mu follows the slip speed, no stuck state
         const double mu_r = adamsFrictionCoefficient(std::abs(w), fp.phidot_s_radps, fp.phidot_d_radps, fp.mu_s, fp.mu_d);
         MzF = -mu_r * weight_ * ev.L_F * (w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0));
@@ -545,7 +549,19 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         if (model.stiction()) {
           for (int which : {kRot, kTrans}) {
             const double g0 = events.g(which, t - h, y0, modes), g1 = events.g(which, t, y, modes);
-            if (g0 > 0 && g1 <= 0) {
+            // A step longer than v_stop / a can jump over the slow-speed ball: a sliding velocity
+            // that reversed over the step counts as stopped too (if the load allows sticking).
+            const bool reversed = which == kTrans && !modes.stuck[kTrans] && model.translation() &&
+                                  y0[kVx] * y[kVx] + y0[kVy] * y[kVy] < 0 && [&] {
+                                    Modes probe = modes;
+                                    probe.stuck[kTrans] = true;
+                                    const Eval e = model.evaluate(t, y, probe);
+                                    return e.F_required.norm() < e.F_break;
+                                  }();
+            // Checked once per step: a margin at or below zero at the step's end switches (for a
+            // sliding DOF g < 0 means it stopped, or turned round, somewhere inside the step).
+            const bool crossed = modes.stuck[which] ? g1 <= 0 : (g1 < 0 || (g0 > 0 && g1 <= 0));
+            if (crossed || reversed) {
               const bool was_sliding = !modes.stuck[which];
               applySwitch(which, t, y, modes, model, switches);
               afterSwitch(which, was_sliding);

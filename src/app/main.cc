@@ -11,10 +11,12 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "experiments/accuracy_study.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/render_case.h"
 #include "mujoco_model/mjcf_generator.h"
+#include "plotting/accuracy_plot.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
 
@@ -90,6 +92,17 @@ int main(int argc, char** argv) {
   auto* report = app.add_subcommand("report", "write DIR/report.md: plots and the paper's findings checked");
   report->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
 
+  std::string acc_out;
+  bool acc_quick = false, acc_no_mujoco = false;
+  int acc_repeats = 3;
+  auto* accuracy = app.add_subcommand("accuracy", "work-precision study of both models' solver settings");
+  accuracy->add_option("experiment", exp_path, "experiment YAML (every simulate case is studied)")
+      ->required()->check(CLI::ExistingFile);
+  accuracy->add_option("--out", acc_out, "output folder")->required();
+  accuracy->add_option("--repeats", acc_repeats, "runs per setting; wall time is their median");
+  accuracy->add_flag("--quick", acc_quick, "a reduced grid");
+  accuracy->add_flag("--no-mujoco", acc_no_mujoco, "analytic model only");
+
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -140,6 +153,19 @@ int main(int argc, char** argv) {
                       st.frames, st.width, st.height, st.fps);
         }
       }
+      return 0;
+    }
+    if (*accuracy) {
+      const Experiment e = loadExperiment(exp_path);
+      fs::create_directories(acc_out);
+      AccuracyOptions ao;
+      ao.repeats = acc_repeats;
+      ao.quick = acc_quick;
+      ao.mujoco = !acc_no_mujoco;
+      const auto studies = runAccuracyStudy(e, ao);
+      writeAccuracyTables(studies, acc_out);
+      for (const std::string& png : plotAccuracy(studies, acc_out)) std::printf("%s\n", png.c_str());
+      std::printf("%s/accuracy.md\n%s/accuracy.csv\n", acc_out.c_str(), acc_out.c_str());
       return 0;
     }
     if (*plot) {

@@ -1,0 +1,51 @@
+// Work-precision study (`tailsim accuracy EXPERIMENT.yaml --out DIR`, issue 6): what each solver
+// setting of each model buys in accuracy and costs in time, against a converged reference of
+// the same model.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_loader.h"
+
+namespace tailsim {
+
+struct AccuracyRow {
+  std::string model;    // analytic | mujoco
+  std::string family;   // curve of the work-precision plot, e.g. "adaptive", "timestep/implicit", "solver"
+  std::string setting;  // what differs from the case's settings, e.g. "rel_tol=1e-8", "solver=CG"
+  double value = 0;     // the swept number (tolerance, step) or 0 for categorical settings
+  bool is_default = false;  // tailsim's shipped setting
+  bool ok = true;
+  std::string failure;  // why not ok (MuJoCo warning, NaN, ...)
+  double phi_net_deg = 0;
+  double err_phi_net_deg = 0;  // |phi_net - reference|
+  double rms_err_phi_deg = 0;  // RMS over the output grid of phi(t) - phi_ref(t)
+  double wall_s = 0;           // median over repeats
+  long steps = 0;
+};
+
+struct AccuracyStudy {
+  std::string case_name;
+  struct Reference {
+    std::string setting;
+    double phi_net_deg = 0;
+    double uncertainty_deg = 0;  // |reference - next coarser refinement|: bounds the reference's own error
+  };
+  Reference analytic, mujoco;
+  std::vector<AccuracyRow> rows;
+};
+
+struct AccuracyOptions {
+  int repeats = 3;          // wall time = median of this many runs (1 for runs above 0.5 s)
+  bool mujoco = true;       // include the MuJoCo families
+  bool quick = false;       // a reduced grid (tests)
+};
+
+// Every case of `e` (kind: simulate), both models unless options.mujoco is false.
+std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyOptions& options);
+
+// DIR/accuracy.csv and DIR/accuracy.md (tables, defaults marked, references and their error).
+void writeAccuracyTables(const std::vector<AccuracyStudy>& studies, const std::string& dir);
+
+}  // namespace tailsim
