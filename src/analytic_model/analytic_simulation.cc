@@ -514,7 +514,9 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
           recordUpTo(t_cut, stateAt);
           stepper.calc_state(t_cut, y);
           t = t_cut;
-          if (!allFinite(y)) throw std::runtime_error("state became non-finite");
+          if (!allFinite(y))
+            throw std::runtime_error("state became non-finite at t=" + std::to_string(t) +
+                                     " s: tighten analytic.rel_tol (" + std::to_string(settings.rel_tol) + ")");
           if (f.hit) {
             const bool was_sliding = !modes.stuck[f.which];
             applySwitch(f.which, t, y, modes, model, switches);
@@ -545,7 +547,9 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         };
         recordUpTo(t1 - 1e-13, lerp);
         t = t1;
-        if (!allFinite(y)) throw std::runtime_error("state became non-finite");
+        if (!allFinite(y))
+          throw std::runtime_error("state became non-finite at t=" + std::to_string(t) +
+                                   " s: analytic.fixed_dt_s=" + std::to_string(settings.fixed_dt_s) + " is too large");
         if (model.stiction()) {
           for (int which : {kRot, kTrans}) {
             const double g0 = events.g(which, t - h, y0, modes), g1 = events.g(which, t, y, modes);
