@@ -256,6 +256,17 @@ class Recorder {
     ++next_;
   }
 
+  // Once everything is at rest for good (tail stopped, body stuck), every remaining row is the
+  // last one with a later time: copy it instead of re-evaluating the model.
+  void repeatLastUntilDone() {
+    if (ts_.numRows() == 0) return;
+    while (!done()) {
+      row_[0] = nextTime();
+      ts_.appendRow(row_);
+      ++next_;
+    }
+  }
+
   TimeSeries take() { return std::move(ts_); }
 
  private:
@@ -491,7 +502,11 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     long steps = 0;
     while (t < t_end - 1e-15) {
       if (settled(t)) {
-        recordUpTo(t_end, [&](double, State& ys) { ys = y; });
+        if (!rec.done() && rec.nextTime() <= t_end + 1e-12) {  // one evaluated row at rest, then copies
+          State ys = y;
+          rec.record(std::min(rec.nextTime(), t_end), ys, modes);
+          rec.repeatLastUntilDone();
+        }
         t = t_end;
         break;
       }
