@@ -391,7 +391,8 @@ TEST(PaperConfigs, SuiteLoadsWithThePaperGrids) {
       {"fig06a_model_comparison_1dof", 1}, {"fig06b_model_comparison_6dof", 1}, {"fig07_loading", 1},
       {"fig08_moment_contributions", 37},  {"fig09_theta0_dQ2B", 49},          {"fig10_LF", 91},
       {"fig11_wss", 9},                    {"fig12_dT_dtheta", 55},            {"fig13_equal_peak_speed", 5},
-      {"fig14_tail_dof", 6},               {"mu_swapped", 1}};
+      {"fig14_tail_dof", 6},               {"mu_swapped", 1},                  {"model_bridge_n1", 4},
+      {"model_bridge_n6", 4}};
   ASSERT_EQ(ex.size(), cases.size());
   for (const auto& [name, n] : cases) {
     ASSERT_TRUE(by.count(name)) << name;
