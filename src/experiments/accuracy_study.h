@@ -3,6 +3,7 @@
 // the same model.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -18,21 +19,29 @@ struct AccuracyRow {
   bool is_default = false;  // tailsim's shipped setting
   bool ok = true;
   std::string failure;  // why not ok (MuJoCo warning, NaN, ...)
-  double phi_net_deg = 0;
+  double phi_net_deg = 0;      // MuJoCo: mean over `runs`
   double err_phi_net_deg = 0;  // |phi_net - reference|
   double rms_err_phi_deg = 0;  // RMS over the output grid of phi(t) - phi_ref(t)
   double wall_s = 0;           // median over repeats
   long steps = 0;
+  int runs = 1;               // runs averaged into phi_net_deg (MuJoCo: a dT_s ensemble)
 };
 
 struct AccuracyStudy {
   std::string case_name;
   struct Reference {
+    bool present = false;
     std::string setting;
-    double phi_net_deg = 0;
-    double uncertainty_deg = 0;  // |reference - next coarser refinement|: bounds the reference's own error
+    double phi_net_deg = 0;      // MuJoCo: mean over the perturbed ensemble
+    double uncertainty_deg = 0;  // estimated error of the reference itself
+    // MuJoCo only: spread (standard deviation) of phi_net when dT_s is perturbed by 1..K us at
+    // fixed settings; contact chatter makes phi_net this sensitive. Errors below it are noise.
+    double noise_deg = 0;
+    double noise_default_deg = 0;  // the same at tailsim's default settings
+    std::vector<std::string> evidence;  // Markdown bullet lines: how convergence was established
   };
   Reference analytic, mujoco;
+  double analytic_exact_deg = NAN;  // analytic reference with the exact coupling (perspective)
   std::vector<AccuracyRow> rows;
 };
 

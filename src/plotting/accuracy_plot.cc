@@ -12,7 +12,8 @@ namespace tailsim {
 std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies, const std::string& dir) {
   std::vector<std::string> pngs;
   for (const AccuracyStudy& st : studies) {
-    std::string stem = "accuracy_" + st.case_name;
+    // DIR/accuracy.png for a single case, DIR/accuracy_<case>.png for several.
+    std::string stem = studies.size() == 1 ? std::string("accuracy") : "accuracy_" + st.case_name;
     std::replace_if(stem.begin(), stem.end(), [](char c) { return !std::isalnum(static_cast<unsigned char>(c)) && c != '_'; }, '_');
     // One data file per curve; errors of exactly 0 sit on the plot's floor (1e-12 deg).
     std::map<std::string, std::vector<std::vector<double>>> curves;
@@ -39,6 +40,9 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
       parts.push_back(gpQuote(stem + "_defaults.dat") +
                       " using 1:2 with points pt 6 ps 4 lw 3 lc rgb 'black' title 'tailsim default'");
     }
+    if (st.mujoco.present && st.mujoco.noise_default_deg > 0)
+      parts.push_back(std::to_string(st.mujoco.noise_default_deg) +
+                      " with lines dt 2 lw 2 lc rgb 'gray40' title 'MuJoCo noise floor (phi_net s.d. under dT +- 1 us)'");
     if (parts.empty()) continue;
     body << "plot ";
     for (size_t i = 0; i < parts.size(); ++i) body << (i ? ", \\\n     " : "") << parts[i];
