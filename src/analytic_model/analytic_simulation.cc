@@ -28,6 +28,7 @@ using State = std::array<double, 6>;
 enum { kPhi = 0, kPhiDot, kX, kY, kVx, kVy };
 
 constexpr int kRot = 0, kTrans = 1;
+using Margins = std::array<double, 2>;  // event margins g of rotation, translation
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Modes {
@@ -52,9 +53,12 @@ struct Eval {
 class Model {
  public:
   Model(const RobotParams& r, const TailTrajectory& tr, const AnalyticSettings& s, const Effects& e)
-      : robot_(r), traj_(tr), s_(e.friction == FrictionLaw::kStiction ? s : s), e_(e) {
+      : robot_(r), traj_(tr), s_(s), e_(e) {
     weight_ = r.systemMass() * (e.gravity ? r.gravity_mps2 : 0.0);
     mu_break_ = breakawayCoefficient(r.friction);
+    // The fixed-step solver keeps plain Coulomb friction in translation (its per-step stop check
+    // ends a slide); the adaptive one regularizes inside |v| < v_stop (see evaluate()).
+    v_reg_ = s.solver == "fixed" ? 0.0 : s.v_stop_mps;
     if (e.foot_loads == FootLoadModel::kConstant && needsArm()) {
       std::vector<JointState> j0;
       traj_.evaluate(0.0, j0);
@@ -64,7 +68,9 @@ class Model {
     }
   }
 
-  bool stiction() const { return e_.friction == FrictionLaw::kStiction && weight_ > 0.0; }
+  // Stuck states exist only with stiction and some friction to hold them (mu = 0: frictionless).
+  bool stiction() const { return e_.friction == FrictionLaw::kStiction && weight_ > 0.0 && mu_break_ > 0.0; }
+  double weight() const { return weight_; }
   bool translation() const { return e_.translation; }
   bool needsArm() const { return e_.friction != FrictionLaw::kNone && weight_ > 0.0; }
   const Effects& effects() const { return e_; }
@@ -93,15 +99,17 @@ class Model {
     const FrictionParams& fp = robot_.friction;
     if (needsArm()) {
       if (e_.friction == FrictionLaw::kStiction) {
-        const double dir = w != 0.0 ? (w > 0 ? 1.0 : -1.0) : m.rot_dir;
-        MzF = -fp.mu_d * weight_ * ev.L_F * dir;  // Eq. (16), sliding
+        // Eq. (16), sliding. The direction is the slip mode's, fixed until the mode ends at a
+        // located event (phi_dot reaching 0): taking it from the sign of phi_dot inside trial
+        // steps would make the right-hand side jump wherever a trial state overshoots zero, and
+        // the solver chatter there with ever smaller steps.
+        MzF = -fp.mu_d * weight_ * ev.L_F * m.rot_dir;
         // Eq. (15), sliding; inside |v| < v_stop the direction is regularized (friction ~ v), so a
         // body creeping at a load just above the static limit does not chatter in direction.
-        // The fixed-step solver keeps plain Coulomb friction (its per-step reversal check stops the
-        // body); the ball's stiffness mu W / (m v_stop) would make coarse explicit steps unstable.
-        const double v_reg = s_.solver == "fixed" ? 0.0 : s_.v_stop_mps;
+        // The fixed-step solver keeps plain Coulomb friction (its per-step stop check ends the
+        // slide); the ball's stiffness mu W / (m v_stop) would make coarse explicit steps unstable.
         const double speed = v.norm();
-        if (speed > 0.0) FF = -fp.mu_d * weight_ * v / std::max(speed, v_reg);
+        if (speed > 0.0) FF = -fp.mu_d * weight_ * v / std::max(speed, v_reg_);
       } else {  // the ADAMS law: mu follows the slip speed, no stuck state
         const double mu_r = adamsFrictionCoefficient(std::abs(w), fp.phidot_s_radps, fp.phidot_d_radps, fp.mu_s, fp.mu_d);
         MzF = -mu_r * weight_ * ev.L_F * (w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0));
@@ -202,7 +210,7 @@ class Model {
   const TailTrajectory& traj_;
   AnalyticSettings s_;
   Effects e_;
-  double weight_ = 0, mu_break_ = 0, L_F_const_ = kNaN;
+  double weight_ = 0, mu_break_ = 0, L_F_const_ = kNaN, v_reg_ = 0;
   // Reused buffers (one Model per run, never shared between threads).
   mutable std::vector<JointState> scratch_joints_;
   mutable LoadScratch scratch_;
@@ -251,7 +259,7 @@ class Recorder {
                              decomp ? ev.loads.MzT_tan : kNaN, decomp ? ev.loads.MzT_cen : kNaN, ev.MzF,
                              ev.loads.Izz_kgm2 * ev.phi_ddot, ev.loads.Izz_kgm2, ev.L_F, ev.FT_W.x(), ev.FT_W.y(),
                              ev.FF_W.x(), ev.FF_W.y(), stiction ? (m.stuck[kRot] ? 0.0 : 1.0) : kNaN,
-                             stiction ? (m.stuck[kTrans] ? 0.0 : 1.0) : kNaN});
+                             stiction && model_.translation() ? (m.stuck[kTrans] ? 0.0 : 1.0) : kNaN});
     ts_.appendRow(row_);
     ++next_;
   }
@@ -284,36 +292,42 @@ class Recorder {
 
 struct Events {
   const Model& model;
-  double v_stop;
+  double v_stop;  // a slide below this speed may stick (fixed solver: at least one step's friction)
 
-  // rotation: sliding -> phi_dot reaches 0 along its direction; stuck -> load reaches the static limit.
-  double rot(double t, const State& y, const Modes& m) const {
-    if (!m.stuck[kRot]) return m.rot_dir * y[kPhiDot];
-    const Eval ev = model.evaluate(t, y, m);
-    return ev.M_break - std::abs(ev.M_required);
-  }
-  double trans(double t, const State& y, const Modes& m) const {
-    if (!model.translation()) return 1.0;
-    // Sliding sticks once the speed is below v_stop and the load no longer exceeds the static
-    // limit (probe: the force a stuck body would need). In 2-D the velocity need not pass
-    // through exactly zero, so "phi_dot changes sign" has no direct analogue.
-    if (!m.stuck[kTrans]) {
-      Modes probe = m;
-      probe.stuck[kTrans] = true;
-      const Eval ev = model.evaluate(t, y, probe);
-      return std::max(std::hypot(y[kVx], y[kVy]) - v_stop, ev.F_required.norm() - ev.F_break);
+  // Both margins at (t, y) from one model evaluation (plus a probe for a slow sliding translation).
+  // rotation: sliding -> rot_dir * phi_dot (the slip ends where it reaches 0);
+  //           stuck   -> static limit minus the moment a stuck body needs.
+  // translation: sliding -> max(|v| - v_stop, F_required - F_break): sticks once slower than
+  //           v_stop with the load under the static limit (in 2-D the velocity need not pass
+  //           through exactly zero, so "changes sign" has no direct analogue);
+  //           stuck   -> static limit minus the force a stuck body needs.
+  Margins g(double t, const State& y, const Modes& m) const {
+    Margins out{1.0, 1.0};
+    const bool trans = model.translation();
+    Eval ev;
+    if (m.stuck[kRot] || (trans && m.stuck[kTrans])) ev = model.evaluate(t, y, m);
+    out[kRot] = m.stuck[kRot] ? ev.M_break - std::abs(ev.M_required) : m.rot_dir * y[kPhiDot];
+    if (trans) {
+      if (m.stuck[kTrans]) {
+        out[kTrans] = ev.F_break - ev.F_required.norm();
+      } else {
+        const double fast = std::hypot(y[kVx], y[kVy]) - v_stop;
+        if (fast > 0) {
+          out[kTrans] = fast;  // same sign as the max below, without the probe's evaluation
+        } else {
+          Modes probe = m;
+          probe.stuck[kTrans] = true;
+          const Eval pe = model.evaluate(t, y, probe);
+          out[kTrans] = std::max(fast, pe.F_required.norm() - pe.F_break);
+        }
+      }
     }
-    const Eval ev = model.evaluate(t, y, m);
-    return ev.F_break - ev.F_required.norm();
-  }
-  double g(int which, double t, const State& y, const Modes& m) const {
-    return which == kRot ? rot(t, y, m) : trans(t, y, m);
+    return out;
   }
 };
 
-// Switches the modes at an event time t (state y already at t).
-void applySwitch(int which, double t, State& y, Modes& m, const Model& model, int& counter) {
-  ++counter;
+// Switches DOF `which` at time t (state y already at t). Returns the mode change made.
+void applySwitch(int which, double t, State& y, Modes& m, const Model& model) {
   if (which == kRot) {
     if (!m.stuck[kRot]) {  // stopped sliding: stick, unless the load exceeds the static limit
       y[kPhiDot] = 0.0;
@@ -331,10 +345,31 @@ void applySwitch(int which, double t, State& y, Modes& m, const Model& model, in
       m.rot_dir = e.M_required < 0 ? 1.0 : -1.0;
     }
   } else {
-    // Stop (the event fires only below v_stop with the load under the static limit) or
-    // breakaway (Eq. 15, second case: the regularized friction lets it accelerate along F_T).
+    // Stop (below v_stop with the load under the static limit) or breakaway (Eq. 15, second
+    // case: the regularized friction lets it accelerate along the load).
     if (!m.stuck[kTrans]) y[kVx] = y[kVy] = 0.0;
     m.stuck[kTrans] = !m.stuck[kTrans];
+  }
+}
+
+// The modes consistent with (t, y): a stuck DOF whose margin is at or below zero breaks away at
+// once, a slide slower than v_stop under the static limit sticks, a rotation sliding against its
+// own direction stops (and sticks or turns round). Switching one DOF can change the other's
+// margin (exact coupling), so this repeats until nothing changes. Returns the switches made.
+int settleModes(double t, State& y, Modes& m, const Model& model, const Events& events) {
+  if (!model.stiction()) return 0;
+  for (int n = 0;; ++n) {
+    if (n > 8)
+      throw std::runtime_error("stick/slip modes do not settle at t=" + std::to_string(t) +
+                               " s (each switch undoes the other)");
+    const Margins g = events.g(t, y, m);
+    int which = -1;
+    for (int w : {kRot, kTrans})
+      if (m.stuck[w] && g[w] <= 0) which = w;
+    if (which < 0 && model.translation() && !m.stuck[kTrans] && g[kTrans] < 0) which = kTrans;
+    if (which < 0 && !m.stuck[kRot] && g[kRot] < 0) which = kRot;
+    if (which < 0) return n;
+    applySwitch(which, t, y, m, model);
   }
 }
 
@@ -379,46 +414,51 @@ struct Found {
   int which = 0;
 };
 
-// Searches [ta, tb] for the first switch, sampling the event functions every h_scan (so a short
-// load peak between two solver steps is not stepped over: READING-NOTES point 4) and refining a
-// local minimum of a stuck DOF's margin that the samples alone do not show crossing zero.
+// Searches [ta, tb] for the first switch of either DOF. Both margins are sampled together every
+// h_scan (so a short load peak between two solver steps is not stepped over: docs/paper-notes.md
+// point 4); in the first sample interval where any margin reaches zero, every DOF that crosses
+// there is located and the earliest wins, so no DOF's switch can hide behind another's. A dip of
+// a stuck DOF's margin between samples (all samples positive) is refined by golden section.
 template <class StateAt>
 Found findSwitch(const Events& events, const Modes& m, double ta, double tb, double h_scan, double tol,
                  const StateAt& stateAt) {
   const int k = std::max(2, static_cast<int>(std::ceil((tb - ta) / h_scan)));
-  Found best;
   State y;
-  for (int which : {kRot, kTrans}) {
-    auto g = [&](double t) {
-      stateAt(t, y);
-      return events.g(which, t, y, m);
-    };
-    double t_prev2 = ta, g_prev2 = 0, t_prev = ta, g_prev = g(ta);
-    const double limit = best.hit ? best.t : tb;
-    for (int i = 1; i <= k; ++i) {
-      const double t = ta + (tb - ta) * i / k;
-      if (t > limit) break;
-      const double gt = g(t);
-      // Sliding DOFs start at g = 0 and must not turn negative: that is a stop as well.
-      if ((g_prev > 0 && gt <= 0) || (!m.stuck[which] && g_prev >= 0 && gt < 0)) {
-        const double ts = illinois(g, t_prev, t, g_prev, gt, tol);
-        if (!best.hit || ts < best.t) best = {true, ts, which};
-        break;
-      }
-      // A dip between samples: g fell then rose again, all samples positive.
-      if (m.stuck[which] && i >= 2 && g_prev < g_prev2 && g_prev < gt && g_prev > 0) {
-        auto [tm, gm] = goldenMin(g, t_prev2, t, tol * 1e3);
+  auto gAt = [&](double t) {
+    stateAt(t, y);
+    return events.g(t, y, m);
+  };
+  // A stuck margin reaching 0 from above, or a sliding one turning negative (a stop).
+  auto crosses = [&](int w, double g0, double g1) { return (g0 > 0 && g1 <= 0) || (!m.stuck[w] && g0 >= 0 && g1 < 0); };
+  Margins g_prev = gAt(ta), g_prev2 = g_prev;
+  for (int w : {kRot, kTrans})  // already past the switch (settleModes normally resolves this)
+    if ((m.stuck[w] && g_prev[w] <= 0) || (!m.stuck[w] && g_prev[w] < 0)) return {true, ta, w};
+  double t_prev = ta, t_prev2 = ta;
+  for (int i = 1; i <= k; ++i) {
+    const double t = ta + (tb - ta) * i / k;
+    const Margins gt = gAt(t);
+    Found best;
+    for (int w : {kRot, kTrans}) {
+      auto gw = [&](double tt) { return gAt(tt)[w]; };
+      double ts = 0;
+      bool hit = false;
+      if (crosses(w, g_prev[w], gt[w])) {
+        ts = illinois(gw, t_prev, t, g_prev[w], gt[w], tol);
+        hit = true;
+      } else if (m.stuck[w] && i >= 2 && g_prev[w] < g_prev2[w] && g_prev[w] < gt[w] && g_prev[w] > 0) {
+        const auto [tm, gm] = goldenMin(gw, t_prev2, t, tol * 1e3);
         if (gm <= 0) {
-          const double ts = illinois(g, t_prev2, tm, g_prev2, gm, tol);
-          if (!best.hit || ts < best.t) best = {true, ts, which};
-          break;
+          ts = illinois(gw, t_prev2, tm, g_prev2[w], gm, tol);
+          hit = true;
         }
       }
-      t_prev2 = t_prev; g_prev2 = g_prev;
-      t_prev = t; g_prev = gt;
+      if (hit && (!best.hit || ts < best.t)) best = {true, ts, w};
     }
+    if (best.hit) return best;
+    t_prev2 = t_prev; g_prev2 = g_prev;
+    t_prev = t; g_prev = gt;
   }
-  return best;
+  return {};
 }
 
 bool allFinite(const State& y) {
@@ -436,12 +476,16 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
   if (!(settings.rel_tol > 0) || !(settings.abs_tol > 0)) throw std::invalid_argument("analytic tolerances must be > 0");
   if (!(settings.fixed_dt_s > 0)) throw std::invalid_argument("analytic.fixed_dt_s must be > 0");
   if (!(output.sample_dt_s > 0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
+  const double t_end = output.duration_s > 0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  if (output.sample_dt_s > t_end)
+    throw std::invalid_argument("output.sample_dt_s = " + std::to_string(output.sample_dt_s) +
+                                " s is longer than the run (" + std::to_string(t_end) +
+                                " s): the time series needs at least 2 rows");
 
   const auto wall0 = std::chrono::steady_clock::now();
   RunResult result;
   RunSummary& sum = result.summary;
   sum.model = "analytic";
-  const double t_end = output.duration_s > 0 ? output.duration_s : trajectory.endTime() + output.settle_s;
   const double tail_end = trajectory.endTime();
 
   // Shortest acceleration or deceleration phase sets the event sampling and the step bound.
@@ -450,11 +494,17 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     shortest = std::min({shortest, j.params().w_ss * j.params().dT_s, (1 - j.params().w_ss) * j.params().dT_s});
   const double h_scan = shortest / 32.0;
   const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
+  const bool adaptive = settings.solver == "adaptive";
 
   try {
     const Model model(robot, trajectory, settings, effects);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, t_end);
-    Events events{model, settings.v_stop_mps};
+    // The fixed-step solver checks once per step: a slide slower than one step's friction
+    // deceleration (mu_d g h) would reverse within the next step, so it counts as stopped.
+    const double v_stop = adaptive ? settings.v_stop_mps
+                                   : std::max(settings.v_stop_mps, robot.friction.mu_d * model.weight() /
+                                                                       robot.systemMass() * settings.fixed_dt_s);
+    const Events events{model, v_stop};
     Modes modes;
     State y{};
     double t = 0.0;
@@ -462,15 +512,24 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     double t_stop = 0.0;
     bool ever_rotated = false;
 
-    // Initially at rest: stuck wherever stiction holds (Eq. 14-16 first cases).
+    // Switches DOF `which` (or none, -1) at t, then settles the modes; keeps the summary counters.
+    auto switchAt = [&](int which) {
+      const Modes before = modes;
+      if (which >= 0) {
+        applySwitch(which, t, y, modes, model);
+        ++switches;
+      }
+      switches += settleModes(t, y, modes, model, events);
+      if (!before.stuck[kRot] && modes.stuck[kRot]) t_stop = t;
+      if (!modes.stuck[kRot]) ever_rotated = true;
+    };
+
+    // Initially at rest: stuck wherever stiction holds (Eqs. 14-16, first cases); a load already
+    // above the static limit breaks away at once.
     if (model.stiction()) {
       modes.stuck[kRot] = true;
       modes.stuck[kTrans] = model.translation();
-      for (int which : {kRot, kTrans}) {
-        if (modes.stuck[which] && events.g(which, 0.0, y, modes) <= 0) {
-          applySwitch(which, 0.0, y, modes, model, switches);
-        }
-      }
+      switchAt(-1);
     }
 
     auto rhs = [&](const State& x, State& dx, double tt) { model.derivative(tt, x, modes, dx); };
@@ -491,14 +550,11 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         rec.record(ts, ys, modes);
       }
     };
-    auto afterSwitch = [&](int which, bool was_sliding) {
-      if (which == kRot) {
-        if (was_sliding && modes.stuck[kRot]) t_stop = t;
-        if (!modes.stuck[kRot]) ever_rotated = true;
-      }
+    auto checkFinite = [&](const char* what) {
+      if (!allFinite(y))
+        throw std::runtime_error("state became non-finite at t=" + std::to_string(t) + " s: " + what);
     };
 
-    const bool adaptive = settings.solver == "adaptive";
     long steps = 0;
     while (t < t_end - 1e-15) {
       if (settled(t)) {
@@ -529,13 +585,9 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
           recordUpTo(t_cut, stateAt);
           stepper.calc_state(t_cut, y);
           t = t_cut;
-          if (!allFinite(y))
-            throw std::runtime_error("state became non-finite at t=" + std::to_string(t) +
-                                     " s: tighten analytic.rel_tol (" + std::to_string(settings.rel_tol) + ")");
+          checkFinite(("tighten analytic.rel_tol (" + std::to_string(settings.rel_tol) + ")").c_str());
           if (f.hit) {
-            const bool was_sliding = !modes.stuck[f.which];
-            applySwitch(f.which, t, y, modes, model, switches);
-            afterSwitch(f.which, was_sliding);
+            switchAt(f.which);
             restart = true;
           } else if (tb_raw >= seg_end - 1e-15) {
             restart = true;  // a breakpoint of the tail profile: restart the step there
@@ -548,10 +600,14 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         }
       } else {
         // Fixed-step classic RK4; switches checked once per step, the way a fixed-step Simulink
-        // model with a zero-crossing reset would (phi_dot zeroed when it would change sign).
+        // model with a zero-crossing reset would: a margin at or below zero at the step's end
+        // switches (for a slide, g < 0 means it stopped somewhere inside the step). The slip
+        // direction is the mode's, fixed over the step's four stages, so a rotation that stops
+        // inside a step overshoots zero and is caught, instead of its stages averaging the
+        // Coulomb sign away into an endless creep.
         odeint::runge_kutta4<State> rk4;
         const double h = std::min(settings.fixed_dt_s, seg_end - t);
-        State y0 = y;
+        const State y0 = y;
         rk4.do_step(rhs, y, t, h);
         ++steps;
         const double t1 = t + h;
@@ -562,43 +618,34 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         };
         recordUpTo(t1 - 1e-13, lerp);
         t = t1;
-        if (!allFinite(y))
-          throw std::runtime_error("state became non-finite at t=" + std::to_string(t) +
-                                   " s: analytic.fixed_dt_s=" + std::to_string(settings.fixed_dt_s) + " is too large");
+        checkFinite(("analytic.fixed_dt_s=" + std::to_string(settings.fixed_dt_s) + " is too large").c_str());
         if (model.stiction()) {
-          for (int which : {kRot, kTrans}) {
-            const double g0 = events.g(which, t - h, y0, modes), g1 = events.g(which, t, y, modes);
-            // A step longer than v_stop / a can jump over the slow-speed ball: a sliding velocity
-            // that reversed over the step counts as stopped too (if the load allows sticking).
-            const bool reversed = which == kTrans && !modes.stuck[kTrans] && model.translation() &&
-                                  y0[kVx] * y[kVx] + y0[kVy] * y[kVy] < 0 && [&] {
-                                    Modes probe = modes;
-                                    probe.stuck[kTrans] = true;
-                                    const Eval e = model.evaluate(t, y, probe);
-                                    return e.F_required.norm() < e.F_break;
-                                  }();
-            // Checked once per step: a margin at or below zero at the step's end switches (for a
-            // sliding DOF g < 0 means it stopped, or turned round, somewhere inside the step).
-            const bool crossed = modes.stuck[which] ? g1 <= 0 : (g1 < 0 || (g0 > 0 && g1 <= 0));
-            if (crossed || reversed) {
-              const bool was_sliding = !modes.stuck[which];
-              applySwitch(which, t, y, modes, model, switches);
-              afterSwitch(which, was_sliding);
-            }
+          // A 2-D slide whose velocity turned by more than 90 deg over the step stopped inside it.
+          const bool reversed = model.translation() && !modes.stuck[kTrans] &&
+                                y0[kVx] * y[kVx] + y0[kVy] * y[kVy] < 0;
+          if (reversed) {
+            Modes probe = modes;
+            probe.stuck[kTrans] = true;
+            const Eval e = model.evaluate(t, y, probe);
+            if (e.F_required.norm() < e.F_break) switchAt(kTrans);
           }
+          switchAt(-1);
         }
         recordUpTo(t, [&](double, State& ys) { ys = y; });
       }
     }
 
     result.series = rec.take();
-    const auto& phi = result.series.values("phi_deg");
-    sum.phi_net_deg = phi.empty() ? 0.0 : phi.back() - phi.front();
+    // Summaries from the simulated state at t_end, not from the sampled rows (phi(0) = 0).
+    sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
     const bool still = !model.stiction() || !modes.stuck[kRot];
     sum.t_stop_s = still ? t_end : t_stop;
     sum.stick_slip_events = switches;
     sum.solver_steps = steps;
+    sum.extra["final_x_m"] = y[kX];
+    sum.extra["final_y_m"] = y[kY];
     sum.extra["final_phidot_dps"] = y[kPhiDot] * 180.0 / M_PI;
+    sum.extra["final_speed_mps"] = std::hypot(y[kVx], y[kVy]);
     sum.extra["still_rotating_at_end"] = still && std::abs(y[kPhiDot]) > 0 ? 1.0 : 0.0;
     sum.extra["ever_rotated"] = ever_rotated || !model.stiction() ? 1.0 : 0.0;
   } catch (const TippingError& e) {
