@@ -1,6 +1,7 @@
 // The analytic model in time: stiction law (Eqs. 14-16) with event-located switching.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "analytic_test_util.h"
@@ -176,4 +177,59 @@ TEST(AnalyticSimulation, SwappedFrictionBreaksAwayAtTheLargerCoefficient) {
   const double c = simulateAnalytic(swapped, tr, {}, {}, {}).summary.phi_net_deg;
   EXPECT_EQ(a, b);
   EXPECT_GT(std::abs(c), std::abs(a));
+}
+
+// phi_net and the final state come from the simulation, not from the sampled rows: any grid gives
+// the same summary (a spacing that does not divide the run's length included), and a grid with
+// fewer than 2 rows is refused instead of reporting phi_net = 0.
+TEST(AnalyticSimulation, SummaryDoesNotDependOnTheOutputGrid) {
+  const RunResult fine = runFig7();
+  ASSERT_TRUE(fine.summary.ok);
+  for (double dt : {0.0007, 0.01, 0.3, 0.75}) {
+    OutputSettings o;
+    o.sample_dt_s = dt;
+    const RunResult r = runFig7({}, {}, o);
+    ASSERT_TRUE(r.summary.ok) << dt;
+    EXPECT_EQ(r.summary.phi_net_deg, fine.summary.phi_net_deg) << dt;
+    EXPECT_EQ(r.summary.extra.at("final_x_m"), fine.summary.extra.at("final_x_m")) << dt;
+    EXPECT_EQ(r.summary.extra.at("final_y_m"), fine.summary.extra.at("final_y_m")) << dt;
+    EXPECT_EQ(r.series.numRows(), static_cast<size_t>(std::floor(0.75 / dt + 1e-9)) + 1) << dt;
+  }
+  OutputSettings too_coarse;
+  too_coarse.sample_dt_s = 0.76;
+  EXPECT_THROW(runFig7({}, {}, too_coarse), std::invalid_argument);
+}
+
+// The translation of the Fig. 6 / Fig. 9 minimal case (d_Q2B = 0, theta0 = 0, dtheta = -90 deg)
+// breaks away although the rotation switches first; the default settings agree with a 2e-5 s step
+// bound (before the fix the default left the body at x = y = 0).
+TEST(AnalyticSimulation, TranslationBreaksAwayBehindARotationSwitch) {
+  const RobotParams r = paperRobot(1, 0.0);
+  const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);
+  AnalyticSettings fine;
+  fine.max_step_s = 2e-5;
+  const RunResult a = simulateAnalytic(r, tr, {}, {}, {}), b = simulateAnalytic(r, tr, fine, {}, {});
+  ASSERT_TRUE(a.summary.ok && b.summary.ok);
+  EXPECT_NEAR(a.summary.extra.at("final_x_m"), -0.00982, 5e-5);
+  EXPECT_NEAR(a.summary.extra.at("final_y_m"), -0.00492, 5e-5);
+  EXPECT_NEAR(a.summary.extra.at("final_x_m"), b.summary.extra.at("final_x_m"), 1e-8);
+  EXPECT_NEAR(a.summary.extra.at("final_y_m"), b.summary.extra.at("final_y_m"), 1e-8);
+}
+
+// No friction: no stuck states, no switches; translation locked: no translational state reported.
+TEST(AnalyticSimulation, StateColumnsAndEventsMeanWhatTheySay) {
+  RobotParams r = paperRobot(1);
+  r.friction.mu_s = r.friction.mu_d = 0.0;
+  const RunResult free = simulateAnalytic(r, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  ASSERT_TRUE(free.summary.ok);
+  EXPECT_EQ(free.summary.stick_slip_events, 0);
+  Effects locked;
+  locked.translation = false;
+  const RunResult l = runFig7({}, locked);
+  ASSERT_TRUE(l.summary.ok);
+  for (double v : col(l, "trans_state")) EXPECT_TRUE(std::isnan(v));
+  for (double v : col(l, "x_m")) EXPECT_EQ(v, 0.0);
+  const auto& rot = col(l, "rot_state");
+  EXPECT_EQ(rot.front(), 0.0);
+  EXPECT_TRUE(std::find(rot.begin(), rot.end(), 1.0) != rot.end());
 }

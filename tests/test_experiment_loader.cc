@@ -215,8 +215,8 @@ TEST_F(LoaderTest, RangeIsInclusiveAndRobustToFloatSteps) {
   EXPECT_EQ(f.cases.front().name, "theta0_deg=90,dtheta_deg=-0.1");
   EXPECT_EQ(f.cases.back().name, "theta0_deg=0,dtheta_deg=-0.3");
   EXPECT_DOUBLE_EQ(f.cases.back().joints[0].dtheta_rad, -0.3 * kDeg);
-  const std::string r = write("exp.yaml", exp("output: {sample_dt_s: {range: [0.1, 1.0, 0.1]}}\n") + kTraj);
-  EXPECT_EQ(loadExperiment(r).cases.size(), 10u);
+  const std::string r = write("exp.yaml", exp("output: {sample_dt_s: {range: [0.1, 0.7, 0.1]}}\n") + kTraj);
+  EXPECT_EQ(loadExperiment(r).cases.size(), 7u);
 }
 
 TEST_F(LoaderTest, SweepValuesArePrintedAsWritten) {
@@ -483,6 +483,11 @@ TEST_F(LoaderTest, BadRobotValues) {
 
 TEST_F(LoaderTest, BadSettings) {
   expectError(exp(std::string(kTraj) + "output:\n  sample_dt_s: 0\n"), 6, "output.sample_dt_s", "> 0");
+  // A grid with fewer than 2 rows (spacing longer than the 0.25 + 0.5 s run) is an error, not phi_net = 0.
+  expectError(exp(std::string(kTraj) + "output:\n  sample_dt_s: 10\n"), 6, "output.sample_dt_s",
+              "longer than the run (0.75 s)");
+  expectError(exp(std::string(kTraj) + "output: {sample_dt_s: 0.2, duration_s: 0.1}\n"), 5, "output.sample_dt_s",
+              "at least 2 rows");
   expectError(exp(std::string(kTraj) + "mujoco:\n  timestep_s: -1e-4\n"), 6, "mujoco.timestep_s", "> 0");
   expectError(exp(std::string(kTraj) + "mujoco: {condim: 2}\n"), 5, "mujoco.condim", "1, 3, 4, 6");
   expectError(exp(std::string(kTraj) + "mujoco: {body_height_m: 0}\n"), 5, "mujoco.body_height_m", "> 0");

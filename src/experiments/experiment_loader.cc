@@ -679,12 +679,20 @@ Effects readEffects(const Reader& r, const Item& item) {
   return e;
 }
 
-OutputSettings readOutput(const Reader& r, const Item& item) {
+// tail_end_s: when the tail stops (kind: simulate), or < 0 (kind: pose, no time series).
+OutputSettings readOutput(const Reader& r, const Item& item, double tail_end_s) {
   const MapView m = r.map(item, {"sample_dt_s", "duration_s", "settle_s"});
   OutputSettings o;
   if (const Item* x = m.get("sample_dt_s")) o.sample_dt_s = r.positive(*x);
   if (const Item* x = m.get("duration_s")) o.duration_s = r.nonNegative(*x);
   if (const Item* x = m.get("settle_s")) o.settle_s = r.nonNegative(*x);
+  // The time series needs at least 2 rows (t = 0 and the end); a longer spacing is a mistake.
+  const double t_end = o.duration_s > 0 ? o.duration_s : tail_end_s + o.settle_s;
+  if (tail_end_s >= 0 && o.sample_dt_s > t_end) {
+    const Item* at = m.get("sample_dt_s") ? m.get("sample_dt_s") : m.get("duration_s") ? m.get("duration_s") : &item;
+    r.fail(*at, "sample_dt_s = " + fmtG(o.sample_dt_s) + " s is longer than the run (" + fmtG(t_end) +
+                    " s): the time series needs at least 2 rows");
+  }
   return o;
 }
 
@@ -800,7 +808,8 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   if (const Item* x = top.get("analytic")) c.analytic = readAnalytic(r, *x);
   if (const Item* x = top.get("mujoco")) c.mujoco = readMujoco(r, *x);
   if (const Item* x = top.get("effects")) c.effects = readEffects(r, *x);
-  if (const Item* x = top.get("output")) c.output = readOutput(r, *x);
+  if (const Item* x = top.get("output"))
+    c.output = readOutput(r, *x, c.kind == "simulate" ? c.trajectory().endTime() : -1.0);
   if (const Item* x = top.get("render")) c.render = readRender(r, *x);
   return c;
 }
