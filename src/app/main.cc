@@ -45,19 +45,19 @@ std::string versionString() {
 }
 
 // `--case NAME` must name a case of the suite: an error listing the available ones otherwise.
-void requireCase(const std::vector<Experiment>& suite, const std::string& name) {
+void requireCase(const std::vector<Experiment>& suite, const std::string& file, const std::string& name) {
   if (name.empty()) return;
   std::vector<std::string> names;
   for (const Experiment& e : suite)
     for (const ExperimentCase& c : e.cases) {
       if (c.name == name) return;
-      names.push_back(c.name);
+      if (std::find(names.begin(), names.end(), c.name) == names.end()) names.push_back(c.name);
     }
   std::string list;
   const size_t show = std::min<size_t>(names.size(), 20);
   for (size_t i = 0; i < show; ++i) list += (i ? ", " : "") + names[i];
   if (names.size() > show) list += ", ... (" + std::to_string(names.size() - show) + " more)";
-  throw std::runtime_error("no case named '" + name + "' in " + (suite.empty() ? std::string("the experiment") : suite.front().source_file) +
+  throw std::runtime_error("no case named '" + name + "' in " + file +
                            "; cases: " + (list.empty() ? "(none)" : list));
 }
 
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
       o.progress = !quiet;
       o.only_case = case_name;
       o.stop_on_sigint = true;
-      requireCase(suite, case_name);
+      requireCase(suite, exp_path, case_name);
       const RunStats s = runSuite(suite, o);
       std::printf("%d cases: %d run, %d resumed, %d failed model runs, %.3f s wall\n", s.total, s.ran, s.resumed,
                   s.failed, s.wall_time_s);
@@ -194,12 +194,13 @@ int main(int argc, char** argv) {
     }
     if (*mjcf) {
       const bool to_stream = writeMjcfFile(links, mjcf_out);
-      std::fprintf(to_stream ? stderr : stdout, "wrote %s\n", mjcf_out.c_str());  // XML on stdout stays XML
+      // XML on stdout stays XML: the message goes to stderr when the model went to a stream.
+      std::fprintf(to_stream ? stderr : stdout, "wrote %s\n", mjcf_out == "-" ? "the MJCF to stdout" : mjcf_out.c_str());
       return kExitOk;
     }
     if (*render) {
       const std::vector<Experiment> suite = loadExperimentSuite(exp_path);
-      requireCase(suite, case_name);
+      requireCase(suite, exp_path, case_name);
       for (const Experiment& e : suite) {
         const fs::path dir = fs::path(render_out) / e.name;
         for (ExperimentCase c : e.cases) {
