@@ -3,6 +3,8 @@
 //   tailsim plot DIR | tailsim report DIR      figures / Markdown report from saved results
 //   tailsim render EXPERIMENT.yaml --out DIR   headless MP4 + PNG of each case
 //   tailsim mjcf --links N --out FILE          the MuJoCo model of the paper robot
+//   tailsim accuracy EXPERIMENT.yaml --out DIR work-precision study of both models
+// Exit codes: see kExitCodes below (also printed by --help).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -19,11 +21,45 @@
 #include "plotting/accuracy_plot.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
+#include "results/atomic_file.h"
+#include "tailsim_version.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;
 
 namespace {
+
+constexpr int kExitOk = 0, kExitError = 1, kExitUsage = 2, kExitRunsFailed = 3, kExitInterrupted = 130;
+constexpr const char* kExitCodes =
+    "Exit codes:\n"
+    "  0    ok\n"
+    "  1    error: bad input (named file:line:col) or a failure that stopped the command\n"
+    "  2    usage error: unknown subcommand or option, missing or bad argument\n"
+    "  3    run: some model runs failed (the rest is saved; see summary.json)\n"
+    "  130  run: interrupted by Ctrl-C (finished cases are saved; run again to resume)";
+
+std::string versionString() {
+  std::string v = std::string("tailsim ") + kVersion;
+  if (*kGitCommit) v += std::string(" (git ") + kGitCommit + ")";
+  return v;
+}
+
+// `--case NAME` must name a case of the suite: an error listing the available ones otherwise.
+void requireCase(const std::vector<Experiment>& suite, const std::string& file, const std::string& name) {
+  if (name.empty()) return;
+  std::vector<std::string> names;
+  for (const Experiment& e : suite)
+    for (const ExperimentCase& c : e.cases) {
+      if (c.name == name) return;
+      if (std::find(names.begin(), names.end(), c.name) == names.end()) names.push_back(c.name);
+    }
+  std::string list;
+  const size_t show = std::min<size_t>(names.size(), 20);
+  for (size_t i = 0; i < show; ++i) list += (i ? ", " : "") + names[i];
+  if (names.size() > show) list += ", ... (" + std::to_string(names.size() - show) + " more)";
+  throw std::runtime_error("no case named '" + name + "' in " + file +
+                           "; cases: " + (list.empty() ? "(none)" : list));
+}
 
 void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite) {
   // A short table of phi_net per case and model, read back from the result folders.
@@ -57,6 +93,8 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
 int main(int argc, char** argv) {
   CLI::App app{"tailsim: quadruped yaw turning with a planar robotic tail (Rone & Ben-Tzvi 2016)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", versionString(), "print the version and exit");
+  app.footer(kExitCodes);
 
   std::string exp_path, out_dir, case_name;
   int threads = 0;
@@ -103,7 +141,23 @@ int main(int argc, char** argv) {
   accuracy->add_flag("--quick", acc_quick, "a reduced grid");
   accuracy->add_flag("--no-mujoco", acc_no_mujoco, "analytic model only");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 says "A subcommand is required" for `tailsim rn`: name the word it did not know.
+    const std::string first = argc > 1 ? argv[1] : "";
+    if (!first.empty() && first[0] != '-' && app.get_subcommands().empty()) {
+      std::string names;
+      for (const CLI::App* sc : app.get_subcommands([](CLI::App*) { return true; })) names += (names.empty() ? "" : ", ") + sc->get_name();
+      std::fprintf(stderr, "error: unknown subcommand '%s' (one of: %s)\nRun with --help for more information.\n",
+                   first.c_str(), names.c_str());
+    } else {
+      app.exit(e);  // CLI11's message names the option or argument
+    }
+    return kExitUsage;
+  }
 
   try {
     if (*run) {
@@ -123,20 +177,30 @@ int main(int argc, char** argv) {
       o.resume = !fresh;
       o.progress = !quiet;
       o.only_case = case_name;
+      o.stop_on_sigint = true;
+      requireCase(suite, exp_path, case_name);
       const RunStats s = runSuite(suite, o);
       std::printf("%d cases: %d run, %d resumed, %d failed model runs, %.3f s wall\n", s.total, s.ran, s.resumed,
                   s.failed, s.wall_time_s);
+      if (s.interrupted) {
+        std::fflush(stdout);
+        std::fprintf(stderr, "interrupted: %d of %d cases saved in %s; run the same command again to resume\n",
+                     s.ran + s.resumed, s.total, out_dir.c_str());
+        return kExitInterrupted;
+      }
       printCases(suite, out_dir, suite.size() > 1);
       if (plots) std::printf("report: %s\n", writeReport(out_dir).c_str());
-      return s.failed ? 2 : 0;
+      return s.failed ? kExitRunsFailed : kExitOk;
     }
     if (*mjcf) {
-      writeMjcfFile(links, mjcf_out);
-      std::printf("wrote %s\n", mjcf_out.c_str());
-      return 0;
+      const bool to_stream = writeMjcfFile(links, mjcf_out);
+      // XML on stdout stays XML: the message goes to stderr when the model went to a stream.
+      std::fprintf(to_stream ? stderr : stdout, "wrote %s\n", mjcf_out == "-" ? "the MJCF to stdout" : mjcf_out.c_str());
+      return kExitOk;
     }
     if (*render) {
       const std::vector<Experiment> suite = loadExperimentSuite(exp_path);
+      requireCase(suite, exp_path, case_name);
       for (const Experiment& e : suite) {
         const fs::path dir = fs::path(render_out) / e.name;
         for (ExperimentCase c : e.cases) {
@@ -153,7 +217,7 @@ int main(int argc, char** argv) {
                       st.frames, st.width, st.height, st.fps);
         }
       }
-      return 0;
+      return kExitOk;
     }
     if (*accuracy) {
       const Experiment e = loadExperiment(exp_path);
@@ -166,23 +230,23 @@ int main(int argc, char** argv) {
       writeAccuracyTables(studies, acc_out);
       for (const std::string& png : plotAccuracy(studies, acc_out)) std::printf("%s\n", png.c_str());
       std::printf("%s/accuracy.md\n%s/accuracy.csv\n", acc_out.c_str(), acc_out.c_str());
-      return 0;
+      return kExitOk;
     }
     if (*plot) {
       const auto files = plotResults(result_dir);
       for (const auto& f : files) std::printf("%s\n", f.png.c_str());
-      return 0;
+      return kExitOk;
     }
     if (*report) {
       std::printf("%s\n", writeReport(result_dir).c_str());
-      return 0;
+      return kExitOk;
     }
   } catch (const ConfigError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    return kExitError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
+    return kExitError;
   }
-  return 0;
+  return kExitOk;
 }

@@ -1,9 +1,13 @@
 #include "experiments/experiment_runner.h"
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <condition_variable>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +21,7 @@
 #include "experiments/render_case.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "results/atomic_file.h"
+#include "tailsim_version.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;
@@ -171,6 +176,8 @@ void writeSummary(const Job& job) {
   const Experiment& e = *job.e;
   json s;
   s["experiment"] = e.name;
+  s["tailsim_version"] = kVersion;
+  if (*kGitCommit) s["tailsim_git_commit"] = kGitCommit;
   s["description"] = e.description;
   s["source"] = e.source_file;
   s["kind"] = e.cases.empty() ? "simulate" : e.cases.front().kind;
@@ -206,15 +213,26 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
     return heavy(a) && !heavy(b);
   });
 
+  // Ctrl-C (opt.stop_on_sigint): SIGINT is blocked in this thread before the workers start (they
+  // inherit the mask, and so do ffmpeg/gnuplot children), and taken here with sigtimedwait: no
+  // handler, no global flag. The first stops new cases, the in-flight ones finish and are saved; a
+  // second terminates the process at once (finished cases stay saved: each is written whole).
+  sigset_t int_set, old_mask;
+  sigemptyset(&int_set);
+  sigaddset(&int_set, SIGINT);
+  if (opt.stop_on_sigint) pthread_sigmask(SIG_BLOCK, &int_set, &old_mask);
+
   std::atomic<size_t> next{0};
-  std::atomic<int> done{0}, failed{0};
+  std::atomic<int> done{0}, failed{0}, running{0};
+  std::atomic<bool> stop{false};
   std::mutex mu;
   std::condition_variable cv;
   std::string first_error;
   auto worker = [&]() {
     for (;;) {
+      if (stop.load()) break;
       const size_t k = next.fetch_add(1);
-      if (k >= tasks.size()) return;
+      if (k >= tasks.size()) break;
       const Task& t = tasks[k];
       try {
         int f = 0;
@@ -228,30 +246,84 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
       ++done;
       cv.notify_all();
     }
+    std::lock_guard<std::mutex> lock(mu);
+    --running;
+    cv.notify_all();
   };
   const int n_threads = std::max(1, std::min<int>(opt.threads > 0 ? opt.threads : std::thread::hardware_concurrency(),
                                                   static_cast<int>(tasks.size())));
   std::vector<std::thread> pool;
-  for (int t = 0; t < n_threads && !tasks.empty(); ++t) pool.emplace_back(worker);
-  if (opt.progress && !tasks.empty()) {
-    std::unique_lock<std::mutex> lock(mu);
-    int shown = -1;
-    while (done.load() < static_cast<int>(tasks.size())) {
-      cv.wait_for(lock, std::chrono::milliseconds(500));
-      const int d = done.load();
-      if (d == shown) continue;
-      shown = d;
-      const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-      const double eta = d > 0 ? el / d * (tasks.size() - d) : 0.0;
-      std::fprintf(stderr, "\r[%s] %d/%d cases (%d resumed), %s elapsed, ETA %s   ", label.c_str(),
-                   d + stats.resumed, stats.total, stats.resumed, fmtSeconds(el).c_str(), fmtSeconds(eta).c_str());
+  for (int t = 0; t < n_threads && !tasks.empty(); ++t) {
+    ++running;
+    pool.emplace_back(worker);
+  }
+
+  // Progress: on a terminal one line redrawn with \r; in a log (not a TTY) a plain line every
+  // few seconds, so the log is readable and not flooded.
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  const bool show = opt.progress && !tasks.empty();
+  const auto period = tty ? std::chrono::milliseconds(500) : std::chrono::milliseconds(5000);
+  bool line_open = false;  // a \r line is on screen
+  int shown = -1;
+  auto last_print = wall0;
+  auto printProgress = [&](bool final_line) {
+    const int d = done.load();
+    const auto now = std::chrono::steady_clock::now();
+    if (!final_line && (d == shown || now - last_print < period)) return;
+    shown = d;
+    last_print = now;
+    const double el = std::chrono::duration<double>(now - wall0).count();
+    const double eta = d > 0 ? el / d * (tasks.size() - d) : 0.0;
+    char line[256];
+    std::snprintf(line, sizeof line, "[%s] %d/%d cases (%d resumed), %s elapsed", label.c_str(), d + stats.resumed,
+                  stats.total, stats.resumed, fmtSeconds(el).c_str());
+    const std::string eta_s = final_line ? std::string() : ", ETA " + fmtSeconds(eta);
+    if (tty) {
+      std::fprintf(stderr, "\r%s%s   ", line, eta_s.c_str());
+      line_open = true;
+      if (final_line) {
+        std::fprintf(stderr, "\n");
+        line_open = false;
+      }
+    } else {
+      std::fprintf(stderr, "%s%s\n", line, eta_s.c_str());
     }
-    std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+  for (;;) {
+    {
+      std::unique_lock<std::mutex> lock(mu);
+      if (running.load() == 0) break;
+      if (!opt.stop_on_sigint) cv.wait_for(lock, std::chrono::milliseconds(100));
+    }
+    if (opt.stop_on_sigint) {
+      const timespec wait{0, 100 * 1000 * 1000};
+      if (sigtimedwait(&int_set, nullptr, &wait) == SIGINT) {
+        if (line_open) std::fprintf(stderr, "\n");
+        line_open = false;
+        if (!stop.exchange(true)) {
+          const int in_flight = static_cast<int>(std::min(next.load(), tasks.size())) - done.load();
+          std::fprintf(stderr, "interrupted: finishing %d running case%s (Ctrl-C again to abandon %s)\n", in_flight,
+                       in_flight == 1 ? "" : "s", in_flight == 1 ? "it" : "them");
+        } else {
+          std::fprintf(stderr, "interrupted again: abandoning the running cases; %d cases saved\n",
+                       done.load() + stats.resumed);
+          std::signal(SIGINT, SIG_DFL);
+          pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+          std::raise(SIGINT);  // terminates: the shell sees "killed by SIGINT"
+        }
+      }
+    }
+    if (show) printProgress(false);
   }
   for (auto& th : pool) th.join();
+  if (opt.stop_on_sigint) pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+  if (show) printProgress(true);
+  else if (line_open) std::fprintf(stderr, "\n");
+  stats.interrupted = stop.load();
   for (const Job& job : jobs) writeSummary(job);  // also after a failure: finished cases count
   if (!first_error.empty()) throw std::runtime_error(first_error);
-  stats.ran = static_cast<int>(tasks.size());
+  stats.ran = done.load();
   stats.failed = failed.load();
   stats.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return stats;

@@ -15,11 +15,14 @@ namespace tailsim {
 struct RunOptions {
   std::string out_dir;           // result folder (a suite writes out_dir/<experiment>/)
   int threads = 0;               // worker threads; 0 = all cores
-  bool progress = true;          // done/total, elapsed and ETA on stderr
+  bool progress = true;          // done/total, elapsed and ETA on stderr (redrawn on a TTY, a line
+                                 // every 5 s otherwise)
   bool render = true;            // render cases whose experiment has a render section
   bool resume = true;            // skip cases whose result.json matches this configuration
   std::string only_case;         // run just this case ("" = all)
   long max_new_cases = -1;       // stop after this many newly run cases (tests of resuming)
+  bool stop_on_sigint = false;   // Ctrl-C: start no new case, let running ones finish and save them
+                                 // (RunStats::interrupted); a second Ctrl-C terminates the process
 };
 
 struct RunStats {
@@ -28,6 +31,7 @@ struct RunStats {
   int resumed = 0;   // cases found finished and skipped
   int failed = 0;    // model runs with ok == false
   double wall_time_s = 0;
+  bool interrupted = false;  // stopped early by SIGINT; resumed + ran cases are saved
 };
 
 // All models of one case (no files written). Pose cases evaluate the analytic model only.

@@ -372,8 +372,8 @@ RobotParams paperRobot(int links) {
   return p;
 }
 
-void writeMjcfFile(int links, const std::string& out) {
-  writeFileAtomic(out, generateMjcf(paperRobot(links), MujocoSettings{}, Effects{}));
+bool writeMjcfFile(int links, const std::string& out) {
+  return writeUserFile(out, generateMjcf(paperRobot(links), MujocoSettings{}, Effects{}));
 }
 
 }  // namespace tailsim

@@ -60,7 +60,8 @@ std::string generateMjcf(const RobotParams& p, const MujocoSettings& s, const Ef
 // The paper robot (Table 1 defaults of RobotParams, Table 2 n-link tail).
 RobotParams paperRobot(int links);
 
-// `tailsim mjcf --links N --out FILE`: the paper robot with default settings and effects.
-void writeMjcfFile(int links, const std::string& out);
+// `tailsim mjcf --links N --out FILE`: the paper robot with default settings and effects, written
+// as writeUserFile (FILE may be "-" for stdout, a symlink or a device). True when it went to a stream.
+bool writeMjcfFile(int links, const std::string& out);
 
 }  // namespace tailsim

@@ -1,16 +1,23 @@
 #include "plotting/gnuplot.h"
 
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <cstring>
 #include <stdexcept>
 
 #include "results/atomic_file.h"
+
+extern char** environ;
 
 namespace tailsim {
 
@@ -24,10 +31,32 @@ std::string gpQuote(const std::string& s) {
 
 namespace {
 
-std::string shellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
+// Runs `gnuplot SCRIPT` in `dir` without a shell (as ffmpeg is started, rendering/ffmpeg_writer.cc):
+// stdin /dev/null, stdout and stderr into `log_path` (absolute). Returns the wait status, or
+// throws if gnuplot cannot be started.
+int runGnuplot(const fs::path& dir, const std::string& script, const fs::path& log_path) {
+  const int log_fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (log_fd < 0) throw std::runtime_error("cannot write " + log_path.string() + ": " + std::strerror(errno));
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&fa, log_fd, 1);
+  posix_spawn_file_actions_adddup2(&fa, log_fd, 2);
+  posix_spawn_file_actions_addchdir_np(&fa, dir.c_str());
+  std::string exe = "gnuplot", arg = script;
+  char* argv[] = {exe.data(), arg.data(), nullptr};
+  pid_t pid = -1;
+  const int rc = posix_spawnp(&pid, "gnuplot", &fa, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&fa);
+  ::close(log_fd);
+  if (rc != 0)
+    throw std::runtime_error("cannot start gnuplot for " + (dir / script).string() + ": " + std::strerror(rc) +
+                             (rc == ENOENT ? " (gnuplot not installed? scripts/setup.sh installs gnuplot-nox)" : ""));
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) throw std::runtime_error(std::string("waiting for gnuplot: ") + std::strerror(errno));
+  }
+  return status;
 }
 
 std::string terminalBlock(const GnuplotFigure& f, bool png) {
@@ -69,15 +98,14 @@ void writeDataFile(const std::string& path, const std::vector<std::string>& head
 
 std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig) {
   fs::create_directories(plots_dir);
-  const fs::path dir(plots_dir);
+  const fs::path user_dir(plots_dir);              // paths as the user gave them, for messages
+  const fs::path dir = fs::absolute(plots_dir);  // gnuplot's working directory: any cwd works
   const std::string script = "# " + fig.stem + ": written by tailsim plot; rerun with `gnuplot " + fig.stem +
                              ".gp` in this folder\nset encoding utf8\nset datafile missing 'NaN'\n" +
                              terminalBlock(fig, true) + terminalBlock(fig, false);
   writeFileAtomic((dir / (fig.stem + ".gp")).string(), script);
-  const std::string log = (dir / (fig.stem + ".log")).string();
-  const std::string cmd = "cd " + shellQuote(plots_dir) + " && gnuplot " + shellQuote(fig.stem + ".gp") +
-                          " > " + shellQuote(log) + " 2>&1";
-  const int status = std::system(cmd.c_str());
+  const fs::path log = dir / (fig.stem + ".log");
+  const int status = runGnuplot(dir, fig.stem + ".gp", log);
   std::string err;
   {
     std::ifstream in(log);
@@ -85,17 +113,18 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
     ss << in.rdbuf();
     err = ss.str();
   }
-  if (status == -1 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw std::runtime_error("gnuplot failed on " + (dir / (fig.stem + ".gp")).string() +
-                             (WIFEXITED(status) && WEXITSTATUS(status) == 127 ? " (gnuplot not installed?)" : "") +
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    throw std::runtime_error("gnuplot failed on " + (user_dir / (fig.stem + ".gp")).string() +
+                             (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
+                                                : std::string(" (killed by a signal)")) +
                              ":\n" + err);
   for (const char* ext : {".png", ".svg"}) {
-    const fs::path p = dir / (fig.stem + ext);
-    if (!fs::exists(p) || fs::file_size(p) == 0)
+    const fs::path p = user_dir / (fig.stem + ext);
+    if (!fs::exists(dir / p.filename()) || fs::file_size(dir / p.filename()) == 0)
       throw std::runtime_error("gnuplot wrote no " + p.string() + ":\n" + err);
   }
   if (err.empty()) fs::remove(log);
-  return (dir / (fig.stem + ".png")).string();
+  return (user_dir / (fig.stem + ".png")).string();
 }
 
 }  // namespace tailsim

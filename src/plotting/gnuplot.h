@@ -14,9 +14,10 @@ struct GnuplotFigure {
   int height_px = 700;
 };
 
-// Writes <plots_dir>/<stem>.gp, runs gnuplot in plots_dir, checks <stem>.png and .svg exist and
-// are not empty. Throws std::runtime_error with gnuplot's stderr on failure.
-// Returns the PNG path.
+// Writes <plots_dir>/<stem>.gp, runs gnuplot in plots_dir (posix_spawn, no shell; plots_dir may be
+// relative to the current directory), checks <stem>.png and .svg exist and are not empty. Throws
+// std::runtime_error with gnuplot's output (kept in <plots_dir>/<stem>.log) on failure.
+// Returns the PNG path, as plots_dir / "<stem>.png".
 std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig);
 
 // A whitespace-separated data file for gnuplot (NaN for missing values), written atomically.

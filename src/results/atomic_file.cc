@@ -1,5 +1,7 @@
 #include "results/atomic_file.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -29,6 +31,66 @@ void writeFileAtomic(const std::string& path, const std::string& contents) {
     std::remove(tmp.c_str());
     throw std::runtime_error("cannot move " + tmp + " to " + path + ": " + std::strerror(errno));
   }
+}
+
+namespace {
+
+// The descriptor a path names directly ("-", /dev/stdout, /dev/fd/N, ...), or -1.
+int ownDescriptor(const std::string& path) {
+  if (path == "-" || path == "/dev/stdout") return STDOUT_FILENO;
+  if (path == "/dev/stderr") return STDERR_FILENO;
+  for (const char* prefix : {"/dev/fd/", "/proc/self/fd/"}) {
+    const std::string pre(prefix);
+    if (path.size() > pre.size() && path.compare(0, pre.size(), pre) == 0 &&
+        path.find_first_not_of("0123456789", pre.size()) == std::string::npos)
+      return std::stoi(path.substr(pre.size()));
+  }
+  return -1;
+}
+
+void writeAllTo(int fd, const std::string& path, const std::string& contents) {
+  const char* p = contents.data();
+  size_t n = contents.size();
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+    }
+    p += w;
+    n -= static_cast<size_t>(w);
+  }
+}
+
+}  // namespace
+
+bool writeUserFile(const std::string& path, const std::string& contents) {
+  if (path.empty()) throw std::runtime_error("empty output path");
+  if (const int fd = ownDescriptor(path); fd >= 0) {
+    writeAllTo(fd, path, contents);
+    return true;
+  }
+  struct stat lst;
+  if (::lstat(path.c_str(), &lst) != 0 || S_ISREG(lst.st_mode)) {
+    writeFileAtomic(path, contents);  // a new name or a regular file: whole or not at all
+    return false;
+  }
+  if (S_ISDIR(lst.st_mode)) throw std::runtime_error("cannot write " + path + ": it is a directory");
+  // A symlink (to anything), a device, a FIFO or a socket: write through it, replace nothing.
+  struct stat st;
+  const bool exists = ::stat(path.c_str(), &st) == 0;
+  if (exists && S_ISDIR(st.st_mode)) throw std::runtime_error("cannot write " + path + ": it is a directory");
+  const bool stream = exists && !S_ISREG(st.st_mode);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  try {
+    writeAllTo(fd, path, contents);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  if (::close(fd) != 0) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  return stream;
 }
 
 std::string toCsv(const TimeSeries& ts) {

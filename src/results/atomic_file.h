@@ -11,6 +11,17 @@ namespace tailsim {
 // Writes `contents` to `path` atomically; throws std::runtime_error naming the path on failure.
 void writeFileAtomic(const std::string& path, const std::string& contents);
 
+// Writes a file the user named on the command line (e.g. `tailsim mjcf --out PATH`) without ever
+// replacing what is at PATH with something else:
+//  - "-" is stdout; /dev/stdout, /dev/stderr, /dev/fd/N and /proc/self/fd/N are written to this
+//    process's descriptor N directly (never reopened: `>> log` keeps appending);
+//  - an existing symlink is written through to its target (the link stays a link), and an existing
+//    device, FIFO or socket is opened and written (nothing is renamed over it);
+//  - anything else (a regular file or a new name) atomically, as writeFileAtomic.
+// Returns true when the contents went to a stream (descriptor, device, FIFO, socket) rather than
+// to a file, so callers can keep their messages off stdout. Throws std::runtime_error naming PATH.
+bool writeUserFile(const std::string& path, const std::string& contents);
+
 // CSV with a header row of column names; numbers with 12 significant digits.
 std::string toCsv(const TimeSeries& ts);
 void writeCsvAtomic(const std::string& path, const TimeSeries& ts);

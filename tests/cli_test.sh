@@ -1,0 +1,127 @@
+#!/usr/bin/env bash
+# The command line as a user meets it: --version (and in summary.json), usage errors naming the
+# unknown word (exit 2), render/run --case checked (exit 1), failed model runs (exit 3), outputs the
+# user names written through symlinks/devices/stdout, the progress output in a log, Ctrl-C (130).
+#   tests/cli_test.sh SOURCE_DIR BUILD_DIR      (CTest: cli)
+set -euo pipefail
+src=$(cd "$1" && pwd)
+bld=$(cd "$2" && pwd)
+tailsim="$bld/tailsim"
+[ -x "$tailsim" ] || { echo "FAIL: $tailsim not built"; exit 1; }
+work=$(mktemp -d "${TMPDIR:-/tmp}/tailsim_cli.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+
+fail() { printf 'FAIL: %b\n' "$*"; exit 1; }
+ok() { echo "  ok: $*"; }
+# run EXPECTED_RC CMD...: stdout -> out.txt, stderr -> err.txt; fails unless the exit code matches.
+run() {
+  local want=$1; shift
+  local rc=0
+  "$@" >out.txt 2>err.txt || rc=$?
+  [ "$rc" -eq "$want" ] || fail "exit $rc (want $want) from: $*\nstdout: $(head -c 2000 out.txt)\nstderr: $(head -c 2000 err.txt)"
+}
+robot="$src/configs/robots/paper_quadruped.yaml"
+
+echo "== version"
+version=$(sed -n 's/^project(tailsim VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")
+[ -n "$version" ] || fail "no project(tailsim VERSION ...) in CMakeLists.txt"
+run 0 "$tailsim" --version
+grep -q "^tailsim $version\b" out.txt || fail "--version printed '$(cat out.txt)', not tailsim $version"
+ok "--version: $(cat out.txt)"
+
+echo "== usage errors: exit 2, the unknown word named"
+run 2 "$tailsim" rn configs/default.yaml
+grep -q "unknown subcommand 'rn'" err.txt || fail "tailsim rn: $(cat err.txt)"
+grep -q "run, " err.txt || fail "tailsim rn does not list the subcommands: $(cat err.txt)"
+run 2 "$tailsim" run "$src/configs/default.yaml" --out r --bogus
+grep -q -- "--bogus" err.txt || fail "an unknown flag is not named: $(cat err.txt)"
+run 2 "$tailsim"
+run 2 "$tailsim" mjcf --links 9 --out x.xml
+[ ! -e x.xml ] || fail "mjcf --links 9 wrote x.xml"
+run 0 "$tailsim" --help
+for code in 0 1 2 3 130; do grep -Eq "^ +$code +[a-z]" out.txt || fail "--help does not document exit code $code"; done
+ok "rn, --bogus, no subcommand, --links 9: exit 2; --help lists exit codes 0 1 2 3 130"
+
+echo "== --case names a case (exit 1, lists the cases), before any work"
+run 1 "$tailsim" render "$src/configs/default.yaml" --case nosuch --out rend
+grep -q "no case named 'nosuch'" err.txt && grep -q "cases: base" err.txt || fail "render --case nosuch: $(cat err.txt)"
+[ ! -e rend ] || fail "render --case nosuch created its output folder"
+run 1 "$tailsim" run "$src/configs/paper/all.yaml" --case nosuch --out runout
+grep -q "no case named 'nosuch'" err.txt || fail "run --case nosuch (suite): $(cat err.txt)"
+[ ! -e runout ] || fail "run --case nosuch created its output folder"
+ok "render/run --case nosuch: exit 1, '$(cut -c1-90 err.txt)...'"
+
+echo "== failed model runs: exit 3; tailsim_version in summary.json"
+printf 'name: tipping\nrobot: %s\ntail: {custom: [{mass_kg: 50, izz_kgm2: 0.5, length_m: 0.3}]}\n' "$robot" >tip.yaml
+printf 'trajectory: {theta0_deg: 0, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.25}\nmodels: [analytic]\n' >>tip.yaml
+run 3 "$tailsim" run tip.yaml --out tip --quiet
+grep -q "1 failed model runs" out.txt || fail "run with a failing model run: $(cat out.txt)"
+grep -q "\"tailsim_version\": \"$version\"" tip/summary.json || fail "tip/summary.json has no tailsim_version $version"
+ok "a tipping robot: exit 3, summary.json tailsim_version $version"
+
+echo "== user-named outputs are written through, never replaced"
+run 0 "$tailsim" mjcf --links 2 --out -
+grep -q "^<mujoco model=" out.txt || fail "mjcf --out - did not write the XML to stdout"
+tail -n 2 out.txt | grep -q "</mujoco>" || fail "mjcf --out -: stdout is not only the XML: $(tail -n 2 out.txt)"
+grep -q "^wrote" out.txt && fail "mjcf --out -: a message went into the XML on stdout"
+cp out.txt expected2.xml
+run 0 "$tailsim" mjcf --links 2 --out /dev/null
+[ -c /dev/null ] || fail "/dev/null is no longer a character device"
+echo "kept line" >appended.txt
+rc=0
+"$tailsim" mjcf --links 2 --out /dev/stdout >>appended.txt 2>err.txt || rc=$?
+[ $rc -eq 0 ] || fail "mjcf --out /dev/stdout: exit $rc: $(cat err.txt)"
+[ -L /dev/stdout ] || fail "/dev/stdout is no longer a symlink"
+[ "$(head -n 1 appended.txt)" = "kept line" ] || fail "mjcf --out /dev/stdout >> file truncated the file"
+cmp -s <(tail -n +2 appended.txt) expected2.xml || fail "mjcf --out /dev/stdout >> file: not the XML appended"
+echo old >target.xml
+ln -s target.xml link.xml
+run 0 "$tailsim" mjcf --links 2 --out link.xml
+[ -L link.xml ] || fail "mjcf --out link.xml replaced the symlink"
+cmp -s target.xml expected2.xml || fail "mjcf --out link.xml did not write the link's target"
+run 0 "$tailsim" mjcf --links 2 --out plain.xml
+cmp -s plain.xml expected2.xml || fail "mjcf --out plain.xml differs from the stdout XML"
+mkdir adir
+run 1 "$tailsim" mjcf --links 2 --out adir
+[ -d adir ] || fail "mjcf --out DIR replaced the folder"
+ok "mjcf --out: - (XML only), /dev/null, /dev/stdout >> file (appended), symlink (kept, target written), folder (error)"
+
+echo "== progress in a log (stderr not a TTY): plain lines, no carriage returns"
+printf 'name: wss_sweep\nrobot: %s\ntail: {links: 1}\n' "$robot" >sweep.yaml
+printf 'trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: {range: [0.1, 0.9, 0.03]}}\n' >>sweep.yaml
+printf 'models: [mujoco]\n' >>sweep.yaml
+run 0 "$tailsim" run sweep.yaml --out log_run --threads 2 --models mujoco
+total=$(sed -n 's/^\([0-9]*\) cases: .*/\1/p' out.txt)
+[ "${total:-0}" -ge 20 ] || fail "sweep.yaml has ${total:-0} cases, want >= 20: $(head -n 2 out.txt)"
+grep -q $'\r' err.txt && fail "progress in a log contains carriage returns"
+grep -Eq "^\[wss_sweep\] $total/$total cases \(0 resumed\), [0-9.]+ s elapsed$" err.txt ||
+  fail "no final progress line in the log: $(cat err.txt)"
+ok "progress in a log: '$(tail -n 1 err.txt)', no \\r"
+
+echo "== Ctrl-C: running cases finish, the count saved is printed, exit 130, a rerun resumes"
+set -m  # job control: the background run gets SIGINT like a foreground one (not ignored)
+"$tailsim" run sweep.yaml --out int_run --threads 1 >out.txt 2>err.txt &
+pid=$!
+for _ in $(seq 1 600); do  # until the first case is saved (the run is under way), at most 60 s
+  [ -n "$(find int_run/cases -name result.json 2>/dev/null | head -n 1)" ] && break
+  sleep 0.1
+done
+kill -INT "$pid"
+rc=0
+wait "$pid" || rc=$?
+set +m
+[ $rc -eq 130 ] || fail "exit $rc after Ctrl-C (want 130)\n$(cat err.txt)"
+grep -Eq "^interrupted: finishing [01] running cases? \(Ctrl-C again to abandon" err.txt || fail "no 'finishing' message: $(cat err.txt)"
+saved=$(sed -n 's/^interrupted: \([0-9]*\) of \([0-9]*\) cases saved in int_run; run the same command again to resume$/\1/p' err.txt)
+[ -n "$saved" ] || fail "no 'N of M cases saved' message: $(cat err.txt)"
+[ "$saved" -ge 1 ] && [ "$saved" -lt "$total" ] || fail "$saved of $total saved after an early Ctrl-C"
+files=$(find int_run/cases -name result.json | wc -l)
+[ "$files" -eq "$saved" ] || fail "$files result.json files, but the message says $saved saved"
+grep -q '"cases"' int_run/summary.json || fail "no summary.json after Ctrl-C"
+said=$(tail -n 1 err.txt)
+run 0 "$tailsim" run sweep.yaml --out int_run --threads 2 --quiet
+grep -q "^$total cases: $((total - saved)) run, $saved resumed, 0 failed" out.txt || fail "rerun: $(head -n 1 out.txt)"
+ok "Ctrl-C after the first case: exit 130, '$said', rerun resumed $saved"
+
+echo "PASS"
