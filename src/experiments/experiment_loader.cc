@@ -616,7 +616,8 @@ MujocoSettings readMujoco(const Reader& r, const Item& item) {
   const MapView m = r.map(item, {"timestep_s", "integrator", "solver", "iterations", "tolerance", "cone",
                                  "noslip_iterations", "condim", "impratio", "solref", "solimp", "mu", "kp", "kv",
                                  "velocity_feedforward", "inverse_dynamics_feedforward", "servo_wn_dt", "body_height_m",
-                                 "foot_radius_m", "settle_s", "stop_phidot_radps"});
+                                 "foot_radius_m", "settle_s", "stop_phidot_radps", "max_tilt_deg",
+                                 "max_all_feet_off_s"});
   MujocoSettings s;
   if (const Item* x = m.get("timestep_s")) s.timestep_s = r.positive(*x);
   if (const Item* x = m.get("integrator")) s.integrator = r.choice(*x, {"Euler", "RK4", "implicit"});
@@ -658,6 +659,8 @@ MujocoSettings readMujoco(const Reader& r, const Item& item) {
   if (const Item* x = m.get("foot_radius_m")) s.foot_radius_m = r.positive(*x);
   if (const Item* x = m.get("settle_s")) s.settle_s = r.nonNegative(*x);
   if (const Item* x = m.get("stop_phidot_radps")) s.stop_phidot_radps = r.positive(*x);
+  if (const Item* x = m.get("max_tilt_deg")) s.max_tilt_deg = r.nonNegative(*x);
+  if (const Item* x = m.get("max_all_feet_off_s")) s.max_all_feet_off_s = r.nonNegative(*x);
   return s;
 }
 

@@ -47,7 +47,8 @@ std::string fingerprint(const Experiment& e) {
 json summaryJson(const RunSummary& s) {
   json j;
   j["ok"] = s.ok;
-  j["phi_net_deg"] = std::isfinite(s.phi_net_deg) ? json(s.phi_net_deg) : json(nullptr);
+  // A failed run has no phi_net (null, never a number a reader could take for a result).
+  j["phi_net_deg"] = s.ok && std::isfinite(s.phi_net_deg) ? json(s.phi_net_deg) : json(nullptr);
   j["t_stop_s"] = s.t_stop_s;
   j["stick_slip_events"] = s.stick_slip_events;
   j["wall_time_s"] = s.wall_time_s;

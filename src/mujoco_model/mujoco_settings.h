@@ -29,6 +29,13 @@ struct MujocoSettings {
   double foot_radius_m = 0.01;          // foot spheres  [m]
   double settle_s = 0.1;                // pre-roll with the tail held at theta(0) so the feet settle; then t = 0  [s]
   double stop_phidot_radps = 1e-3;      // t_stop: |phi_dot| below this from then on  [rad/s]
+  // Tipping over (docs/mujoco-model.md "Tipping over"): with gravity and ground contact on, the run
+  // fails when the quadruped body tilts beyond max_tilt_deg (angle between its z axis and the
+  // vertical; the paper's cases stay below 0.33 deg, a robot tipping over passes 12 deg) or no
+  // foot carries load for longer than max_all_feet_off_s (paper cases: up to 0.022 s of contact
+  // chatter). 0 = that check off.
+  double max_tilt_deg = 5.0;            // [deg]
+  double max_all_feet_off_s = 0.1;      // [s]
 };
 
 }  // namespace tailsim

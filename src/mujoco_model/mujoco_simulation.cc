@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <limits>
+#include <map>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -189,6 +191,76 @@ void updateFootFriction(mjModel* m, const mjData* d, const Layout& L, const Fric
   }
 }
 
+// Watches whether the quadruped still stands (docs/mujoco-model.md "Falling over"). Called once
+// per step with the state the step started from (xmat, xpos, contacts and efc_force of time t):
+// one comparison for the tilt, one for the height, a loop over the few foot contacts.
+class StandingMonitor {
+ public:
+  StandingMonitor(const MujocoSettings& s, const Effects& e, int body)
+      : body_(body),
+        z_ref_(s.body_height_m),
+        h_(s.timestep_s),
+        enforce_(e.gravity && e.ground_contact),
+        pyramid_rows_(s.cone == "pyramidal"),
+        cos_limit_(s.max_tilt_deg > 0.0 ? std::cos(s.max_tilt_deg * M_PI / 180.0) : -2.0),
+        off_limit_steps_(s.max_all_feet_off_s > 0.0 ? static_cast<long>(std::ceil(s.max_all_feet_off_s / h_ - 1e-9))
+                                                    : -1),
+        max_tilt_deg_(s.max_tilt_deg),
+        max_off_s_(s.max_all_feet_off_s) {}
+
+  // Returns false (and why()) once the robot has fallen. t_s: time of the state, for the message.
+  bool update(const mjData* d, double t_s) {
+    const double cz = d->xmat[9 * body_ + 8];  // cos(tilt) = body z axis . world z
+    min_cos_ = std::min(min_cos_, cz);
+    const double dz = d->xpos[3 * body_ + 2] - z_ref_;
+    max_dz_ = std::max(max_dz_, std::abs(dz));
+    bool loaded = false;
+    for (int i = 0; i < d->ncon && !loaded; ++i) {
+      const int a = d->contact[i].efc_address;  // only feet touch the floor
+      if (a < 0) continue;
+      loaded = d->efc_force[a] > 0.0;  // elliptic: the normal force; pyramidal: the first edge
+      if (pyramid_rows_)  // pyramidal: the normal force is the sum of the (>= 0) edge forces
+        for (int r = 1; r < 2 * (d->contact[i].dim - 1) && !loaded; ++r) loaded = d->efc_force[a + r] > 0.0;
+    }
+    off_steps_ = loaded ? 0 : off_steps_ + 1;
+    longest_off_steps_ = std::max(longest_off_steps_, off_steps_);
+    if (!enforce_ || !why_.empty()) return why_.empty();
+    std::ostringstream os;
+    os.precision(3);
+    if (cz < cos_limit_) {
+      os << "robot fell over at t = " << t_s << " s: body tilt " << tiltDeg(cz) << " deg (limit max_tilt_deg = "
+         << max_tilt_deg_ << " deg)";
+    } else if (off_limit_steps_ > 0 && off_steps_ >= off_limit_steps_) {
+      os << "robot fell over at t = " << t_s << " s: no foot has touched the ground for " << off_steps_ * h_
+         << " s (limit max_all_feet_off_s = " << max_off_s_ << " s), body tilt " << tiltDeg(cz) << " deg";
+    } else {
+      return true;
+    }
+    os << "; the analytic model reports this as tipping over (system COM outside the support rectangle)";
+    why_ = os.str();
+    return false;
+  }
+  const std::string& why() const { return why_; }
+  // The figures a user judges the run by (summary extras).
+  void report(std::map<std::string, double>& extra) const {
+    extra["max_tilt_deg"] = tiltDeg(min_cos_);
+    extra["max_height_change_m"] = max_dz_;
+    extra["longest_all_feet_off_s"] = longest_off_steps_ * h_;
+  }
+
+ private:
+  static double tiltDeg(double c) { return std::acos(std::clamp(c, -1.0, 1.0)) * kRad2Deg; }
+  int body_;
+  double z_ref_, h_;
+  bool enforce_, pyramid_rows_;
+  double cos_limit_;
+  long off_limit_steps_;
+  double max_tilt_deg_, max_off_s_;
+  double min_cos_ = 1.0, max_dz_ = 0.0;
+  long off_steps_ = 0, longest_off_steps_ = 0;
+  std::string why_;
+};
+
 std::string instabilityMessage(const mjData* d, double t, const MujocoSettings& s, const ServoGains& g) {
   std::ostringstream os;
   os << "MuJoCo became unstable at t=" << t << " s (" << describeWarnings(d) << "): timestep_s=" << s.timestep_s
@@ -253,11 +325,20 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
     }
   };
 
+  StandingMonitor standing(settings, effects, L.quad_body);
+  auto failed = [&]() {  // the run's result when it fails
+    sum.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+    standing.report(sum.extra);
+    sum.extra["mujoco_warnings"] = warningCount(d);
+    return result;
+  };
   while (d->time < settings.settle_s - 0.5 * settings.timestep_s && sum.ok) {
+    const double t_state = d->time - settings.settle_s;
     step(0.0, false);
     if (warningCount(d) > 0) fail(instabilityMessage(d, d->time - settings.settle_s, settings, gains) + " (settling)");
+    else if (!standing.update(d, t_state)) fail(standing.why() + " (while settling with the tail held at theta(0))");
   }
-  if (!sum.ok) return result;
+  if (!sum.ok) return failed();
   d->time = 0.0;
   for (int v = 0; v < m->nv; ++v) d->qvel[v] = 0.0;
   mj_forward(m, d);
@@ -303,6 +384,10 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       fail(instabilityMessage(d, t, settings, gains));
       break;
     }
+    if (!standing.update(d, t)) {
+      fail(standing.why());
+      break;
+    }
     if (sample && !rk4) {
       const double yaw = yawOf(d, L.quad_body);  // xmat of time t
       phi += wrapPi(yaw - yaw_prev);
@@ -339,6 +424,8 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   }
   sum.extra["mujoco_warnings"] = warningCount(d);
   sum.extra["kp_j1"] = gains.kp[0];
+  standing.report(sum.extra);
+  if (!sum.ok) sum.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
   return result;
 }
 

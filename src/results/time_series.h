@@ -32,7 +32,7 @@ class TimeSeries {
 // Summary of one model run of one case (goes into summary.json).
 struct RunSummary {
   std::string model;          // "analytic" | "mujoco"
-  double phi_net_deg = 0.0;   // phi at the end of the run minus phi at t = 0
+  double phi_net_deg = 0.0;   // phi at the end of the run minus phi at t = 0 (summary.json: null when !ok)
   double t_stop_s = 0.0;      // last time the body came to rest in yaw (or the run's end if it never did)
   int stick_slip_events = 0;  // all located stick/slip switches (rotation + translation)
   double wall_time_s = 0.0;   // wall-clock time of the simulation itself
