@@ -353,9 +353,11 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   double phi = yawOf(d, L.quad_body), yaw_prev = phi, phi0 = phi;
   long steps = 0;
   const auto wall0 = std::chrono::steady_clock::now();
-  while (k < num_samples) {
+  // Runs to the end of the simulated time even when the output grid ends earlier (a spacing that
+  // does not divide the duration): the summary is the state at the end, not the last row.
+  while (k < num_samples || d->time < duration - eps) {
     const double t = d->time;
-    const bool sample = t >= k * output.sample_dt_s - eps;
+    const bool sample = k < num_samples && t >= k * output.sample_dt_s - eps;
     if (sample) {
       if (observer) observer(k * output.sample_dt_s, m, d);
       std::copy(d->qpos, d->qpos + m->nq, qpos_t.begin());
@@ -388,10 +390,12 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       fail(standing.why());
       break;
     }
-    if (sample && !rk4) {
+    if (!rk4) {  // unwrapped every step, so a coarse output grid cannot alias a fast spin
       const double yaw = yawOf(d, L.quad_body);  // xmat of time t
       phi += wrapPi(yaw - yaw_prev);
       yaw_prev = yaw;
+    }
+    if (sample && !rk4) {
       // The acceleration the integrator applied (implicit: (M - h D)^-1 f, not d->qacc's explicit one).
       for (int v = 0; v < m->nv; ++v) qacc_t[v] = (d->qvel[v] - qvel_t[v]) / h;
       while (k < num_samples && t >= k * output.sample_dt_s - eps) {
@@ -405,8 +409,11 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   sum.solver_steps = steps;
 
   // Summary.
-  const std::vector<double>& phis = ts.values(cols.phi);
-  if (!phis.empty()) sum.phi_net_deg = phis.back() - phi0 * kRad2Deg;
+  mj_kinematics(m, d);  // xmat of the final state
+  phi += wrapPi(yawOf(d, L.quad_body) - yaw_prev);
+  sum.phi_net_deg = (phi - phi0) * kRad2Deg;
+  sum.extra["final_x_m"] = d->xpos[3 * L.quad_body];  // as the x_m, y_m columns: the quadruped COM
+  sum.extra["final_y_m"] = d->xpos[3 * L.quad_body + 1];
   const std::vector<double>& tcol = ts.values(cols.t);
   const std::vector<double>& pd = ts.values(cols.phidot);
   const double thr = settings.stop_phidot_radps * kRad2Deg;
