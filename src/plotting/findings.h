@@ -29,7 +29,7 @@ struct Finding {
   std::string where;  // "Sec. 4.4, Fig. 9"
   std::string claim;  // what the paper says
   std::vector<ModelVerdict> verdicts;
-  std::string brief;  // the claim in a few words (report table)
+  std::string brief{};  // the claim in a few words (report table); set by computeFindings
   const ModelVerdict* verdictFor(const std::string& model) const;  // nullptr if absent
 };
 
