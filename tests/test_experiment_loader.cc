@@ -142,8 +142,8 @@ TEST_F(LoaderTest, RobotTailsMatchTable2ForEveryN) {
   }
 }
 
-// READING-NOTES "Checks": Eq. (25) with thetadot_max = 10.47 rad/s.
-TEST_F(LoaderTest, Eq25RuleGivesReadingNotesNumbers) {
+// paper-notes "Checks that follow from the text": Eq. (25) with thetadot_max = 10.47 rad/s.
+TEST_F(LoaderTest, Eq25RuleGivesPaperNotesNumbers) {
   const double dtheta_deg[] = {-180, -120, -90, -72, -60, -51.43};
   const double dT_s[] = {0.600, 0.400, 0.300, 0.240, 0.200, 0.171};
   for (const char* speed : {"thetadot_max_radps: 10.47", "thetadot_max_dps: 600"}) {

@@ -19,7 +19,7 @@ namespace odeint = boost::numeric::odeint;
 
 // State: phi, phi_dot, x, y, vx, vy (world frame; x, y is the quadruped COM).
 //
-// Choice (READING-NOTES point 2): with the paper's coupling, the body and the frozen tail move as
+// Choice (paper-notes point 2): with the paper's coupling, the body and the frozen tail move as
 // one rigid body; the tail's relative motion enters only through F_T and M_z,T. Its translation
 // is tracked at the quadruped COM, m dv_Q/dt = F_T + F_F (the rigid system's rotation terms are
 // dropped, as Eq. 9 drops dI_zz/dt), and friction resists v_Q (Eqs. 14-15). Rotation does not
@@ -167,7 +167,7 @@ class Model {
   }
 
  private:
-  // READING-NOTES point 3: the planar multibody with the base moving. Newton-Euler of every body
+  // paper-notes point 3: the planar multibody with the base moving. Newton-Euler of every body
   // (quadruped + links) summed: linear momentum, and angular momentum about the quadruped COM.
   // Friction: F_F acts at the system COM (no moment about it, as in Eq. 9) plus the pure M_z,F.
   void exactCoupling(const std::vector<JointState>& js, double phi, double w, Eval& ev, Eigen::Matrix3d& A,
@@ -380,7 +380,7 @@ struct Found {
 };
 
 // Searches [ta, tb] for the first switch, sampling the event functions every h_scan (so a short
-// load peak between two solver steps is not stepped over: READING-NOTES point 4) and refining a
+// load peak between two solver steps is not stepped over: paper-notes point 4) and refining a
 // local minimum of a stuck DOF's margin that the samples alone do not show crossing zero.
 template <class StateAt>
 Found findSwitch(const Events& events, const Modes& m, double ta, double tb, double h_scan, double tol,

@@ -517,7 +517,8 @@ std::string builtinRobotFile(const std::string& name, const Loc& at) {
   static const std::map<std::string, std::string> kBuiltin = {{"paper", "paper_quadruped.yaml"}};
   const auto it = kBuiltin.find(name);
   if (it == kBuiltin.end())
-    fail(at, "unknown built-in robot '" + name + "' (built-in: paper); a robot file is given by its path, e.g. my_robot.yaml");
+    fail(at, "unknown built-in robot '" + name +
+                 "' (built-in: paper); a robot file is given by its path, e.g. my_robot.yaml");
   std::string looked;
   for (const fs::path& d : builtinRobotDirs()) {
     const fs::path f = d / it->second;

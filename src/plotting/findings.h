@@ -1,4 +1,4 @@
-// The paper's claims (READING-NOTES "Checks that follow from the text", Sec. 4.4's Fig. 8
+// The paper's claims (paper-notes "Checks that follow from the text", Sec. 4.4's Fig. 8
 // statements and Fig. 13's "larger |dtheta| wins at a fixed peak speed"), each checked against
 // a result folder, model by model, with the numbers that decide it.
 //
