@@ -63,7 +63,7 @@ static double criticalMu() {
 }
 
 TEST(AnalyticSimulation, ShortLoadPeakAboveStaticFrictionIsNotMissed) {
-  // READING-NOTES point 4: the load exceeds static friction only for a fraction of a millisecond.
+  // paper-notes point 4: the load exceeds static friction only for a fraction of a millisecond.
   const double mu_c = criticalMu();
   RobotParams robot = paperRobot(1);
   robot.friction.mu_s = robot.friction.mu_d = mu_c * (1 - 1e-5);
@@ -79,7 +79,7 @@ TEST(AnalyticSimulation, ShortLoadPeakAboveStaticFrictionIsNotMissed) {
 }
 
 TEST(AnalyticSimulation, FrictionlessPaperModelLeavesResidualSpin) {
-  // READING-NOTES point 3: the paper's equations do not conserve angular momentum. This pins the
+  // paper-notes point 3: the paper's equations do not conserve angular momentum. This pins the
   // spin left after the Fig. 7 move with mu = 0, so it cannot drift unnoticed.
   Effects e;
   e.friction = FrictionLaw::kNone;
@@ -165,7 +165,7 @@ TEST(AnalyticSimulation, ContinuousLawRunsAndStops) {
 }
 
 TEST(AnalyticSimulation, SwappedFrictionBreaksAwayAtTheLargerCoefficient) {
-  // READING-NOTES point 1: breakaway at max(mu_s, mu_d). Printed (0.25 / 0.30) and
+  // paper-notes point 1: breakaway at max(mu_s, mu_d). Printed (0.25 / 0.30) and
   // mu_s = mu_d = 0.30 behave identically; swapping (0.30 / 0.25) slides further.
   RobotParams printed = paperRobot(1), same = paperRobot(1), swapped = paperRobot(1);
   same.friction.mu_s = 0.30;

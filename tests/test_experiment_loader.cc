@@ -142,8 +142,8 @@ TEST_F(LoaderTest, RobotTailsMatchTable2ForEveryN) {
   }
 }
 
-// READING-NOTES "Checks": Eq. (25) with thetadot_max = 10.47 rad/s.
-TEST_F(LoaderTest, Eq25RuleGivesReadingNotesNumbers) {
+// paper-notes "Checks that follow from the text": Eq. (25) with thetadot_max = 10.47 rad/s.
+TEST_F(LoaderTest, Eq25RuleGivesPaperNotesNumbers) {
   const double dtheta_deg[] = {-180, -120, -90, -72, -60, -51.43};
   const double dT_s[] = {0.600, 0.400, 0.300, 0.240, 0.200, 0.171};
   for (const char* speed : {"thetadot_max_radps: 10.47", "thetadot_max_dps: 600"}) {
@@ -392,6 +392,35 @@ TEST_F(LoaderTest, RobotPathIsRelativeToTheExperimentFile) {
   const Experiment e = loadExperiment(p);
   EXPECT_EQ(e.cases[0].robot.numLinks(), 1);  // tail defaults to {links: 1}
   EXPECT_EQ(e.source_file, p);
+}
+
+// `robot: paper` is the packaged robot file, wherever the experiment is saved (README example).
+TEST_F(LoaderTest, BuiltinRobotNameIsThePackagedFile) {
+  const Experiment named = loadExperiment(write("far/away/exp.yaml", "name: t\nrobot: paper\n" + std::string(kTraj)));
+  const Experiment path = loadExperiment(write("exp.yaml", exp(kTraj)));
+  EXPECT_EQ(fs::path(named.cases[0].robot_file),
+            fs::path(kSourceDir + "/configs/robots/paper_quadruped.yaml").lexically_normal());
+  const RobotParams& a = named.cases[0].robot;
+  const RobotParams& b = path.cases[0].robot;
+  EXPECT_EQ(a.quadruped.mass_kg, b.quadruped.mass_kg);
+  EXPECT_EQ(a.quadruped.d_Q2B_m, b.quadruped.d_Q2B_m);
+  EXPECT_EQ(a.friction.mu_s, b.friction.mu_s);
+  EXPECT_EQ(a.friction.mu_d, b.friction.mu_d);
+  ASSERT_EQ(a.numLinks(), 1);
+  EXPECT_EQ(a.tail[0].mass_kg, b.tail[0].mass_kg);
+  // A value with '/' or '.' stays a path relative to the experiment file; a file named like a
+  // built-in is not picked up by the name.
+  write("paper", "not a robot file");
+  EXPECT_EQ(loadExperiment(write("exp2.yaml", "name: t\nrobot: paper\n" + std::string(kTraj))).cases[0].robot_file,
+            named.cases[0].robot_file);
+  try {
+    loadExperiment(write("exp3.yaml", "name: t\nrobot: ./paper\n" + std::string(kTraj)));
+    ADD_FAILURE() << "./paper is the local (bad) file";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind((dir_ / "paper").string() + ":", 0), 0u) << e.what();
+  }
+  expectError("name: t\n\nrobot: papr\n" + std::string(kTraj), 3, "robot",
+              "unknown built-in robot 'papr' (built-in: paper)", "exp.yaml", 8);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -102,7 +102,9 @@ TEST(HardCases, LoadHoveringAtStaticFriction) {
     RobotParams r = base;
     r.friction.mu_s = r.friction.mu_d = f * mu_c;
     const RunResult a = analyticConverges(r, tr, {}, 12);
-    if (f > 1) EXPECT_EQ(a.summary.phi_net_deg, 0.0);
+    if (f > 1) {
+      EXPECT_EQ(a.summary.phi_net_deg, 0.0);
+    }
   }
 }
 

@@ -1,4 +1,4 @@
-// The ADAMS friction law of Fig. 4 (READING-NOTES point 6), checked against closed forms.
+// The ADAMS friction law of Fig. 4 (paper-notes point 6), checked against closed forms.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -89,7 +89,9 @@ TEST_P(MujocoModelParams, CompiledModelEqualsParameters) {
     EXPECT_NEAR(d->xaxis[3 * j + 2], 1.0, tol);
     jx -= l.length_m;
     for (int g = 0; g < m->ngeom; ++g)
-      if (m->geom_bodyid[g] == b) EXPECT_EQ(m->geom_contype[g] | m->geom_conaffinity[g], 0);
+      if (m->geom_bodyid[g] == b) {
+        EXPECT_EQ(m->geom_contype[g] | m->geom_conaffinity[g], 0);
+      }
     // Servo: gain kp, bias (0, -kp, -kv) with the documented gain rule.
     const int a = actuatorId(m, mjcf::tailActuatorName(i));
     const ServoGains gains = tailServoGains(p, s);

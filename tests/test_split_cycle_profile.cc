@@ -60,7 +60,7 @@ TEST(SplitCycleProfile, RejectsBadParameters) {
   EXPECT_THROW(SplitCycleProfile({0, NAN, 0.25, 0.5, 0}), std::invalid_argument);
 }
 
-TEST(EqualPeakSpeedRule, MatchesReadingNotesNumbers) {
+TEST(EqualPeakSpeedRule, MatchesPaperNotesNumbers) {
   const double dtheta_deg[] = {-180, -120, -90, -72, -60, -51.43};
   const double dT[] = {0.600, 0.400, 0.300, 0.240, 0.200, 0.171};
   for (int n = 1; n <= 6; ++n) {

@@ -91,7 +91,7 @@ TEST(TailDynamics, SixLinkTipComDistanceSec47) {
   const RobotParams r = paperRobot(6);
   EXPECT_NEAR(linkComDistance(r.tail, std::vector<double>(6, 0.0), 5), 0.2750, 5e-5);
   EXPECT_NEAR(linkComDistance(r.tail, std::vector<double>(6, deg(180.0 / 7)), 5), 0.2094, 5e-5);
-  // The paper's "theta = 30 deg" reading gives 188.3 mm instead (READING-NOTES).
+  // The paper's "theta = 30 deg" reading gives 188.3 mm instead (paper-notes misprints).
   EXPECT_NEAR(linkComDistance(r.tail, std::vector<double>(6, deg(30)), 5), 0.1883, 5e-5);
 }
 

@@ -7,7 +7,7 @@ namespace tailsim {
 
 enum class Coupling {
   kPaper,  // Eqs. (5)-(13) as printed: tail loads from an inertial base, I_zz phi_ddot = M
-  kExact,  // planar multibody with the base moving (READING-NOTES point 3)
+  kExact,  // planar multibody with the base moving (paper-notes point 3)
 };
 
 // Settings of the analytic ("Simulink") model.
@@ -19,7 +19,7 @@ struct AnalyticSettings {
   double event_tol_s = 1e-12;       // stick/slip event location tolerance in time  [s]
   double max_step_s = 0.0;          // adaptive: step bound while the tail moves; 0 = dT/50  [s]
   // Translation: sliding speed below which the body is declared stopped  [m/s]. Near zero speed
-  // the 2-D velocity turns ever faster (READING-NOTES point 4); stopping at v_stop instead of 0
+  // the 2-D velocity turns ever faster (paper-notes point 4); stopping at v_stop instead of 0
   // moves the body by at most v_stop^2 / (2 a) (~5e-9 m here) and saves ~10^4 tiny steps.
   double v_stop_mps = 1e-4;
   Coupling coupling = Coupling::kPaper;

@@ -19,7 +19,7 @@ namespace odeint = boost::numeric::odeint;
 
 // State: phi, phi_dot, x, y, vx, vy (world frame; x, y is the quadruped COM).
 //
-// Choice (READING-NOTES point 2): with the paper's coupling, the body and the frozen tail move as
+// Choice (paper-notes point 2): with the paper's coupling, the body and the frozen tail move as
 // one rigid body; the tail's relative motion enters only through F_T and M_z,T. Its translation
 // is tracked at the quadruped COM, m dv_Q/dt = F_T + F_F (the rigid system's rotation terms are
 // dropped, as Eq. 9 drops dI_zz/dt), and friction resists v_Q (Eqs. 14-15). Rotation does not
@@ -175,7 +175,7 @@ class Model {
   }
 
  private:
-  // READING-NOTES point 3: the planar multibody with the base moving. Newton-Euler of every body
+  // paper-notes point 3: the planar multibody with the base moving. Newton-Euler of every body
   // (quadruped + links) summed: linear momentum, and angular momentum about the quadruped COM.
   // Friction: F_F acts at the system COM (no moment about it, as in Eq. 9) plus the pure M_z,F.
   void exactCoupling(const std::vector<JointState>& js, double phi, double w, Eval& ev, Eigen::Matrix3d& A,
@@ -415,7 +415,7 @@ struct Found {
 };
 
 // Searches [ta, tb] for the first switch of either DOF. Both margins are sampled together every
-// h_scan (so a short load peak between two solver steps is not stepped over: docs/paper-notes.md
+// h_scan (so a short load peak between two solver steps is not stepped over: paper-notes
 // point 4); in the first sample interval where any margin reaches zero, every DOF that crosses
 // there is located and the earliest wins, so no DOF's switch can hide behind another's. A dip of
 // a stuck DOF's margin between samples (all samples positive) is refined by golden section.

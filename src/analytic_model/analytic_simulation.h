@@ -24,7 +24,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
 // kind: pose — loads, mass properties and L_F at one tail state; one row, no integration.
 RunResult evaluatePose(const RobotParams& robot, const std::vector<JointState>& joints, const Effects& effects);
 
-// Breakaway uses the larger of mu_s and mu_d (READING-NOTES point 1): with mu_s < mu_d, a body
+// Breakaway uses the larger of mu_s and mu_d (paper-notes point 1): with mu_s < mu_d, a body
 // that broke away at mu_s would feel mu_d > load and re-stick at once, forever.
 inline double breakawayCoefficient(const FrictionParams& f) { return f.mu_s > f.mu_d ? f.mu_s : f.mu_d; }
 

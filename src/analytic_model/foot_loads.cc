@@ -18,7 +18,7 @@ FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
        << "rectangle (+-" << 0.5 * l << ", +-" << 0.5 * w << ") m: the robot tips over";
     throw TippingError(os.str());
   }
-  // Eq. (A3) solved (READING-NOTES point 5): ellipse with a/b = l_F/w_F,
+  // Eq. (A3) solved (paper-notes point 5): ellipse with a/b = l_F/w_F,
   //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).
   // Eqs. (A4)-(A5), f_i = 1/4 + B sin(xi + C_i) with B = b sqrt(2) / (2 w_F), expanded with
   // b sin(xi) = y_e, b cos(xi) = x_e w_F / l_F and C_i = 45, 135, 225, 315 deg: no trigonometry.

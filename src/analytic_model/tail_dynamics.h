@@ -25,7 +25,7 @@ inline Vec2 rotate(double angle, const Vec2& a) {
 // Link-by-link kinematics in frame B.
 struct TailKinematics {
   std::vector<double> psi, omega, alpha;  // link angle, angular velocity, angular acceleration (Eq. 4)
-  std::vector<Vec2> p_J;                  // joint i position (Eq. 3, with the READING-NOTES typo fix)
+  std::vector<Vec2> p_J;                  // joint i position (Eq. 3, with the paper-notes misprint fix)
   std::vector<Vec2> p_L, v_L, a_L;        // link i COM position, velocity, acceleration
 };
 

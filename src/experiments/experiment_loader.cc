@@ -495,6 +495,40 @@ std::string resolveRelative(const std::string& base_file, const std::string& p) 
   return (q.is_absolute() ? q : fs::path(base_file).parent_path() / q).lexically_normal().string();
 }
 
+// Built-in robots: `robot: paper` names the robot file packaged with tailsim, so an experiment
+// runs from wherever it is saved. A value without '/' and '.' is such a name; anything else is a
+// path, relative to the experiment file.
+bool isBuiltinRobotName(const std::string& v) { return v.find_first_of("/.") == std::string::npos; }
+
+// The packaged robots folder: configs/robots next to the executable's build folder (build/tailsim ->
+// configs/robots, so a moved checkout still works), then the source tree tailsim was built from.
+std::vector<fs::path> builtinRobotDirs() {
+  std::vector<fs::path> dirs;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back((exe.parent_path().parent_path() / "configs" / "robots").lexically_normal());
+#ifdef TAILSIM_ROBOTS_DIR
+  dirs.push_back(fs::path(TAILSIM_ROBOTS_DIR).lexically_normal());
+#endif
+  return dirs;
+}
+
+std::string builtinRobotFile(const std::string& name, const Loc& at) {
+  static const std::map<std::string, std::string> kBuiltin = {{"paper", "paper_quadruped.yaml"}};
+  const auto it = kBuiltin.find(name);
+  if (it == kBuiltin.end())
+    fail(at, "unknown built-in robot '" + name +
+                 "' (built-in: paper); a robot file is given by its path, e.g. my_robot.yaml");
+  std::string looked;
+  for (const fs::path& d : builtinRobotDirs()) {
+    const fs::path f = d / it->second;
+    std::error_code ec;
+    if (fs::is_regular_file(f, ec)) return f.string();
+    looked += (looked.empty() ? "" : ", ") + f.string();
+  }
+  fail(at, "built-in robot '" + name + "' not found (looked for " + looked + ")");
+}
+
 struct JointLocs {
   Loc dT, w_ss;
 };
@@ -743,8 +777,9 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   // Robot file, then the experiment's overrides.
   const Item& robotItem = r.need(top, "robot");
   const std::string robotRel = r.string(robotItem);
-  if (robotRel.empty()) r.fail(robotItem, "needs the path of a robot file");
-  c.robot_file = resolveRelative(source, robotRel);
+  if (robotRel.empty()) r.fail(robotItem, "needs a built-in robot name (paper) or the path of a robot file");
+  c.robot_file = isBuiltinRobotName(robotRel) ? builtinRobotFile(robotRel, r.loc(robotItem))
+                                              : resolveRelative(source, robotRel);
   const RobotFile& rf = L.robot(c.robot_file, r.loc(robotItem));
   c.robot = rf.base;
   Origins origin = rf.origin;

@@ -49,7 +49,7 @@ struct ServoGains {
 ServoGains tailServoGains(const RobotParams& p, const MujocoSettings& s);
 
 // The foot friction coefficient written into the model: settings.mu, or max(mu_s, mu_d) if mu < 0
-// (READING-NOTES point 1); 0 for FrictionLaw::kNone; 0 at start for kContinuous (mu(0) = 0, the
+// (paper-notes point 1); 0 for FrictionLaw::kNone; 0 at start for kContinuous (mu(0) = 0, the
 // simulation updates it every step).
 double footFrictionCoefficient(const RobotParams& p, const MujocoSettings& s, const Effects& e);
 

@@ -1,4 +1,4 @@
-// The paper's claims (READING-NOTES "Checks that follow from the text", Sec. 4.4's Fig. 8
+// The paper's claims (paper-notes "Checks that follow from the text", Sec. 4.4's Fig. 8
 // statements and Fig. 13's "larger |dtheta| wins at a fixed peak speed"), each checked against
 // a result folder, model by model, with the numbers that decide it.
 //
@@ -29,7 +29,7 @@ struct Finding {
   std::string where;  // "Sec. 4.4, Fig. 9"
   std::string claim;  // what the paper says
   std::vector<ModelVerdict> verdicts;
-  std::string brief;  // the claim in a few words (report table)
+  std::string brief{};  // the claim in a few words (report table); set by computeFindings
   const ModelVerdict* verdictFor(const std::string& model) const;  // nullptr if absent
 };
 

@@ -68,17 +68,6 @@ std::string header(const std::string& title, const std::string& xlabel, const st
   return o.str();
 }
 
-std::string caseLabel(const ExperimentResults& r, const CaseRecord& c) {
-  std::string s;
-  for (const SweepAxis& a : r.axes) {
-    auto it = c.sweep.find(a.key);
-    if (it == c.sweep.end()) continue;
-    if (!s.empty()) s += ", ";
-    s += leafKey(a.key) + "=" + it->second;
-  }
-  return s.empty() ? c.name : s;
-}
-
 // ---- simulate, one case: phi(t) and moments ------------------------------------------------
 
 void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefix) {

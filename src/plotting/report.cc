@@ -107,7 +107,7 @@ void muSwapTable(std::ostringstream& o, const std::vector<ExperimentResults>& re
   const ExperimentResults* base = findExperiment(results, "fig07");
   const ExperimentResults* sw = findExperiment(results, "mu_swapped");
   if (!sw) return;
-  o << "## Table 1's friction coefficients swapped (READING-NOTES point 1)\n\n"
+  o << "## Table 1's friction coefficients swapped (docs/paper-notes.md point 1)\n\n"
     << "The Fig. 7 case as printed (mu_s 0.25, mu_d 0.30: breakaway at max(mu_s, mu_d) = 0.30) and with the two "
        "coefficients swapped (mu_s 0.30, mu_d 0.25).\n\n"
     << "| model | phi_net as printed [deg] | phi_net swapped [deg] | change [deg] |\n|---|---|---|---|\n";

@@ -41,7 +41,7 @@ class PlanarStateSampler {
 
 // Paper Eqs. (1)-(3): tail base p_B = p_Q - d_Q2B R_Q x; R_B = R_Q R_Z(180 deg); link i points
 // along R_B R_T,i x with R_T,i = R_Z(theta_1 + ... + theta_i); joint i+1 = joint i + L_L,i R_T,i x
-// (Eq. 3 with the READING-NOTES index fix).
+// (Eq. 3 with the paper-notes misprint fix).
 struct PlanarTailPose {
   std::vector<std::array<double, 2>> joints;  // p of joint 1 (= p_B) .. joint n, then the tip (n+1 points)
   std::vector<double> link_yaw;               // world yaw of link i  [rad]

@@ -1,5 +1,5 @@
 // The ADAMS ("continuous") friction law of the paper's multibody model (Sec. 3.2, Fig. 4;
-// READING-NOTES point 6). Shared by the MuJoCo model (per-foot coefficient each step) and the
+// paper-notes point 6). Shared by the MuJoCo model (per-foot coefficient each step) and the
 // analytic model (kContinuous).
 #pragma once
 

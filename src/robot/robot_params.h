@@ -24,7 +24,7 @@ struct QuadrupedParams {
   double w_F_m = 0.26;      // foot spacing along body y  [m]
 };
 
-// Foot-ground friction (paper Table 1, Fig. 4; READING-NOTES points 1 and 6).
+// Foot-ground friction (paper Table 1, Fig. 4; paper-notes points 1 and 6).
 struct FrictionParams {
   double mu_s = 0.25;            // static coefficient (as printed in Table 1)
   double mu_d = 0.30;            // dynamic coefficient (as printed in Table 1)

@@ -7,7 +7,7 @@ namespace tailsim {
 enum class FrictionLaw {
   kNone,        // no foot friction at all (free-floating in the plane)
   kStiction,    // the paper's Simulink law, Eqs. (14)-(16), with event-located stick/slip
-  kContinuous,  // the paper's ADAMS law (Fig. 4, READING-NOTES point 6): mu(slip speed)
+  kContinuous,  // the paper's ADAMS law (Fig. 4, paper-notes point 6): mu(slip speed)
 };
 
 enum class FootLoadModel {

@@ -50,7 +50,7 @@ struct TailTrajectory {
   std::vector<double> breakpoints() const;
 };
 
-// Eq. (25) with the sign fixes of READING-NOTES: dtheta = -360 deg / (n+1),
+// Eq. (25) with the misprint fixes of paper-notes: dtheta = -360 deg / (n+1),
 // dT = 2 |dtheta| / thetadot_max, theta_0 = -0.5 dtheta.
 SplitCycleParams equalPeakSpeedParams(int n_links, double thetadot_max_radps, double w_ss, double t0_s = 0.0);
 
