@@ -60,8 +60,9 @@ TEST(RandomSweep, WorkIsBoundedAndEveryOutputChecks) {
       ASSERT_TRUE(std::isfinite(s.at(key))) << key;
     ASSERT_TRUE(std::isfinite(r.summary.phi_net_deg));
     if (c.effects.friction == FrictionLaw::kStiction && s.at("still_rotating_at_end") == 0.0 &&
-        c.robot.friction.mu_s + c.robot.friction.mu_d > 0)
+        c.robot.friction.mu_s + c.robot.friction.mu_d > 0) {
       EXPECT_EQ(s.at("final_phidot_dps"), 0.0);
+    }
     if (k < kMirrored) {
       const RunResult m = simulateAnalytic(c.robot, mirrored(c.trajectory), c.settings, c.effects, {});
       ASSERT_TRUE(m.summary.ok) << m.summary.error;
