@@ -36,6 +36,11 @@ grep -q "unknown subcommand 'rn'" err.txt || fail "tailsim rn: $(cat err.txt)"
 grep -q "run, " err.txt || fail "tailsim rn does not list the subcommands: $(cat err.txt)"
 run 2 "$tailsim" run "$src/configs/default.yaml" --out r --bogus
 grep -q -- "--bogus" err.txt || fail "an unknown flag is not named: $(cat err.txt)"
+# ... also when a required argument is missing too (CLI11 alone says "--out is required").
+for args in "run --bogus" "run $src/configs/default.yaml --bogus" "mjcf --bogus" "--bogus"; do
+  run 2 "$tailsim" $args
+  grep -q -- "unknown option '--bogus'" err.txt || fail "tailsim $args does not name --bogus: $(cat err.txt)"
+done
 run 2 "$tailsim"
 run 2 "$tailsim" mjcf --links 9 --out x.xml
 [ ! -e x.xml ] || fail "mjcf --links 9 wrote x.xml"

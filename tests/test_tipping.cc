@@ -127,6 +127,19 @@ TEST(Tipping, LimitsAreSettingsAndZeroTurnsACheckOff) {
   EXPECT_TRUE(simulateMujoco(r, wag, {}, no_ground, {}).summary.ok);
 }
 
+// A diverging integration (explicit Euler with a timestep too large for the servo gains) throws
+// the body over a few steps before MuJoCo warns: the run names the timestep, not a fall.
+TEST(Tipping, DivergingIntegrationIsNotReportedAsAFall) {
+  MujocoSettings s;
+  s.integrator = "Euler";
+  s.timestep_s = 5e-4;
+  s.kp = 76360;
+  const RunResult r = simulateMujoco(paperRobot(1), sameMove(1, 0, -90, 0.25, 0.25), s, {}, {});
+  ASSERT_FALSE(r.summary.ok);
+  EXPECT_NE(r.summary.error.find("timestep_s=0.0005 too large"), std::string::npos) << r.summary.error;
+  EXPECT_EQ(r.summary.error.find("fell over"), std::string::npos) << r.summary.error;
+}
+
 TEST(Tipping, StaticTipIsCaughtWhileSettling) {
   // COM 0.1 m behind the rear edge: the robot falls during the settling pre-roll.
   const RunResult m = simulateMujoco(heavyTail(30, 0.3, 0.02, 0.3), sameMove(1, 0, -5, 0.25, 0.25), {}, {}, {});

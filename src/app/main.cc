@@ -66,7 +66,7 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
   for (const Experiment& e : suite) {
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
     std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
-    if (e.cases.size() > 12) {
+    if (e.cases.size() > 60) {  // a longer table scrolls away; summary.json has them all
       std::printf("  %zu cases (see %s/summary.json)\n", e.cases.size(), dir.c_str());
       continue;
     }
@@ -154,7 +154,22 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "error: unknown subcommand '%s' (one of: %s)\nRun with --help for more information.\n",
                    first.c_str(), names.c_str());
     } else {
-      app.exit(e);  // CLI11's message names the option or argument
+      // CLI11 checks required arguments before unknown ones ("--out is required" for
+      // `tailsim run --bogus`): name an unknown option first, it is the likelier mistake.
+      std::string unknown, where = "tailsim";
+      for (const std::string& a : app.remaining())
+        if (unknown.empty() && a.size() > 1 && a[0] == '-') unknown = a;
+      for (const CLI::App* sc : app.get_subcommands())
+        for (const std::string& a : sc->remaining())
+          if (unknown.empty() && a.size() > 1 && a[0] == '-') {
+            unknown = a;
+            where = "tailsim " + sc->get_name();
+          }
+      if (!unknown.empty() && dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr)
+        std::fprintf(stderr, "error: unknown option '%s' for '%s'\nRun '%s --help' for the options.\n", unknown.c_str(),
+                     where.c_str(), where.c_str());
+      else
+        app.exit(e);  // CLI11's message names the option or argument
     }
     return kExitUsage;
   }

@@ -226,7 +226,7 @@ class StandingMonitor {
     longest_off_steps_ = std::max(longest_off_steps_, off_steps_);
     if (!enforce_ || !why_.empty()) return why_.empty();
     std::ostringstream os;
-    os.precision(3);
+    os.precision(4);
     if (cz < cos_limit_) {
       os << "robot fell over at t = " << t_s << " s: body tilt " << tiltDeg(cz) << " deg (limit max_tilt_deg = "
          << max_tilt_deg_ << " deg)";
@@ -387,7 +387,20 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       break;
     }
     if (!standing.update(d, t)) {
-      fail(standing.why());
+      // A diverging integration (timestep too large for the servo gains) also throws the body
+      // over, usually a few steps before MuJoCo's own warning. Look 0.05 s further: if MuJoCo then
+      // warns, the cause is the step, not the robot's balance.
+      const long look = std::max(1L, std::lround(0.05 / h));
+      bool unstable = false;
+      double t_bad = t;
+      for (long i = 0; i < look && !unstable; ++i) {
+        mj_step(m, d);  // (MuJoCo resets d, time included, when it finds a bad acceleration)
+        t_bad += h;
+        unstable = warningCount(d) > 0 || !std::isfinite(d->qacc[L.root_dofadr]);
+      }
+      std::ostringstream tilt;
+      tilt << " (the body had tilted past max_tilt_deg at t=" << t << " s as it diverged)";
+      fail(unstable ? instabilityMessage(d, t_bad, settings, gains) + tilt.str() : standing.why());
       break;
     }
     if (!rk4) {  // unwrapped every step, so a coarse output grid cannot alias a fast spin
