@@ -11,6 +11,7 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "mujoco_model/mujoco_handles.h"
+#include "rendering/ffmpeg_writer.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;
@@ -94,4 +95,35 @@ TEST(OutputConfinement, Finding9_MujocoErrorIsAnExceptionNotAnExit) {
     }
   });
   EXPECT_FALSE(fs::exists(dir / "MUJOCO_LOG.TXT"));
+}
+
+// Issue 16 finding 11: ffmpeg's log file never outlives its creation (unlinked at once), so a
+// run killed while rendering leaves no /tmp/tailsim-ffmpeg-* behind; its messages still arrive.
+TEST(OutputConfinement, Finding11_FfmpegLogLeavesNoFileInTmp) {
+  const std::string exe = findExecutable("ffmpeg");
+  if (exe.empty()) GTEST_SKIP() << "ffmpeg not installed";
+  const fs::path tmp = tempDir("ffmpeglog"), out = tempDir("ffmpegout");
+  const char* old = std::getenv("TMPDIR");
+  const std::string old_value = old ? old : "";
+  ::setenv("TMPDIR", tmp.c_str(), 1);
+  {
+    FfmpegSink sink(exe, 64, 48, VideoEncoding{}, {{FfmpegOutput::Kind::kMp4, (out / "v.mp4").string(), 0}});
+    EXPECT_TRUE(fs::is_empty(tmp));  // while ffmpeg runs: this is what a kill -9 would leave
+    const std::vector<uint8_t> frame(64 * 48 * 3, 128);
+    sink.writeFrame(frame.data());
+    sink.finish();
+    sink.commit();
+  }
+  // A failing ffmpeg still reports its own message.
+  try {
+    FfmpegSink bad(exe, 64, 48, VideoEncoding{}, {{FfmpegOutput::Kind::kMp4, (out / "no/such/dir/v.mp4").string(), 0}});
+    bad.finish();
+    ADD_FAILURE() << "ffmpeg wrote into a missing folder";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos) << e.what();
+  }
+  if (old) ::setenv("TMPDIR", old_value.c_str(), 1);
+  else ::unsetenv("TMPDIR");
+  EXPECT_TRUE(fs::is_empty(tmp));
+  EXPECT_TRUE(fs::exists(out / "v.mp4"));
 }
