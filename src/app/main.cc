@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
   run->add_option("--threads", threads, "worker threads (default: all cores)");
   run->add_option("--case", case_name, "run only this case");
   run->add_flag("--no-render", no_render, "skip the render section");
-  run->add_flag("--fresh", fresh, "recompute finished cases instead of resuming");
+  run->add_flag("--fresh", fresh, "start from an empty result folder (deletes tailsim's results in --out, also another experiment's)");
   run->add_flag("--quiet", quiet, "no progress line");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
   std::vector<std::string> only_models;
