@@ -7,7 +7,17 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <thread>
+
 #include "experiments/experiment_runner.h"
+#include "results/atomic_file.h"
+#include "tailsim_version.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;
@@ -114,4 +124,267 @@ TEST(ExperimentRunner, InvalidSweepValueFailsBeforeAnythingRuns) {
     EXPECT_NE(m.find("w_ss"), std::string::npos) << m;
   }
   EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// A copy of the paper robot with its quadruped mass set.
+void writeRobot(const fs::path& f, double mass_kg) {
+  std::string t = slurp(fs::path(TAILSIM_SOURCE_DIR) / "configs/robots/paper_quadruped.yaml");
+  const size_t at = t.find("mass_kg: 8.458");
+  t.replace(at, std::string("mass_kg: 8.458").size(), "mass_kg: " + std::to_string(mass_kg));
+  std::ofstream(f) << t;
+}
+
+fs::path writeExperiment(const fs::path& dir, const std::string& file, const std::string& body) {
+  const fs::path f = dir / file;
+  std::ofstream(f) << body;
+  return f;
+}
+
+const char* kShortTrajectory = "tail: {links: 1}\ntrajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.25}\n";
+
+double phiNet(const fs::path& out, const std::string& case_name, const std::string& model) {
+  const nlohmann::json sum = readJson(out / "summary.json");
+  for (const auto& c : sum["cases"])
+    if (c["name"] == case_name) return c["runs"][model]["phi_net_deg"].get<double>();
+  ADD_FAILURE() << "no case " << case_name;
+  return NAN;
+}
+
+// Keeps only these models, as `tailsim run --models` does.
+Experiment onlyModels(Experiment e, const std::vector<std::string>& models) {
+  for (ExperimentCase& c : e.cases) c.models = models;
+  return e;
+}
+
+}  // namespace
+
+// Issue 16 finding 1: editing the second robot file of a robot sweep must recompute its cases.
+TEST(ExperimentRunner, Finding1_EditedSweptRobotFileInvalidatesItsCases) {
+  const fs::path dir = tempDir("f1robot");
+  writeRobot(dir / "robotA.yaml", 8.458);
+  writeRobot(dir / "robotB.yaml", 8.458);
+  const fs::path f = writeExperiment(dir, "robots.yaml",
+                                     std::string("name: robots\nrobot: {sweep: [robotA.yaml, robotB.yaml]}\n") +
+                                         kShortTrajectory + "models: [analytic]\n");
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  EXPECT_EQ(runExperiment(loadExperiment(f.string()), o).ran, 2);
+  writeRobot(dir / "robotB.yaml", 4.0);  // a lighter body turns further
+  const RunStats s = runExperiment(loadExperiment(f.string()), o);
+  EXPECT_EQ(s.resumed, 1);  // robotA's case is unchanged
+  EXPECT_EQ(s.ran, 1);
+  RunOptions fresh = o;
+  fresh.out_dir = (dir / "fresh").string();
+  runExperiment(loadExperiment(f.string()), fresh);
+  const Experiment e = loadExperiment(f.string());
+  for (const ExperimentCase& c : e.cases)
+    EXPECT_EQ(phiNet(dir / "out", c.name, "analytic"), phiNet(dir / "fresh", c.name, "analytic")) << c.name;
+}
+
+// Issue 16 finding 1: `run X --models analytic` then `run X` must compute MuJoCo.
+TEST(ExperimentRunner, Finding1_ModelsFilterIsPartOfTheResumeKey) {
+  const fs::path dir = tempDir("f1models");
+  const fs::path f = writeExperiment(dir, "both.yaml",
+                                     std::string("name: both\nrobot: paper\n") + kShortTrajectory +
+                                         "models: [analytic, mujoco]\noutput: {settle_s: 0.05, sample_dt_s: 0.01}\n");
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  const Experiment e = loadExperiment(f.string());
+  runExperiment(onlyModels(e, {"analytic"}), o);
+  EXPECT_FALSE(readJson(dir / "out" / "summary.json")["cases"][0]["runs"].contains("mujoco"));
+  const RunStats s = runExperiment(e, o);
+  EXPECT_EQ(s.resumed, 0);
+  EXPECT_EQ(s.ran, 1);
+  EXPECT_TRUE(readJson(dir / "out" / "summary.json")["cases"][0]["runs"].contains("mujoco"));
+  EXPECT_TRUE(fs::exists(dir / "out" / "cases" / "base" / "mujoco.csv"));
+  EXPECT_EQ(runExperiment(e, o).resumed, 1);  // and now it is finished
+}
+
+// Issue 16 finding 1: rendering on/off, the version and every resolved setting are in the key.
+TEST(ExperimentRunner, Finding1_ResumeKeyCoversRenderVersionAndSettings) {
+  const fs::path dir = tempDir("f1key");
+  const Experiment e = loadExperiment(
+      writeExperiment(dir, "k.yaml", std::string("name: k\nrobot: paper\n") + kShortTrajectory + "models: [analytic]\n")
+          .string());
+  const ExperimentCase& c = e.cases.at(0);
+  EXPECT_NE(caseKey(c, true), caseKey(c, false));
+  EXPECT_EQ(caseKey(c, false), caseKey(e.cases.at(0), false));  // stable
+  EXPECT_EQ(caseKey(c, false).size(), 64u);
+  EXPECT_NE(caseKeyText(c, false).find(std::string("tailsim.version=") + std::to_string(std::string(kVersion).size()) +
+                                       ":" + kVersion),
+            std::string::npos);
+  auto changed = [&](auto edit) {
+    ExperimentCase d = c;
+    edit(d);
+    return caseKey(d, false) != caseKey(c, false);
+  };
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.robot.tail[0].izz_kgm2 *= 1.01; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.robot.friction.mu_d += 0.01; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.joints[0].w_ss = 0.3; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.analytic.rel_tol = 1e-6; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.mujoco.solimp[4] = 3.0; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.effects.gravity = false; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.output.sample_dt_s = 2e-3; }));
+  EXPECT_TRUE(changed([](ExperimentCase& d) { d.models.push_back("mujoco"); }));
+  EXPECT_FALSE(changed([](ExperimentCase& d) { d.robot_file = "/elsewhere/same_robot.yaml"; }));  // values count
+}
+
+// Issue 16 finding 2: names that sanitize alike get distinct folders, and the printed/recorded
+// results belong to the right case.
+TEST(ExperimentRunner, Finding2_CaseFoldersAreUniqueByConstruction) {
+  EXPECT_EQ(caseDirName("w_ss=0.25"), "w_ss=0.25");  // plain names stay readable
+  EXPECT_NE(caseDirName("r a.yaml"), caseDirName("r_a.yaml"));
+  EXPECT_NE(caseDirName("a b"), caseDirName("a?b"));
+  for (const std::string& n : {std::string(".."), std::string("."), std::string(""), std::string("-x"),
+                              std::string("a/../../b"), std::string(300, 'x')}) {
+    const std::string d = caseDirName(n);
+    EXPECT_NE(d, n.empty() ? "x" : n);
+    EXPECT_NE(d, ".");
+    EXPECT_NE(d, "..");
+    EXPECT_EQ(d.find('/'), std::string::npos) << d;
+    EXPECT_LE(d.size(), 100u) << d;
+    EXPECT_NE(d[0], '.');
+  }
+  const fs::path dir = tempDir("f2dirs");
+  writeRobot(dir / "r a.yaml", 4.0);
+  writeRobot(dir / "r_a.yaml", 8.458);
+  const fs::path f = writeExperiment(dir, "names.yaml",
+                                     std::string("name: names\nrobot: {sweep: [\"r a.yaml\", \"r_a.yaml\"]}\n") +
+                                         kShortTrajectory + "models: [analytic]\n");
+  for (int threads : {1, 2}) {
+    RunOptions o;
+    o.out_dir = (dir / ("out" + std::to_string(threads))).string();
+    o.progress = false;
+    o.threads = threads;
+    const Experiment e = loadExperiment(f.string());
+    runExperiment(e, o);
+    std::set<std::string> dirs;
+    const nlohmann::json sum = readJson(fs::path(o.out_dir) / "summary.json");
+    for (const auto& c : sum["cases"]) {
+      const std::string d = c["dir"];
+      dirs.insert(d);
+      // Each folder holds its own case's result.
+      EXPECT_EQ(readJson(fs::path(o.out_dir) / "cases" / d / "result.json")["name"], c["name"]);
+      const TimeSeries ts = readCsv((fs::path(o.out_dir) / "cases" / d / "analytic.csv").string());
+      const double phi_end = ts.at(ts.numRows() - 1, ts.column("phi_deg"));
+      EXPECT_NEAR(phi_end, c["runs"]["analytic"]["phi_net_deg"].get<double>(), 1e-2) << d;
+    }
+    EXPECT_EQ(dirs.size(), 2u);
+    EXPECT_NE(phiNet(o.out_dir, e.cases[0].name, "analytic"), phiNet(o.out_dir, e.cases[1].name, "analytic"));
+  }
+}
+
+// Issue 16 finding 2: two threads writing one path atomically never share a temporary file.
+TEST(ExperimentRunner, Finding2_ConcurrentAtomicWritesNeverTear) {
+  const fs::path dir = tempDir("f2atomic");
+  const std::string path = (dir / "same.csv").string();
+  const std::string a(300000, 'a'), b(300000, 'b');
+  std::atomic<int> errors{0};
+  auto writer = [&](const std::string& text) {
+    for (int k = 0; k < 100; ++k) {
+      try {
+        writeFileAtomic(path, text);
+      } catch (const std::exception&) {
+        ++errors;
+      }
+      const std::string now = slurp(path);
+      if (now != a && now != b) ++errors;  // torn: a mix of both
+    }
+  };
+  std::thread t1(writer, a), t2(writer, b);
+  t1.join();
+  t2.join();
+  EXPECT_EQ(errors.load(), 0);
+  for (const auto& f : fs::directory_iterator(dir)) EXPECT_EQ(f.path().filename(), "same.csv");
+}
+
+// Issue 16 finding 3: a second experiment into the same --out is refused, nothing written.
+TEST(ExperimentRunner, Finding3_OtherExperimentInSameOutIsRefused) {
+  const fs::path dir = tempDir("f3other");
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  const Experiment x = loadExperiment(writeSweep(dir, "{sweep: [0.2, 0.3]}").string());
+  runExperiment(x, o);
+  const std::string summary = slurp(dir / "out" / "summary.json");
+  const Experiment y = loadExperiment(
+      writeExperiment(dir, "other.yaml", std::string("name: other\nrobot: paper\n") + kShortTrajectory +
+                                             "models: [analytic]\n")
+          .string());
+  try {
+    runExperiment(y, o);
+    FAIL() << "expected a refusal";
+  } catch (const std::runtime_error& err) {
+    const std::string m = err.what();
+    EXPECT_NE(m.find("holds the results of experiment 'wss_sweep'"), std::string::npos) << m;
+    EXPECT_NE(m.find("--fresh"), std::string::npos) << m;
+  }
+  EXPECT_EQ(slurp(dir / "out" / "summary.json"), summary);
+  EXPECT_FALSE(fs::exists(dir / "out" / "cases" / "base"));
+  // --fresh replaces the old results entirely: no orphaned case folders.
+  o.resume = false;
+  runExperiment(y, o);
+  std::set<std::string> dirs;
+  for (const auto& d : fs::directory_iterator(dir / "out" / "cases")) dirs.insert(d.path().filename().string());
+  EXPECT_EQ(dirs, std::set<std::string>{"base"});
+  EXPECT_EQ(readJson(dir / "out" / "summary.json")["experiment"], "other");
+}
+
+// Issue 16 finding 3: a run into a folder another run holds fails at once, naming its pid.
+TEST(ExperimentRunner, Finding3_ConcurrentRunIntoSameOutFails) {
+  const fs::path dir = tempDir("f3lock");
+  fs::create_directories(dir / "out");
+  const int fd = ::open((dir / "out" / ".tailsim.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+  ASSERT_EQ(::write(fd, "4242\n", 5), 5);
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  try {
+    runExperiment(loadExperiment(writeSweep(dir, "{sweep: [0.2, 0.3]}").string()), o);
+    FAIL() << "expected the lock to be refused";
+  } catch (const std::runtime_error& err) {
+    EXPECT_EQ(std::string(err.what()), o.out_dir + " is in use by another tailsim run (pid 4242)");
+  }
+  EXPECT_FALSE(fs::exists(dir / "out" / "cases"));
+  ::close(fd);  // released: now it runs
+  EXPECT_EQ(runExperiment(loadExperiment((dir / "sweep.yaml").string()), o).ran, 2);
+}
+
+// Issue 16 finding 11: temporaries a killed run left are removed by the next run of the folder;
+// those of a live process and files not named like tailsim's temporaries stay.
+TEST(ExperimentRunner, Finding11_KilledRunTemporariesAreCleaned) {
+  const fs::path dir = tempDir("f11");
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  const Experiment e = loadExperiment(writeSweep(dir, "{sweep: [0.2, 0.3]}").string());
+  runExperiment(e, o);
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);  // a pid that is no longer running
+  const std::string dead = std::to_string(child), live = std::to_string(::getppid());
+  const fs::path out = dir / "out", c = out / "cases" / "w_ss=0.2";
+  fs::create_directories(out / "renders");
+  const std::vector<fs::path> stale = {c / ("analytic.csv.tmp." + dead), c / ("result.json.tmp." + dead + ".7"),
+                                       out / ("summary.json.tmp." + dead + ".0"),
+                                       out / "renders" / ("w_ss=0.2.tmp." + dead + ".3.mp4")};
+  const std::vector<fs::path> kept = {c / ("analytic.csv.tmp." + live), out / "notes.tmp.txt", out / "mine.tmp"};
+  for (const auto& p : stale) std::ofstream(p) << "partial";
+  for (const auto& p : kept) std::ofstream(p) << "keep";
+  EXPECT_EQ(runExperiment(e, o).resumed, 2);
+  for (const auto& p : stale) EXPECT_FALSE(fs::exists(p)) << p;
+  for (const auto& p : kept) EXPECT_TRUE(fs::exists(p)) << p;
 }

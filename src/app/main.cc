@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "experiments/accuracy_study.h"
@@ -62,7 +63,8 @@ void requireCase(const std::vector<Experiment>& suite, const std::string& file, 
 }
 
 void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite) {
-  // A short table of phi_net per case and model, read back from the result folders.
+  // A short table of phi_net per case and model, read back from the result folder's summary.json
+  // (its entries name each case's folder: "dir").
   for (const Experiment& e : suite) {
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
     std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
@@ -70,12 +72,18 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
       std::printf("  %zu cases (see %s/summary.json)\n", e.cases.size(), dir.c_str());
       continue;
     }
+    std::ifstream in(dir / "summary.json");
+    const nlohmann::json s = nlohmann::json::parse(in, nullptr, false);
+    std::map<std::string, const nlohmann::json*> by_name;
+    if (!s.is_discarded() && s.contains("cases") && s["cases"].is_array())
+      for (const nlohmann::json& c : s["cases"])
+        if (c.is_object() && c.contains("name") && c["name"].is_string()) by_name[c["name"].get<std::string>()] = &c;
     for (const ExperimentCase& c : e.cases) {
       std::printf("  %-40s", c.name.c_str());
-      std::ifstream in(dir / "cases" / caseDirName(c.name) / "result.json");
-      if (!in) { std::printf(" (not run)\n"); continue; }
-      const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-      if (j.is_discarded() || !j.contains("runs")) { std::printf(" (unreadable)\n"); continue; }
+      const auto it = by_name.find(c.name);
+      if (it == by_name.end()) { std::printf(" (not run)\n"); continue; }
+      const nlohmann::json& j = *it->second;
+      if (!j.contains("runs") || !j["runs"].is_object()) { std::printf(" (unreadable)\n"); continue; }
       for (const auto& [model, r] : j["runs"].items()) {
         if (!r.value("ok", false)) std::printf(" %s: FAILED (%s)", model.c_str(), r.value("error", std::string()).c_str());
         else if (r["phi_net_deg"].is_number())
@@ -105,7 +113,7 @@ int main(int argc, char** argv) {
   run->add_option("--threads", threads, "worker threads (default: all cores)");
   run->add_option("--case", case_name, "run only this case");
   run->add_flag("--no-render", no_render, "skip the render section");
-  run->add_flag("--fresh", fresh, "recompute finished cases instead of resuming");
+  run->add_flag("--fresh", fresh, "start from an empty result folder (deletes tailsim's results in --out, also another experiment's)");
   run->add_flag("--quiet", quiet, "no progress line");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
   std::vector<std::string> only_models;

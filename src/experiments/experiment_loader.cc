@@ -770,8 +770,15 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   c.source_file = source;
   const Item& name = r.need(top, "name");
   c.experiment = r.string(name);
-  if (c.experiment.empty() || c.experiment.find_first_of("/\\") != std::string::npos)
-    r.fail(name, "must be a non-empty name without '/' or '\\'");
+  // The name becomes a folder (a suite's OUT/<name>/, render's OUT/<name>/): one safe path component.
+  const std::string& nm = c.experiment;
+  const bool control = std::any_of(nm.begin(), nm.end(), [](char ch) {
+    return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+  });
+  if (nm.empty() || nm.size() > 100 || nm == "." || nm == ".." || nm[0] == '-' || control ||
+      nm.find_first_of("/\\") != std::string::npos)
+    r.fail(name, "must be a folder name: 1 to 100 characters, no '/', '\\' or control characters, "
+                 "not '.' or '..', not starting with '-'");
   if (const Item* d = top.get("description")) r.string(*d);
 
   // Robot file, then the experiment's overrides.

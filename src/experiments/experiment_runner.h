@@ -18,7 +18,10 @@ struct RunOptions {
   bool progress = true;          // done/total, elapsed and ETA on stderr (redrawn on a TTY, a line
                                  // every 5 s otherwise)
   bool render = true;            // render cases whose experiment has a render section
-  bool resume = true;            // skip cases whose result.json matches this configuration
+  bool resume = true;            // skip cases whose result.json has this case's key (caseKey);
+                                 // false (--fresh): start from an empty result folder (tailsim's
+                                 // entries removed; with only_case just that case recomputed), and
+                                 // results of another experiment in out_dir are deleted, not refused
   std::string only_case;         // run just this case ("" = all)
   long max_new_cases = -1;       // stop after this many newly run cases (tests of resuming)
   bool stop_on_sigint = false;   // Ctrl-C: start no new case, let running ones finish and save them
@@ -38,7 +41,15 @@ struct RunStats {
 std::vector<RunResult> runCase(const ExperimentCase& c);
 
 // The folder name of a case under DIR/cases/.
+// Unique by construction: a name of [A-Za-z0-9.=,_-] (not starting with . or -, <= 100 chars) is
+// its own folder; any other gets a sanitized, shortened form + "~" + 16 hex digits of its SHA-256.
 std::string caseDirName(const std::string& case_name);
+
+// The resume key of a case: SHA-256 of caseKeyText, a canonical text of everything the case's
+// results depend on (resolved robot, trajectory, model/output/effects settings, the models run,
+// rendering on or off, tailsim version). A finished case is reused only when its key matches.
+std::string caseKeyText(const ExperimentCase& c, bool render);
+std::string caseKey(const ExperimentCase& c, bool render);
 
 RunStats runExperiment(const Experiment& e, const RunOptions& options);
 RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& options);

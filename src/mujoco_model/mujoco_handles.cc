@@ -1,6 +1,8 @@
 #include "mujoco_model/mujoco_handles.h"
 
+#include <cstdio>
 #include <cstring>
+#include <mutex>
 #include <sstream>
 #include <vector>
 
@@ -29,9 +31,43 @@ int lookup(const mjModel* m, mjtObj type, const std::string& name, const char* w
   return id;
 }
 
+thread_local MujocoMessages* tl_messages = nullptr;
+
+void onMujocoWarning(const char* msg) {
+  const std::string m = std::string("MuJoCo warning: ") + (msg ? msg : "");
+  if (tl_messages) tl_messages->add(m);
+  else std::fprintf(stderr, "%s\n", m.c_str());
+}
+
+// MuJoCo must not continue after an error: the exception unwinds to the tailsim code that called
+// into MuJoCo (runCase turns it into a failed run).
+void onMujocoError(const char* msg) { throw MujocoError(std::string("MuJoCo error: ") + (msg ? msg : "")); }
+
 }  // namespace
 
+void installMujocoMessageHandlers() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mju_user_warning = onMujocoWarning;
+    mju_user_error = onMujocoError;
+  });
+}
+
+MujocoMessages::MujocoMessages() : outer_(tl_messages) {
+  installMujocoMessageHandlers();
+  tl_messages = this;
+}
+
+MujocoMessages::~MujocoMessages() { tl_messages = outer_; }
+
+void MujocoMessages::add(const std::string& message) {
+  if (text_.size() > 4000) return;  // a bounded record: the first messages say what went wrong
+  if (!text_.empty()) text_ += "; ";
+  text_ += message;
+}
+
 ModelPtr loadModelFromXml(const std::string& xml) {
+  installMujocoMessageHandlers();
   std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
   mj_defaultVFS(vfs.get());
   const char* kName = "tailsim_model.xml";
@@ -46,6 +82,7 @@ ModelPtr loadModelFromXml(const std::string& xml) {
 }
 
 ModelPtr loadModelFromFile(const std::string& path) {
+  installMujocoMessageHandlers();
   char err[1024] = "";
   mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof(err));
   if (!m) throw MujocoError("MuJoCo could not load " + path + ": " + err);
@@ -53,6 +90,7 @@ ModelPtr loadModelFromFile(const std::string& path) {
 }
 
 DataPtr makeData(const mjModel* m) {
+  installMujocoMessageHandlers();
   mjData* d = mj_makeData(m);
   if (!d) throw MujocoError("mj_makeData failed");
   return DataPtr(d);

@@ -32,6 +32,28 @@ using DataPtr = std::unique_ptr<mjData, MjDataDeleter>;
 
 // Compiles an MJCF document held in memory (through a private mjVFS, no temporary file).
 // Throws MujocoError with MuJoCo's compiler message on failure.
+// MuJoCo reports through two global hooks (mju_user_warning, mju_user_error); without them it
+// appends to MUJOCO_LOG.TXT in the current directory (and exits on an error). tailsim installs its
+// own handlers once per process (thread-safe, before the first model is loaded): a warning goes
+// to the innermost MujocoMessages of the calling thread (stderr when there is none), an error is
+// thrown as MujocoError ("MuJoCo error: ...") to the caller of the MuJoCo function.
+void installMujocoMessageHandlers();
+
+// Collects the MuJoCo warnings raised on this thread while it lives (scopes nest).
+class MujocoMessages {
+ public:
+  MujocoMessages();
+  ~MujocoMessages();
+  MujocoMessages(const MujocoMessages&) = delete;
+  MujocoMessages& operator=(const MujocoMessages&) = delete;
+  const std::string& text() const { return text_; }  // "MuJoCo warning: ...; MuJoCo warning: ..."
+  void add(const std::string& message);
+
+ private:
+  std::string text_;
+  MujocoMessages* outer_;
+};
+
 ModelPtr loadModelFromXml(const std::string& xml);
 // Loads an MJCF file from disk (throws MujocoError naming the file).
 ModelPtr loadModelFromFile(const std::string& path);

@@ -283,6 +283,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   if (!(duration >= 0.0) || !std::isfinite(duration)) throw std::invalid_argument("bad simulation duration");
 
   const std::string xml = generateMjcf(robot, settings, effects);  // validates robot + settings
+  const MujocoMessages messages;  // MuJoCo's warnings go into this run's error text, not MUJOCO_LOG.TXT
   ModelPtr model = loadModelFromXml(xml);
   mjModel* m = model.get();
   DataPtr data = makeData(m);
@@ -310,7 +311,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
 
   auto fail = [&](const std::string& why) {
     sum.ok = false;
-    sum.error = why;
+    sum.error = why + (messages.text().empty() ? "" : " [" + messages.text() + "]");
   };
   auto step = [&](double t_ref, bool record) {
     if (continuous) updateFootFriction(m, d, L, robot.friction);

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "experiments/experiment_runner.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {
@@ -87,7 +88,7 @@ double numberOr(const json& j, const char* key, double fallback) {
 CaseRecord parseCase(const json& c) {
   CaseRecord r;
   r.name = c.value("name", std::string("base"));
-  r.dir = c.value("dir", r.name);
+  r.dir = c.value("dir", caseDirName(r.name));  // recorded by the run; older folders: the same mapping
   if (auto s = c.find("sweep"); s != c.end() && s->is_object())
     for (auto it = s->begin(); it != s->end(); ++it) r.sweep[it.key()] = valueText(it.value());
   if (auto runs = c.find("runs"); runs != c.end() && runs->is_object()) {

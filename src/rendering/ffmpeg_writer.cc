@@ -85,23 +85,29 @@ std::string findExecutable(const std::string& name) {
 }
 
 namespace {
-// mkstemp in $TMPDIR (or /tmp); returns the fd and sets `path`.
-int makeLogFile(std::string& path) {
+// ffmpeg's stderr: a file created in $TMPDIR (or /tmp) and unlinked at once, so nothing is left
+// behind whatever happens to this process (kill -9 included); read back through the descriptor.
+int makeLogFile() {
   const char* tmpdir = std::getenv("TMPDIR");
   std::string tmpl_s = std::string(tmpdir && *tmpdir ? tmpdir : "/tmp") + "/tailsim-ffmpeg-XXXXXX";
   std::vector<char> tmpl(tmpl_s.begin(), tmpl_s.end());
   tmpl.push_back('\0');
-  const int fd = ::mkstemp(tmpl.data());
+  const int fd = ::mkostemp(tmpl.data(), O_CLOEXEC);
   if (fd < 0) throw std::runtime_error(std::string("cannot create an ffmpeg log file: ") + std::strerror(errno));
-  path = tmpl.data();
+  ::unlink(tmpl.data());
   return fd;
 }
 
-std::string readLog(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string s = ss.str();
+std::string readLog(int fd) {
+  std::string s;
+  char buf[4096];
+  off_t off = 0;
+  for (;;) {
+    const ssize_t n = ::pread(fd, buf, sizeof buf, off);
+    if (n <= 0) break;
+    s.append(buf, static_cast<size_t>(n));
+    off += n;
+  }
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
   if (s.size() > 2000) s = "..." + s.substr(s.size() - 2000);
   return s.empty() ? "(no message)" : s;
@@ -109,8 +115,7 @@ std::string readLog(const std::string& path) {
 }  // namespace
 
 std::string probeFfmpeg(const std::string& ffmpeg_exe) {
-  std::string log_path;
-  const int log_fd = makeLogFile(log_path);
+  const int log_fd = makeLogFile();
   std::vector<std::string> args = {ffmpeg_exe, "-hide_banner", "-loglevel", "error", "-nostdin",
                                    "-f", "lavfi", "-i", "testsrc=size=64x48:rate=1:duration=1",
                                    "-frames:v", "1", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-f", "null", "-"};
@@ -125,7 +130,6 @@ std::string probeFfmpeg(const std::string& ffmpeg_exe) {
   pid_t pid = -1;
   const int rc = posix_spawn(&pid, ffmpeg_exe.c_str(), &fa, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
-  ::close(log_fd);
   std::string result;
   if (rc != 0) {
     result = std::string("cannot start it: ") + std::strerror(rc);
@@ -134,9 +138,9 @@ std::string probeFfmpeg(const std::string& ffmpeg_exe) {
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-      result = "a test encode with libx264 failed: " + readLog(log_path);
+      result = "a test encode with libx264 failed: " + readLog(log_fd);
   }
-  std::remove(log_path.c_str());
+  ::close(log_fd);
   return result;
 }
 
@@ -145,7 +149,8 @@ FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, con
     : outputs_(outputs), frame_bytes_(static_cast<size_t>(width) * height * 3) {
   if (outputs.empty()) throw std::invalid_argument("FfmpegSink needs at least one output");
   for (const FfmpegOutput& o : outputs) tmp_paths_.push_back(tempNameFor(o.path));
-  const int log_fd = makeLogFile(log_path_);
+  log_fd_ = makeLogFile();
+  const int log_fd = log_fd_;
 
   const std::string size = std::to_string(width) + "x" + std::to_string(height);
   std::vector<std::string> args = {ffmpeg_exe, "-hide_banner", "-loglevel", "error", "-y",
@@ -167,8 +172,8 @@ FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, con
 
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) {
-    ::close(log_fd);
-    std::remove(log_path_.c_str());
+    ::close(log_fd_);
+    log_fd_ = -1;
     throw std::runtime_error(std::string("cannot create a pipe to ffmpeg: ") + std::strerror(errno));
   }
   posix_spawn_file_actions_t fa;
@@ -182,10 +187,10 @@ FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, con
   const int rc = posix_spawn(&pid_, ffmpeg_exe.c_str(), &fa, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   ::close(fds[0]);
-  ::close(log_fd);
   if (rc != 0) {
     ::close(fds[1]);
-    std::remove(log_path_.c_str());
+    ::close(log_fd_);
+    log_fd_ = -1;
     pid_ = -1;
     throw std::runtime_error("cannot start ffmpeg (" + ffmpeg_exe + "): " + std::strerror(rc));
   }
@@ -195,7 +200,7 @@ FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, con
 
 FfmpegSink::~FfmpegSink() { abort(); }
 
-std::string FfmpegSink::errorLog() const { return readLog(log_path_); }
+std::string FfmpegSink::errorLog() const { return log_fd_ >= 0 ? readLog(log_fd_) : "(no message)"; }
 
 void FfmpegSink::writeFrame(const uint8_t* rgb) {
   if (stdin_fd_ < 0) throw std::logic_error("FfmpegSink::writeFrame after finish");
@@ -257,8 +262,8 @@ void FfmpegSink::commit() {
     }
     tmp_paths_[i].clear();
   }
-  std::remove(log_path_.c_str());
-  log_path_.clear();
+  ::close(log_fd_);
+  log_fd_ = -1;
 }
 
 void FfmpegSink::abort() noexcept {
@@ -277,9 +282,9 @@ void FfmpegSink::abort() noexcept {
     if (!t.empty()) std::remove(t.c_str());
     t.clear();
   }
-  if (!log_path_.empty()) {
-    std::remove(log_path_.c_str());
-    log_path_.clear();
+  if (log_fd_ >= 0) {
+    ::close(log_fd_);
+    log_fd_ = -1;
   }
 }
 

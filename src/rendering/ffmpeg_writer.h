@@ -65,7 +65,7 @@ class FfmpegSink {
   int stdin_fd_ = -1;
   std::vector<FfmpegOutput> outputs_;
   std::vector<std::string> tmp_paths_;
-  std::string log_path_;
+  int log_fd_ = -1;  // ffmpeg's stderr (an unlinked temporary file)
   size_t frame_bytes_ = 0;
   long frames_ = 0;
   bool finished_ = false;

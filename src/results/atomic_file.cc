@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -16,7 +17,10 @@
 namespace tailsim {
 
 void writeFileAtomic(const std::string& path, const std::string& contents) {
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  // "<path>.tmp.<pid>.<k>": unique per writer (process and call), so two threads writing the same
+  // path never share a temporary; `tailsim run` removes those of dead processes.
+  static std::atomic<unsigned long> counter{0};
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
   // No fsync: rename makes the file appear whole or not at all if the process dies (the
