@@ -67,7 +67,17 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
     std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
     if (e.cases.size() > 12) {
-      std::printf("  %zu cases (see %s/summary.json)\n", e.cases.size(), dir.c_str());
+      int warned = 0;  // runs whose result carries warnings (e.g. still moving at the end)
+      for (const ExperimentCase& c : e.cases) {
+        std::ifstream in(dir / "cases" / caseDirName(c.name) / "result.json");
+        const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+        if (!in || j.is_discarded() || !j.contains("runs")) continue;
+        for (const auto& [model, r] : j["runs"].items())
+          if (r.contains("warnings") && r["warnings"].is_array() && !r["warnings"].empty()) ++warned;
+      }
+      std::printf("  %zu cases (see %s/summary.json)", e.cases.size(), dir.c_str());
+      if (warned > 0) std::printf(", %d model runs with warnings", warned);
+      std::printf("\n");
       continue;
     }
     for (const ExperimentCase& c : e.cases) {
@@ -84,6 +94,10 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
         else std::printf(" %s: ok", model.c_str());
       }
       std::printf("\n");
+      for (const auto& [model, r] : j["runs"].items())
+        if (r.contains("warnings") && r["warnings"].is_array())
+          for (const auto& w : r["warnings"])
+            if (w.is_string()) std::printf("    warning (%s): %s\n", model.c_str(), w.get<std::string>().c_str());
     }
   }
 }
