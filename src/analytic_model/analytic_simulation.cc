@@ -611,7 +611,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
 
     long steps = 0;
     // Step budget: a run that needs more steps fails with this message instead of running on.
-    const long max_steps = static_cast<long>(limits::kMaxAnalyticSteps);
+    const long max_steps = settings.max_steps;
     auto checkBudget = [&]() {
       if (steps > max_steps)
         throw std::runtime_error("step budget of " + std::to_string(max_steps) + " steps exhausted at t=" +

@@ -422,6 +422,19 @@ void validateRobot(const RobotParams& p, const Origins& origin, const Loc& fallb
   }
 }
 
+// Masses within [kMinMassKg, kMaxMassKg] (docs/experiment-format.md "Limits"), at the value that set them.
+void checkMasses(const RobotParams& p, const Origins& origin, const Loc& fallback) {
+  auto check = [&](double m, const std::string& key) {
+    if (m >= limits::kMinMassKg && m <= limits::kMaxMassKg) return;
+    const auto it = origin.find(key);
+    fail(it == origin.end() ? fallback : it->second,
+         "must lie in [" + fmtG(limits::kMinMassKg) + ", " + fmtG(limits::kMaxMassKg) + "] kg, got " + fmtG(m) +
+             " (docs/experiment-format.md \"Limits\")");
+  };
+  check(p.quadruped.mass_kg, "quadruped.mass_kg");
+  for (std::size_t i = 0; i < p.tail.size(); ++i) check(p.tail[i].mass_kg, "tail link " + std::to_string(i + 1) + " mass_kg");
+}
+
 struct RobotFile {
   std::string file;  // absolute path
   RobotParams base;  // tail empty
@@ -556,6 +569,7 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
     const std::vector<Item> v = r.perJoint(*w, n);
     for (int i = 0; i < n; ++i) {
       const double x = r.number(v[i]);
+      if (!(x > 0.0 && x < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(x));
       if (!(x >= limits::kMinWss && x <= limits::kMaxWss))
         r.fail(v[i], "must lie in [" + fmtG(limits::kMinWss) + ", " + fmtG(limits::kMaxWss) + "], got " + fmtG(x) +
                          " (docs/experiment-format.md \"Limits\")");
@@ -862,6 +876,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     origin["gravity_mps2"] = r.loc(*g);
   }
   validateRobot(c.robot, origin, r.loc(root));
+  checkMasses(c.robot, origin, r.loc(root));
   const int n = c.robot.numLinks();
 
   const Item* traj = top.get("trajectory");

@@ -395,8 +395,8 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       step(t, true);
     }
     ++steps;
-    if (steps > static_cast<long>(limits::kMaxMujocoSteps)) {
-      fail("step budget of " + std::to_string(static_cast<long>(limits::kMaxMujocoSteps)) +
+    if (steps > settings.max_steps) {
+      fail("step budget of " + std::to_string(settings.max_steps) +
            " MuJoCo steps exhausted at t=" + std::to_string(t) + " s (docs/experiment-format.md \"Limits\")");
       break;
     }
