@@ -665,6 +665,54 @@ TEST_F(LoaderTest, SuiteErrors) {
   expectSuiteError("experiments: [a.yaml, bad.yaml]\n", "bad.yaml", 3, "trajectory.dT_s");
 }
 
+// Issue 16, finding 5: counts that overflowed a float-to-integer conversion (0 rows, phi_net 0,
+// ok) are refused at load, at the key that makes them.
+TEST_F(LoaderTest, Finding5OverflowingCountsAreRefusedAtLoad) {
+  expectError(exp(std::string(kTraj) + "output: {sample_dt_s: 1e-20}\n"), 5, "output.sample_dt_s", "rows");
+  expectError(exp(std::string(kTraj) + "output: {duration_s: 1e300}\n"), 5, "output.duration_s", "rows");
+  expectError(exp(std::string(kTraj) + "output:\n  settle_s: 1e300\n"), 6, "output.settle_s", "rows");
+  expectError(exp(std::string(kTraj) + "models: [mujoco]\nrender: {slowmo: 1e300}\n"), 6, "render.slowmo", "frames");
+}
+
+// Issue 16, finding 7: accepted values that never finished or exhausted memory are refused at
+// load with file:line:col at the offending key; the limits' own edges and the paper's extremes load.
+TEST_F(LoaderTest, Finding7UnboundedWorkIsRefusedAtLoad) {
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 1e-9}\n"), 4, "trajectory.dT_s", ">= 0.001 s");
+  expectError(exp("trajectory: {dtheta_deg: -90, peak_speed_dps: 1e9}\n"), 4, "trajectory.peak_speed_dps", "shorter");
+  expectError(exp("trajectory: {rule: eq25, thetadot_max_dps: 1e9}\n"), 4, "trajectory.thetadot_max_dps", "shorter");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: 1e-8}\n"), 4, "trajectory.w_ss", "[0.01, 0.99]");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: 0.99999999}\n"), 4, "trajectory.w_ss");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, t0_s: 1e300}\n"), 4, "trajectory.t0_s", "rows");
+  expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 0.25, t0_s: 1e5}\noutput: {sample_dt_s: 1}\n"), 4,
+              "trajectory.t0_s", "analytic model would take at least");
+  expectError(exp(std::string(kTraj) + "analytic: {max_step_s: 5e-324}\n"), 5, "analytic.max_step_s", "steps");
+  expectError(exp(std::string(kTraj) + "analytic: {solver: fixed, fixed_dt_s: 1e-12}\n"), 5, "analytic.fixed_dt_s");
+  expectError(exp(std::string(kTraj) + "models: [mujoco]\nmujoco: {settle_s: 1e300}\n"), 6, "mujoco.settle_s",
+              "MuJoCo would take");
+  expectError(exp(std::string(kTraj) + "models: [mujoco]\nmujoco: {timestep_s: 1e-9}\n"), 6, "mujoco.timestep_s");
+  expectError(exp(std::string(kTraj) + "output: {sample_dt_s: 1e-7}\n"), 5, "output.sample_dt_s", "1e+06 rows");
+  expectError(exp(std::string(kTraj) + "output: {duration_s: 1e9}\n"), 5, "output.duration_s");
+  // A sweep value is reported at the value itself.
+  expectError(exp(std::string(kTraj) + "output: {sample_dt_s: {sweep: [1e-3, 1e-12]}}\n"), 5, "output.sample_dt_s");
+  // Inside the limits: the paper's and the tests' extremes.
+  const Experiment ok = loadExperiment(write(
+      "ok.yaml", exp("trajectory: {dtheta_deg: -3600, theta0_deg: 360, dT_s: {sweep: [0.001, 0.05]}, "
+                     "w_ss: {sweep: [0.01, 0.02, 0.98, 0.99]}}\nmodels: [analytic, mujoco]\n")));
+  EXPECT_EQ(ok.cases.size(), 8u);
+}
+
+// Issue 16, finding 6 (b, c): angles and masses are bounded at load (dtheta -1e300 deg gave NaN
+// loads reported ok; a 1e-6 kg body disagreed between the models).
+TEST_F(LoaderTest, Finding6AnglesAndMassesAreBoundedAtLoad) {
+  expectError(exp("trajectory: {dtheta_deg: -1e300, dT_s: 0.25}\n"), 4, "trajectory.dtheta_deg", "[-3600, 3600]");
+  expectError(exp("trajectory: {theta0_deg: 400, dtheta_deg: -90, dT_s: 0.25}\n"), 4, "trajectory.theta0_deg",
+              "[-360, 360]");
+  expectError(exp(std::string(kTraj) + "quadruped: {mass_kg: 1e-6}\n"), 5, "quadruped.mass_kg", "[0.001, 10000] kg");
+  expectError("name: t\nrobot: robots/paper_quadruped.yaml\ntail:\n  custom:\n"
+              "    - {mass_kg: 1e9, izz_kgm2: 0.01, length_m: 0.3}\n" + std::string(kTraj),
+              5, "tail.custom[0].mass_kg", "kg");
+}
+
 // Every config shipped in the repository loads.
 TEST(ShippedConfigs, AllLoad) {
   const fs::path configs = fs::path(kSourceDir) / "configs";

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "results/work_limits.h"
+
 namespace tailsim {
 
 enum class Coupling {
@@ -23,6 +25,8 @@ struct AnalyticSettings {
   // moves the body by at most v_stop^2 / (2 a) (~5e-9 m here) and saves ~10^4 tiny steps.
   double v_stop_mps = 1e-4;
   Coupling coupling = Coupling::kPaper;
+  // Step budget: a run needing more accepted steps fails with a clear error (not a loader key).
+  long max_steps = static_cast<long>(limits::kMaxAnalyticSteps);
 };
 
 }  // namespace tailsim

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "results/work_limits.h"
 #include "robot/friction_law.h"
 
 namespace tailsim {
@@ -84,6 +85,10 @@ class Model {
     std::vector<JointState>& js = scratch_joints_;
     traj_.evaluate(t, js);
     systemLoads(robot_, js, decompose, ev.loads, scratch_);
+    if (!std::isfinite(ev.loads.MzT) || !std::isfinite(ev.loads.F_T_Q.x()) || !std::isfinite(ev.loads.F_T_Q.y()) ||
+        !std::isfinite(ev.loads.Izz_kgm2) || !std::isfinite(js.empty() ? 0.0 : js.front().theta))
+      throw std::runtime_error("the tail loads became non-finite at t=" + std::to_string(t) +
+                               " s (M_z,T = " + std::to_string(ev.loads.MzT) + " N m): check the trajectory values");
     if (needsArm())
       ev.L_F = e_.foot_loads == FootLoadModel::kConstant ? L_F_const_
                                                          : footLoads(robot_.quadruped, ev.loads.p_QC).L_F;
@@ -222,7 +227,9 @@ class Model {
 
 class Recorder {
  public:
-  Recorder(const Model& model, int n_links, double dt, double t_end) : model_(model), n_(n_links), dt_(dt), t_end_(t_end) {
+  // n_samples: rows on the grid 0, dt, ... <= t_end (outputRows(), bounded before any work).
+  Recorder(const Model& model, int n_links, double dt, double t_end, long n_samples)
+      : model_(model), n_(n_links), dt_(dt), t_end_(t_end), n_samples_(n_samples) {
     for (int i = 1; i <= n_; ++i) ts_.addColumn("theta" + std::to_string(i) + "_deg");
     for (int i = 1; i <= n_; ++i) ts_.addColumn("thetadot" + std::to_string(i) + "_dps");
     for (int i = 1; i <= n_; ++i) ts_.addColumn("thetaddot" + std::to_string(i) + "_dps2");
@@ -235,7 +242,6 @@ class Recorder {
     withT.addColumn("t_s");
     for (const auto& n : ts_.names()) withT.addColumn(n);
     ts_ = std::move(withT);
-    n_samples_ = static_cast<long>(std::floor(t_end / dt + 1e-9)) + 1;
   }
 
   // Next sample time not yet written (or +inf when done).
@@ -408,6 +414,15 @@ std::pair<double, double> goldenMin(const G& g, double a, double b, double tol) 
   return gc < gd ? std::make_pair(c, gc) : std::make_pair(d, gd);
 }
 
+std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) {
+  std::ostringstream os;
+  os.precision(4);
+  os << "the body is still moving when the run ends at t = " << t_end << " s (|phi_dot| " << phidot_dps
+     << " deg/s, speed " << speed_mps << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
+     << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
+  return os.str();
+}
+
 struct Found {
   bool hit = false;
   double t = 0;
@@ -461,6 +476,39 @@ Found findSwitch(const Events& events, const Modes& m, double ta, double tb, dou
   return {};
 }
 
+// Frictionless residual spin of the paper coupling (docs/accuracy.md "Paper coupling diagnostic").
+// With the paper's coupling, I_zz phi_ddot = M_z,T depends on the joint trajectory alone, so the
+// body rate it gives with mu = 0 is the quadrature of M_z,T / I_zz. The system starts at rest and
+// the tail ends at rest: angular momentum conservation (exact coupling, MuJoCo) leaves the body
+// with no spin after the motion; what the paper's rate keeps is its angular-momentum error.
+// Returns the residual rate at the tail's end  [rad/s].
+double paperResidualSpin(const RobotParams& robot, const TailTrajectory& traj) {
+  std::vector<double> b = traj.breakpoints();
+  std::vector<JointState> js;
+  SystemLoads sl;
+  LoadScratch scratch;
+  auto f = [&](double t) {
+    traj.evaluate(t, js);
+    systemLoads(robot, js, false, sl, scratch);
+    return sl.MzT / sl.Izz_kgm2;
+  };
+  double w = 0;
+  constexpr int kPerSegment = 64;  // Simpson intervals between two breakpoints (the loads are smooth there)
+  for (std::size_t s = 0; s + 1 < b.size(); ++s) {
+    const double a = b[s], h = (b[s + 1] - b[s]) / kPerSegment;
+    if (!(h > 0)) continue;
+    double fa = f(a);
+    for (int i = 0; i < kPerSegment; ++i) {
+      const double t0 = a + i * h, fm = f(t0 + 0.5 * h), fb = f(t0 + h);
+      w += h / 6.0 * (fa + 4.0 * fm + fb);
+      fa = fb;
+    }
+  }
+  return w;
+}
+
+bool needsFrictionArm(const Model& m) { return m.needsArm(); }
+
 bool allFinite(const State& y) {
   for (double v : y)
     if (!std::isfinite(v)) return false;
@@ -481,6 +529,12 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     throw std::invalid_argument("output.sample_dt_s = " + std::to_string(output.sample_dt_s) +
                                 " s is longer than the run (" + std::to_string(t_end) +
                                 " s): the time series needs at least 2 rows");
+  // Checked as a double before it becomes a count (no float-to-integer overflow).
+  const double rows = std::floor(t_end / output.sample_dt_s + 1e-9) + 1;
+  if (!(rows <= limits::kMaxRowsPerRun))
+    throw std::invalid_argument("the run (" + std::to_string(t_end) + " s / output.sample_dt_s " +
+                                std::to_string(output.sample_dt_s) + " s) would write more than " +
+                                std::to_string(static_cast<long>(limits::kMaxRowsPerRun)) + " rows");
 
   const auto wall0 = std::chrono::steady_clock::now();
   RunResult result;
@@ -498,7 +552,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
 
   try {
     const Model model(robot, trajectory, settings, effects);
-    Recorder rec(model, robot.numLinks(), output.sample_dt_s, t_end);
+    Recorder rec(model, robot.numLinks(), output.sample_dt_s, t_end, static_cast<long>(rows));
     // The fixed-step solver checks once per step: a slide slower than one step's friction
     // deceleration (mu_d g h) would reverse within the next step, so it counts as stopped.
     const double v_stop = adaptive ? settings.v_stop_mps
@@ -556,6 +610,15 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     };
 
     long steps = 0;
+    // Step budget: a run that needs more steps fails with this message instead of running on.
+    const long max_steps = settings.max_steps;
+    auto checkBudget = [&]() {
+      if (steps > max_steps)
+        throw std::runtime_error("step budget of " + std::to_string(max_steps) + " steps exhausted at t=" +
+                                 std::to_string(t) + " s of " + std::to_string(t_end) +
+                                 " s (docs/experiment-format.md \"Limits\"): loosen analytic.rel_tol/abs_tol, "
+                                 "raise max_step_s or fixed_dt_s, or shorten the run");
+    };
     while (t < t_end - 1e-15) {
       if (settled(t)) {
         if (!rec.done() && rec.nextTime() <= t_end + 1e-12) {  // one evaluated row at rest, then copies
@@ -577,6 +640,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         while (!restart) {
           const auto [ta, tb_raw] = stepper.do_step(rhs);
           ++steps;
+          checkBudget();
           const double tb = std::min(tb_raw, seg_end);
           auto stateAt = [&](double tt, State& ys) { stepper.calc_state(tt, ys); };
           Found f;
@@ -610,6 +674,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
         const State y0 = y;
         rk4.do_step(rhs, y, t, h);
         ++steps;
+        checkBudget();
         const double t1 = t + h;
         const State y1 = y;
         auto lerp = [&](double tt, State& ys) {
@@ -648,6 +713,33 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     sum.extra["final_speed_mps"] = std::hypot(y[kVx], y[kVy]);
     sum.extra["still_rotating_at_end"] = still && std::abs(y[kPhiDot]) > 0 ? 1.0 : 0.0;
     sum.extra["ever_rotated"] = ever_rotated || !model.stiction() ? 1.0 : 0.0;
+    // At rest: both DOFs stuck (stiction), or rate and speed below the documented thresholds.
+    const bool stuck_all = model.stiction() && modes.stuck[kRot] && (modes.stuck[kTrans] || !model.translation());
+    const double phidot_dps = std::abs(y[kPhiDot]) * 180.0 / M_PI, speed = std::hypot(y[kVx], y[kVy]);
+    sum.at_rest = stuck_all || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
+    if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
+    if (settings.coupling == Coupling::kPaper) {
+      // The turn the paper coupling's residual spin alone would cause before sliding friction
+      // (deceleration mu_d m g L_F / I_zz at the final pose) stops it: w^2 / (2 alpha).
+      const double w_res = paperResidualSpin(robot, trajectory);
+      const Eval ev_end = model.evaluate(t_end, y, modes);
+      const double alpha = needsFrictionArm(model) && std::isfinite(ev_end.L_F)
+                               ? robot.friction.mu_d * model.weight() * ev_end.L_F / ev_end.loads.Izz_kgm2
+                               : 0.0;
+      const double turn_deg = w_res == 0.0 ? 0.0 : alpha > 0 ? w_res * w_res / (2.0 * alpha) * 180.0 / M_PI
+                                                            : std::numeric_limits<double>::infinity();
+      sum.extra["paper_residual_spin_dps"] = w_res * 180.0 / M_PI;
+      sum.extra["paper_spurious_turn_deg"] = turn_deg;
+      if (!(turn_deg <= limits::kMaxPaperSpuriousTurnDeg)) {
+        std::ostringstream os;
+        os.precision(3);
+        os << "the paper coupling's angular-momentum error is large: with mu = 0 it would leave the body spinning at "
+           << w_res * 180.0 / M_PI << " deg/s after the tail stops (the exact coupling: 0), enough to turn it by "
+           << turn_deg << " deg against sliding friction (limit " << limits::kMaxPaperSpuriousTurnDeg
+           << " deg); the paper's model is outside its validity here, compare analytic.coupling: exact";
+        sum.warnings.push_back(os.str());
+      }
+    }
   } catch (const TippingError& e) {
     sum.ok = false;
     sum.error = e.what();

@@ -68,16 +68,23 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
   for (const Experiment& e : suite) {
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
     std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
-    if (e.cases.size() > 60) {  // a longer table scrolls away; summary.json has them all
-      std::printf("  %zu cases (see %s/summary.json)\n", e.cases.size(), dir.c_str());
-      continue;
-    }
     std::ifstream in(dir / "summary.json");
     const nlohmann::json s = nlohmann::json::parse(in, nullptr, false);
     std::map<std::string, const nlohmann::json*> by_name;
     if (!s.is_discarded() && s.contains("cases") && s["cases"].is_array())
       for (const nlohmann::json& c : s["cases"])
         if (c.is_object() && c.contains("name") && c["name"].is_string()) by_name[c["name"].get<std::string>()] = &c;
+    if (e.cases.size() > 60) {  // a longer table scrolls away; summary.json has them all
+      int warned = 0;  // runs whose result carries warnings (e.g. still moving at the end)
+      for (const auto& [name, j] : by_name)
+        if (j->contains("runs") && (*j)["runs"].is_object())
+          for (const auto& [model, r] : (*j)["runs"].items())
+            if (r.contains("warnings") && r["warnings"].is_array() && !r["warnings"].empty()) ++warned;
+      std::printf("  %zu cases (see %s/summary.json)", e.cases.size(), dir.c_str());
+      if (warned > 0) std::printf(", %d model runs with warnings", warned);
+      std::printf("\n");
+      continue;
+    }
     for (const ExperimentCase& c : e.cases) {
       std::printf("  %-40s", c.name.c_str());
       const auto it = by_name.find(c.name);
@@ -92,6 +99,10 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
         else std::printf(" %s: ok", model.c_str());
       }
       std::printf("\n");
+      for (const auto& [model, r] : j["runs"].items())
+        if (r.contains("warnings") && r["warnings"].is_array())
+          for (const auto& w : r["warnings"])
+            if (w.is_string()) std::printf("    warning (%s): %s\n", model.c_str(), w.get<std::string>().c_str());
     }
   }
 }

@@ -9,6 +9,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "experiments/work_estimate.h"
+#include "results/work_limits.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -419,6 +422,19 @@ void validateRobot(const RobotParams& p, const Origins& origin, const Loc& fallb
   }
 }
 
+// Masses within [kMinMassKg, kMaxMassKg] (docs/experiment-format.md "Limits"), at the value that set them.
+void checkMasses(const RobotParams& p, const Origins& origin, const Loc& fallback) {
+  auto check = [&](double m, const std::string& key) {
+    if (m >= limits::kMinMassKg && m <= limits::kMaxMassKg) return;
+    const auto it = origin.find(key);
+    fail(it == origin.end() ? fallback : it->second,
+         "must lie in [" + fmtG(limits::kMinMassKg) + ", " + fmtG(limits::kMaxMassKg) + "] kg, got " + fmtG(m) +
+             " (docs/experiment-format.md \"Limits\")");
+  };
+  check(p.quadruped.mass_kg, "quadruped.mass_kg");
+  for (std::size_t i = 0; i < p.tail.size(); ++i) check(p.tail[i].mass_kg, "tail link " + std::to_string(i + 1) + " mass_kg");
+}
+
 struct RobotFile {
   std::string file;  // absolute path
   RobotParams base;  // tail empty
@@ -529,6 +545,15 @@ std::string builtinRobotFile(const std::string& name, const Loc& at) {
   fail(at, "built-in robot '" + name + "' not found (looked for " + looked + ")");
 }
 
+// An angle in degrees with |value| <= max_abs.
+double boundedDeg(const Reader& r, const Item& it, double max_abs) {
+  const double v = r.number(it);
+  if (!(std::abs(v) <= max_abs))
+    r.fail(it, "must lie in [-" + fmtG(max_abs) + ", " + fmtG(max_abs) + "] deg, got " + fmtG(v) +
+                   " (docs/experiment-format.md \"Limits\")");
+  return v;
+}
+
 struct JointLocs {
   Loc dT, w_ss;
 };
@@ -545,6 +570,9 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
     for (int i = 0; i < n; ++i) {
       const double x = r.number(v[i]);
       if (!(x > 0.0 && x < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(x));
+      if (!(x >= limits::kMinWss && x <= limits::kMaxWss))
+        r.fail(v[i], "must lie in [" + fmtG(limits::kMinWss) + ", " + fmtG(limits::kMaxWss) + "], got " + fmtG(x) +
+                         " (docs/experiment-format.md \"Limits\")");
       joints[i].w_ss = x;
       locs[i].w_ss = r.loc(v[i]);
     }
@@ -573,16 +601,19 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
         r.fail(w, e.what());
       }
       locs[i].dT = r.loc(w);
+      if (!(joints[i].dT_s >= limits::kMinDT_s))
+        r.fail(w, "gives dT_s = " + fmtG(joints[i].dT_s) + " s (Eq. 25), shorter than " + fmtG(limits::kMinDT_s) +
+                      " s (docs/experiment-format.md \"Limits\")");
     }
   } else {
     for (const char* k : {"thetadot_max_dps", "thetadot_max_radps"})
       if (const Item* x = t.get(k)) r.fail(*x, "only used with rule: eq25");
     if (const Item* th0 = t.get("theta0_deg")) {
       const std::vector<Item> v = r.perJoint(*th0, n);
-      for (int i = 0; i < n; ++i) joints[i].theta0_rad = r.number(v[i]) * kRadPerDeg;
+      for (int i = 0; i < n; ++i) joints[i].theta0_rad = boundedDeg(r, v[i], limits::kMaxAbsTheta0Deg) * kRadPerDeg;
     }
     const std::vector<Item> dth = r.perJoint(r.need(t, "dtheta_deg"), n);
-    for (int i = 0; i < n; ++i) joints[i].dtheta_rad = r.number(dth[i]) * kRadPerDeg;
+    for (int i = 0; i < n; ++i) joints[i].dtheta_rad = boundedDeg(r, dth[i], limits::kMaxAbsDthetaDeg) * kRadPerDeg;
     const Item* dT = t.get("dT_s");
     const Item* peak = t.get("peak_speed_dps");
     if (!dT && !peak) tailsim::fail(r.locAt(t.self, "dT_s"), "give dT_s or peak_speed_dps");
@@ -592,6 +623,9 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
       for (int i = 0; i < n; ++i) {
         joints[i].dT_s = r.number(v[i]);
         locs[i].dT = r.loc(v[i]);
+        if (joints[i].dT_s > 0.0 && joints[i].dT_s < limits::kMinDT_s)
+          r.fail(v[i], "must be >= " + fmtG(limits::kMinDT_s) + " s, got " + fmtG(joints[i].dT_s) +
+                           " (docs/experiment-format.md \"Limits\")");
       }
     } else {
       const std::vector<Item> v = r.perJoint(*peak, n);
@@ -599,6 +633,9 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
         const double pk = r.positive(v[i]) * kRadPerDeg;
         joints[i].dT_s = 2.0 * std::abs(joints[i].dtheta_rad) / pk;  // peak speed 2 |dtheta| / dT (Eq. 23)
         if (!(joints[i].dT_s > 0.0)) r.fail(v[i], "dtheta_deg = 0 gives dT_s = 0; give dT_s instead");
+        if (joints[i].dT_s < limits::kMinDT_s)
+          r.fail(v[i], "gives dT_s = 2 |dtheta| / peak speed = " + fmtG(joints[i].dT_s) + " s, shorter than " +
+                           fmtG(limits::kMinDT_s) + " s (docs/experiment-format.md \"Limits\")");
         locs[i].dT = r.loc(v[i]);
       }
     }
@@ -760,6 +797,26 @@ RenderSettings readRender(const Reader& r, const Item& item) {
   return s;
 }
 
+// Refuses a case whose work estimate (experiments/work_estimate.h) exceeds a limit, at the first
+// key among the estimate's culprits that the file sets (else at the section, else the file).
+void checkCaseWork(const Reader& r, const MapView& top, const ExperimentCase& c) {
+  const WorkExcess x = checkWork(c);
+  if (x.what.empty()) return;
+  const Item* first_section = nullptr;
+  for (const std::string& key : x.keys) {
+    const std::size_t dot = key.find('.');
+    const Item* sec = top.get(key.substr(0, dot));
+    if (!sec) continue;
+    if (!first_section) first_section = sec;
+    const YAML::Node& secNode = sec->node;
+    if (r.pick(*sec) || !secNode.IsMap()) continue;
+    const YAML::Node v = secNode[key.substr(dot + 1)];
+    if (v) r.fail(Item{v, key, v.Mark().is_null() ? sec->mark : v.Mark()}, x.what);
+  }
+  if (first_section) r.fail(*first_section, x.what);
+  r.fail(r.root(top.self.node), x.what);
+}
+
 // Pass 2: one case, with the sweeps resolved by `r`.
 ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
   const Item root = r.root(doc);
@@ -826,6 +883,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     origin["gravity_mps2"] = r.loc(*g);
   }
   validateRobot(c.robot, origin, r.loc(root));
+  checkMasses(c.robot, origin, r.loc(root));
   const int n = c.robot.numLinks();
 
   const Item* traj = top.get("trajectory");
@@ -856,6 +914,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   if (const Item* x = top.get("output"))
     c.output = readOutput(r, *x, c.kind == "simulate" ? c.trajectory().endTime() : -1.0);
   if (const Item* x = top.get("render")) c.render = readRender(r, *x);
+  checkCaseWork(r, top, c);
   return c;
 }
 

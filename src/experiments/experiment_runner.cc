@@ -53,6 +53,9 @@ json summaryJson(const RunSummary& s) {
   j["wall_time_s"] = s.wall_time_s;
   j["solver_steps"] = s.solver_steps;
   if (!s.error.empty()) j["error"] = s.error;
+  // A finished run: was the body at rest at the end, and what makes the result doubtful.
+  j["at_rest"] = s.ok ? json(s.at_rest) : json(nullptr);
+  j["warnings"] = s.warnings;
   for (const auto& [k, v] : s.extra) j["extra"][k] = std::isfinite(v) ? json(v) : json(nullptr);
   return j;
 }

@@ -4,6 +4,8 @@
 #include <array>
 #include <string>
 
+#include "results/work_limits.h"
+
 namespace tailsim {
 
 struct MujocoSettings {
@@ -36,6 +38,8 @@ struct MujocoSettings {
   // chatter). 0 = that check off.
   double max_tilt_deg = 5.0;            // [deg]
   double max_all_feet_off_s = 0.1;      // [s]
+  // Step budget of the main loop: a run needing more mj_step calls fails (not a loader key).
+  long max_steps = static_cast<long>(limits::kMaxMujocoSteps);
 };
 
 }  // namespace tailsim

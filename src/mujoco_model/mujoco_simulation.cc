@@ -14,6 +14,7 @@
 #include "controllers/tail_controller.h"
 #include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_handles.h"
+#include "results/work_limits.h"
 #include "robot/friction_law.h"
 
 namespace tailsim {
@@ -281,6 +282,18 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   if (!(output.sample_dt_s > 0.0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
   const double duration = output.duration_s > 0.0 ? output.duration_s : trajectory.endTime() + output.settle_s;
   if (!(duration >= 0.0) || !std::isfinite(duration)) throw std::invalid_argument("bad simulation duration");
+  // Work bounds, checked as doubles before they become counts (no float-to-integer overflow).
+  const double rows = std::floor(duration / output.sample_dt_s + 1e-9) + 1;
+  if (!(rows <= limits::kMaxRowsPerRun))
+    throw std::invalid_argument("the run (" + std::to_string(duration) + " s / output.sample_dt_s " +
+                                std::to_string(output.sample_dt_s) + " s) would write more than " +
+                                std::to_string(static_cast<long>(limits::kMaxRowsPerRun)) + " rows");
+  const double total_steps = (settings.settle_s + duration) / settings.timestep_s;
+  if (!(total_steps <= limits::kMaxMujocoSteps))
+    throw std::invalid_argument("MuJoCo would take " + std::to_string(total_steps) + " steps ((settle_s " +
+                                std::to_string(settings.settle_s) + " s + " + std::to_string(duration) +
+                                " s) / timestep_s " + std::to_string(settings.timestep_s) + " s), more than " +
+                                std::to_string(static_cast<long>(limits::kMaxMujocoSteps)));
 
   const std::string xml = generateMjcf(robot, settings, effects);  // validates robot + settings
   const MujocoMessages messages;  // MuJoCo's warnings go into this run's error text, not MUJOCO_LOG.TXT
@@ -347,7 +360,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   // Main loop. Row k is the state at the start of the first step with t >= t_k (exact when the
   // timestep divides sample_dt; otherwise up to one timestep late, labelled t_k).
   const double h = settings.timestep_s;
-  const long num_samples = static_cast<long>(std::floor(duration / output.sample_dt_s + 1e-9)) + 1;
+  const long num_samples = static_cast<long>(rows);
   const double eps = 1e-6 * h;
   long k = 0;
   std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv), qacc_t(m->nv), scratch;
@@ -383,7 +396,12 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       step(t, true);
     }
     ++steps;
-    if (warningCount(d) > 0 || !std::isfinite(d->qacc[L.root_dofadr])) {
+    if (steps > settings.max_steps) {
+      fail("step budget of " + std::to_string(settings.max_steps) +
+           " MuJoCo steps exhausted at t=" + std::to_string(t) + " s (docs/experiment-format.md \"Limits\")");
+      break;
+    }
+    if (warningCount(d) > 0 || !std::isfinite(d->qacc[L.root_dofadr]) || !std::isfinite(ctrl.lastError(0))) {
       fail(instabilityMessage(d, t, settings, gains));
       break;
     }
@@ -446,6 +464,37 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   sum.extra["mujoco_warnings"] = warningCount(d);
   sum.extra["kp_j1"] = gains.kp[0];
   standing.report(sum.extra);
+  // At rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
+  {
+    mjtNum v6[6];
+    mj_objectVelocity(m, d, mjOBJ_BODY, L.quad_body, v6, 0);  // (angular, linear), world axes
+    const double phidot_dps = std::abs(v6[2]) * kRad2Deg, speed = std::hypot(v6[3], v6[4]);
+    sum.extra["final_phidot_dps"] = v6[2] * kRad2Deg;
+    sum.extra["final_speed_mps"] = speed;
+    sum.at_rest = phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps;
+    if (!sum.at_rest && sum.ok) {
+      std::ostringstream os;
+      os.precision(4);
+      os << "the body is still moving when the run ends at t = " << duration << " s (|phi_dot| " << phidot_dps
+         << " deg/s, speed " << speed << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
+         << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
+      sum.warnings.push_back(os.str());
+    }
+  }
+  // The servo follows the reference only as well as the step allows (a coarse timestep_s lowers
+  // the gains: kp ~ (servo_wn_dt / timestep_s)^2): a large tracking error means a different motion.
+  double worst = 0.0;
+  int worst_j = 0;
+  for (int i = 0; i < n; ++i)
+    if (st.max_abs_rad[i] * kRad2Deg > worst) worst = st.max_abs_rad[i] * kRad2Deg, worst_j = i + 1;
+  if (worst > limits::kMaxTrackingErrorDeg && sum.ok) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "the tail servo is off its reference by up to " << worst << " deg (joint " << worst_j << "; limit "
+       << limits::kMaxTrackingErrorDeg << " deg): the simulated tail motion differs from the trajectory, "
+       << "lower mujoco.timestep_s (" << settings.timestep_s << " s)";
+    sum.warnings.push_back(os.str());
+  }
   if (!sum.ok) sum.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
   return result;
 }

@@ -24,6 +24,7 @@
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/gl_context.h"
 #include "rendering/replay.h"
+#include "results/work_limits.h"
 
 namespace tailsim {
 
@@ -329,7 +330,14 @@ FrameTimes frameTimes(const TimeSeries& mujoco, const RenderSettings& s) {
   f.t_start = mujoco.values("t_s").front();
   f.t_end = mujoco.values("t_s").back();
   if (s.duration_s > 0.0) f.t_end = std::min(f.t_end, f.t_start + s.duration_s);
-  f.frames = static_cast<long>(std::floor((f.t_end - f.t_start) * s.fps * s.slowmo + 1e-9)) + 1;
+  // Checked as a double before it becomes a count (no float-to-integer overflow).
+  const double frames = std::floor((f.t_end - f.t_start) * s.fps * s.slowmo + 1e-9) + 1;
+  if (!(frames >= 1 && frames <= limits::kMaxRenderFrames))
+    throw std::invalid_argument("rendering: " + std::to_string(frames) + " frames (" +
+                                std::to_string(f.t_end - f.t_start) + " s x fps " + std::to_string(s.fps) +
+                                " x slowmo " + std::to_string(s.slowmo) + "), more than the limit " +
+                                std::to_string(static_cast<long>(limits::kMaxRenderFrames)));
+  f.frames = static_cast<long>(frames);
   return f;
 }
 

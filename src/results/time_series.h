@@ -39,6 +39,8 @@ struct RunSummary {
   long solver_steps = 0;      // accepted integrator steps (MuJoCo: mj_step calls)
   bool ok = true;             // false: the run failed (error holds why)
   std::string error;
+  bool at_rest = true;        // the body (yaw and translation) was at rest when the run ended
+  std::vector<std::string> warnings;  // the result is computed but doubtful: why (e.g. still moving at the end)
   std::map<std::string, double> extra;  // model-specific figures (e.g. tracking_rms_deg_j1)
 };
 

@@ -1,0 +1,123 @@
+#include "experiments/work_estimate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "results/work_limits.h"
+
+namespace tailsim {
+namespace {
+
+bool has(const std::vector<std::string>& v, const char* s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+std::string g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+// Output columns per model run (analytic_simulation.cc Recorder, mujoco_simulation.cc makeColumns).
+double analyticColumns(int n) { return 1 + 3 * n + 20; }
+double mujocoColumns(int n) { return 1 + 3 * n + 14 + 8 + n; }
+
+// The keys that set the simulated time, most likely culprit first.
+std::vector<std::string> timeKeys(const ExperimentCase& c) {
+  if (c.output.duration_s > 0) return {"output.duration_s"};
+  double t0 = 0;
+  for (const SplitCycleParams& p : c.joints) t0 = std::max(t0, p.t0_s);
+  if (t0 > c.output.settle_s) return {"trajectory.t0_s", "output.settle_s", "trajectory.dT_s"};
+  return {"output.settle_s", "trajectory.t0_s", "trajectory.dT_s"};
+}
+
+void append(std::vector<std::string>& a, const std::vector<std::string>& b) { a.insert(a.end(), b.begin(), b.end()); }
+
+}  // namespace
+
+WorkEstimate estimateWork(const ExperimentCase& c) {
+  WorkEstimate w;
+  if (c.kind != "simulate") return w;
+  const int n = c.robot.numLinks();
+  const TailTrajectory traj = c.trajectory();
+  const double tail_end = traj.endTime();
+  w.sim_time_s = c.simDuration();
+  w.rows = std::floor(w.sim_time_s / c.output.sample_dt_s) + 1;
+  double cols = 0;
+  if (has(c.models, "analytic")) {
+    cols = std::max(cols, analyticColumns(n));
+    // While the tail moves (t0 delay included) the adaptive step is at most max_step_s, by default
+    // 1/8 of the shortest acceleration or deceleration phase; the fixed step is fixed_dt_s.
+    double shortest = std::numeric_limits<double>::infinity();
+    for (const SplitCycleParams& p : c.joints) shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
+    const double h = c.analytic.solver == "fixed" ? c.analytic.fixed_dt_s
+                     : c.analytic.max_step_s > 0 ? c.analytic.max_step_s
+                                                 : shortest / 8.0;
+    w.analytic_steps = std::min(tail_end, w.sim_time_s) / h;
+  }
+  if (has(c.models, "mujoco")) {
+    cols = std::max(cols, mujocoColumns(n));
+    w.mujoco_steps = (c.mujoco.settle_s + w.sim_time_s) / c.mujoco.timestep_s;
+    if (c.render.enabled) {
+      const double shown = c.render.duration_s > 0 ? std::min(c.render.duration_s, w.sim_time_s) : w.sim_time_s;
+      w.render_frames = std::floor(shown * c.render.fps * c.render.slowmo) + 1;
+    }
+  }
+  w.csv_bytes = w.rows * cols * limits::kCsvBytesPerValue;
+  return w;
+}
+
+WorkExcess checkWork(const ExperimentCase& c) {
+  WorkExcess x;
+  if (c.kind != "simulate") return x;
+  const WorkEstimate w = estimateWork(c);
+  const std::string see = " (docs/experiment-format.md \"Limits\")";
+  const std::string span = g(w.sim_time_s) + " s simulated";
+  // !(a <= b): an infinite or NaN estimate fails too.
+  if (!(w.rows <= limits::kMaxRowsPerRun) || !(w.csv_bytes <= limits::kMaxCsvBytesPerRun)) {
+    x.keys = c.output.sample_dt_s < OutputSettings{}.sample_dt_s ? std::vector<std::string>{"output.sample_dt_s"}
+                                                                  : std::vector<std::string>{};
+    append(x.keys, timeKeys(c));
+    x.keys.push_back("output.sample_dt_s");
+    x.what = "the run would write " + g(w.rows) + " rows per model (" + span + " / sample_dt_s " +
+             g(c.output.sample_dt_s) + " s, about " + g(w.csv_bytes) + " bytes of CSV); the limits are " +
+             g(limits::kMaxRowsPerRun) + " rows and " + g(limits::kMaxCsvBytesPerRun) +
+             " bytes per model run" + see + ": raise sample_dt_s or shorten the run";
+    return x;
+  }
+  if (!(w.analytic_steps <= limits::kMaxAnalyticSteps)) {
+    const bool fixed = c.analytic.solver == "fixed";
+    x.keys = {fixed ? "analytic.fixed_dt_s" : "analytic.max_step_s", "trajectory.t0_s", "trajectory.dT_s"};
+    x.what = "the analytic model would take at least " + g(w.analytic_steps) + " steps (tail motion until t = " +
+             g(std::min(c.trajectory().endTime(), w.sim_time_s)) + " s / step " +
+             (fixed ? g(c.analytic.fixed_dt_s) : g(c.analytic.max_step_s > 0 ? c.analytic.max_step_s : 0.0)) +
+             " s), more than the limit " + g(limits::kMaxAnalyticSteps) + see;
+    if (!fixed && !(c.analytic.max_step_s > 0))
+      x.what = "the analytic model would take at least " + g(w.analytic_steps) +
+               " steps (its step is at most 1/8 of the shortest acceleration phase while the tail moves), more "
+               "than the limit " + g(limits::kMaxAnalyticSteps) + see;
+    return x;
+  }
+  if (!(w.mujoco_steps <= limits::kMaxMujocoSteps)) {
+    x.keys = c.mujoco.timestep_s < MujocoSettings{}.timestep_s ? std::vector<std::string>{"mujoco.timestep_s"}
+                                                                : std::vector<std::string>{};
+    if (c.mujoco.settle_s > w.sim_time_s) x.keys.push_back("mujoco.settle_s");
+    append(x.keys, timeKeys(c));
+    x.keys.push_back("mujoco.settle_s");
+    x.keys.push_back("mujoco.timestep_s");
+    x.what = "MuJoCo would take " + g(w.mujoco_steps) + " steps ((mujoco.settle_s " + g(c.mujoco.settle_s) + " s + " +
+             span + ") / timestep_s " + g(c.mujoco.timestep_s) + " s), more than the limit " +
+             g(limits::kMaxMujocoSteps) + see;
+    return x;
+  }
+  if (!(w.render_frames <= limits::kMaxRenderFrames)) {
+    x.keys = {"render.slowmo", "render.fps", "render.duration_s"};
+    append(x.keys, timeKeys(c));
+    x.what = "the video would have " + g(w.render_frames) + " frames (shown sim time x slowmo " + g(c.render.slowmo) +
+             " x fps " + std::to_string(c.render.fps) + "), more than the limit " + g(limits::kMaxRenderFrames) + see;
+    return x;
+  }
+  return x;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,35 @@
+// The work a case asks for, estimated before it runs (docs/experiment-format.md "Limits"): the
+// one place that turns a case's settings into rows, CSV bytes, solver steps and video frames.
+// The loader refuses a case over a limit of results/work_limits.h with file:line:col.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_config.h"
+
+namespace tailsim {
+
+struct WorkEstimate {
+  double sim_time_s = 0;      // simulated time after t = 0 (duration_s, or tail end + settle_s)
+  double rows = 0;            // output rows per model run
+  double csv_bytes = 0;       // estimated CSV size of the largest model run  [B]
+  double analytic_steps = 0;  // lower bound: tail end time / largest step (0 without the analytic model)
+  double mujoco_steps = 0;    // (mujoco.settle_s + sim time) / timestep_s (0 without MuJoCo)
+  double render_frames = 0;   // shown sim time x slowmo x fps (0 without a render section)
+};
+
+WorkEstimate estimateWork(const ExperimentCase& c);
+
+// A limit the estimate exceeds: `keys` are the dotted keys that set it, most likely culprit first
+// (the loader reports the first one the file sets); `what` says which estimate, its value, how
+// it was computed and the limit.
+struct WorkExcess {
+  std::vector<std::string> keys;
+  std::string what;
+};
+
+// Empty `what` when every estimate is within its limit. kind: pose cases do no work to bound.
+WorkExcess checkWork(const ExperimentCase& c);
+
+}  // namespace tailsim

@@ -1,0 +1,31 @@
+// Limits on the work one case may ask for, and on the inputs that set it (docs/experiment-format.md
+// "Limits"). Each limit is declared here once: the loader refuses a case whose estimate
+// (experiments/work_estimate.h) exceeds one, naming file:line:col of the key; the models and the
+// renderer enforce the same numbers at run time, so a case built in code cannot hang or overflow.
+#pragma once
+
+namespace tailsim::limits {
+
+// Work per model run of one case.
+constexpr double kMaxRowsPerRun = 1e6;      // output rows (time-series samples) per model run
+constexpr double kCsvBytesPerValue = 12.0;  // estimate of one CSV value ("%.9g" plus the separator)
+constexpr double kMaxCsvBytesPerRun = 5e8;  // estimated CSV size per model run  [B]
+constexpr double kMaxAnalyticSteps = 1e7;   // accepted analytic solver steps per run
+constexpr double kMaxMujocoSteps = 1e7;     // mj_step calls per run (settling included)
+constexpr double kMaxRenderFrames = 1e6;    // video frames per case
+
+// Inputs (physical ranges; the paper's cases lie well inside them).
+constexpr double kMinDT_s = 1e-3;              // tail motion duration dT  [s]
+constexpr double kMinWss = 0.01, kMaxWss = 0.99;  // acceleration share w_ss of dT
+constexpr double kMaxAbsDthetaDeg = 3600.0;    // |dtheta| (ten turns)  [deg]
+constexpr double kMaxAbsTheta0Deg = 360.0;     // |theta0|  [deg]
+constexpr double kMinMassKg = 1e-3;            // quadruped and tail link masses  [kg]
+constexpr double kMaxMassKg = 1e4;
+
+// Run-end checks (RunSummary::at_rest and warnings).
+constexpr double kAtRestPhidotDps = 0.1;        // |phi_dot| at the end below this: at rest  [deg/s]
+constexpr double kAtRestSpeedMps = 1e-3;        // body speed at the end below this: at rest  [m/s]
+constexpr double kMaxPaperSpuriousTurnDeg = 10.0;  // paper coupling: turn its momentum error alone causes  [deg]
+constexpr double kMaxTrackingErrorDeg = 1.0;       // MuJoCo: max servo tracking error above this warns  [deg]
+
+}  // namespace tailsim::limits
