@@ -79,12 +79,12 @@ static_assert(sizeof(QuadrupedParams) == 48 && sizeof(FrictionParams) == 48 && s
                   sizeof(RobotParams) == 128,
               "a robot parameter was added: add it to caseKeyText, then update this size");
 static_assert(sizeof(SplitCycleParams) == 40, "a trajectory parameter was added: add it to caseKeyText");
-static_assert(sizeof(AnalyticSettings) == 88, "an analytic setting was added: add it to caseKeyText");
-static_assert(sizeof(MujocoSettings) == 280, "a MuJoCo setting was added: add it to caseKeyText");
+static_assert(sizeof(AnalyticSettings) == 96, "an analytic setting was added: add it to caseKeyText");
+static_assert(sizeof(MujocoSettings) == 288, "a MuJoCo setting was added: add it to caseKeyText");
 static_assert(sizeof(Effects) == 16, "an effect was added: add it to caseKeyText");
 static_assert(sizeof(OutputSettings) == 24, "an output setting was added: add it to caseKeyText");
 static_assert(sizeof(RenderSettings) == 152, "a render setting was added: add it to caseKeyText");
-static_assert(sizeof(PoseSpec) == 72 && sizeof(ExperimentCase) == 1016,
+static_assert(sizeof(PoseSpec) == 72 && sizeof(ExperimentCase) == 1032,
               "a case field was added: add it to caseKeyText if results depend on it");
 
 struct KeyText {
@@ -163,6 +163,7 @@ std::string caseKeyText(const ExperimentCase& c, bool render) {
   t.add("analytic.max_step_s", a.max_step_s);
   t.add("analytic.v_stop_mps", a.v_stop_mps);
   t.add("analytic.coupling", static_cast<int>(a.coupling));
+  t.add("analytic.max_steps", static_cast<double>(a.max_steps));
   const MujocoSettings& m = c.mujoco;
   t.add("mujoco.timestep_s", m.timestep_s);
   t.add("mujoco.integrator", m.integrator);
@@ -187,6 +188,7 @@ std::string caseKeyText(const ExperimentCase& c, bool render) {
   t.add("mujoco.stop_phidot_radps", m.stop_phidot_radps);
   t.add("mujoco.max_tilt_deg", m.max_tilt_deg);
   t.add("mujoco.max_all_feet_off_s", m.max_all_feet_off_s);
+  t.add("mujoco.max_steps", static_cast<double>(m.max_steps));
   const Effects& e = c.effects;
   t.add("effects.friction", static_cast<int>(e.friction));
   t.add("effects.translation", e.translation);
