@@ -16,7 +16,8 @@ fi
 flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
 WERROR=OFF; [ "${CI:-}" = true ] && WERROR=ON
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$flags" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DTAILSIM_WERROR=$WERROR "${launcher[@]}" >/dev/null
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DTAILSIM_WERROR=$WERROR -DTAILSIM_BENCHMARKS=OFF \
+  "${launcher[@]}" >/dev/null
 cmake --build build-asan -j"$(nproc)"
 export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"

@@ -272,10 +272,7 @@ void FfmpegSink::writeFrame(const uint8_t* rgb) {
     int status = 0;
     if (pid_ > 0) ::waitpid(pid_, &status, 0);
     pid_ = -1;
-    const std::string msg = "ffmpeg stopped reading frames for " + outputs_[0].path + " (" + std::strerror(err) +
-                            "): " + errorLog();
-    abort();
-    throw std::runtime_error(msg);
+    fail("ffmpeg stopped reading frames for " + outputs_[0].path + " (" + std::strerror(err) + "): " + errorLog());
   }
   ++frames_;
 }
@@ -294,14 +291,10 @@ void FfmpegSink::finish() {
           (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
                              : std::string(" (killed by a signal)")) +
           ": " + errorLog();
-  } else if (const std::string log = rawLog(log_path_); log.find("rror") != std::string::npos) {
+  } else if (rawLog(log_path_).find("rror") != std::string::npos) {
     // ffmpeg exits 0 when writing the MP4's trailer fails (e.g. the disk is full): with
     // -loglevel error, any "Error ..." line means an output is damaged.
     msg = "ffmpeg failed writing " + outputs_[0].path + ": " + errorLog();
-    if (log.find("No space left on device") != std::string::npos) {
-      abort();
-      throw std::system_error(ENOSPC, std::generic_category(), msg);
-    }
   } else {
     for (size_t i = 0; i < tmp_paths_.size() && msg.empty(); ++i) {
       struct stat st;
@@ -322,11 +315,17 @@ void FfmpegSink::finish() {
               " (" + std::to_string(frames_) + " written)";
     }
   }
-  if (!msg.empty()) {
-    abort();
-    throw std::runtime_error(msg);
-  }
+  if (!msg.empty()) fail(msg);
   finished_ = true;
+}
+
+void FfmpegSink::fail(const std::string& msg) {
+  // A full disk (ffmpeg's own writes failed with ENOSPC) is a std::system_error, so that a sweep
+  // stops instead of failing every remaining video the same way.
+  const bool disk_full = rawLog(log_path_).find("No space left on device") != std::string::npos;
+  abort();
+  if (disk_full) throw std::system_error(ENOSPC, std::generic_category(), msg);
+  throw std::runtime_error(msg);
 }
 
 void FfmpegSink::commit() {

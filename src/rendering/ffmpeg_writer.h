@@ -66,6 +66,7 @@ class FfmpegSink {
 
  private:
   void abort() noexcept;
+  [[noreturn]] void fail(const std::string& msg);  // abort(), then throw
   std::string errorLog() const;
 
   pid_t pid_ = -1;
