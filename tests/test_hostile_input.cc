@@ -146,6 +146,20 @@ TEST_F(HostileInput, Finding10_NonUtf8TextIsRefusedAtLoad) {
             "caf\xc3\xa9 \xe2\x86\x92 \xf0\x9f\x90\x95");
 }
 
+TEST_F(HostileInput, Finding10_NonUtf8FilePathIsRefusedAtLoad) {
+  // The path goes into summary.json (UTF-8 JSON): refused before any case runs.
+  const std::string p = write("caf\xe9.yaml", exp(""));
+  for (auto load : {+[](const std::string& f) { loadExperiment(f); },
+                    +[](const std::string& f) { loadExperimentSuite(f); }}) {
+    try {
+      load(p);
+      ADD_FAILURE() << "loaded";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("path is not UTF-8"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(HostileInput, Finding10_RenderLimitsAreCheckedAtLoad) {
   // Everything the renderer would refuse later, refused at load with file:line (render_settings.h).
   expectAt(errorOf(exp("render: {width: 10000}\n")), 5, "render.width: must be in 16..8192");

@@ -1146,6 +1146,9 @@ Experiment loadExperiment(const std::string& path) {
   const std::string* file = L.keep(absolutePath(path));
   std::error_code ec;
   if (!fs::is_regular_file(*file, ec)) throw ConfigError(*file + ": experiment file not found");
+  // Its path goes into summary.json, which must be UTF-8: refuse now, not after every case ran.
+  if (invalidUtf8At(*file) != std::string::npos)
+    throw ConfigError(clip(*file, 200) + ": the file's path is not UTF-8; rename it");
   const YAML::Node doc = parseYaml(file);
   if (isSuite(doc))
     fail(Loc{file, doc["experiments"].Mark(), "experiments"}, "this is a suite file; load it with loadExperimentSuite");
@@ -1157,6 +1160,9 @@ std::vector<Experiment> loadExperimentSuite(const std::string& path) {
   const std::string* file = L.keep(absolutePath(path));
   std::error_code ec;
   if (!fs::is_regular_file(*file, ec)) throw ConfigError(*file + ": experiment file not found");
+  // Its path goes into summary.json, which must be UTF-8: refuse now, not after every case ran.
+  if (invalidUtf8At(*file) != std::string::npos)
+    throw ConfigError(clip(*file, 200) + ": the file's path is not UTF-8; rename it");
   const YAML::Node doc = parseYaml(file);
   std::vector<Experiment> out;
   if (!isSuite(doc)) {
