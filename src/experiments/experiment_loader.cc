@@ -7,12 +7,18 @@
 // reported before any work starts. Each error names file:line:col and the dotted key.
 #include "experiments/experiment_loader.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -22,6 +28,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <utility>
 
 namespace tailsim {
@@ -48,6 +55,28 @@ std::string joinKey(const std::string& parent, const std::string& k) {
 }
 std::string indexKey(const std::string& parent, std::size_t i) { return parent + "[" + std::to_string(i) + "]"; }
 
+// A value quoted in an error message: at most kMaxQuoted bytes (cut at a UTF-8 character
+// boundary, then "..."), line breaks shown as \n, so an error is one readable line whatever the
+// input (a robot file that is /etc/passwd, a 10 MB value).
+constexpr std::size_t kMaxQuoted = 80;
+std::string clip(const std::string& v, std::size_t max = kMaxQuoted) {
+  std::size_t n = v.size();
+  bool cut = false;
+  if (n > max) {
+    n = max;
+    while (n > 0 && (static_cast<unsigned char>(v[n]) & 0xC0) == 0x80) --n;  // not inside a character
+    cut = true;
+  }
+  std::string s;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (v[i] == '\n') s += "\\n";
+    else if (v[i] == '\r') s += "\\r";
+    else s += v[i];
+  }
+  return cut ? s + "..." : s;
+}
+std::string quote(const std::string& v) { return "'" + clip(v) + "'"; }
+
 // Where a value came from.
 struct Loc {
   const std::string* file = nullptr;  // points into the loader's long-lived file list
@@ -59,8 +88,8 @@ struct Loc {
   std::string s = at.file ? *at.file : std::string("<unknown file>");
   if (!at.mark.is_null()) s += ":" + std::to_string(at.mark.line + 1) + ":" + std::to_string(at.mark.column + 1);
   s += ": ";
-  if (!at.key.empty()) s += at.key + ": ";
-  throw ConfigError(s + what);
+  if (!at.key.empty()) s += clip(at.key, 200) + ": ";
+  throw ConfigError(s + clip(what, 2000));
 }
 
 // Re-throws a std::invalid_argument from tailsim::validate() / SplitCycleProfile as a
@@ -98,7 +127,7 @@ std::string describe(const YAML::Node& n) {
     case YAML::NodeType::Null: return "nothing (empty value)";
     case YAML::NodeType::Map: return "a map";
     case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+    case YAML::NodeType::Scalar: return quote(n.Scalar());
     default: return "nothing";
   }
 }
@@ -129,7 +158,7 @@ Sweep parseSweep(const std::string* file, const YAML::Node& n, const std::string
     for (const YAML::Node& v : list) {
       if (!v.IsScalar()) fail(Loc{file, v.Mark().is_null() ? list.Mark() : v.Mark(), key},
                               "sweep values must be single values, got " + describe(v));
-      if (!seen.insert(v.Scalar()).second) fail(Loc{file, v.Mark(), key}, "value '" + v.Scalar() + "' appears twice in the sweep");
+      if (!seen.insert(v.Scalar()).second) fail(Loc{file, v.Mark(), key}, "value " + quote(v.Scalar()) + " appears twice in the sweep");
       SweepValue sv;
       sv.node = v;
       sv.text = v.Scalar();
@@ -144,7 +173,7 @@ Sweep parseSweep(const std::string* file, const YAML::Node& n, const std::string
   double a[3];
   for (int i = 0; i < 3; ++i) {
     if (!parseNumber(r[i], a[i])) fail(rl, "range: [start, stop, step] must be numbers, got " + describe(r[i]));
-    if (!std::isfinite(a[i])) fail(rl, "range: values must be finite, got " + r[i].Scalar());
+    if (!std::isfinite(a[i])) fail(rl, "range: values must be finite, got " + quote(r[i].Scalar()));
   }
   const double start = a[0], stop = a[1], step = a[2];
   if (step == 0.0) fail(rl, "range: step must not be 0");
@@ -280,10 +309,10 @@ class Reader {
     if (sv && sv->from_range) return sv->number;
     const YAML::Node& n = sv ? sv->node : it.node;
     scalarOrFail(it, n, "a number");
-    if (n.Tag() == "!") fail(it, "expected a number, got the string \"" + n.Scalar() + "\"");
+    if (n.Tag() == "!") fail(it, "expected a number, got the string " + quote(n.Scalar()));
     double v;
     if (!parseNumber(n, v)) fail(it, "expected a number, got " + describe(n));
-    if (!std::isfinite(v)) fail(it, "must be a finite number, got " + n.Scalar());
+    if (!std::isfinite(v)) fail(it, "must be a finite number, got " + quote(n.Scalar()));
     return v;
   }
   double positive(const Item& it) const {
@@ -332,7 +361,7 @@ class Reader {
   std::string choice(const Item& it, std::initializer_list<const char*> allowed) const {
     const std::string s = string(it);
     if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; }) == allowed.end())
-      fail(it, "unknown value '" + s + "' (allowed: " + joinList(allowed) + ")");
+      fail(it, "unknown value " + quote(s) + " (allowed: " + joinList(allowed) + ")");
     return s;
   }
 
@@ -443,11 +472,162 @@ struct RobotFile {
   std::map<int, Origins> tail_origin;  // keys "tail link 1 <field>"
 };
 
+// ---------------------------------------------------------------------------------------------
+// Reading a YAML file within bounds (issue 16, finding 8): the file is read whole (at most
+// kMaxYamlBytes), then walked once as parser events before any node is built. The walk refuses,
+// at the offending line:col, nesting deeper than kMaxYamlDepth, more than kMaxYamlNodes nodes
+// counting every alias as the nodes it stands for (an alias "bomb" expands exponentially), an
+// alias inside the node it names (a cycle: `a: &a [*a]`), and text that is not valid UTF-8.
+// Only then does yaml-cpp build the node tree, which every later step can walk recursively.
+
+struct YamlLimitError {
+  YAML::Mark mark;
+  std::string what;
+};
+
+// Offset of the first byte of `s` that is not part of valid UTF-8, or npos.
+std::size_t invalidUtf8At(const std::string& s) {
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  for (std::size_t i = 0; i < n;) {
+    const unsigned c = p[i];
+    std::size_t len;
+    unsigned min;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      len = 2, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+      len = 3, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+      len = 4, min = 0x10000;
+    } else {
+      return i;
+    }
+    if (i + len > n) return i;
+    unsigned cp = c & (0xFF >> (len + 1));
+    for (std::size_t k = 1; k < len; ++k) {
+      if ((p[i + k] & 0xC0) != 0x80) return i;
+      cp = (cp << 6) | (p[i + k] & 0x3F);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;  // overlong, too big, surrogate
+    i += len;
+  }
+  return std::string::npos;
+}
+
+class YamlBounds : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& m, YAML::anchor_t a) override { leaf(m, a); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t a, const std::string& v) override {
+    const std::size_t bad = invalidUtf8At(v);
+    if (bad != std::string::npos) {
+      char b[96];
+      std::snprintf(b, sizeof b, "text must be UTF-8; byte 0x%02X at byte %zu of this value is not",
+                    static_cast<unsigned char>(v[bad]), bad + 1);
+      throw YamlLimitError{m, b};
+    }
+    leaf(m, a);
+  }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t a) override {
+    const auto f = anchors_.find(a);
+    if (f == anchors_.end()) throw YamlLimitError{m, "an alias inside the node it names (a cycle) is not allowed"};
+    add(m, f->second.nodes);
+    reach(m, depth() + f->second.height);
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t a, YAML::EmitterStyle::value) override {
+    open(m, a);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t a, YAML::EmitterStyle::value) override {
+    open(m, a);
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Open {
+    YAML::anchor_t anchor;
+    long nodes_before;
+    int deepest;  // deepest nesting reached inside, counting this node
+  };
+  struct Anchored {
+    long nodes;  // nodes it stands for, itself included
+    int height;  // nesting levels it adds (0 for a single value)
+  };
+  int depth() const { return static_cast<int>(stack_.size()); }
+  void reach(const YAML::Mark& m, int d) {
+    if (d > kMaxYamlDepth)
+      throw YamlLimitError{m, "lists and maps are nested more than " + std::to_string(kMaxYamlDepth) + " levels deep"};
+    if (!stack_.empty()) stack_.back().deepest = std::max(stack_.back().deepest, d);
+  }
+  void add(const YAML::Mark& m, long n) {
+    nodes_ += n;
+    if (nodes_ > kMaxYamlNodes)
+      throw YamlLimitError{m, "more than " + std::to_string(kMaxYamlNodes) +
+                                  " values, lists and maps (counting what every alias *name stands for)"};
+  }
+  void leaf(const YAML::Mark& m, YAML::anchor_t a) {
+    add(m, 1);
+    if (a) anchors_[a] = Anchored{1, 0};
+  }
+  void open(const YAML::Mark& m, YAML::anchor_t a) {
+    add(m, 1);
+    reach(m, depth() + 1);
+    stack_.push_back(Open{a, nodes_ - 1, depth() + 1});
+  }
+  void close() {
+    const Open o = stack_.back();
+    stack_.pop_back();
+    if (o.anchor) anchors_[o.anchor] = Anchored{nodes_ - o.nodes_before, o.deepest - depth()};
+    if (!stack_.empty()) stack_.back().deepest = std::max(stack_.back().deepest, o.deepest);
+  }
+
+  std::vector<Open> stack_;
+  std::map<YAML::anchor_t, Anchored> anchors_;
+  long nodes_ = 0;
+};
+
+// The whole file, or a ConfigError naming it and the OS error.
+std::string readFileBounded(const std::string& file) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw ConfigError(file + ": cannot read the file: " + std::strerror(errno));
+  std::string text;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(fd);
+      throw ConfigError(file + ": cannot read the file: " + std::strerror(err));
+    }
+    if (n == 0) break;
+    if (text.size() + static_cast<std::size_t>(n) > kMaxYamlBytes) {
+      ::close(fd);
+      throw ConfigError(file + ": the file is larger than " + std::to_string(kMaxYamlBytes >> 20) +
+                        " MiB; experiment, suite and robot files are small YAML files");
+    }
+    text.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return text;
+}
+
 YAML::Node parseYaml(const std::string* file) {
-  std::ifstream in(*file);
-  if (!in) throw ConfigError(*file + ": cannot read file");
+  const std::string text = readFileBounded(*file);
   try {
-    return YAML::Load(in);
+    {
+      std::istringstream in(text);
+      YAML::Parser parser(in);
+      YamlBounds bounds;
+      parser.HandleNextDocument(bounds);
+    }
+    return YAML::Load(text);
+  } catch (const YamlLimitError& e) {
+    fail(Loc{file, e.mark, ""}, e.what);
   } catch (const YAML::ParserException& e) {
     fail(Loc{file, e.mark, ""}, "YAML syntax error: " + e.msg);
   } catch (const YAML::Exception& e) {
@@ -533,8 +713,8 @@ std::string builtinRobotFile(const std::string& name, const Loc& at) {
   static const std::map<std::string, std::string> kBuiltin = {{"paper", "paper_quadruped.yaml"}};
   const auto it = kBuiltin.find(name);
   if (it == kBuiltin.end())
-    fail(at, "unknown built-in robot '" + name +
-                 "' (built-in: paper); a robot file is given by its path, e.g. my_robot.yaml");
+    fail(at, "unknown built-in robot " + quote(name) +
+                 " (built-in: paper); a robot file is given by its path, e.g. my_robot.yaml");
   std::string looked;
   for (const fs::path& d : builtinRobotDirs()) {
     const fs::path f = d / it->second;
@@ -770,27 +950,47 @@ OutputSettings readOutput(const Reader& r, const Item& item, double tail_end_s) 
   return o;
 }
 
-RenderSettings readRender(const Reader& r, const Item& item) {
+// run_end_s: simulated seconds of the run (the video shows at most that), or < 0 when unknown.
+// Limits: render_settings.h, the same the renderer checks.
+RenderSettings readRender(const Reader& r, const Item& item, double run_end_s) {
   RenderSettings s;
   s.enabled = true;  // the section's presence asks for a video
   if (item.node.IsNull() && !r.pick(item)) return s;  // `render:` with nothing: all defaults
   const MapView m = r.map(item, {"width", "height", "fps", "slowmo", "duration_s", "camera", "shadows",
                                  "reflections", "msaa", "ghost", "ffmpeg", "crf", "preset"});
-  if (const Item* x = m.get("width")) s.width = r.integer(*x, 16, 16384);
-  if (const Item* x = m.get("height")) s.height = r.integer(*x, 16, 16384);
-  if (const Item* x = m.get("fps")) s.fps = r.integer(*x, 1, 1000);
-  if (const Item* x = m.get("slowmo")) s.slowmo = r.positive(*x);
+  for (const char* k : {"width", "height"})
+    if (const Item* x = m.get(k)) {
+      const int v = r.integer(*x, kRenderMinSize, kRenderMaxSize);
+      if (v % 2) r.fail(*x, "must be even (H.264 yuv420p), got " + std::to_string(v));
+      (std::string(k) == "width" ? s.width : s.height) = v;
+    }
+  if (const Item* x = m.get("fps")) s.fps = r.integer(*x, kRenderMinFps, kRenderMaxFps);
+  if (const Item* x = m.get("slowmo")) {
+    s.slowmo = r.number(*x);
+    if (!(s.slowmo >= kRenderMinSlowmo && s.slowmo <= kRenderMaxSlowmo))
+      r.fail(*x, "must lie in [" + fmtG(kRenderMinSlowmo) + ", " + fmtG(kRenderMaxSlowmo) + "], got " + fmtG(s.slowmo));
+  }
   if (const Item* x = m.get("duration_s")) s.duration_s = r.nonNegative(*x);
+  if (run_end_s >= 0.0) {
+    const double span = s.duration_s > 0.0 ? std::min(s.duration_s, run_end_s) : run_end_s;
+    const double frames = renderFrameCount(span, s);
+    if (!(frames <= kRenderMaxFrames)) {
+      const Item* at = m.get("duration_s") ? m.get("duration_s") : m.get("slowmo") ? m.get("slowmo") : m.get("fps") ? m.get("fps") : &item;
+      r.fail(*at, "the video would have " + fmtG(frames) + " frames (" + fmtG(span) + " s simulated x fps " +
+                      std::to_string(s.fps) + " x slowmo " + fmtG(s.slowmo) + "), more than " +
+                      fmtG(kRenderMaxFrames) + ": lower fps, slowmo or render.duration_s");
+    }
+  }
   if (const Item* x = m.get("camera")) s.camera = r.choice(*x, {"top", "perspective"});
   if (const Item* x = m.get("shadows")) s.shadows = r.boolean(*x);
   if (const Item* x = m.get("reflections")) s.reflections = r.boolean(*x);
-  if (const Item* x = m.get("msaa")) s.msaa = r.integer(*x, 0, 64);
+  if (const Item* x = m.get("msaa")) s.msaa = r.integer(*x, 0, kRenderMaxMsaa);
   if (const Item* x = m.get("ghost")) s.ghost = r.boolean(*x);
   if (const Item* x = m.get("ffmpeg")) {
     s.ffmpeg = r.string(*x);
     if (s.ffmpeg.empty()) r.fail(*x, "needs the ffmpeg executable (name or path)");
   }
-  if (const Item* x = m.get("crf")) s.crf = r.integer(*x, 0, 51);  // libx264 range
+  if (const Item* x = m.get("crf")) s.crf = r.integer(*x, kRenderMinCrf, kRenderMaxCrf);  // libx264 range
   if (const Item* x = m.get("preset"))
     s.preset = r.choice(*x, {"ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
                              "veryslow", "placebo"});
@@ -913,7 +1113,11 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   if (const Item* x = top.get("effects")) c.effects = readEffects(r, *x);
   if (const Item* x = top.get("output"))
     c.output = readOutput(r, *x, c.kind == "simulate" ? c.trajectory().endTime() : -1.0);
-  if (const Item* x = top.get("render")) c.render = readRender(r, *x);
+  if (const Item* x = top.get("render")) {
+    const double run_end =
+        c.kind != "simulate" ? -1.0 : c.output.duration_s > 0 ? c.output.duration_s : c.trajectory().endTime() + c.output.settle_s;
+    c.render = readRender(r, *x, run_end);
+  }
   checkCaseWork(r, top, c);
   return c;
 }
@@ -987,6 +1191,9 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
     if (std::find(stack.begin(), stack.end(), *path) != stack.end()) r.fail(entry, "suite includes itself: " + *path);
     const YAML::Node sub = parseYaml(path);
     if (isSuite(sub)) {
+      if (stack.size() >= kMaxSuiteDepth)
+        r.fail(entry, "suites are nested more than " + std::to_string(kMaxSuiteDepth) +
+                          " deep (a suite listing a suite listing a suite ...)");
       readSuite(L, path, sub, stack, out, names);
       continue;
     }
@@ -1005,6 +1212,9 @@ Experiment loadExperiment(const std::string& path) {
   const std::string* file = L.keep(absolutePath(path));
   std::error_code ec;
   if (!fs::is_regular_file(*file, ec)) throw ConfigError(*file + ": experiment file not found");
+  // Its path goes into summary.json, which must be UTF-8: refuse now, not after every case ran.
+  if (invalidUtf8At(*file) != std::string::npos)
+    throw ConfigError(clip(*file, 200) + ": the file's path is not UTF-8; rename it");
   const YAML::Node doc = parseYaml(file);
   if (isSuite(doc))
     fail(Loc{file, doc["experiments"].Mark(), "experiments"}, "this is a suite file; load it with loadExperimentSuite");
@@ -1016,6 +1226,9 @@ std::vector<Experiment> loadExperimentSuite(const std::string& path) {
   const std::string* file = L.keep(absolutePath(path));
   std::error_code ec;
   if (!fs::is_regular_file(*file, ec)) throw ConfigError(*file + ": experiment file not found");
+  // Its path goes into summary.json, which must be UTF-8: refuse now, not after every case ran.
+  if (invalidUtf8At(*file) != std::string::npos)
+    throw ConfigError(clip(*file, 200) + ": the file's path is not UTF-8; rename it");
   const YAML::Node doc = parseYaml(file);
   std::vector<Experiment> out;
   if (!isSuite(doc)) {

@@ -36,4 +36,13 @@ std::vector<Experiment> loadExperimentSuite(const std::string& path);
 constexpr std::size_t kMaxSweepValues = 10000;
 constexpr std::size_t kMaxCases = 100000;
 
+// Bounds on any YAML file the loader reads (hostile input must fail fast with file:line:col, never
+// crash or run for minutes): its size, the nesting of lists and maps, the number of values, lists
+// and maps counting each alias (*name) as everything it stands for, and the nesting of suites.
+// Aliases inside the node they name (cycles) are refused, and every string must be UTF-8.
+constexpr std::size_t kMaxYamlBytes = std::size_t{16} << 20;
+constexpr int kMaxYamlDepth = 64;
+constexpr long kMaxYamlNodes = 100000;
+constexpr std::size_t kMaxSuiteDepth = 64;
+
 }  // namespace tailsim

@@ -21,6 +21,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
 #include "analytic_model/analytic_simulation.h"
@@ -572,8 +573,16 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
         failed += f;
         t.job->entries[t.i] = std::move(j);  // distinct element per task: no lock needed
       } catch (const std::exception& ex) {
+        // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
+        const auto* sys = dynamic_cast<const std::system_error*>(&ex);
+        const bool disk_full = sys && sys->code() == std::errc::no_space_on_device;
+        if (disk_full) stop = true;
         std::lock_guard<std::mutex> lock(mu);
-        if (first_error.empty()) first_error = "case " + t.job->e->cases[t.i].name + ": " + ex.what();
+        if (first_error.empty())
+          first_error = "case " + t.job->e->cases[t.i].name + ": " + ex.what() +
+                        (disk_full ? " (the disk is full: no further case was started; free space and run the "
+                                     "same command again to resume)"
+                                   : "");
       }
       ++done;
       cv.notify_all();
@@ -653,7 +662,11 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   if (show) printProgress(true);
   else if (line_open) std::fprintf(stderr, "\n");
   stats.interrupted = stop.load();
-  for (const Job& job : jobs) writeSummary(job);  // also after a failure: finished cases count
+  try {
+    for (const Job& job : jobs) writeSummary(job);  // also after a failure: finished cases count
+  } catch (const std::exception&) {
+    if (first_error.empty()) throw;  // else report the first error (a full disk fails the summary too)
+  }
   if (!first_error.empty()) throw std::runtime_error(first_error);
   stats.ran = done.load();
   stats.failed = failed.load();

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 
 extern char** environ;
 
@@ -98,7 +99,7 @@ int makeLogFile() {
   return fd;
 }
 
-std::string readLog(int fd) {
+std::string rawLog(int fd) {
   std::string s;
   char buf[4096];
   off_t off = 0;
@@ -108,11 +109,75 @@ std::string readLog(int fd) {
     s.append(buf, static_cast<size_t>(n));
     off += n;
   }
+  return s;
+}
+
+std::string readLog(int fd) {
+  std::string s = rawLog(fd);
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
   if (s.size() > 2000) s = "..." + s.substr(s.size() - 2000);
   return s.empty() ? "(no message)" : s;
 }
+
+// Runs argv[0] (a full path) with stdin and stderr on /dev/null; returns its exit status (-1 when
+// it cannot start or is killed) and sets `out` to what it printed on stdout.
+int runCapture(std::vector<std::string> args, std::string& out) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) return -1;
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_adddup2(&fa, fds[1], 1);
+  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, args[0].c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  ::close(fds[1]);
+  out.clear();
+  if (rc == 0) {
+    char buf[4096];
+    for (;;) {
+      const ssize_t n = ::read(fds[0], buf, sizeof buf);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      if (out.size() < 65536) out.append(buf, static_cast<size_t>(n));
+    }
+  }
+  ::close(fds[0]);
+  if (rc != 0) return -1;
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// ffprobe beside the ffmpeg executable (the same Debian package), else on PATH; "" if none.
+std::string ffprobeFor(const std::string& ffmpeg_exe) {
+  const size_t slash = ffmpeg_exe.find_last_of('/');
+  if (slash != std::string::npos) {
+    const std::string beside = ffmpeg_exe.substr(0, slash + 1) + "ffprobe";
+    if (isExecutableFile(beside)) return beside;
+  }
+  return findExecutable("ffprobe");
+}
+
 }  // namespace
+
+// Frames (video packets) in the container at `path`, read by ffprobe; -1 when ffprobe cannot
+// read it (a truncated MP4 has no moov atom).
+long countVideoFrames(const std::string& ffprobe_exe, const std::string& path) {
+  std::string out;
+  const int rc = runCapture({ffprobe_exe, "-v", "error", "-select_streams", "v:0", "-count_packets", "-show_entries",
+                             "stream=nb_read_packets", "-of", "csv=p=0", path},
+                            out);
+  if (rc != 0) return -1;
+  char* end = nullptr;
+  const long n = std::strtol(out.c_str(), &end, 10);
+  return end == out.c_str() ? -1 : n;
+}
 
 std::string probeFfmpeg(const std::string& ffmpeg_exe) {
   const int log_fd = makeLogFile();
@@ -146,7 +211,7 @@ std::string probeFfmpeg(const std::string& ffmpeg_exe) {
 
 FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, const VideoEncoding& enc,
                        const std::vector<FfmpegOutput>& outputs)
-    : outputs_(outputs), frame_bytes_(static_cast<size_t>(width) * height * 3) {
+    : outputs_(outputs), ffprobe_(ffprobeFor(ffmpeg_exe)), frame_bytes_(static_cast<size_t>(width) * height * 3) {
   if (outputs.empty()) throw std::invalid_argument("FfmpegSink needs at least one output");
   for (const FfmpegOutput& o : outputs) tmp_paths_.push_back(tempNameFor(o.path));
   log_fd_ = makeLogFile();
@@ -210,10 +275,7 @@ void FfmpegSink::writeFrame(const uint8_t* rgb) {
     int status = 0;
     if (pid_ > 0) ::waitpid(pid_, &status, 0);
     pid_ = -1;
-    const std::string msg = "ffmpeg stopped reading frames for " + outputs_[0].path + " (" + std::strerror(err) +
-                            "): " + errorLog();
-    abort();
-    throw std::runtime_error(msg);
+    fail("ffmpeg stopped reading frames for " + outputs_[0].path + " (" + std::strerror(err) + "): " + errorLog());
   }
   ++frames_;
 }
@@ -232,6 +294,10 @@ void FfmpegSink::finish() {
           (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
                              : std::string(" (killed by a signal)")) +
           ": " + errorLog();
+  } else if (rawLog(log_fd_).find("rror") != std::string::npos) {
+    // ffmpeg exits 0 when writing the MP4's trailer fails (e.g. the disk is full): with
+    // -loglevel error, any "Error ..." line means an output is damaged.
+    msg = "ffmpeg failed writing " + outputs_[0].path + ": " + errorLog();
   } else {
     for (size_t i = 0; i < tmp_paths_.size() && msg.empty(); ++i) {
       struct stat st;
@@ -242,12 +308,27 @@ void FfmpegSink::finish() {
                    : std::string()) +
               ": " + errorLog();
     }
+    // The container must hold every frame written (a truncated MP4 must never be published).
+    for (size_t i = 0; i < tmp_paths_.size() && msg.empty() && !ffprobe_.empty(); ++i) {
+      if (outputs_[i].kind != FfmpegOutput::Kind::kMp4) continue;
+      const long n = countVideoFrames(ffprobe_, tmp_paths_[i]);
+      if (n != frames_)
+        msg = "ffmpeg exited cleanly but " + outputs_[i].path + " is damaged: " +
+              (n < 0 ? std::string("ffprobe cannot read it") : "it holds " + std::to_string(n) + " frames") +
+              " (" + std::to_string(frames_) + " written)";
+    }
   }
-  if (!msg.empty()) {
-    abort();
-    throw std::runtime_error(msg);
-  }
+  if (!msg.empty()) fail(msg);
   finished_ = true;
+}
+
+void FfmpegSink::fail(const std::string& msg) {
+  // A full disk (ffmpeg's own writes failed with ENOSPC) is a std::system_error, so that a sweep
+  // stops instead of failing every remaining video the same way.
+  const bool disk_full = rawLog(log_fd_).find("No space left on device") != std::string::npos;
+  abort();
+  if (disk_full) throw std::system_error(ENOSPC, std::generic_category(), msg);
+  throw std::runtime_error(msg);
 }
 
 void FfmpegSink::commit() {

@@ -34,6 +34,10 @@ struct VideoEncoding {
   std::string preset = "ultrafast";  // libx264 preset
 };
 
+// Frames (video packets) in the container at `path` as ffprobe counts them; -1 when it cannot
+// read the file (a truncated MP4 has no index).
+long countVideoFrames(const std::string& ffprobe_exe, const std::string& path);
+
 // One ffmpeg process reading rgb24 frames of a fixed size on stdin and writing one or more
 // outputs (an H.264 MP4 and a PNG still from the same stream: one process start, not two).
 class FfmpegSink {
@@ -49,7 +53,10 @@ class FfmpegSink {
   // ffmpeg's own message) when ffmpeg has died.
   void writeFrame(const uint8_t* rgb);
   // Closes stdin and waits for ffmpeg. Throws std::runtime_error with ffmpeg's message on
-  // failure (and removes the temporary files), also when an output was not produced.
+  // failure (and removes the temporary files), also when an output was not produced, when ffmpeg
+  // logged a write error (it exits 0 when writing the MP4 trailer fails) or when an MP4 does not
+  // hold every frame written (checked with ffprobe, from the same package as ffmpeg). A full
+  // disk throws std::system_error with ENOSPC, so a sweep can stop at once.
   void finish();
   // After finish(): renames the temporary files to the final names, in output order.
   void commit();
@@ -59,11 +66,13 @@ class FfmpegSink {
 
  private:
   void abort() noexcept;
+  [[noreturn]] void fail(const std::string& msg);  // abort(), then throw
   std::string errorLog() const;
 
   pid_t pid_ = -1;
   int stdin_fd_ = -1;
   std::vector<FfmpegOutput> outputs_;
+  std::string ffprobe_;  // verifies each MP4 before commit ("" when there is no ffprobe)
   std::vector<std::string> tmp_paths_;
   int log_fd_ = -1;  // ffmpeg's stderr (an unlinked temporary file)
   size_t frame_bytes_ = 0;

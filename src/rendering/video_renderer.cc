@@ -34,20 +34,32 @@ namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------- checks
 
+std::string fmtG(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
 void checkSettings(const RenderSettings& s) {
   auto bad = [](const std::string& what) { throw std::runtime_error("render settings: " + what); };
-  if (s.width < 16 || s.height < 16 || s.width > 8192 || s.height > 8192)
-    bad("width and height must lie in [16, 8192], got " + std::to_string(s.width) + "x" + std::to_string(s.height));
-  if (s.width % 2 || s.height % 2)
-    bad("width and height must be even (H.264 yuv420p), got " + std::to_string(s.width) + "x" +
-        std::to_string(s.height));
-  if (s.fps < 1 || s.fps > 240) bad("fps must lie in [1, 240], got " + std::to_string(s.fps));
-  if (!(s.slowmo > 0.0) || !std::isfinite(s.slowmo)) bad("slowmo must be > 0");
+  const std::string size = std::to_string(s.width) + "x" + std::to_string(s.height);
+  if (s.width < kRenderMinSize || s.height < kRenderMinSize || s.width > kRenderMaxSize || s.height > kRenderMaxSize)
+    bad("width and height must lie in [" + std::to_string(kRenderMinSize) + ", " + std::to_string(kRenderMaxSize) +
+        "], got " + size);
+  if (s.width % 2 || s.height % 2) bad("width and height must be even (H.264 yuv420p), got " + size);
+  if (s.fps < kRenderMinFps || s.fps > kRenderMaxFps)
+    bad("fps must lie in [" + std::to_string(kRenderMinFps) + ", " + std::to_string(kRenderMaxFps) + "], got " +
+        std::to_string(s.fps));
+  if (!(s.slowmo >= kRenderMinSlowmo && s.slowmo <= kRenderMaxSlowmo))
+    bad("slowmo must lie in [" + fmtG(kRenderMinSlowmo) + ", " + fmtG(kRenderMaxSlowmo) + "], got " + fmtG(s.slowmo));
   if (!(s.duration_s >= 0.0) || !std::isfinite(s.duration_s)) bad("duration_s must be >= 0 (0 = whole run)");
   if (s.camera != "top" && s.camera != "perspective")
     bad("camera must be top or perspective, got '" + s.camera + "'");
-  if (s.msaa < 0 || s.msaa > 16) bad("msaa must lie in [0, 16], got " + std::to_string(s.msaa));
-  if (s.crf < 0 || s.crf > 51) bad("crf must lie in [0, 51], got " + std::to_string(s.crf));
+  if (s.msaa < 0 || s.msaa > kRenderMaxMsaa)
+    bad("msaa must lie in [0, " + std::to_string(kRenderMaxMsaa) + "], got " + std::to_string(s.msaa));
+  if (s.crf < kRenderMinCrf || s.crf > kRenderMaxCrf)
+    bad("crf must lie in [" + std::to_string(kRenderMinCrf) + ", " + std::to_string(kRenderMaxCrf) + "], got " +
+        std::to_string(s.crf));
 }
 
 std::string requireFfmpeg(const RenderSettings& s) {
@@ -330,13 +342,10 @@ FrameTimes frameTimes(const TimeSeries& mujoco, const RenderSettings& s) {
   f.t_start = mujoco.values("t_s").front();
   f.t_end = mujoco.values("t_s").back();
   if (s.duration_s > 0.0) f.t_end = std::min(f.t_end, f.t_start + s.duration_s);
-  // Checked as a double before it becomes a count (no float-to-integer overflow).
-  const double frames = std::floor((f.t_end - f.t_start) * s.fps * s.slowmo + 1e-9) + 1;
-  if (!(frames >= 1 && frames <= limits::kMaxRenderFrames))
-    throw std::invalid_argument("rendering: " + std::to_string(frames) + " frames (" +
-                                std::to_string(f.t_end - f.t_start) + " s x fps " + std::to_string(s.fps) +
-                                " x slowmo " + std::to_string(s.slowmo) + "), more than the limit " +
-                                std::to_string(static_cast<long>(limits::kMaxRenderFrames)));
+  const double frames = renderFrameCount(f.t_end - f.t_start, s);
+  if (!(frames >= 1.0 && frames <= kRenderMaxFrames))
+    throw std::runtime_error("render settings: the video would have " + fmtG(frames) + " frames, more than " +
+                             std::to_string(static_cast<long>(kRenderMaxFrames)) + " (lower fps, slowmo or duration_s)");
   f.frames = static_cast<long>(frames);
   return f;
 }

@@ -13,27 +13,32 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 
 namespace tailsim {
 
 void writeFileAtomic(const std::string& path, const std::string& contents) {
+  // Errors are std::system_error carrying errno (a full disk is ENOSPC, which a sweep stops at);
+  // what() reads "cannot write PATH: <OS error>".
   // "<path>.tmp.<pid>.<k>": unique per writer (process and call), so two threads writing the same
   // path never share a temporary; `tailsim run` removes those of dead processes.
   static std::atomic<unsigned long> counter{0};
   const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  if (!f) throw std::system_error(errno, std::generic_category(), "cannot write " + path);
   // No fsync: rename makes the file appear whole or not at all if the process dies (the
   // guarantee we give); fsync per file would only add power-loss durability, at ~10 ms a file.
-  const bool ok = std::fwrite(contents.data(), 1, contents.size(), f) == contents.size() && std::fflush(f) == 0;
-  const bool closed = std::fclose(f) == 0;
-  if (!ok || !closed) {
+  int err = 0;
+  if (std::fwrite(contents.data(), 1, contents.size(), f) != contents.size() || std::fflush(f) != 0) err = errno;
+  if (std::fclose(f) != 0 && err == 0) err = errno;
+  if (err != 0) {
     std::remove(tmp.c_str());
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+    throw std::system_error(err, std::generic_category(), "cannot write " + path);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    err = errno;
     std::remove(tmp.c_str());
-    throw std::runtime_error("cannot move " + tmp + " to " + path + ": " + std::strerror(errno));
+    throw std::system_error(err, std::generic_category(), "cannot move " + tmp + " to " + path);
   }
 }
 

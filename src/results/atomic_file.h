@@ -8,7 +8,8 @@
 
 namespace tailsim {
 
-// Writes `contents` to `path` atomically; throws std::runtime_error naming the path on failure.
+// Writes `contents` to `path` atomically; throws std::system_error (errno, e.g. ENOSPC when the
+// disk is full) naming the path on failure.
 void writeFileAtomic(const std::string& path, const std::string& contents);
 
 // Writes a file the user named on the command line (e.g. `tailsim mjcf --out PATH`) without ever

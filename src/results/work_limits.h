@@ -12,7 +12,7 @@ constexpr double kCsvBytesPerValue = 12.0;  // estimate of one CSV value ("%.9g"
 constexpr double kMaxCsvBytesPerRun = 5e8;  // estimated CSV size per model run  [B]
 constexpr double kMaxAnalyticSteps = 1e7;   // accepted analytic solver steps per run
 constexpr double kMaxMujocoSteps = 1e7;     // mj_step calls per run (settling included)
-constexpr double kMaxRenderFrames = 1e6;    // video frames per case
+constexpr double kMaxRenderFrames = 1e5;    // video frames per case (~55 min at 30 fps; hours of rendering)
 
 // Inputs (physical ranges; the paper's cases lie well inside them).
 constexpr double kMinDT_s = 1e-3;              // tail motion duration dT  [s]

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Builds tailsim and its tests with AddressSanitizer + UndefinedBehaviorSanitizer (GCC) in
+# build-asan/ and runs CTest there; any sanitizer report fails the test that raised it
+# (halt_on_error). LeakSanitizer suppressions: scripts/lsan-suppressions.txt (only OSMesa's and
+# LLVM's own allocations, which they keep for the life of the process).
+#   scripts/sanitize.sh              every test but the slowest end-to-end one (see EXCLUDE)
+#   scripts/sanitize.sh -R loader    extra arguments go to ctest
+# .ci/run calls it after the normal tests when CI=true.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+launcher=()
+if command -v ccache >/dev/null; then
+  export CCACHE_BASEDIR="$PWD/.."
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
+flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
+WERROR=OFF; [ "${CI:-}" = true ] && WERROR=ON
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$flags" \
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DTAILSIM_WERROR=$WERROR -DTAILSIM_BENCHMARKS=OFF \
+  "${launcher[@]}" >/dev/null
+cmake --build build-asan -j"$(nproc)"
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=1:detect_leaks=1:detect_stack_use_after_return=1:strict_string_checks=1"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan-suppressions.txt:print_suppressions=0"
+# readme_tour runs the paper suite three times (about 2 min in Release, over 15 min under ASan);
+# the same code paths run in the cli test and the GoogleTest suites, which do run here.
+EXCLUDE='^readme_tour$'
+ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E "$EXCLUDE" "$@"
