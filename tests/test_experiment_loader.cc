@@ -671,7 +671,9 @@ TEST_F(LoaderTest, Finding5OverflowingCountsAreRefusedAtLoad) {
   expectError(exp(std::string(kTraj) + "output: {sample_dt_s: 1e-20}\n"), 5, "output.sample_dt_s", "rows");
   expectError(exp(std::string(kTraj) + "output: {duration_s: 1e300}\n"), 5, "output.duration_s", "rows");
   expectError(exp(std::string(kTraj) + "output:\n  settle_s: 1e300\n"), 6, "output.settle_s", "rows");
-  expectError(exp(std::string(kTraj) + "models: [mujoco]\nrender: {slowmo: 1e300}\n"), 6, "render.slowmo", "frames");
+  expectError(exp(std::string(kTraj) + "models: [mujoco]\nrender: {slowmo: 1e300}\n"), 6, "render.slowmo", "must lie in");
+  // Inside the slowmo range, the frame count (sim time x fps x slowmo) is the limit that refuses.
+  expectError(exp(std::string(kTraj) + "models: [mujoco]\nrender: {slowmo: 1000, fps: 240}\n"), 6, "render.slowmo", "frames");
 }
 
 // Issue 16, finding 7: accepted values that never finished or exhausted memory are refused at
