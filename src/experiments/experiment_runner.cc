@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -15,7 +16,6 @@
 #include <cstring>
 #include <limits>
 #include <map>
-#include <regex>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -409,16 +409,31 @@ void claimSuiteFolder(const fs::path& root, bool fresh) {
 // a concurrent run; this also spares a concurrent `tailsim plot` or `render`). Only in the
 // folders tailsim writes: DIR, DIR/cases/*, DIR/renders, DIR/plots.
 int removeStaleTemps(const fs::path& root) {
-  static const std::regex pattern(R"(.+\.tmp\.([0-9]{1,10})(\.[0-9]+)?(\.[A-Za-z0-9]+)?)");
+  // The pid of "<name>.tmp.<pid>[.<k>][.<ext>]" (1-10 digits), or -1 when n is not such a name.
+  auto tempPid = [](const std::string& n) -> long {
+    const size_t at = n.rfind(".tmp.");
+    if (at == std::string::npos || at == 0) return -1;
+    size_t i = at + 5, digits = 0;
+    long pid = 0;
+    for (; i < n.size() && std::isdigit(static_cast<unsigned char>(n[i])) && digits <= 10; ++i, ++digits)
+      pid = pid * 10 + (n[i] - '0');
+    if (digits == 0 || digits > 10) return -1;
+    // then at most ".<digits>" and ".<alnum ext>"
+    for (int part = 0; part < 2 && i < n.size(); ++part) {
+      if (n[i] != '.' || i + 1 >= n.size()) return -1;
+      ++i;
+      while (i < n.size() && std::isalnum(static_cast<unsigned char>(n[i]))) ++i;
+    }
+    return i == n.size() ? pid : -1;
+  };
   int removed = 0;
   std::error_code ec;
   auto clean = [&](const fs::path& dir) {
     if (!fs::is_directory(dir, ec)) return;
     for (const auto& f : fs::directory_iterator(dir, ec)) {
-      std::smatch m;
       const std::string n = f.path().filename().string();
-      if (!f.is_regular_file(ec) || !std::regex_match(n, m, pattern)) continue;
-      const long pid = std::stol(m[1].str());
+      if (!f.is_regular_file(ec)) continue;
+      const long pid = tempPid(n);
       if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) continue;
       const bool dead = ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
       if ((dead || pid == ::getpid()) && fs::remove(f.path(), ec)) ++removed;
