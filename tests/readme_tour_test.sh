@@ -59,18 +59,22 @@ check() {
         [ -s "$dir/report.md" ] || fail "run --plot: no $dir/report.md"
         local n; n=$(find "$dir" -path '*/plots/*.png' -size +1k | wc -l)
         [ "$n" -ge 1 ] || fail "run --plot: no plots under $dir"
-        ok "run --plot: report.md and $n PNG plots"
+        [ -s "$dir/figures.html" ] || fail "run --plot: no $dir/figures.html"
+        ok "run --plot: report.md, figures.html and $n PNG plots"
       fi
       ;;
     plot)
       local n=0
       while read -r f; do
         [ -n "$f" ] || continue
+        [ "$f" = "$pos/figures.html" ] && continue
         is_png "$f" || fail "plot: $f (printed) is not a PNG"
+        grep -qF "<img src=\"${f#"$pos"/}\"" "$pos/figures.html" || fail "plot: $pos/figures.html does not show $f"
         n=$((n + 1))
       done <<<"$out"
       [ "$n" -ge 1 ] || fail "plot: printed no PNG"
-      ok "plot $pos: $n PNGs"
+      [ "$(tail -n1 <<<"$out")" = "$pos/figures.html" ] || fail "plot: the figure sheet $pos/figures.html not printed last"
+      ok "plot $pos: $n PNGs and figures.html"
       ;;
     report)
       [ "$(tail -n1 <<<"$out")" = "$pos/report.md" ] || fail "report: printed '$out', not $pos/report.md"
@@ -137,6 +141,9 @@ while IFS= read -r line; do
   n=$((n + 1))
 done <<<"$tour"
 [ "$n" -ge 7 ] || fail "only $n tour commands found in README.md"
+# The paper suite's figures as a reader sees them (every figure, non-blank, titles in words, sheet).
+[ -d results/paper ] || fail "the tour wrote no results/paper"
+bash "$src/tests/check_figures.sh" results/paper
 
 echo "== the same kinds of commands from a subfolder, with ../ paths"
 mkdir -p "$repo/elsewhere"

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,9 +14,11 @@
 #include <sstream>
 
 #include "experiments/experiment_loader.h"
+#include "plotting/figure_sheet.h"
 #include "plotting/findings.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
+#include "plotting/style.h"
 #include "results/atomic_file.h"
 #include "trajectory/split_cycle_profile.h"
 
@@ -359,6 +362,77 @@ TEST_F(SyntheticSuite, PlotsAndReportAreWritten) {
   EXPECT_NE(md.find("](fig09_theta0_dQ2B/plots/fig09_theta0_dQ2B_phi_net_map.png)"), std::string::npos);
   EXPECT_NE(md.find("mujoco: Sec. 4.5, Fig. 11"), std::string::npos);  // listed under "Not reproduced"
   EXPECT_NE(md.find("| fig06a_model_comparison_1dof | mujoco | +14.000 |"), std::string::npos);
+}
+
+// Width and height from a PNG's IHDR chunk (bytes 16-23, big-endian); {0, 0} if not a PNG.
+std::pair<unsigned, unsigned> pngSize(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  unsigned char b[24] = {};
+  in.read(reinterpret_cast<char*>(b), sizeof b);
+  if (!in || b[0] != 0x89 || b[1] != 'P' || b[2] != 'N' || b[3] != 'G' || std::string(b + 12, b + 16) != "IHDR")
+    return {0, 0};
+  auto be = [&](int o) { return (unsigned(b[o]) << 24) | (unsigned(b[o + 1]) << 16) | (unsigned(b[o + 2]) << 8) | b[o + 3]; };
+  return {be(16), be(20)};
+}
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Every figure is drawn at the size its script asks for, titled in words (never the experiment's
+// name), and DIR/figures.html shows each one once, in paper order, with its caption.
+TEST_F(SyntheticSuite, FiguresAreSizedTitledAndListedOnTheSheet) {
+  const std::vector<PlotFile> plots = plotResults(root_.string());
+  ASSERT_GE(plots.size(), 11u);
+  const std::string sheet = readText(root_ / "figures.html");
+  size_t last_pos = 0;
+  for (const PlotFile& p : plots) {
+    const std::string gp = readText(fs::path(p.png).replace_extension(".gp"));
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(gp, m, std::regex(R"(set terminal pngcairo .*size (\d+),(\d+))"))) << p.png;
+    EXPECT_EQ(pngSize(p.png), std::make_pair(unsigned(std::stoul(m[1])), unsigned(std::stoul(m[2])))) << p.png;
+    const std::string experiment = fs::path(p.png).parent_path().parent_path().filename().string();
+    // titles of the figure, its panels and its legend entries
+    const std::regex title_re(R"(title '([^']*)')");
+    for (auto it = std::sregex_iterator(gp.begin(), gp.end(), title_re); it != std::sregex_iterator(); ++it) {
+      const std::string t = (*it)[1].str();
+      EXPECT_EQ(t.find(experiment), std::string::npos) << p.png << ": title '" << t << "'";
+    }
+    EXPECT_EQ(p.title.find(experiment), std::string::npos) << p.title;
+    EXPECT_FALSE(p.caption.empty());
+    // listed once, with a relative link, in the order drawn (experiments in figure order here)
+    const std::string rel = fs::relative(p.png, root_).generic_string();
+    const std::string img = "<img src=\"" + rel + "\"";
+    const size_t pos = sheet.find(img);
+    ASSERT_NE(pos, std::string::npos) << rel << " not on the sheet";
+    EXPECT_EQ(sheet.find(img, pos + 1), std::string::npos) << rel << " twice on the sheet";
+    EXPECT_GT(pos, last_pos) << rel << " out of order";
+    last_pos = pos;
+  }
+  size_t figures = 0;
+  for (size_t i = sheet.find("<figcaption>"); i != std::string::npos; i = sheet.find("<figcaption>", i + 1)) ++figures;
+  EXPECT_EQ(figures, plots.size());
+}
+
+TEST(FigureWords, KeysValuesAndFigureNames) {
+  EXPECT_EQ(gpValueLabel("quadruped.d_Q2B_m", "0.025"), "d_{Q2B} = 25 mm");
+  EXPECT_EQ(gpValueLabel("trajectory.dtheta_deg", "-90"), "Δθ = -90°");
+  EXPECT_EQ(gpValueLabel("effects.friction", "stiction"), "stiction");
+  EXPECT_EQ(gpValueLabel("analytic.coupling", "exact"), "exact coupling");
+  EXPECT_EQ(gpValueLabel("tail.links", "3"), "3 links");
+  EXPECT_EQ(gpAxisLabel("quadruped.d_Q2B_m"), "d_{Q2B} [mm]");
+  EXPECT_EQ(gpText("case d_Q2B_m=0.1"), "case d\\_Q2B\\_m=0.1");
+  EXPECT_EQ(gpSymbols("phi_net over theta0 and M_zT"), "φ_{net} over θ_0 and M_{z,T}");
+  EXPECT_EQ(figureName("Fig. 6(a): phi(t), analytic vs MuJoCo", "fig06a"), "Fig. 6a");
+  EXPECT_EQ(figureName("", "my_run"), "my run");
+  EXPECT_LT(figureOrder("Fig. 6(b): x"), figureOrder("Fig. 6 1-link case: y"));
+  EXPECT_LT(figureOrder("Fig. 7: x"), figureOrder("Fig. 7 case with mu_s and mu_d swapped"));
+  EXPECT_LT(figureOrder("Fig. 9: x"), figureOrder("Fig. 10: x"));
+  EXPECT_EQ(modelColor("analytic"), "#0072B2");
+  EXPECT_EQ(modelColor("mujoco"), "#D55E00");
 }
 
 TEST(ResultFolder, FallsBackToCaseResultFiles) {

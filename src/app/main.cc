@@ -20,6 +20,7 @@
 #include "experiments/render_case.h"
 #include "mujoco_model/mjcf_generator.h"
 #include "plotting/accuracy_plot.h"
+#include "plotting/figure_sheet.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
 #include "results/atomic_file.h"
@@ -269,6 +270,7 @@ int main(int argc, char** argv) {
     if (*plot) {
       const auto files = plotResults(result_dir);
       for (const auto& f : files) std::printf("%s\n", f.png.c_str());
+      std::printf("%s\n", figureSheetPath(result_dir).c_str());
       return kExitOk;
     }
     if (*report) {

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "plotting/gnuplot.h"
+#include "plotting/style.h"
 
 namespace tailsim {
 
@@ -26,14 +27,19 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
     }
     std::ostringstream body;
     body << "set logscale xy\nset grid\nset format y '10^{%L}'\nset xlabel 'wall time per run [ms]'\n"
-         << "set ylabel '|phi_net - reference| [deg]'\nset title " << gpQuote("Work-precision: " + st.case_name)
-         << "\nset key outside right top\nset format y '%.0e'\n";
+         << "set ylabel '|φ_{net} − reference| [deg]'\nset title "
+         << gpQuote("Work-precision: error of φ_{net} against wall time, case " + gpText(st.case_name))
+         << "\nset key outside right top\n";
     std::vector<std::string> parts;
     int k = 0;
     for (const auto& [name, rows] : curves) {
       const std::string dat = stem + "_" + std::to_string(k++) + ".dat";
       writeDataFile(dir + "/" + dat, {"wall_ms", "err_deg", "value"}, rows);
-      parts.push_back(gpQuote(dat) + " using 1:2 with linespoints title " + gpQuote(name));
+      // One Okabe-Ito colour per series (style.h); point type and, past seven series, dashes as well.
+      const size_t i = static_cast<size_t>(k - 1);
+      parts.push_back(gpQuote(dat) + " using 1:2 with linespoints lw 2 pt " + std::to_string(1 + i % 13) + " ps 1.4 dt " +
+                      std::to_string(1 + static_cast<int>(i / 7) % 4) + " lc rgb " + gpQuote(categoricalColor(i)) +
+                      " title " + gpQuote(gpText(name)));
     }
     if (!defaults.empty()) {
       writeDataFile(dir + "/" + stem + "_defaults.dat", {"wall_ms", "err_deg", "value"}, defaults);
@@ -42,7 +48,7 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
     }
     if (st.mujoco.present && st.mujoco.noise_default_deg > 0)
       parts.push_back(std::to_string(st.mujoco.noise_default_deg) +
-                      " with lines dt 2 lw 2 lc rgb 'gray40' title 'MuJoCo noise floor (phi_net s.d. under dT +- 1 us)'");
+                      " with lines dt 2 lw 2 lc rgb 'gray40' title 'MuJoCo noise floor (φ_{net} s.d. under ΔT ± 1 μs)'");
     if (parts.empty()) continue;
     body << "plot ";
     for (size_t i = 0; i < parts.size(); ++i) body << (i ? ", \\\n     " : "") << parts[i];

@@ -62,11 +62,11 @@ int runGnuplot(const fs::path& dir, const std::string& script, const fs::path& l
 std::string terminalBlock(const GnuplotFigure& f, bool png) {
   std::ostringstream o;
   if (png)
-    o << "set terminal pngcairo noenhanced size " << f.width_px << "," << f.height_px
+    o << "set terminal pngcairo enhanced size " << f.width_px << "," << f.height_px
       << " font 'Sans,15' linewidth 2\n"
       << "set output " << gpQuote(f.stem + ".png") << "\n";
   else
-    o << "set terminal svg noenhanced size " << f.width_px << "," << f.height_px
+    o << "set terminal svg enhanced size " << f.width_px << "," << f.height_px
       << " font 'Sans,15' linewidth 2 background rgb 'white'\n"
       << "set output " << gpQuote(f.stem + ".svg") << "\n";
   o << f.body << "\nunset output\n";

@@ -1,5 +1,6 @@
 // Running gnuplot on a generated script: every figure is written as PNG (pngcairo) and SVG from
-// the same plot commands, with its script and data files kept beside it (DIR/plots/).
+// the same plot commands, with its script and data files kept beside it (DIR/plots/). Both
+// terminals use enhanced text (φ_{net}, 10^{-3}): escape free text with gpText (style.h).
 #pragma once
 
 #include <string>

@@ -8,7 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "plotting/figure_sheet.h"
 #include "plotting/gnuplot.h"
+#include "plotting/style.h"
 
 namespace tailsim {
 
@@ -18,54 +20,206 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string modelColor(const std::string& model) {
-  if (model == "analytic") return "#1f5fb4";
-  if (model == "mujoco") return "#d62728";
-  return "#2ca02c";
-}
-
-std::string modelTitle(const std::string& model) {
-  if (model == "analytic") return "analytic (stiction)";
-  if (model == "mujoco") return "MuJoCo (contact)";
-  return model;
-}
-
 std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
-  return buf;
+  std::string s = buf;
+  // "-0.0" -> "0.0": a value that rounds to zero has no sign.
+  if (s.size() > 1 && s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
+  return s;
 }
 
-// Series colours for curves that are not models (one per case / per value of a key).
-std::string seriesColor(size_t i) {
-  static const char* c[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
-                            "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#393b79", "#637939"};
-  return c[i % (sizeof c / sizeof c[0])];
+// Text in two forms: gnuplot enhanced text for the figure, plain Unicode for captions.
+struct Txt {
+  std::string gp, plain;
+  Txt operator+(const Txt& o) const { return {gp + o.gp, plain + o.plain}; }
+};
+// Words with tailsim identifiers (phi_net, d_Q2B, ...) turned into symbols.
+Txt W(const std::string& words) { return {gpSymbols(words), plainSymbols(words)}; }
+// A swept key's symbol.
+Txt K(const std::string& key) {
+  const KeyDisplay d = keyDisplay(key);
+  return {d.symbol, d.plain};
+}
+Txt V(const std::string& key, const std::string& value) {
+  return {gpValueLabel(key, value), plainValueLabel(key, value)};
+}
+
+// A tic label: the value in the axis's unit (d_Q2B in mm), words for non-numeric values.
+std::string ticLabel(const std::string& key, const std::string& value) {
+  const auto v = parseNumber(value);
+  if (!v) return gpValueLabel(key, value, false);
+  return fmt("%g", *v * keyDisplay(key).scale);
 }
 
 struct Ctx {
   const ExperimentResults& r;
   std::string plots;  // r.dir/plots
+  Txt fig;            // "Fig. 6a"
+  Txt tail;           // ", 1-link tail" when the experiment has one tail
   std::vector<PlotFile> out;
 
+  Txt title(const Txt& what) const { return fig + Txt{" — ", " — "} + what; }
   std::string data(const std::string& stem) const { return (fs::path(plots) / (stem + ".dat")).string(); }
-  void render(const std::string& stem, const std::string& body, const std::string& caption, int w = 1000,
-              int h = 700) {
+  void render(const std::string& stem, const std::string& body, const Txt& title, const std::string& caption,
+              int w = 1000, int h = 700) {
     GnuplotFigure f;
     f.stem = stem;
     f.body = body;
     f.width_px = w;
     f.height_px = h;
-    out.push_back({renderFigure(plots, f), caption});
+    out.push_back({renderFigure(plots, f), caption, title.plain});
   }
 };
 
-std::string header(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
+std::string header(const Txt& title, const std::string& xlabel, const std::string& ylabel) {
   std::ostringstream o;
   o << "reset\nset grid\nset key top left box opaque\n";
-  if (!title.empty()) o << "set title " << gpQuote(title) << "\n";
+  o << "set title " << gpQuote(title.gp) << "\n";
   o << "set xlabel " << gpQuote(xlabel) << "\nset ylabel " << gpQuote(ylabel) << "\n";
   return o.str();
+}
+
+std::string range(const char* axis, double lo, double hi) {
+  return std::string("set ") + axis + "range [" + fmt("%.6g", lo) + ":" + fmt("%.6g", hi) + "]\n";
+}
+
+// [lo, hi] of the finite values, widened by `margin` of the span on both sides.
+std::pair<double, double> span(const std::vector<double>& v, double margin) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double x : v)
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
+  if (!std::isfinite(lo)) return {kNaN, kNaN};
+  double d = hi - lo;
+  if (d <= 0) d = std::max(1e-3, std::fabs(hi));
+  return {lo - margin * d, hi + margin * d};
+}
+
+// ---- time axes and phases -------------------------------------------------------------------
+
+std::vector<std::string> jointSpeedColumns(const TimeSeries& s) {
+  std::vector<std::string> cols;
+  for (int i = 1; s.has("thetadot" + std::to_string(i) + "_dps"); ++i) cols.push_back("thetadot" + std::to_string(i) + "_dps");
+  return cols;
+}
+
+// Start and end of the tail's motion: the first and last sample where some joint moves faster
+// than `rel` times the peak joint speed (NaN if the CSV has no joint speeds).
+std::pair<double, double> tailMotion(const TimeSeries& s, double rel) {
+  const auto cols = jointSpeedColumns(s);
+  if (cols.empty() || !s.has("t_s")) return {kNaN, kNaN};
+  double peak = 0;
+  for (const auto& c : cols)
+    for (double v : s.values(c))
+      if (std::isfinite(v)) peak = std::max(peak, std::fabs(v));
+  if (!(peak > 0)) return {kNaN, kNaN};
+  const auto& t = s.values("t_s");
+  double first = kNaN, last = kNaN;
+  for (size_t k = 0; k < t.size(); ++k)
+    for (const auto& c : cols)
+      if (std::fabs(s.values(c)[k]) > rel * peak) {
+        if (!std::isfinite(first)) first = t[k];
+        last = t[k];
+      }
+  return {first, last};
+}
+
+// End of a time axis: the later of the tail's end and the models' t_stop_s, plus 15 % (at
+// least two output samples), never beyond the data.
+double timeAxisEnd(const std::vector<const TimeSeries*>& series, const std::vector<double>& t_stops) {
+  double last = 0, data_end = 0, dt = 0;
+  for (const TimeSeries* s : series) {
+    if (!s->has("t_s") || s->numRows() < 2) continue;
+    const auto& t = s->values("t_s");
+    data_end = std::max(data_end, t.back());
+    dt = std::max(dt, t[1] - t[0]);
+    const double end = tailMotion(*s, 0.01).second;  // 1 %: a servo's jitter is not motion
+    if (std::isfinite(end)) last = std::max(last, end);
+  }
+  for (double ts : t_stops)
+    if (std::isfinite(ts)) last = std::max(last, ts);
+  if (!(last > 0) || !(data_end > 0)) return data_end;
+  return std::min(data_end, last + std::max(0.15 * last, 2 * dt));
+}
+
+struct Phases {
+  bool ok = false;
+  double t_start = 0, t1 = 0, t_rev = 0, t_stuck = 0, t2 = 0;
+};
+
+// Fig. 7's phases from the analytic run's own events: A tail accelerates (tail start -> t1, peak
+// joint speed), B tail decelerates while the body still turns forward (t1 -> phidot changes
+// sign), C body turns back (-> rot_state returns to stuck), D body at rest. t2 = end of the tail's
+// motion. Needs t_s, joint speeds, phidot_dps and rot_state, with the events in this order.
+Phases findPhases(const TimeSeries& s) {
+  Phases p;
+  const auto cols = jointSpeedColumns(s);
+  if (cols.empty() || !s.has("t_s") || !s.has("phidot_dps") || !s.has("rot_state") || s.numRows() < 4) return p;
+  const auto& t = s.values("t_s");
+  const auto& w = s.values("phidot_dps");
+  const auto& rot = s.values("rot_state");
+  const auto& th = s.values(cols[0]);
+  size_t ipk = 0;
+  for (size_t k = 0; k < th.size(); ++k)
+    if (std::fabs(th[k]) > std::fabs(th[ipk])) ipk = k;
+  const auto [start, end] = tailMotion(s, 1e-6);  // the analytic profile is exact
+  if (!std::isfinite(start)) return p;
+  // first sample of the tail's motion: the sample before it is still at rest
+  size_t i0 = 0;
+  while (i0 + 1 < t.size() && t[i0 + 1] < start) ++i0;
+  p.t_start = t[i0];
+  p.t1 = t[ipk];
+  // phidot's sign after the tail starts, then its first change of sign after t1
+  double sign = 0;
+  for (size_t k = i0; k < w.size() && sign == 0; ++k)
+    if (std::fabs(w[k]) > 1e-9) sign = w[k] > 0 ? 1 : -1;
+  size_t irev = w.size();
+  for (size_t k = ipk; k < w.size(); ++k)
+    if (w[k] * sign < 0) { irev = k; break; }
+  if (irev == w.size()) return p;
+  size_t istuck = rot.size();
+  for (size_t k = irev; k < rot.size(); ++k)
+    if (rot[k] == 0 && rot[k - 1] == 1) { istuck = k; break; }
+  if (istuck == rot.size()) return p;
+  p.t_rev = t[irev];
+  p.t_stuck = t[istuck];
+  p.t2 = end;
+  p.ok = p.t_start < p.t1 && p.t1 < p.t_rev && p.t_rev < p.t_stuck;
+  return p;
+}
+
+// Shaded bands and letters for the phases (gnuplot objects persist over a multiplot's panels),
+// and the tail's t1, t2 as dotted lines.
+std::string phaseObjects(const Phases& p, double t_end) {
+  if (!p.ok) return {};
+  std::ostringstream o;
+  const double b[] = {p.t_start, p.t1, p.t_rev, p.t_stuck, std::max(t_end, p.t_stuck)};
+  const char* shade[] = {"#E8E8E8", "#F6F6F6", "#E8E8E8", "#F6F6F6"};
+  const char* letter[] = {"A", "B", "C", "D"};
+  for (int i = 0; i < 4; ++i) {
+    o << "set object " << 10 + i << " rect from " << fmt("%.6g", b[i]) << ", graph 0 to " << fmt("%.6g", b[i + 1])
+      << ", graph 1 behind fc rgb '" << shade[i] << "' fs solid 1.0 noborder\n"
+      << "set label " << 10 + i << " '" << letter[i] << "' at " << fmt("%.6g", 0.5 * (b[i] + b[i + 1]))
+      << ", graph 0.92 center font 'Sans,17' tc rgb '#444444' front\n";
+  }
+  o << "set arrow 20 from " << fmt("%.6g", p.t1) << ", graph 0 to " << fmt("%.6g", p.t1)
+    << ", graph 1 nohead dt 3 lw 1 lc rgb '#666666' back\n";
+  if (std::isfinite(p.t2))
+    o << "set arrow 21 from " << fmt("%.6g", p.t2) << ", graph 0 to " << fmt("%.6g", p.t2)
+      << ", graph 1 nohead dt 3 lw 1 lc rgb '#666666' back\n"
+      << "set label 21 't_2' at " << fmt("%.6g", p.t2) << ", graph 0.975 left offset char 0.3,0 font 'Sans,12' "
+      << "tc rgb '#444444' front\n";
+  o << "set label 20 't_1' at " << fmt("%.6g", p.t1) << ", graph 0.975 left offset char 0.3,0 font 'Sans,12' "
+    << "tc rgb '#444444' front\n";
+  return o.str();
+}
+
+std::string phaseCaption(const Phases& p) {
+  if (!p.ok) return {};
+  return " Shaded phases from the analytic run's events: A tail accelerates (" + fmt("%.3f", p.t_start) + "–" +
+         fmt("%.3f", p.t1) + " s, t1 = peak joint speed), B tail decelerates while the body still turns (to φ̇ = 0 at " +
+         fmt("%.3f", p.t_rev) + " s), C body turns back (until it sticks again, rot_state, at " +
+         fmt("%.3f", p.t_stuck) + " s), D body at rest; t2 = end of the tail's motion.";
 }
 
 // ---- simulate, one case: phi(t) and moments ------------------------------------------------
@@ -85,10 +239,23 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     }
   }
   if (models.empty()) return;
+  std::vector<const TimeSeries*> all;
+  std::vector<double> stops;
+  for (const std::string& m : models) {
+    all.push_back(&ts[m]);
+    if (auto it = c.runs.find(m); it != c.runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
+  }
+  const double t_end = timeAxisEnd(all, stops);
+  const Phases phases = ts.count("analytic") ? findPhases(ts["analytic"]) : Phases{};
+
+  Txt vs = {"", ""};
+  if (models.size() == 2 && ts.count("analytic") && ts.count("mujoco")) vs = {": analytic vs MuJoCo", ": analytic vs MuJoCo"};
+  else if (models.size() == 1) vs = {": " + gpText(modelTitle(models[0])), ": " + modelTitle(models[0])};
 
   // phi(t), all models overlaid (Figs. 6, 7a).
+  const Txt phi_title = ctx.title(W("body yaw phi(t)") + ctx.tail + vs);
   std::ostringstream body;
-  body << header(r.name + ": body yaw φ(t)", "t [s]", "φ [deg]");
+  body << header(phi_title, "t [s]", "φ [deg]") << range("x", 0, t_end) << phaseObjects(phases, t_end);
   body << "set key bottom right box opaque\nplot ";  // phi rises from 0 and settles: bottom right is free
   for (size_t i = 0; i < models.size(); ++i) {
     const std::string& m = models[i];
@@ -100,17 +267,20 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     for (size_t k = 0; k < t.size(); ++k) rows.push_back({t[k], phi[k]});
     writeDataFile(ctx.data(stem), {"t_s", "phi_deg"}, rows);
     const double net = r.phiNet(c, m);
-    std::string title = modelTitle(m);
-    if (std::isfinite(net)) title += ", φ_net = " + fmt("%.2f", net) + " deg";
-    body << (i ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:2 with lines lw 2 lc rgb "
+    std::string title = gpText(modelTitle(m));
+    if (std::isfinite(net)) title += ", φ_{net} = " + fmt("%.2f", net) + "°";
+    body << (i ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:2 with lines lw 2.5 lc rgb "
          << gpQuote(modelColor(m)) << " title " << gpQuote(title);
   }
   body << "\n";
-  ctx.render(stem_prefix + "_phi", body.str(), r.name + ": φ(t), " + std::to_string(models.size()) + " model(s)");
+  ctx.render(stem_prefix + "_phi", body.str(), phi_title,
+             phi_title.plain + ". Body yaw angle over time" +
+                 (models.size() > 1 ? std::string(", both models overlaid") : std::string()) +
+                 "; the legend gives each model's net rotation φ_net." + phaseCaption(phases));
 
-  // Moments over time, one panel per model (Fig. 7b).
+  // Moments over time, one panel per model, one y scale (Fig. 7b).
   static const std::vector<std::pair<std::string, std::string>> cols = {
-      {"MzT_Nm", "M_z,T (tail)"}, {"MzF_Nm", "M_z,F (friction)"}, {"Izz_phiddot_Nm", "I_zz φ̈ (inertial)"}};
+      {"MzT_Nm", "M_{z,T} (tail)"}, {"MzF_Nm", "M_{z,F} (friction)"}, {"Izz_phiddot_Nm", "I_{zz} φ̈ (inertial)"}};
   std::vector<std::string> mm;
   for (const std::string& m : models)
     for (const auto& [col, label] : cols)
@@ -119,8 +289,27 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
         break;
       }
   if (mm.empty()) return;
+  // The y range: the analytic curves' with a margin (MuJoCo's sampled contact moments chatter far
+  // beyond the signal and are clipped); without an analytic run, the 2nd-98th percentile.
+  std::vector<double> yv;
+  const bool from_analytic = std::find(mm.begin(), mm.end(), "analytic") != mm.end();
+  for (const std::string& m : mm) {
+    if (from_analytic && m != "analytic") continue;
+    const TimeSeries& s = ts[m];
+    for (const auto& [col, label] : cols)
+      if (s.has(col))
+        for (size_t k = 0; k < s.numRows(); ++k)
+          if (s.values("t_s")[k] <= t_end) yv.push_back(s.values(col)[k]);
+  }
+  if (!from_analytic && yv.size() > 50) {
+    std::sort(yv.begin(), yv.end());
+    yv = {yv[yv.size() / 50], yv[yv.size() - 1 - yv.size() / 50]};
+  }
+  const auto [ylo, yhi] = span(yv, 0.12);
+  const Txt mom_title = ctx.title(W("moments about the system COM") + ctx.tail);
   std::ostringstream mb;
-  mb << "reset\nset multiplot layout " << mm.size() << ",1\n";
+  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << gpQuote(mom_title.gp) << " font 'Sans,17'\n"
+     << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string()) << phaseObjects(phases, t_end);
   for (const std::string& m : mm) {
     const TimeSeries& s = ts[m];
     const std::string stem = stem_prefix + "_moments_" + m;
@@ -133,65 +322,91 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
       rows.push_back(row);
     }
     writeDataFile(ctx.data(stem), names, rows);
-    mb << "set grid\nset key top right box opaque\nset title " << gpQuote(r.name + ": moments, " + modelTitle(m))
+    std::string panel = gpText(modelTitle(m));
+    if (m == "mujoco") panel += ": sampled contact moments, clipped to the analytic range";
+    mb << "set grid\nset key bottom right box opaque\nset title " << gpQuote(panel)
        << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
     int n = 0;
     for (size_t j = 0; j < cols.size(); ++j) {
       if (!s.has(cols[j].first)) continue;
       mb << (n++ ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2 << " with lines lw 2 lc rgb "
-         << gpQuote(seriesColor(j)) << " title " << gpQuote(cols[j].second);
+         << gpQuote(quantityColor(j)) << " title " << gpQuote(cols[j].second);
     }
     mb << "\n";
   }
   mb << "unset multiplot\n";
-  ctx.render(stem_prefix + "_moments", mb.str(), r.name + ": M_z,T, M_z,F and I_zz φ̈ over time, per model", 1000,
-             450 * static_cast<int>(mm.size()));
+  std::string cap = mom_title.plain +
+                    ". Tail moment M_z,T (Eq. 13), friction moment M_z,F and inertial moment I_zz φ̈ over time, one "
+                    "panel per model, same scales.";
+  if (ts.count("mujoco") && std::find(mm.begin(), mm.end(), "mujoco") != mm.end())
+    cap += from_analytic ? " MuJoCo's moments are single samples of the contact forces at each output instant (not "
+                           "averaged), so they chatter; the y range is the analytic curves' with a 12 % margin and "
+                           "MuJoCo values beyond it are clipped."
+                         : " MuJoCo's moments are single samples at each output instant; the y range is their 2nd to "
+                           "98th percentile.";
+  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1000,
+             60 + 430 * static_cast<int>(mm.size()));
 }
 
 // ---- heat maps ------------------------------------------------------------------------------
 
-// values[model][iy][ix]; x = axes[1], y = axes[0].
-void heatMap(Ctx& ctx, const std::string& stem, const std::string& what, const std::string& cblabel,
-             const char* cellfmt, const SweepAxis& ax, const SweepAxis& ay,
-             const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& values) {
+// values[model][iy][ix]; x = axes[1], y = axes[0]. A signed quantity (or any map with both signs)
+// gets a diverging colour map centred on zero; cell text is white on dark cells, a value that rounds to zero prints unsigned.
+void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::string& cblabel, const SweepAxis& ax,
+             const SweepAxis& ay, const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& values,
+             const std::string& caption_more, bool signed_quantity) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const auto& [m, grid] : values)
     for (const auto& row : grid)
       for (double v : row)
         if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
   if (!std::isfinite(lo)) return;
-  if (hi <= lo) hi = lo + 1.0;
+  // A signed quantity (phi_net) is centred on zero even when this sweep has one sign only.
+  const bool is_signed = signed_quantity || (lo < 0 && hi > 0);
+  double cblo = lo, cbhi = hi;
+  if (is_signed) cbhi = std::max(std::fabs(lo), std::fabs(hi)), cblo = -cbhi;
+  if (cbhi <= cblo) cbhi = cblo + 1.0;
   auto tics = [](const SweepAxis& a, const char* axis) {
     std::ostringstream o;
     o << "set " << axis << "tics (";
-    for (size_t i = 0; i < a.values.size(); ++i) o << (i ? ", " : "") << gpQuote(a.values[i]) << " " << i;
+    for (size_t i = 0; i < a.values.size(); ++i) o << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
     o << ")\n";
     return o.str();
   };
+  // Dark cells: |value| beyond 60 % of the scale (diverging) or the top 40 % (sequential).
+  const std::string dark = is_signed ? "(abs($3) > " + fmt("%.6g", 0.6 * cbhi) + ")"
+                                     : "($3 > " + fmt("%.6g", cblo + 0.6 * (cbhi - cblo)) + ")";
+  const std::string text = "(abs($3) < 0.05 ? '0.0' : sprintf('%.1f', $3))";
+  const bool stacked = ax.values.size() > ay.values.size() && values.size() > 1;
+  const int pw = static_cast<int>(std::max<size_t>(4, ax.values.size()) * 105 + 420);
+  const int ph = static_cast<int>(std::max<size_t>(3, ay.values.size()) * 82 + 230);
+  const Txt title = ctx.title(what + ctx.tail);
   std::ostringstream b;
-  b << "reset\nset multiplot layout 1," << values.size() << "\n";
+  b << "reset\nset multiplot layout " << (stacked ? values.size() : 1) << "," << (stacked ? 1 : values.size())
+    << " title " << gpQuote(title.gp) << " font 'Sans,17'\n";
   for (const auto& [m, grid] : values) {
     const std::string dstem = stem + "_" + m;
     std::vector<std::vector<double>> rows;
     for (size_t iy = 0; iy < grid.size(); ++iy)
-      for (size_t ix = 0; ix < grid[iy].size(); ++ix)
-        rows.push_back({double(ix), double(iy), grid[iy][ix]});
+      for (size_t ix = 0; ix < grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), grid[iy][ix]});
     writeDataFile(ctx.data(dstem), {"ix", "iy", "value"}, rows);
-    b << "set title " << gpQuote(ctx.r.name + ": " + what + ", " + modelTitle(m)) << "\n"
-      << "set xlabel " << gpQuote(axisLabel(ax.key)) << "\nset ylabel " << gpQuote(axisLabel(ay.key)) << "\n"
+    b << "set title " << gpQuote(gpText(modelTitle(m))) << "\n"
+      << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel " << gpQuote(gpAxisLabel(ay.key)) << "\n"
       << "set xrange [-0.5:" << ax.values.size() - 0.5 << "]\nset yrange [-0.5:" << ay.values.size() - 0.5 << "]\n"
-      << tics(ax, "x") << tics(ay, "y") << "set cbrange [" << lo << ":" << hi << "]\n"
-      << "set cblabel " << gpQuote(cblabel) << "\n"
-      << "set palette defined (0 '#fff7bc', 1 '#fec44f', 2 '#f07b2a')\n"
+      << tics(ax, "x") << tics(ay, "y") << range("cb", cblo, cbhi) << "set cblabel " << gpQuote(cblabel)
+      << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
+      << (is_signed ? divergingPalette() : sequentialPalette())
       << "plot " << gpQuote(dstem + ".dat")
       << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
-      << "     '' using 1:2:(sprintf(" << gpQuote(cellfmt) << ", $3)) with labels font 'Sans,"
-      << (ax.values.size() > 9 ? 11 : 12) << "' notitle\n";
+      << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
+      << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
   }
   b << "unset multiplot\n";
-  const int w = std::max(800, static_cast<int>(80 * ax.values.size() + 320)) * static_cast<int>(values.size());
-  const int h = std::max(600, static_cast<int>(50 * ay.values.size() + 250));
-  ctx.render(stem, b.str(), ctx.r.name + ": " + what + " over " + leafKey(ax.key) + " and " + leafKey(ay.key), w, h);
+  const int n = static_cast<int>(values.size());
+  const int w = stacked ? pw : pw * n, h = (stacked ? ph * n : ph) + 40;
+  std::string cap = title.plain + ". " + caption_more + " One panel per model, one colour scale";
+  cap += is_signed ? " (diverging, centred on zero: blue negative, vermillion positive)." : ".";
+  ctx.render(stem, b.str(), title, cap, w, h);
 }
 
 // ---- simulate, sweeps -----------------------------------------------------------------------
@@ -199,10 +414,11 @@ void heatMap(Ctx& ctx, const std::string& stem, const std::string& what, const s
 void plotOneKey(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
   const SweepAxis& a = r.axes[0];
+  const KeyDisplay kd = keyDisplay(a.key);
   const std::string stem = r.name + "_phi_net";
   std::vector<std::vector<double>> rows;
   for (size_t i = 0; i < a.values.size(); ++i) {
-    std::vector<double> row = {a.number(i)};
+    std::vector<double> row = {a.numeric ? a.number(i) * kd.scale : double(i)};
     const CaseRecord* c = r.find({{a.key, a.values[i]}});
     for (const std::string& m : r.models) row.push_back(c ? r.phiNet(*c, m) : kNaN);
     rows.push_back(row);
@@ -211,34 +427,41 @@ void plotOneKey(Ctx& ctx) {
   for (const std::string& m : r.models) names.push_back(m + "_phi_net_deg");
   writeDataFile(ctx.data(stem), names, rows);
 
+  const Txt title = ctx.title(W("net body rotation phi_net over ") + K(a.key) + ctx.tail);
   std::ostringstream b;
-  b << header(r.name + ": net rotation φ_net", axisLabel(a.key), "φ_net [deg]");
+  b << header(title, gpAxisLabel(a.key), "φ_{net} [deg]");
   const bool bars = leafKey(a.key) == "links" || !a.numeric;
   if (bars) {
     b << "set style data histogram\nset style histogram cluster gap 1\nset style fill solid 0.85 border -1\n"
-      << "set boxwidth 0.9\nset offsets 0, 0, graph 0.1, 0\nset xzeroaxis lt -1\nset grid noxtics\nplot ";
+      << "set boxwidth 0.9\nset offsets 0, 0, graph 0.1, 0\nset xzeroaxis lt -1\nset grid noxtics\nset xtics (";
+    for (size_t i = 0; i < a.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
+    b << ")\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
-      b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using " << j + 2 << (j ? "" : ":xtic(1)") << " lc rgb "
-        << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(modelTitle(r.models[j]));
-    // gnuplot's xtic(1) prints the number as written in the data file
+      b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using " << j + 2 << " lc rgb "
+        << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(modelTitle(r.models[j])));
   } else {
-    b << "plot ";
+    b << "set xzeroaxis lt -1\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
       b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2
-        << " with linespoints lw 2 pt 7 ps 1.2 lc rgb " << gpQuote(modelColor(r.models[j])) << " title "
-        << gpQuote(modelTitle(r.models[j]));
+        << " with linespoints lw 2.5 pt " << (j ? 5 : 7) << " ps 1.3 lc rgb " << gpQuote(modelColor(r.models[j]))
+        << " title " << gpQuote(gpText(modelTitle(r.models[j])));
   }
   b << "\n";
-  ctx.render(stem, b.str(), r.name + ": φ_net over " + leafKey(a.key) + (bars ? " (bars)" : "") + ", per model");
+  ctx.render(stem, b.str(), title,
+             title.plain + ". Net body rotation φ_net of each case" + (bars ? " (bars)" : "") + ", one colour per model.");
 
-  // phi(t) of every case, one panel per model (few cases only).
+  // phi(t) of every case, one panel per model, one time and one angle scale (few cases only).
   if (r.cases.size() > 12) return;
-  std::vector<std::string> models;
-  std::ostringstream t;
-  std::ostringstream panels;
+  struct Curve {
+    std::string dat;
+    size_t i;
+  };
+  std::vector<std::pair<std::string, std::vector<Curve>>> panels;
+  std::vector<TimeSeries> loaded;
+  std::vector<double> stops, phis;
+  loaded.reserve(r.cases.size() * r.models.size());
   for (const std::string& m : r.models) {
-    std::ostringstream p;
-    int n = 0;
+    std::vector<Curve> curves;
     for (size_t i = 0; i < a.values.size(); ++i) {
       const CaseRecord* c = r.find({{a.key, a.values[i]}});
       if (!c) continue;
@@ -253,19 +476,36 @@ void plotOneKey(Ctx& ctx) {
       std::vector<std::vector<double>> rr;
       for (size_t k = 0; k < s.numRows(); ++k) rr.push_back({s.values("t_s")[k], s.values("phi_deg")[k]});
       writeDataFile(ctx.data(dstem), {"t_s", "phi_deg"}, rr);
-      p << (n++ ? ", \\\n     " : "plot ") << gpQuote(dstem + ".dat") << " using 1:2 with lines lw 2 lc rgb "
-        << gpQuote(seriesColor(i)) << " title " << gpQuote(leafKey(a.key) + " = " + a.values[i]);
+      for (double v : s.values("phi_deg")) phis.push_back(v);
+      if (auto it = c->runs.find(m); it != c->runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
+      loaded.push_back(std::move(s));
+      curves.push_back({dstem + ".dat", i});
     }
-    if (!n) continue;
-    models.push_back(m);
-    panels << "set grid\nset key outside right box\nset title " << gpQuote(r.name + ": φ(t), " + modelTitle(m))
-           << "\nset xlabel 't [s]'\nset ylabel 'φ [deg]'\n"
-           << p.str() << "\n";
+    if (!curves.empty()) panels.emplace_back(m, curves);
   }
-  if (models.empty()) return;
-  t << "reset\nset multiplot layout " << models.size() << ",1\n" << panels.str() << "unset multiplot\n";
-  ctx.render(r.name + "_phi_t", t.str(), r.name + ": φ(t) of every case, per model", 1100,
-             450 * static_cast<int>(models.size()));
+  if (panels.empty()) return;
+  std::vector<const TimeSeries*> all;
+  for (const TimeSeries& s : loaded) all.push_back(&s);
+  const double t_end = timeAxisEnd(all, stops);
+  const auto [ylo, yhi] = span(phis, 0.06);
+  const Txt ttitle = ctx.title(W("body yaw phi(t) for each ") + K(a.key) + ctx.tail);
+  std::ostringstream t;
+  t << "reset\nset multiplot layout " << panels.size() << ",1 title " << gpQuote(ttitle.gp) << " font 'Sans,17'\n"
+    << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
+  for (const auto& [m, curves] : panels) {
+    t << "set grid\nset key outside right box\nset title " << gpQuote(gpText(modelTitle(m)))
+      << "\nset xlabel 't [s]'\nset ylabel 'φ [deg]'\nplot ";
+    for (size_t n = 0; n < curves.size(); ++n)
+      t << (n ? ", \\\n     " : "") << gpQuote(curves[n].dat) << " using 1:2 with lines lw 2 dt "
+        << seriesDash(curves[n].i) << " lc rgb " << gpQuote(seriesColor(curves[n].i)) << " title "
+        << gpQuote(V(a.key, a.values[curves[n].i]).gp);
+    t << "\n";
+  }
+  t << "unset multiplot\n";
+  ctx.render(r.name + "_phi_t", t.str(), ttitle,
+             ttitle.plain + ". Body yaw over time, one curve per value of " + K(a.key).plain +
+                 ", one panel per model, same scales.",
+             1150, 60 + 430 * static_cast<int>(panels.size()));
 }
 
 void plotTwoKeys(Ctx& ctx) {
@@ -273,41 +513,57 @@ void plotTwoKeys(Ctx& ctx) {
   const SweepAxis& ay = r.axes[0];  // slowest-varying key (first in the file)
   const SweepAxis& ax = r.axes[1];
   std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
+  std::vector<double> all;
   for (const std::string& m : r.models) {
     std::vector<std::vector<double>> g(ay.values.size(), std::vector<double>(ax.values.size(), kNaN));
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       for (size_t ix = 0; ix < ax.values.size(); ++ix)
-        if (const CaseRecord* c = r.find({{ay.key, ay.values[iy]}, {ax.key, ax.values[ix]}}))
+        if (const CaseRecord* c = r.find({{ay.key, ay.values[iy]}, {ax.key, ax.values[ix]}})) {
           g[iy][ix] = r.phiNet(*c, m);
+          all.push_back(g[iy][ix]);
+        }
     grids.emplace_back(m, g);
   }
-  heatMap(ctx, r.name + "_phi_net_map", "φ_net [deg]", "φ_net [deg]", "%.1f", ax, ay, grids);
+  heatMap(ctx, r.name + "_phi_net_map", W("net body rotation phi_net over ") + K(ax.key) + W(" and ") + K(ay.key),
+          "φ_{net} [deg]", ax, ay, grids, "Cells: φ_net in degrees for each case.", true);
 
-  // Curves over the x key, one per y value, one panel per model.
+  // Curves over the x key, one per y value, one panel per model, one y scale.
+  const KeyDisplay kx = keyDisplay(ax.key);
+  const auto [ylo, yhi] = span(all, 0.08);
+  const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(ay.key) + ctx.tail);
   std::ostringstream b;
-  b << "reset\nset multiplot layout 1," << grids.size() << "\n";
+  b << "reset\nset multiplot layout 1," << grids.size() << " title " << gpQuote(title.gp) << " font 'Sans,17'\n"
+    << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
+  if (!ax.numeric) {
+    b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
+    for (size_t i = 0; i < ax.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ax.key, ax.values[i])) << " " << i;
+    b << ")\n";
+  }
   for (const auto& [m, g] : grids) {
     const std::string dstem = r.name + "_phi_net_lines_" + m;
     std::vector<std::vector<double>> rows;
     for (size_t ix = 0; ix < ax.values.size(); ++ix) {
-      std::vector<double> row = {ax.number(ix)};
+      std::vector<double> row = {ax.numeric ? ax.number(ix) * kx.scale : double(ix)};
       for (size_t iy = 0; iy < ay.values.size(); ++iy) row.push_back(g[iy][ix]);
       rows.push_back(row);
     }
     std::vector<std::string> names = {leafKey(ax.key)};
     for (const std::string& v : ay.values) names.push_back(leafKey(ay.key) + "=" + v);
     writeDataFile(ctx.data(dstem), names, rows);
-    b << "set grid\nset key outside right box\nset title " << gpQuote(r.name + ": φ_net, " + modelTitle(m)) << "\n"
-      << "set xlabel " << gpQuote(axisLabel(ax.key)) << "\nset ylabel 'φ_net [deg]'\nplot ";
+    b << "set grid\nset key outside right box\nset title " << gpQuote(gpText(modelTitle(m))) << "\n"
+      << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel 'φ_{net} [deg]'\nplot ";
+    static const int pts[] = {7, 5, 9, 11, 13};
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       b << (iy ? ", \\\n     " : "") << gpQuote(dstem + ".dat") << " using 1:" << iy + 2
-        << " with linespoints lw 2 pt 7 lc rgb " << gpQuote(seriesColor(iy)) << " title "
-        << gpQuote(leafKey(ay.key) + " = " + ay.values[iy]);
+        << " with linespoints lw 2 pt " << pts[iy % 5] << " ps 1.3 dt " << (seriesDash(iy) + int(iy % 2))
+        << " lc rgb " << gpQuote(seriesColor(iy)) << " title " << gpQuote(V(ay.key, ay.values[iy]).gp);
     b << "\n";
   }
   b << "unset multiplot\n";
-  ctx.render(r.name + "_phi_net_lines", b.str(),
-             r.name + ": φ_net over " + leafKey(ax.key) + ", one curve per " + leafKey(ay.key), 1100 * grids.size(), 700);
+  ctx.render(r.name + "_phi_net_lines", b.str(), title,
+             title.plain + ". φ_net over " + K(ax.key).plain + ", one curve per value of " + K(ay.key).plain +
+                 ", one panel per model, same y scale.",
+             std::max(1100, 900) * static_cast<int>(grids.size()), 720);
 }
 
 void plotManyKeys(Ctx& ctx) {
@@ -320,14 +576,14 @@ void plotManyKeys(Ctx& ctx) {
     rows.push_back(row);
   }
   writeDataFile(ctx.data(stem), {"case"}, rows);
+  const Txt title = ctx.title(W("net body rotation phi_net per case") + ctx.tail);
   std::ostringstream b;
-  b << header(r.name + ": φ_net per case (see summary.json for the case order)", "case index", "φ_net [deg]")
-    << "plot ";
+  b << header(title, "case index (order of summary.json)", "φ_{net} [deg]") << "plot ";
   for (size_t j = 0; j < r.models.size(); ++j)
     b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2 << " with linespoints pt 7 lc rgb "
-      << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(modelTitle(r.models[j]));
+      << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(modelTitle(r.models[j])));
   b << "\n";
-  ctx.render(stem, b.str(), r.name + ": φ_net per case");
+  ctx.render(stem, b.str(), title, title.plain + ". φ_net of every case in the order of summary.json.");
 }
 
 // ---- pose -----------------------------------------------------------------------------------
@@ -346,6 +602,7 @@ double poseValue(const ExperimentResults& r, const CaseRecord* c, const std::str
 void plotPoseOneKey(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
   const SweepAxis& a = r.axes[0];
+  const KeyDisplay kd = keyDisplay(a.key);
   // Columns present in the first readable pose CSV.
   TimeSeries probe;
   std::string model;
@@ -361,45 +618,53 @@ void plotPoseOneKey(Ctx& ctx) {
     if (!model.empty()) break;
   }
   if (model.empty()) return;
-  std::vector<std::pair<std::string, std::string>> parts;
+  struct Part {
+    std::string col, gp, plain;
+  };
+  std::vector<Part> parts;
   if (probe.has("MzT_tan_Nm") && probe.has("MzT_cen_Nm"))
-    parts = {{"MzT_tan_Nm", "(a) tangential M_z,T,tan / I_zz"}, {"MzT_cen_Nm", "(b) centripetal M_z,T,cen / I_zz"}};
+    parts = {{"MzT_tan_Nm", "(a) tangential M_{z,T,tan} / I_{zz}", "tangential M_z,T,tan / I_zz"},
+             {"MzT_cen_Nm", "(b) centripetal M_{z,T,cen} / I_{zz}", "centripetal M_z,T,cen / I_zz"}};
   else if (probe.has("MzT_acc_Nm") && probe.has("MzT_speed_Nm"))
-    parts = {{"MzT_acc_Nm", "(a) acceleration-driven M_z,T,acc / I_zz"},
-             {"MzT_speed_Nm", "(b) speed-driven M_z,T,speed / I_zz"}};
+    parts = {{"MzT_acc_Nm", "(a) acceleration-driven M_{z,T,acc} / I_{zz}", "acceleration-driven M_z,T,acc / I_zz"},
+             {"MzT_speed_Nm", "(b) speed-driven M_{z,T,speed} / I_{zz}", "speed-driven M_z,T,speed / I_zz"}};
   const bool perIzz = probe.has("Izz_kgm2");
+  const double xs = a.numeric ? kd.scale : 1.0;
   if (!parts.empty()) {
     const std::string stem = r.name + "_contributions";
     std::vector<std::vector<double>> rows;
     for (size_t i = 0; i < a.values.size(); ++i) {
       const CaseRecord* c = r.find({{a.key, a.values[i]}});
       const double izz = perIzz ? poseValue(r, c, model, "Izz_kgm2") : 1.0;
-      rows.push_back({a.number(i), poseValue(r, c, model, parts[0].first) / izz,
-                      poseValue(r, c, model, parts[1].first) / izz});
+      rows.push_back({a.number(i) * xs, poseValue(r, c, model, parts[0].col) / izz,
+                      poseValue(r, c, model, parts[1].col) / izz});
     }
-    writeDataFile(ctx.data(stem), {leafKey(a.key), parts[0].first, parts[1].first}, rows);
-    const std::string ylabel = perIzz ? "contribution to φ̈ [rad/s²]" : "moment [N m]";
+    writeDataFile(ctx.data(stem), {leafKey(a.key), parts[0].col, parts[1].col}, rows);
+    const std::string ylabel = perIzz ? "contribution to φ̈ [rad/s^2]" : "moment [N m]";
+    const Txt title = ctx.title(Txt{"tail moment contributions over ", "tail moment contributions over "} + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << "reset\nset multiplot layout 1,2\n";
+    b << "reset\nset multiplot layout 1,2 title " << gpQuote(title.gp) << " font 'Sans,17'\n";
     for (int j = 0; j < 2; ++j)
-      b << "set grid\nunset key\nset title " << gpQuote(parts[j].second) << "\nset xlabel "
-        << gpQuote(axisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpQuote(stem + ".dat")
-        << " using 1:" << j + 2 << " with linespoints lw 2 pt 7 lc rgb " << gpQuote(seriesColor(j)) << "\n";
+      b << "set grid\nunset key\nset xzeroaxis lt -1\nset title " << gpQuote(parts[j].gp) << "\nset xlabel "
+        << gpQuote(gpAxisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpQuote(stem + ".dat")
+        << " using 1:" << j + 2 << " with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
     b << "unset multiplot\n";
-    ctx.render(stem, b.str(), r.name + ": " + parts[0].second + " and " + parts[1].second + " over " + leafKey(a.key),
-               1600, 650);
+    ctx.render(stem, b.str(), title,
+               title.plain + ": (a) " + parts[0].plain + " and (b) " + parts[1].plain + " over " + kd.plain + " (" +
+                   modelTitle(model) + ").",
+               1600, 690);
   }
   if (probe.has("LF_m")) {
     const std::string stem = r.name + "_LF";
     std::vector<std::vector<double>> rows;
     for (size_t i = 0; i < a.values.size(); ++i)
-      rows.push_back({a.number(i), 1e3 * poseValue(r, r.find({{a.key, a.values[i]}}), model, "LF_m")});
+      rows.push_back({a.number(i) * xs, 1e3 * poseValue(r, r.find({{a.key, a.values[i]}}), model, "LF_m")});
     writeDataFile(ctx.data(stem), {leafKey(a.key), "LF_mm"}, rows);
+    const Txt title = ctx.title(W("friction moment arm L_F over ") + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << header(r.name + ": friction moment arm L_F", axisLabel(a.key), "L_F [mm]") << "unset key\nplot "
-      << gpQuote(stem + ".dat") << " using 1:2 with linespoints lw 2 pt 7 lc rgb " << gpQuote(modelColor(model))
-      << "\n";
-    ctx.render(stem, b.str(), r.name + ": L_F over " + leafKey(a.key));
+    b << header(title, gpAxisLabel(a.key), "L_F [mm]") << "unset key\nplot " << gpQuote(stem + ".dat")
+      << " using 1:2 with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
+    ctx.render(stem, b.str(), title, title.plain + " (Eqs. 17-19, " + modelTitle(model) + ").");
   }
 }
 
@@ -418,13 +683,22 @@ void plotPoseTwoKeys(Ctx& ctx) {
       }
     if (any) grids.emplace_back(m, g);
   }
-  if (!grids.empty()) heatMap(ctx, r.name + "_LF_map", "L_F [mm]", "L_F [mm]", "%.1f", ax, ay, grids);
+  if (!grids.empty())
+    heatMap(ctx, r.name + "_LF_map", W("friction moment arm L_F over ") + K(ax.key) + W(" and ") + K(ay.key),
+            "L_F [mm]", ax, ay, grids, "Cells: L_F in millimetres (Eqs. 17-19).", false);
 }
 
 }  // namespace
 
 std::vector<PlotFile> plotExperiment(const ExperimentResults& r) {
-  Ctx ctx{r, (fs::path(r.dir) / "plots").string(), {}};
+  Ctx ctx{r, (fs::path(r.dir) / "plots").string(), {}, {}, {}};
+  const std::string name = figureName(r.description, r.name);
+  ctx.fig = {gpSymbols(name), name};
+  if (r.links > 0) {
+    const std::string t = ", " + std::to_string(r.links) + "-link tail";
+    // the figure name may say it already ("Fig. 6 1-link case")
+    if (name.find(std::to_string(r.links) + "-link") == std::string::npos) ctx.tail = {t, t};
+  }
   fs::create_directories(ctx.plots);
   if (r.cases.empty() || r.models.empty()) return {};
   if (r.kind == "pose") {
@@ -444,10 +718,12 @@ std::vector<PlotFile> plotExperiment(const ExperimentResults& r) {
 
 std::vector<PlotFile> plotResults(const std::string& dir) {
   std::vector<PlotFile> all;
-  for (const ExperimentResults& r : loadResultTree(dir)) {
+  const std::vector<ExperimentResults> results = loadResultTree(dir);
+  for (const ExperimentResults& r : results) {
     std::vector<PlotFile> p = plotExperiment(r);
     all.insert(all.end(), p.begin(), p.end());
   }
+  writeFigureSheet(dir, results, all);
   return all;
 }
 

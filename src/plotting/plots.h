@@ -13,6 +13,10 @@
 //                              parts) over the key; L_F over the key                      (Fig. 8)
 //   pose, 2 swept keys      -> heat map of L_F                                           (Fig. 10)
 // Every figure is DIR/plots/<experiment>_<what>.png and .svg, with its .gp script and .dat files.
+// Titles are words ("Fig. 6a — body yaw φ(t), 1-link tail: analytic vs MuJoCo", from the
+// experiment's description), colours follow plotting/style.h (one colour per model everywhere),
+// time axes end shortly after the last motion, and single-case figures shade the phases A-D of
+// the analytic run (tail t1; φ̇ = 0; body stuck again).
 #pragma once
 
 #include <string>
@@ -24,7 +28,8 @@ namespace tailsim {
 
 struct PlotFile {
   std::string png;      // absolute or DIR-relative path as built from the result folder; .svg beside it
-  std::string caption;  // one line saying what the figure shows
+  std::string caption;  // what the figure shows, in words (plain Unicode, no markup)
+  std::string title;    // the figure's title as drawn, in plain Unicode ("Fig. 7 — moments ...")
 };
 
 // Draws the figures of one experiment into r.dir/plots/. Throws std::runtime_error if gnuplot
@@ -32,7 +37,7 @@ struct PlotFile {
 std::vector<PlotFile> plotExperiment(const ExperimentResults& r);
 
 // DIR is one result folder or a suite folder (one result folder per experiment under it).
-// Returns every figure written.
+// Returns every figure written, and writes DIR/figures.html (figure_sheet.h) listing them.
 std::vector<PlotFile> plotResults(const std::string& dir);
 
 }  // namespace tailsim

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "plotting/figure_sheet.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {
@@ -46,7 +47,7 @@ std::vector<PlotFile> existingPlots(const ExperimentResults& r) {
   const fs::path p = fs::path(r.dir) / "plots";
   if (!fs::is_directory(p)) return out;
   for (const auto& e : fs::directory_iterator(p))
-    if (e.path().extension() == ".png") out.push_back({e.path().string(), e.path().stem().string()});
+    if (e.path().extension() == ".png") out.push_back({e.path().string(), e.path().stem().string(), ""});
   std::sort(out.begin(), out.end(), [](const PlotFile& a, const PlotFile& b) { return a.png < b.png; });
   return out;
 }
@@ -200,6 +201,7 @@ std::string writeReport(const std::string& dir, bool draw_plots) {
       std::vector<PlotFile> p = plotExperiment(r);
       plots.insert(plots.end(), p.begin(), p.end());
     }
+  if (draw_plots) writeFigureSheet(dir, results, plots);
   const std::vector<Finding> findings = computeFindings(results);
   const std::string path = (fs::path(dir) / "report.md").string();
   writeFileAtomic(path, reportMarkdown(results, findings, plots, dir));

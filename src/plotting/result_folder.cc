@@ -123,6 +123,8 @@ void readExperimentYaml(const fs::path& p, ExperimentResults& r) {
   try {
     const YAML::Node n = YAML::LoadFile(p.string());
     if (n["kind"]) r.kind = n["kind"].as<std::string>();
+    if (n["tail"] && n["tail"].IsMap() && n["tail"]["links"] && n["tail"]["links"].IsScalar())
+      r.links = n["tail"]["links"].as<int>();
     if (r.description.empty() && n["description"]) r.description = n["description"].as<std::string>();
     if (r.name.empty() && n["name"]) r.name = n["name"].as<std::string>();
   } catch (const YAML::Exception&) {
@@ -193,6 +195,7 @@ ExperimentResults loadResults(const std::string& dir) {
   readExperimentYaml(root / "experiment.yaml", fromYaml);
   if (!kind_given) r.kind = fromYaml.kind;
   if (r.description.empty()) r.description = fromYaml.description;
+  r.links = fromYaml.links;
   if (r.name.empty()) r.name = fromYaml.name.empty() ? root.filename().string() : fromYaml.name;
 
   // Keys: summary order first, then any others found in the cases.

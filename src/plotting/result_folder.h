@@ -45,6 +45,7 @@ struct ExperimentResults {
   std::string description;
   std::string source;       // YAML file it was run from
   std::string kind = "simulate";  // "simulate" | "pose"
+  int links = 0;                    // tail links when experiment.yaml gives one number, else 0
   std::vector<std::string> models;  // every model that has a run, "analytic" first
   std::vector<SweepAxis> axes;      // swept keys with more than one value, in summary order
   std::vector<CaseRecord> cases;
