@@ -14,7 +14,9 @@ if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 flags="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
-WERROR=OFF; [ "${CI:-}" = true ] && WERROR=ON
+# Warnings are errors in the Release build (scripts/setup.sh under CI); not here: GCC's sanitizer
+# instrumentation raises false -Wmaybe-uninitialized / -Wstringop-* warnings in library headers.
+WERROR=OFF
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS="$flags" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DTAILSIM_WERROR=$WERROR -DTAILSIM_BENCHMARKS=OFF \
   "${launcher[@]}" >/dev/null
@@ -24,5 +26,7 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan-suppressions.txt:print_suppressions=0"
 # readme_tour runs the paper suite three times (about 2 min in Release, over 15 min under ASan);
 # the same code paths run in the cli test and the GoogleTest suites, which do run here.
-EXCLUDE='^readme_tour$'
+# readme_images_current compares hashes of the Release build's output bit for bit; this build is
+# -O2, so its last digits may differ without anything being wrong.
+EXCLUDE='^(readme_tour|readme_images_current)$'
 ctest --test-dir build-asan --output-on-failure -j"$(nproc)" -E "$EXCLUDE" "$@"
