@@ -9,6 +9,8 @@
 #                                                   fail if it differs from SOURCES.txt
 #                                                   (CTest: readme_images_current)
 # BUILD_DIR defaults to build/ (it must hold a built tailsim).
+# Also docs/images/video_frame.png: the poster frame of `tailsim render` of Fig. 6a (640x480
+# defaults; docs/rendering.md), recorded by the SHA-256 of the two time series it replays.
 set -euo pipefail
 check=0
 if [ "${1:-}" = "--check" ]; then check=1; shift; fi
@@ -55,6 +57,8 @@ sheet=$work/SOURCES.txt
     echo "image $image <- configs/paper/$exp.yaml, figure $stem"
     sources "$work/$exp/plots" "$stem" | sed 's/^/  /'
   done
+  echo "image video_frame.png <- configs/paper/fig06a_model_comparison_1dof.yaml, tailsim render, poster frame"
+  (cd "$work/fig06a_model_comparison_1dof" && sha256sum cases/base/mujoco.csv cases/base/analytic.csv) | sed 's/^/  /'
 } >"$sheet"
 
 if [ $check = 1 ]; then
@@ -62,7 +66,7 @@ if [ $check = 1 ]; then
     echo "FAIL: docs/images are not current with the code: run scripts/readme_images.sh" >&2
     exit 1
   fi
-  echo "ok: docs/images/SOURCES.txt matches the regenerated data of ${#figures[@]} images"
+  echo "ok: docs/images/SOURCES.txt matches the regenerated data of $(( ${#figures[@]} + 1 )) images"
   exit 0
 fi
 
@@ -84,6 +88,10 @@ for f in "${figures[@]}"; do
   mv "$images/$image.tmp" "$images/$image"
   echo "$images/$image"
 done
+"$tailsim" render "$src/configs/paper/fig06a_model_comparison_1dof.yaml" --out "$work/video" >/dev/null
+cp "$work/video/fig06a_model_comparison_1dof/base.png" "$images/video_frame.png.tmp"
+mv "$images/video_frame.png.tmp" "$images/video_frame.png"
+echo "$images/video_frame.png"
 cp "$sheet" "$images/SOURCES.txt.tmp"
 mv "$images/SOURCES.txt.tmp" "$images/SOURCES.txt"
 echo "$images/SOURCES.txt"

@@ -8,7 +8,8 @@ cd "$(dirname "$0")/.."
 PKGS="build-essential cmake libmujoco-dev libmujoco-samples libeigen3-dev libyaml-cpp-dev
   libosmesa6-dev ffmpeg libgtest-dev googletest libbenchmark-dev libboost-dev libcli11-dev
   gnuplot-nox libtinyxml2-dev nlohmann-json3-dev
-  libqhull-dev clang libclang-rt-14-dev"
+  libqhull-dev clang libclang-rt-14-dev python3-jsonschema python3-yaml libpagmo-dev libnlopt-cxx-dev
+  parallel slurm-wlm munge"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
@@ -22,4 +23,6 @@ fi
 # CI builds with warnings as errors (CMake option TAILSIM_WERROR); set explicitly so the cache never keeps it.
 WERROR=OFF; [ "${CI:-}" = true ] && WERROR=ON
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTAILSIM_WERROR=$WERROR >/dev/null
-cmake --build build -j"$(nproc)"
+# TAILSIM_TARGET=tailsim (scripts/run.sh): only the program and the 6 libraries it links (7 targets);
+# unset: everything, tests and benchmarks included.
+cmake --build build -j"$(nproc)" ${TAILSIM_TARGET:+--target "$TAILSIM_TARGET"}

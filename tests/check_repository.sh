@@ -62,6 +62,14 @@ for f in "${files[@]}"; do
                 }' "$f")
 done
 
+# Reports and plots read result folders, never YAML inputs (issue 10): no yaml-cpp in src/plotting
+# or src/app, and the CMake plotting target does not name it.
+while IFS= read -r hit; do
+  report "$hit: the plotting and app layers read result folders through the experiments layer, not YAML"
+done < <(grep -rnE 'yaml-cpp|YAML::' "$root/src/plotting" "$root/src/app" 2>/dev/null || true)
+grep -qE '^tailsim_layer\(tailsim_plotting [^)]*yaml' "$root/CMakeLists.txt" &&
+  report "CMakeLists.txt: tailsim_plotting links yaml-cpp"
+
 if [ "$problems" -gt 0 ]; then
   echo "$problems problem(s): the repository must stand alone (reading notes: docs/paper-notes.md)"
   exit 1

@@ -129,4 +129,10 @@ run 0 "$tailsim" run sweep.yaml --out int_run --threads 2 --quiet
 grep -q "^$total cases: $((total - saved)) run, $saved resumed, 0 failed" out.txt || fail "rerun: $(head -n 1 out.txt)"
 ok "Ctrl-C after the first case: exit 130, '$said', rerun resumed $saved"
 
+# Issue 13: a run that renders nothing does not load OSMesa (LLVM, z3, ICU) at all.
+LD_DEBUG=libs "$tailsim" run "$src/configs/default.yaml" --out lazy_gl --quiet >out.txt 2>err.txt || fail "lazy-GL run: $(tail -3 err.txt)"
+grep -q "calling init: .*libyaml-cpp" err.txt || fail "LD_DEBUG=libs printed no library list: cannot check OSMesa"
+! grep -q "libOSMesa\|libLLVM" err.txt || fail "an analytic run loaded OSMesa/LLVM: $(grep -m1 'libOSMesa\|libLLVM' err.txt)"
+ok "an analytic run starts without OSMesa/LLVM (LD_DEBUG=libs)"
+
 echo "PASS"

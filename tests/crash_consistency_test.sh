@@ -48,6 +48,13 @@ for d in fresh crashed; do
   cp -r "$W/$d" "$W/cmp_$d"
   rm -f "$W/cmp_$d/.tailsim.lock"
   find "$W/cmp_$d" -name '*.json' -exec sed -i -E 's/"wall_time_s": [-0-9.eE+]+/"wall_time_s": W/' {} +
+  python3 - "$W/cmp_$d/results.csv" <<'PY'  # results.csv: its wall_time_s column
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1], newline='')))
+i = rows[0].index('wall_time_s')
+for r in rows[1:]: r[i] = 'W'
+csv.writer(open(sys.argv[1], 'w', newline=''), lineterminator='\n').writerows(rows)
+PY
 done
 if ! diff -r "$W/cmp_fresh" "$W/cmp_crashed" > "$W/diff.txt"; then
   echo "FAIL: the resumed result folder differs from the fresh one:"; head -20 "$W/diff.txt"; exit 1

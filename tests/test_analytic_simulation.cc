@@ -145,7 +145,7 @@ TEST(AnalyticSimulation, FixedStepConvergesToEventLocatedResult) {
   double prev = 1e9;
   for (double h : {1e-3, 1e-4, 1e-5}) {
     AnalyticSettings s;
-    s.solver = "fixed";
+    s.solver = AnalyticSolver::kFixed;
     s.fixed_dt_s = h;
     const double err = std::abs(runFig7(s).summary.phi_net_deg - phi_ref);
     std::printf("fixed h %.0e: err %.3e deg\n", h, err);

@@ -109,7 +109,6 @@ TEST(DiskFull, Finding4_SweepStopsAtTheFirstDiskFullError) {
   std::ofstream(exp) << "name: full\nrobot: paper\nmodels: [analytic]\n"
                         "trajectory: {dtheta_deg: {range: [-100, -61, 1]}, dT_s: 0.25}\n";
   const Experiment e = loadExperiment(exp.string());
-  fs::remove(exp);
   ASSERT_EQ(e.cases.size(), 40u);
   RunOptions o;
   o.out_dir = (disk.dir() / "out").string();
@@ -123,6 +122,7 @@ TEST(DiskFull, Finding4_SweepStopsAtTheFirstDiskFullError) {
     EXPECT_NE(msg.find("No space left on device"), std::string::npos) << msg;
     EXPECT_NE(msg.find("the disk is full: no further case was started"), std::string::npos) << msg;
   }
+  fs::remove(exp);  // after the run: it copies the experiment file into the result folder
   // Case folders: the finished ones (whole) and the one that failed; none of the 40 - n after it.
   int started = 0, finished = 0;
   for (const auto& c : fs::directory_iterator(disk.dir() / "out" / "cases")) {

@@ -221,9 +221,7 @@ TEST(ExperimentRunner, Finding1_ResumeKeyCoversRenderVersionAndSettings) {
   EXPECT_NE(caseKey(c, true), caseKey(c, false));
   EXPECT_EQ(caseKey(c, false), caseKey(e.cases.at(0), false));  // stable
   EXPECT_EQ(caseKey(c, false).size(), 64u);
-  EXPECT_NE(caseKeyText(c, false).find(std::string("tailsim.version=") + std::to_string(std::string(kVersion).size()) +
-                                       ":" + kVersion),
-            std::string::npos);
+  EXPECT_NE(caseKeyText(c, false).find(std::string("\"tailsim_version\":\"") + kVersion + "\""), std::string::npos);
   auto changed = [&](auto edit) {
     ExperimentCase d = c;
     edit(d);

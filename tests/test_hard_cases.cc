@@ -173,7 +173,7 @@ TEST(HardCases, MujocoTimestepNearTheStabilityLimit) {
   // ... the explicit Euler integrator at the default step does not, and tailsim says which
   // setting to change instead of writing garbage.
   MujocoSettings euler;
-  euler.integrator = "Euler";
+  euler.integrator = MujocoIntegrator::kEuler;
   const RunResult bad = simulateMujoco(r, tr, euler, {}, {});
   EXPECT_FALSE(bad.summary.ok);
   EXPECT_NE(bad.summary.error.find("timestep_s"), std::string::npos) << bad.summary.error;

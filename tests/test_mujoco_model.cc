@@ -131,10 +131,10 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
   const RobotParams p = paperRobot(2);
   MujocoSettings s;
   s.timestep_s = 5e-4;
-  s.integrator = "Euler";
-  s.solver = "CG";
+  s.integrator = MujocoIntegrator::kEuler;
+  s.solver = MujocoSolver::kCG;
   s.iterations = 37;
-  s.cone = "pyramidal";
+  s.cone = MujocoCone::kPyramidal;
   s.noslip_iterations = 3;
   s.impratio = 2.5;
   s.mu = 0.42;
@@ -178,7 +178,7 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
 
 TEST(MujocoModel, BadSettingsAreRejectedByName) {
   MujocoSettings s;
-  s.integrator = "RK45";
+  s.integrator = static_cast<MujocoIntegrator>(9);  // not a declared integrator
   try {
     generateMjcf(paperRobot(1), s, Effects{});
     FAIL() << "expected std::invalid_argument";

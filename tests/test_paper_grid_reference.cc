@@ -60,7 +60,7 @@ std::vector<ExperimentCase> paperGrid() {
   std::vector<ExperimentCase> out;
   for (const Experiment& e : loadExperimentSuite(TAILSIM_SOURCE_DIR "/configs/paper/all.yaml"))
     for (const ExperimentCase& c : e.cases)
-      if (c.kind == "simulate" && c.analytic.coupling == Coupling::kPaper &&
+      if (c.kind == CaseKind::kSimulate && c.analytic.coupling == Coupling::kPaper &&
           c.effects.friction == FrictionLaw::kStiction && c.effects.foot_loads == FootLoadModel::kDistributed &&
           c.effects.translation && c.effects.gravity)
         out.push_back(c);
@@ -112,7 +112,7 @@ TEST(PaperGridReference, FixedStepSolverComesToRest) {
   for (const ExperimentCase& c : paperGrid()) {
     SCOPED_TRACE(c.experiment + "/" + c.name);
     AnalyticSettings fixed = c.analytic;
-    fixed.solver = "fixed";
+    fixed.solver = AnalyticSolver::kFixed;
     const RunResult adaptive = simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, c.output);
     double phi_first = NAN;
     for (double duration : {c.simDuration(), 5.0}) {

@@ -37,7 +37,9 @@ struct SynthCase {
   std::map<std::string, TimeSeries> csv;         // model -> CSV
 };
 
-// Writes DIR/summary.json, experiment.yaml, cases/<name>/<model>.csv in the documented layout.
+// Writes DIR/summary.json, experiment.yaml, robot.yaml (the paper robot, as a run copies it),
+// cases/<name>/<model>.csv in the documented layout. Findings take the values the cases ran with
+// from experiment.yaml through the loader, so the experiments they need are real experiment files.
 void writeExperiment(const fs::path& dir, const std::string& name, const std::vector<std::string>& swept_keys,
                      const std::vector<SynthCase>& cases, const std::string& yaml) {
   fs::create_directories(dir / "cases");
@@ -68,6 +70,10 @@ void writeExperiment(const fs::path& dir, const std::string& name, const std::ve
   writeFileAtomic((dir / "summary.json").string(), s.dump(2));
   writeFileAtomic((dir / "experiment.yaml").string(), yaml);
   writeFileAtomic((dir / "source.yaml").string(), yaml);
+  std::ifstream robot(fs::path(TAILSIM_SOURCE_DIR) / "configs" / "robots" / "paper_quadruped.yaml");
+  std::stringstream rs;
+  rs << robot.rdbuf();
+  writeFileAtomic((dir / "robot.yaml").string(), rs.str());
 }
 
 // A simulate CSV driven by split-cycle profiles (joint columns), with a made-up phi(t) and
@@ -115,11 +121,6 @@ TimeSeries poseCsv(const std::map<std::string, double>& values) {
   return ts;
 }
 
-const std::string kRobotYaml = R"(quadruped: {mass_kg: 8.458, izz_kgm2: 0.1916, d_Q2C_m: -0.0155, d_Q2B_m: 0.125, l_F_m: 0.30, w_F_m: 0.26}
-tails:
-  1: {mass_kg: 2.40, izz_kgm2: 2.236e-2, length_m: 0.300}
-)";
-
 class SyntheticSuite : public ::testing::Test {
  protected:
   static void TearDownTestSuite() { fs::remove_all(root_); }
@@ -128,7 +129,6 @@ class SyntheticSuite : public ::testing::Test {
     root_ = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_suite_" + std::to_string(::getpid()));
     fs::remove_all(root_);
     fs::create_directories(root_);
-    writeFileAtomic((root_ / "robot.yaml").string(), kRobotYaml);
 
     // fig06a: no sweep, MuJoCo rotates more.
     {
@@ -144,8 +144,8 @@ class SyntheticSuite : public ::testing::Test {
       writeExperiment(root_ / "fig07_loading", "fig07_loading", {},
                       {{{}, {{"analytic", 8.0}, {"mujoco", 9.0}},
                         {{"analytic", simCsv({p}, 8.0)}, {"mujoco", simCsv({p}, 9.0, 0.02)}}}},
-                      "name: fig07_loading\nkind: simulate\ntrajectory: {theta0_deg: 0, dtheta_deg: -90, dT_s: 0.25, "
-                      "w_ss: 0.25}\n");
+                      "name: fig07_loading\nkind: simulate\nrobot: robot.yaml\ntrajectory: {theta0_deg: 0, "
+                      "dtheta_deg: -90, dT_s: 0.25, w_ss: 0.25}\n");
     }
     // fig08: pose over theta, Eq. (24) closed form with thetadot = thetaddot = 1.
     {
@@ -160,7 +160,7 @@ class SyntheticSuite : public ::testing::Test {
                                              {"Izz_kgm2", 0.3}, {"LF_m", 0.2}})}}});
       }
       writeExperiment(root_ / "fig08_moment_contributions", "fig08_moment_contributions", {"pose.theta_deg"}, cs,
-                      "name: fig08_moment_contributions\nkind: pose\nrobot: ../robot.yaml\ntail: {links: 1}\n"
+                      "name: fig08_moment_contributions\nkind: pose\nrobot: robot.yaml\ntail: {links: 1}\n"
                       "quadruped: {d_Q2B_m: 0.125}\npose: {theta_deg: {range: [-90, 90, 15]}, thetadot_radps: 1, "
                       "thetaddot_radps2: 1}\n");
     }
@@ -193,7 +193,8 @@ class SyntheticSuite : public ::testing::Test {
                         {{"analytic", poseCsv({{"LF_m", 0.2 * (1 + 0.02 * std::sin(th * kDeg) * d / 0.15)}})}}});
         }
       writeExperiment(root_ / "fig10_LF", "fig10_LF", {"quadruped.d_Q2B_m", "pose.theta_deg"}, cs,
-                      "name: fig10_LF\nkind: pose\n");
+                      "name: fig10_LF\nkind: pose\nrobot: robot.yaml\nquadruped: {d_Q2B_m: {range: [0, 0.15, "
+                      "0.025]}}\npose: {theta_deg: {range: [-90, 90, 30]}}\n");
     }
     // fig11: analytic falls with w_ss; MuJoCo has a bump between 0.5 and 0.6.
     {
@@ -219,7 +220,8 @@ class SyntheticSuite : public ::testing::Test {
                       {{"analytic", simCsv(joints, 5.0 + n)}, {"mujoco", simCsv(joints, 6.0 + n)}}});
       }
       writeExperiment(root_ / "fig14_tail_dof", "fig14_tail_dof", {"tail.links"}, cs,
-                      "name: fig14_tail_dof\ntrajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\n");
+                      "name: fig14_tail_dof\nrobot: robot.yaml\ntail: {links: {range: [1, 6, 1]}}\n"
+                      "trajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\n");
     }
   }
 
@@ -334,6 +336,31 @@ TEST_F(SyntheticSuite, WrongEq24DataIsRejected) {
   EXPECT_EQ(verdict(fs_, "eq24_closed_form", "analytic"), Verdict::kNo);
 }
 
+// The findings read the folder, never the inputs it was made from: a changed source file (the
+// live experiment) or a folder whose experiment.yaml cannot be loaded changes no verdict to YES.
+TEST_F(SyntheticSuite, FindingsIgnoreTheLiveInputs) {
+  const fs::path dir = root_ / "fig08_moment_contributions";
+  std::ifstream in(dir / "source.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string yaml = ss.str();
+  writeFileAtomic((dir / "source.yaml").string(),
+                  std::regex_replace(yaml, std::regex("d_Q2B_m: 0.125"), "d_Q2B_m: 0.15"));
+  const auto live_changed = computeFindings(loadResultTree(root_.string()));
+  writeFileAtomic((dir / "source.yaml").string(), yaml);
+  EXPECT_EQ(verdict(live_changed, "eq24_closed_form", "analytic"), Verdict::kYes);
+  // Without its robot copy the folder's cases cannot be resolved: n/a saying why, not a guess.
+  fs::rename(dir / "robot.yaml", dir / "robot.yaml.away");
+  const auto rs = loadResultTree(root_.string());
+  const auto no_robot = computeFindings(rs);
+  fs::rename(dir / "robot.yaml.away", dir / "robot.yaml");
+  EXPECT_EQ(verdict(no_robot, "eq24_closed_form", "analytic"), Verdict::kNotAvailable);
+  const ExperimentResults* f08 = findExperiment(rs, "fig08");
+  ASSERT_NE(f08, nullptr);
+  EXPECT_TRUE(f08->resolved.empty());
+  EXPECT_NE(f08->resolve_error.find("robot.yaml"), std::string::npos) << f08->resolve_error;
+}
+
 TEST_F(SyntheticSuite, PlotsAndReportAreWritten) {
   const std::vector<PlotFile> plots = plotResults(root_.string());
   std::set<std::string> stems;
@@ -444,6 +471,7 @@ TEST(ResultFolder, FallsBackToCaseResultFiles) {
   for (const char* w : {"0.1", "0.2"}) {
     json j = {{"name", std::string("w_ss=") + w},
               {"dir", std::string("w_ss=") + w},
+              {"experiment", "partial"},
               {"sweep", {{"trajectory.w_ss", w}}},
               {"runs", {{"analytic", {{"phi_net_deg", 3.0}, {"ok", true}}}}}};
     writeFileAtomic((dir / "cases" / (std::string("w_ss=") + w) / "result.json").string(), j.dump());
@@ -496,7 +524,7 @@ TEST(PaperConfigs, SuiteLoadsWithThePaperGrids) {
   const ExperimentCase& f7 = by["fig07_loading"]->cases[0];
   EXPECT_DOUBLE_EQ(mu.robot.friction.mu_s, f7.robot.friction.mu_d);
   EXPECT_DOUBLE_EQ(mu.robot.friction.mu_d, f7.robot.friction.mu_s);
-  EXPECT_EQ(by["fig10_LF"]->cases[0].kind, "pose");
+  EXPECT_EQ(by["fig10_LF"]->cases[0].kind, CaseKind::kPose);
 }
 
 TEST(AxisLabel, UnitsFromNames) {

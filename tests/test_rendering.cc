@@ -255,31 +255,42 @@ Probe ffprobe(const std::string& path) {
   return p;
 }
 
-// Robot-coloured pixels: the generated floor is a blue checker (b - r ~ 0.2 of full scale, lit),
-// the robot grey (b - r = 0.05) and orange (r > b).
-bool robotColoured(const uint8_t* p) { return int(p[2]) - int(p[0]) < 30; }
+// What a frame shows (docs/rendering.md "What a video shows"): the 3-D scene on the left on a
+// grey checker floor, a dark panel on the right (text, colour key, phi(t) inset).
+const uint8_t* px(const std::vector<uint8_t>& rgb, int w, int x, int y) { return &rgb[3 * (y * w + x)]; }
+bool dark(const uint8_t* p) { return p[0] < 45 && p[1] < 45 && p[2] < 50; }
+// The MuJoCo model: vermillion shades (floor grey: r = g = b; ghost blue: b > r).
+bool robotColoured(const uint8_t* p) { return int(p[0]) - int(p[2]) > 50 && p[0] > 90; }
+// The key and inset colours: Okabe-Ito vermillion #D55E00, blue #0072B2 (with encoder slack).
+bool vermillion(const uint8_t* p) { return p[0] > 170 && p[1] > 50 && p[1] < 130 && p[2] < 60; }
+bool blue(const uint8_t* p) { return p[0] < 60 && p[1] > 70 && p[1] < 160 && p[2] > 120; }
+bool white(const uint8_t* p) { return p[0] > 210 && p[1] > 210 && p[2] > 210; }
 
-// Fraction of robot pixels in a square around the image centre (+-h/20): the tracking top
-// camera looks at the quadruped COM, so the torso (half width 0.11 m ~ h/5 here) fills it.
-double robotFractionInCentre(const std::vector<uint8_t>& rgb, int w, int h) {
-  int robot = 0, total = 0;
-  for (int y = h / 2 - h / 20; y < h / 2 + h / 20; ++y)
-    for (int x = w / 2 - h / 20; x < w / 2 + h / 20; ++x, ++total) robot += robotColoured(&rgb[3 * (y * w + x)]);
-  return double(robot) / total;
+// Width of the scene: the panel is the dark run at the right end of the bottom row.
+int sceneWidth(const std::vector<uint8_t>& rgb, int w, int h) {
+  int x = w;
+  while (x > 0 && dark(px(rgb, w, x - 1, h - 1))) --x;
+  return x;
 }
 
-// Same in two strips the robot cannot reach and the text does not cover: the left eighth of the
-// lower half, the right eighth of the upper half (floor only).
-double robotFractionInBorder(const std::vector<uint8_t>& rgb, int w, int h) {
-  int robot = 0, total = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const bool strip = (y >= h / 2 && x < w / 8) || (y < h / 2 && x >= w - w / 8);
-      if (!strip) continue;
-      robot += robotColoured(&rgb[3 * (y * w + x)]);
-      ++total;
-    }
-  return double(robot) / total;
+// Rows between the topmost and the bottommost row with robot pixels in the scene (at least 2 per
+// row, against encoder noise): how much of the frame height the robot fills.
+int robotRowExtent(const std::vector<uint8_t>& rgb, int w, int h) {
+  const int sw = sceneWidth(rgb, w, h);
+  int top = -1, bottom = -1;
+  for (int y = 0; y < h; ++y) {
+    int n = 0;
+    for (int x = 0; x < sw; ++x) n += robotColoured(px(rgb, w, x, y));
+    if (n >= 2) bottom = y, top = top < 0 ? y : top;
+  }
+  return top < 0 ? 0 : bottom - top + 1;
+}
+
+int countIn(const std::vector<uint8_t>& rgb, int w, int x0, int x1, int y0, int y1, bool (*pred)(const uint8_t*)) {
+  int n = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) n += pred(px(rgb, w, x, y));
+  return n;
 }
 
 TEST(RenderVideo, Mp4AndPosterAreReadableAndShowTheRobot) {
@@ -305,10 +316,8 @@ TEST(RenderVideo, Mp4AndPosterAreReadableAndShowTheRobot) {
 
   const std::vector<uint8_t> poster = decodeRgb(dir / "case.png");
   ASSERT_EQ(poster.size(), 320u * 240u * 3u);
-  // The tracking top camera centres the robot: robot-coloured pixels dominate the centre and
-  // are rare at the border (floor).
-  EXPECT_GT(robotFractionInCentre(poster, 320, 240), 0.9);
-  EXPECT_LT(robotFractionInBorder(poster, 320, 240), 0.02);
+  // The tracking camera frames the robot: it fills at least half the frame height.
+  EXPECT_GE(robotRowExtent(poster, 320, 240), 120);
   // Not blank: the picture has contrast.
   double mean = 0, var = 0;
   for (uint8_t v : poster) mean += v;
@@ -325,8 +334,7 @@ TEST(RenderVideo, Mp4AndPosterAreReadableAndShowTheRobot) {
   // The video's frames are not blank either.
   const std::vector<uint8_t> last = decodeRgb(dir / "case.mp4", 4);
   ASSERT_EQ(last.size(), 320u * 240u * 3u);
-  EXPECT_GT(robotFractionInCentre(last, 320, 240), 0.9);
-  EXPECT_LT(robotFractionInBorder(last, 320, 240), 0.02);
+  EXPECT_GE(robotRowExtent(last, 320, 240), 120);
 }
 
 TEST(RenderVideo, GhostAndCameraChangeThePicture) {
@@ -338,7 +346,7 @@ TEST(RenderVideo, GhostAndCameraChangeThePicture) {
   RenderInputs without{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, ""};
   renderVideo(with, s, dir / "a.mp4", dir / "a.png");
   renderVideo(without, s, dir / "b.mp4", dir / "b.png");
-  s.camera = "perspective";
+  s.camera = RenderCamera::kPerspective;
   renderVideo(with, s, dir / "c.mp4", dir / "c.png");
   const auto a = decodeRgb(dir / "a.png"), b = decodeRgb(dir / "b.png"), cp = decodeRgb(dir / "c.png");
   ASSERT_EQ(a.size(), b.size());
@@ -374,7 +382,77 @@ TEST(RenderVideo, ReplaysBothModelsOfFig7) {
   EXPECT_EQ(ffprobe(dir / "fig7.mp4").frames, 11);
   const std::vector<uint8_t> last = decodeRgb(dir / "fig7.mp4", 10);
   ASSERT_EQ(last.size(), 320u * 240u * 3u);
-  EXPECT_LT(robotFractionInBorder(last, 320, 240), 0.02);
+  EXPECT_GE(robotRowExtent(last, 320, 240), 120);
+}
+
+// The default 640x480 frame as a reader sees it (issue 15): the robot fills at least half the
+// frame height, the analytic model is a blue outline, the colour key names each model in its
+// colour, and the phi(t) inset shows both curves with a time cursor that moves.
+TEST(RenderVideo, DefaultFrameHasTheRobotLargeTheKeyAndTheInset) {
+  TempDir dir;
+  Case c = makeCase(1, 0.3);
+  RenderSettings s;  // defaults: 640x480, msaa 4, top camera
+  s.enabled = true;
+  s.fps = 10;
+  s.slowmo = 1.0;
+  RenderInputs in{&c.robot, &c.traj, &c.mujoco, &c.analytic, c.xml, "fig07"};
+  renderVideo(in, s, dir / "a.mp4", "");
+  const int w = 640, h = 480;
+  const std::vector<uint8_t> first = decodeRgb(dir / "a.mp4", 0), last = decodeRgb(dir / "a.mp4", 3);
+  ASSERT_EQ(first.size(), size_t(w) * h * 3);
+  ASSERT_EQ(last.size(), first.size());
+  const int sw = sceneWidth(first, w, h);
+  ASSERT_GT(sw, w / 2);   // the scene takes most of the width,
+  ASSERT_LT(sw, w - 150);  // the panel the rest
+  for (const auto* f : {&first, &last}) {
+    EXPECT_GE(robotRowExtent(*f, w, h), h / 2);
+    EXPECT_GT(countIn(*f, w, 0, sw, 0, h, blue), 300);  // the ghost's outline
+    // Key: the top 40 % of the panel holds a vermillion and a blue label (~200 x 25 px each).
+    EXPECT_GT(countIn(*f, w, sw, w, 0, h * 2 / 5, vermillion), 2000);
+    EXPECT_GT(countIn(*f, w, sw, w, 0, h * 2 / 5, blue), 2000);
+    // Inset: both curves in the lower half of the panel.
+    EXPECT_GT(countIn(*f, w, sw, w, h / 2, h, vermillion), 40);
+    EXPECT_GT(countIn(*f, w, sw, w, h / 2, h, blue), 40);
+  }
+  // The time cursor: the column of the inset with the most white pixels moves right.
+  auto cursor = [&](const std::vector<uint8_t>& f) {
+    int best = -1, best_n = 0;
+    for (int x = sw; x < w; ++x) {
+      const int n = countIn(f, w, x, x + 1, h / 2, h, white);
+      if (n > best_n) best = x, best_n = n;
+    }
+    EXPECT_GT(best_n, 40) << "no vertical cursor line";
+    return best;
+  };
+  EXPECT_GT(cursor(last), cursor(first) + 50);
+  // Without the analytic run: no blue outline in the scene, no blue label.
+  RenderInputs solo{&c.robot, &c.traj, &c.mujoco, nullptr, c.xml, "fig07"};
+  renderVideo(solo, s, dir / "b.mp4", "");
+  const std::vector<uint8_t> b = decodeRgb(dir / "b.mp4", 0);
+  ASSERT_EQ(b.size(), first.size());
+  EXPECT_LT(countIn(b, w, 0, sw, 0, h, blue), 20);
+  EXPECT_LT(countIn(b, w, sw, w, 0, h * 2 / 5, blue), 20);
+}
+
+// The 1280x720 preset (render.size) renders at that size, with the robot as large.
+TEST(RenderVideo, Preset1280x720GivesThatSize) {
+  TempDir dir;
+  Case c = makeCase(1, 0.2);
+  RenderSettings s;
+  s.enabled = true;
+  s.width = kRenderSizePresets[1].width;
+  s.height = kRenderSizePresets[1].height;
+  s.fps = 10;
+  s.slowmo = 1.0;
+  s.msaa = 0;
+  RenderInputs in{&c.robot, &c.traj, &c.mujoco, &c.analytic, c.xml, "fig07"};
+  renderVideo(in, s, dir / "hd.mp4", dir / "hd.png");
+  const Probe p = ffprobe(dir / "hd.mp4");
+  EXPECT_EQ(p.width, 1280);
+  EXPECT_EQ(p.height, 720);
+  const std::vector<uint8_t> f = decodeRgb(dir / "hd.png");
+  ASSERT_EQ(f.size(), 1280u * 720u * 3u);
+  EXPECT_GE(robotRowExtent(f, 1280, 720), 360);
 }
 
 // Cases render on the experiment runner's worker threads: two renders at once, each in its
@@ -473,7 +551,7 @@ TEST(RenderErrors, BadSettingsAreReported) {
   s.width = 161;
   EXPECT_THROW(checkRenderPrerequisites(s, dir.str()), std::runtime_error);
   s = smallSettings();
-  s.camera = "side";
+  s.camera = static_cast<RenderCamera>(7);  // not a declared camera
   EXPECT_THROW(checkRenderPrerequisites(s, dir.str()), std::runtime_error);
   s = smallSettings();
   s.slowmo = 0;

@@ -131,7 +131,7 @@ TEST(Tipping, LimitsAreSettingsAndZeroTurnsACheckOff) {
 // the body over a few steps before MuJoCo warns: the run names the timestep, not a fall.
 TEST(Tipping, DivergingIntegrationIsNotReportedAsAFall) {
   MujocoSettings s;
-  s.integrator = "Euler";
+  s.integrator = MujocoIntegrator::kEuler;
   s.timestep_s = 5e-4;
   s.kp = 76360;
   const RunResult r = simulateMujoco(paperRobot(1), sameMove(1, 0, -90, 0.25, 0.25), s, {}, {});

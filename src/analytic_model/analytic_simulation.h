@@ -7,6 +7,7 @@
 
 #include "analytic_model/analytic_settings.h"
 #include "analytic_model/foot_loads.h"
+#include "analytic_model/stick_slip.h"  // breakawayCoefficient
 #include "analytic_model/system_loads.h"
 #include "results/output_settings.h"
 #include "results/time_series.h"
@@ -23,9 +24,5 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
 
 // kind: pose — loads, mass properties and L_F at one tail state; one row, no integration.
 RunResult evaluatePose(const RobotParams& robot, const std::vector<JointState>& joints, const Effects& effects);
-
-// Breakaway uses the larger of mu_s and mu_d (paper-notes point 1): with mu_s < mu_d, a body
-// that broke away at mu_s would feel mu_d > load and re-stick at once, forever.
-inline double breakawayCoefficient(const FrictionParams& f) { return f.mu_s > f.mu_d ? f.mu_s : f.mu_d; }
 
 }  // namespace tailsim

@@ -4,9 +4,13 @@
 //   tailsim render EXPERIMENT.yaml --out DIR   headless MP4 + PNG of each case
 //   tailsim mjcf --links N --out FILE          the MuJoCo model of the paper robot
 //   tailsim accuracy EXPERIMENT.yaml --out DIR work-precision study of both models
+//   tailsim optimize EXPERIMENT.yaml --out DIR best tail stroke (kind: optimize, docs/design-a-tail-stroke.md)
 // Exit codes: see kExitCodes below (also printed by --help).
 #include <CLI/CLI.hpp>
+#include <dlfcn.h>
+
 #include <algorithm>
+#include <set>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -17,8 +21,12 @@
 #include "experiments/accuracy_study.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/model_registry.h"
+#include "experiments/settings_schema.h"
 #include "experiments/render_case.h"
+#include "experiments/sharding.h"
 #include "mujoco_model/mjcf_generator.h"
+#include "plotting/ladder.h"
 #include "plotting/accuracy_plot.h"
 #include "plotting/figure_sheet.h"
 #include "plotting/plots.h"
@@ -37,7 +45,7 @@ constexpr const char* kExitCodes =
     "  0    ok\n"
     "  1    error: bad input (named file:line:col) or a failure that stopped the command\n"
     "  2    usage error: unknown subcommand or option, missing or bad argument\n"
-    "  3    run: some model runs failed (the rest is saved; see summary.json)\n"
+    "  3    run: some model runs failed (the rest is saved; see summary.json); optimize: a limit violated on the re-run\n"
     "  130  run: interrupted by Ctrl-C (finished cases are saved; run again to resume)";
 
 std::string versionString() {
@@ -49,11 +57,12 @@ std::string versionString() {
 // `--case NAME` must name a case of the suite: an error listing the available ones otherwise.
 void requireCase(const std::vector<Experiment>& suite, const std::string& file, const std::string& name) {
   if (name.empty()) return;
-  std::vector<std::string> names;
+  std::vector<std::string> names;  // in file order, each once
+  std::set<std::string> listed;     // (a set: a 10^5-case sweep must not cost 10^10 comparisons)
   for (const Experiment& e : suite)
     for (const ExperimentCase& c : e.cases) {
       if (c.name == name) return;
-      if (std::find(names.begin(), names.end(), c.name) == names.end()) names.push_back(c.name);
+      if (listed.insert(c.name).second) names.push_back(c.name);
     }
   std::string list;
   const size_t show = std::min<size_t>(names.size(), 20);
@@ -128,9 +137,18 @@ int main(int argc, char** argv) {
   run->add_flag("--fresh", fresh, "start from an empty result folder (deletes tailsim's results in --out, also another experiment's)");
   run->add_flag("--quiet", quiet, "no progress line");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
+  std::string shard_text;
+  run->add_option("--shard", shard_text,
+                  "K/N: run only shard K of N (cases balanced by expected cost; join the shards with tailsim merge)");
+  std::vector<std::string> merge_dirs;
+  std::string merge_out;
+  auto* merge = app.add_subcommand("merge", "join the result folders of `run --shard K/N` into one folder");
+  merge->add_option("shards", merge_dirs, "the shards' result folders")->required()->check(CLI::ExistingDirectory);
+  merge->add_option("--out", merge_out, "the merged result folder (new or empty)")->required();
+  merge->add_option("--threads", threads, "worker threads (default: all cores)");
   std::vector<std::string> only_models;
   run->add_option("--models", only_models, "run only these models (analytic, mujoco) of each case")
-      ->check(CLI::IsMember({"analytic", "mujoco"}));
+      ->check(CLI::IsMember(modelNames()));
 
   int links = 1;
   std::string mjcf_out;
@@ -149,6 +167,8 @@ int main(int argc, char** argv) {
   plot->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
   auto* report = app.add_subcommand("report", "write DIR/report.md: plots and the paper's findings checked");
   report->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
+  auto* ladder = app.add_subcommand("ladder", "write DIR/ladder.md: the gap ladder of a configs/ladder/ result folder");
+  ladder->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
 
   std::string acc_out;
   bool acc_quick = false, acc_no_mujoco = false;
@@ -160,6 +180,17 @@ int main(int argc, char** argv) {
   accuracy->add_option("--repeats", acc_repeats, "runs per setting; wall time is their median");
   accuracy->add_flag("--quick", acc_quick, "a reduced grid");
   accuracy->add_flag("--no-mujoco", acc_no_mujoco, "analytic model only");
+
+  bool schema_markdown = false, schema_robot = false;
+  auto* schema = app.add_subcommand("schema", "print the JSON Schema of experiment and suite files (for editors)");
+  schema->add_flag("--robot", schema_robot, "the schema of robot files instead");
+  schema->add_flag("--markdown", schema_markdown, "the key tables of docs/experiment-format.md instead");
+  std::string opt_out;
+  bool opt_quiet = false;
+  auto* optimize = app.add_subcommand("optimize", "optimise a tail stroke (kind: optimize experiment)");
+  optimize->add_option("experiment", exp_path, "optimize experiment YAML")->required()->check(CLI::ExistingFile);
+  optimize->add_option("--out", opt_out, "result folder")->required();
+  optimize->add_flag("--quiet", opt_quiet, "no progress lines");
 
   try {
     app.parse(argc, argv);
@@ -213,19 +244,30 @@ int main(int argc, char** argv) {
       o.progress = !quiet;
       o.only_case = case_name;
       o.stop_on_sigint = true;
+      if (!shard_text.empty()) {
+        const ShardSpec sh = parseShard(shard_text);
+        o.shard_index = sh.index;
+        o.shard_count = sh.count;
+      }
       requireCase(suite, exp_path, case_name);
       const RunStats s = runSuite(suite, o);
-      std::printf("%d cases: %d run, %d resumed, %d failed model runs, %.3f s wall\n", s.total, s.ran, s.resumed,
-                  s.failed, s.wall_time_s);
+      std::printf("%d cases%s: %d run, %d resumed, %d failed model runs, %.3f s wall\n", s.total,
+                  shard_text.empty() ? "" : (" in shard " + shard_text).c_str(), s.ran, s.resumed, s.failed,
+                  s.wall_time_s);
       if (s.interrupted) {
         std::fflush(stdout);
         std::fprintf(stderr, "interrupted: %d of %d cases saved in %s; run the same command again to resume\n",
                      s.ran + s.resumed, s.total, out_dir.c_str());
         return kExitInterrupted;
       }
-      printCases(suite, out_dir, suite.size() > 1);
+      if (shard_text.empty()) printCases(suite, out_dir, suite.size() > 1);  // a shard's table is mostly "not run"
       if (plots) std::printf("report: %s\n", writeReport(out_dir).c_str());
       return s.failed ? kExitRunsFailed : kExitOk;
+    }
+    if (*merge) {
+      const MergeStats m = mergeShards(merge_dirs, merge_out, threads);
+      std::printf("merged %d shards: %d cases, %d files into %s\n", m.shards, m.cases, m.files_copied, merge_out.c_str());
+      return kExitOk;
     }
     if (*mjcf) {
       const bool to_stream = writeMjcfFile(links, mjcf_out);
@@ -242,7 +284,7 @@ int main(int argc, char** argv) {
           if (!case_name.empty() && c.name != case_name) continue;
           if (!c.render.enabled) c.render.enabled = true;  // defaults when the file has no render section
           checkRenderPrerequisites(c.render, dir.string());  // before simulating
-          if (c.kind != "simulate") throw std::runtime_error("only kind: simulate experiments can be rendered");
+          if (c.kind != CaseKind::kSimulate) throw std::runtime_error("only kind: simulate experiments can be rendered");
           c.models = {"analytic", "mujoco"};
           const std::vector<RunResult> runs = runCase(c);
           for (const RunResult& r : runs)
@@ -267,6 +309,34 @@ int main(int argc, char** argv) {
       std::printf("%s/accuracy.md\n%s/accuracy.csv\n", acc_out.c_str(), acc_out.c_str());
       return kExitOk;
     }
+    if (*schema) {
+      if (schema_markdown) std::printf("%s", settingsMarkdown().c_str());
+      else std::printf("%s\n", (schema_robot ? robotSchema() : experimentSchema()).dump(2).c_str());
+      return kExitOk;
+    }
+    if (*optimize) {
+      // The optimiser lives in a module loaded only here (src/app/modules/optimize.cc): pagmo's
+      // start-up cost stays out of every other command.
+      const fs::path exe = fs::read_symlink("/proc/self/exe");
+      std::string tried;
+      void* lib = nullptr;
+      for (const fs::path& p : {exe.parent_path() / "tailsim_optimize.so",
+                                exe.parent_path().parent_path() / "lib" / "tailsim" / "tailsim_optimize.so"}) {
+        lib = ::dlopen(p.c_str(), RTLD_NOW | RTLD_LOCAL);
+        if (lib) break;
+        const char* why = ::dlerror();
+        tried += "\n  " + p.string() + ": " + (why ? why : "?");
+      }
+      if (!lib) throw std::runtime_error("optimize: cannot load the optimiser module:" + tried);
+      using Entry = int (*)(const char*, const char*, int, char*, size_t);
+      const auto entry = reinterpret_cast<Entry>(::dlsym(lib, "tailsim_optimize_main"));
+      if (!entry) throw std::runtime_error("optimize: the optimiser module has no tailsim_optimize_main");
+      char err[8192] = {0};
+      const int rc = entry(exp_path.c_str(), opt_out.c_str(), opt_quiet ? 1 : 0, err, sizeof err);
+      if (rc == -1) throw ConfigError(err);
+      if (rc < 0) throw std::runtime_error(err);
+      return rc == 0 ? kExitOk : kExitRunsFailed;
+    }
     if (*plot) {
       const auto files = plotResults(result_dir);
       for (const auto& f : files) std::printf("%s\n", f.png.c_str());
@@ -275,6 +345,10 @@ int main(int argc, char** argv) {
     }
     if (*report) {
       std::printf("%s\n", writeReport(result_dir).c_str());
+      return kExitOk;
+    }
+    if (*ladder) {
+      for (const std::string& f : writeLadder(result_dir)) std::printf("%s\n", f.c_str());
       return kExitOk;
     }
   } catch (const ConfigError& e) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "analytic_model/analytic_simulation.h"
+#include "results/columns.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "results/atomic_file.h"
 
@@ -20,9 +21,9 @@ std::string num(double v) {
 }
 
 double rmsDiff(const TimeSeries& a, const TimeSeries& b) {
-  if (!a.has("phi_deg") || !b.has("phi_deg")) return NAN;
-  const auto& x = a.values("phi_deg");
-  const auto& y = b.values("phi_deg");
+  if (!a.has(col::kPhi) || !b.has(col::kPhi)) return NAN;
+  const auto& x = a.values(col::kPhi);
+  const auto& y = b.values(col::kPhi);
   const size_t n = std::min(x.size(), y.size());
   if (n == 0) return NAN;
   double s = 0;
@@ -75,7 +76,7 @@ AccuracyRow makeRow(const std::string& model, const std::string& family, const s
 std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyOptions& opt) {
   std::vector<AccuracyStudy> out;
   for (const ExperimentCase& c : e.cases) {
-    if (c.kind != "simulate") continue;
+    if (c.kind != CaseKind::kSimulate) continue;
     AccuracyStudy st;
     st.case_name = e.name + (c.name == "base" ? "" : ":" + c.name);
     const TailTrajectory traj = c.trajectory();
@@ -87,7 +88,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
     auto analytic = [&](const AnalyticSettings& s) { return simulateAnalytic(c.robot, traj, s, c.effects, c.output); };
     auto adaptive = [&](double tol) {
       AnalyticSettings s = c.analytic;
-      s.solver = "adaptive";
+      s.solver = AnalyticSolver::kAdaptive;
       s.rel_tol = tol;
       s.abs_tol = tol * 1e-2;
       return s;
@@ -134,7 +135,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
                                              : std::vector<double>{1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6};
     for (double h : hs) {
       AnalyticSettings s = c.analytic;
-      s.solver = "fixed";
+      s.solver = AnalyticSolver::kFixed;
       s.fixed_dt_s = h;
       double wall = 0, mean = 0;
       int runs = 0;
@@ -198,7 +199,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
       };
       const double h_ref = opt.quick ? 1e-4 : 2.5e-5;
       MujocoSettings ref_m = withStep(c.mujoco, h_ref);
-      ref_m.integrator = "implicit";
+      ref_m.integrator = MujocoIntegrator::kImplicit;
       ref_m.iterations = std::max(ref_m.iterations, 100);
       ref_m.tolerance = std::min(ref_m.tolerance, 1e-10);
       const Ensemble e_ref = ensemble(ref_m);
@@ -245,16 +246,18 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
       };
       const std::vector<double> steps = opt.quick ? std::vector<double>{5e-4, 2e-4}
                                                   : std::vector<double>{1e-3, 5e-4, 2e-4, 1e-4, 5e-5};
-      for (const char* integ : {"implicit", "Euler", "RK4"})
+      for (const MujocoIntegrator in : {MujocoIntegrator::kImplicit, MujocoIntegrator::kEuler, MujocoIntegrator::kRK4})
         for (double h : steps) {
+          const std::string integ = name(in);
           MujocoSettings s = withStep(c.mujoco, h);
-          s.integrator = integ;
+          s.integrator = in;
           add(std::string("timestep/") + integ, std::string("integrator=") + integ + " timestep_s=" + num(h), h, s);
         }
       if (!opt.quick) {
-        for (const char* solver : {"Newton", "CG", "PGS"}) {
+        for (const MujocoSolver so : {MujocoSolver::kNewton, MujocoSolver::kCG, MujocoSolver::kPGS}) {
+          const std::string solver = name(so);
           MujocoSettings s = c.mujoco;
-          s.solver = solver;
+          s.solver = so;
           add("solver", std::string("solver=") + solver, 0, s);
         }
         for (auto [it, tol] : {std::pair<int, double>{100, 1e-10}, {20, 1e-6}, {5, 1e-3}}) {
@@ -263,9 +266,10 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
           s.tolerance = tol;
           add("iterations", "iterations=" + std::to_string(it) + " tolerance=" + num(tol), tol, s);
         }
-        for (const char* cone : {"elliptic", "pyramidal"}) {
+        for (const MujocoCone co : {MujocoCone::kElliptic, MujocoCone::kPyramidal}) {
+          const std::string cone = name(co);
           MujocoSettings s = c.mujoco;
-          s.cone = cone;
+          s.cone = co;
           add("cone", std::string("cone=") + cone, 0, s);
         }
         for (int ns : {0, 10}) {

@@ -10,12 +10,23 @@
 #include "trajectory/split_cycle_profile.h"
 #include "robot/scene_effects.h"
 #include "analytic_model/analytic_settings.h"
+#include "analytic_model/per_foot_model.h"
 #include "mujoco_model/mujoco_settings.h"
 #include "rendering/render_settings.h"
 #include "results/output_settings.h"
 
 namespace tailsim {
 
+
+enum class CaseKind {
+  kSimulate,  // integrate a trajectory
+  kPose,      // loads at one tail state (Figs. 8, 10)
+};
+inline const settings::EnumNames<CaseKind>& kindNames() {
+  static const settings::EnumNames<CaseKind> k = {{CaseKind::kSimulate, "simulate"}, {CaseKind::kPose, "pose"}};
+  return k;
+}
+inline const char* name(CaseKind k) { return settings::nameOf(kindNames(), k); }
 
 // kind: pose — evaluate loads at one tail state, no time integration (Figs. 8, 10).
 struct PoseSpec {
@@ -31,13 +42,14 @@ struct ExperimentCase {
   std::string robot_file;   // the robot file it names (absolute)
   std::map<std::string, std::string> sweep_values;  // swept key -> value as written
 
-  std::string kind = "simulate";  // "simulate" | "pose"
-  PoseSpec pose;                   // kind == "pose"
+  CaseKind kind = CaseKind::kSimulate;
+  PoseSpec pose;  // kind == kPose
 
   RobotParams robot;
   std::vector<SplitCycleParams> joints;  // one per tail link
-  std::vector<std::string> models;       // "analytic", "mujoco"
+  std::vector<std::string> models;       // "analytic", "perfoot", "mujoco" (experiments/model_registry.h)
   AnalyticSettings analytic;
+  PerFootSettings perfoot;
   MujocoSettings mujoco;
   Effects effects;
   OutputSettings output;

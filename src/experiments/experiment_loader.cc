@@ -257,6 +257,9 @@ class Reader {
   [[noreturn]] void fail(const Item& it, const std::string& what) const { tailsim::fail(loc(it), what); }
 
   MapView map(const Item& it, std::initializer_list<const char*> allowed) const {
+    return map(it, std::vector<std::string>(allowed.begin(), allowed.end()));
+  }
+  MapView map(const Item& it, const std::vector<std::string>& allowed) const {
     if (pick(it)) fail(it, "a sweep can replace a single value only, not a section or list");
     if (!it.node.IsMap()) {
       if (it.key.empty()) fail(it, "the file must be a map of key: value, got " + describe(it.node));
@@ -268,8 +271,11 @@ class Reader {
       if (!kv.first.IsScalar()) tailsim::fail(Loc{file_, kv.first.Mark(), it.key}, "keys must be plain names");
       const std::string k = kv.first.Scalar();
       const Loc keyLoc{file_, kv.first.Mark(), joinKey(it.key, k)};
-      if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }) == allowed.end())
-        tailsim::fail(keyLoc, "unknown key (allowed here: " + joinList(allowed) + ")");
+      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
+        std::string list;
+        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        tailsim::fail(keyLoc, "unknown key (allowed here: " + list + ")");
+      }
       if (m.get(k)) tailsim::fail(keyLoc, "duplicate key");
       const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
       m.fields.emplace_back(k, Item{kv.second, keyLoc.key, empty ? kv.first.Mark() : kv.second.Mark(), kv.first.Mark()});
@@ -358,6 +364,17 @@ class Reader {
     scalarOrFail(it, n, "a string");
     return n.Scalar();
   }
+  template <class E>
+  E choice(const Item& it, const settings::EnumNames<E>& names) const {
+    const std::string s = string(it);
+    E v{};
+    if (!settings::valueOf(names, s, v)) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + std::string(n.name);
+      fail(it, "unknown value " + quote(s) + " (allowed: " + list + ")");
+    }
+    return v;
+  }
   std::string choice(const Item& it, std::initializer_list<const char*> allowed) const {
     const std::string s = string(it);
     if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; }) == allowed.end())
@@ -379,66 +396,149 @@ class Reader {
 // ---------------------------------------------------------------------------------------------
 // Robot files
 
-struct DoubleField {
-  const char* name;
-  double QuadrupedParams::*quad;
-  double FrictionParams::*fric;
-};
-constexpr DoubleField kQuadFields[] = {
-    {"mass_kg", &QuadrupedParams::mass_kg, nullptr}, {"izz_kgm2", &QuadrupedParams::izz_kgm2, nullptr},
-    {"d_Q2C_m", &QuadrupedParams::d_Q2C_m, nullptr}, {"d_Q2B_m", &QuadrupedParams::d_Q2B_m, nullptr},
-    {"l_F_m", &QuadrupedParams::l_F_m, nullptr},     {"w_F_m", &QuadrupedParams::w_F_m, nullptr}};
-constexpr DoubleField kFrictionFields[] = {
-    {"mu_s", nullptr, &FrictionParams::mu_s},
-    {"mu_d", nullptr, &FrictionParams::mu_d},
-    {"phidot_s_radps", nullptr, &FrictionParams::phidot_s_radps},
-    {"phidot_d_radps", nullptr, &FrictionParams::phidot_d_radps},
-    {"v_s_mps", nullptr, &FrictionParams::v_s_mps},
-    {"v_d_mps", nullptr, &FrictionParams::v_d_mps}};
-#define TAILSIM_QUAD_KEYS {"mass_kg", "izz_kgm2", "d_Q2C_m", "d_Q2B_m", "l_F_m", "w_F_m"}
-#define TAILSIM_FRICTION_KEYS {"mu_s", "mu_d", "phidot_s_radps", "phidot_d_radps", "v_s_mps", "v_d_mps"}
-#define TAILSIM_LINK_KEYS {"mass_kg", "izz_kgm2", "length_m", "com_offset_m"}
-
 using Origins = std::map<std::string, Loc>;  // tailsim::validate() field name -> where it was set
 
-// Sets the quadruped / friction fields present in `m` (all of them when `all`).
-void readQuadruped(const Reader& r, const MapView& m, bool all, QuadrupedParams& q, Origins& origin) {
-  for (const DoubleField& f : kQuadFields) {
-    const Item* it = all ? &r.need(m, f.name) : m.get(f.name);
-    if (!it) continue;
-    q.*(f.quad) = r.number(*it);
-    origin[std::string("quadruped.") + f.name] = r.loc(*it);
-  }
+// The keys a struct declares (settings/fields.h), YAML keys only (not internal ones).
+struct KeyLister {
+  std::vector<std::string> keys;
+  void add(const settings::Field& f) { keys.push_back(f.key); }
+  template <class... T>
+  void number(const settings::Field& f, T&&...) { add(f); }
+  template <class... T>
+  void integer(const settings::Field& f, T&&...) { add(f); }
+  template <class... T>
+  void boolean(const settings::Field& f, T&&...) { add(f); }
+  template <class... T>
+  void choice(const settings::Field& f, T&&...) { add(f); }
+  template <class... T>
+  void text(const settings::Field& f, T&&...) { add(f); }
+  template <class... T>
+  void numbers(const settings::Field& f, T&&...) { add(f); }
+  template <class... T>
+  void internal(const settings::Field&, T&&...) {}
+};
+template <class S>
+std::vector<std::string> declaredKeys() {
+  KeyLister k;
+  const S s{};
+  declareFields(k, s);
+  return k.keys;
 }
-void readFriction(const Reader& r, const MapView& m, bool all, FrictionParams& fp, Origins& origin) {
-  for (const DoubleField& f : kFrictionFields) {
-    const Item* it = all ? &r.need(m, f.name) : m.get(f.name);
-    if (!it) continue;
-    fp.*(f.fric) = r.number(*it);
-    origin[std::string("friction.") + f.name] = r.loc(*it);
+
+// Reads the declared fields of one struct from a YAML map: each present key (every key when
+// `all`) is read, type- and range-checked at its file:line:col, and stored (times its scale).
+// Where a key was set goes into `origin` under origin_prefix + key (for validate()'s messages).
+class YamlFields {
+ public:
+  YamlFields(const Reader& r, const MapView& m, bool all, bool check_ranges, Origins* origin, std::string origin_prefix)
+      : r_(r), m_(m), all_(all), ranges_(check_ranges), origin_(origin), prefix_(std::move(origin_prefix)) {}
+
+  void number(const settings::Field& f, double& x, const settings::Limits& l) {
+    const Item* it = get(f);
+    if (!it) return;
+    const double v = r_.number(*it);
+    if (ranges_ && !l.ok(v)) r_.fail(*it, "must " + l.text() + ", got " + fmtG(v));
+    x = v * f.scale;
   }
+  void integer(const settings::Field& f, int& x, const settings::Limits& l, const settings::IntSet& only = {}) {
+    const Item* it = get(f);
+    if (!it) return;
+    const long lo = l.hasLo() ? static_cast<long>(std::ceil(l.lo)) : std::numeric_limits<int>::min();
+    const long hi = l.hasHi() ? static_cast<long>(std::floor(l.hi)) : std::numeric_limits<int>::max();
+    x = r_.integer(*it, lo, hi);
+    if (!only.one_of.empty() && std::find(only.one_of.begin(), only.one_of.end(), x) == only.one_of.end()) {
+      std::string list;
+      for (int k : only.one_of) list += (list.empty() ? "" : ", ") + std::to_string(k);
+      r_.fail(*it, "must be one of " + list + ", got " + std::to_string(x));
+    }
+    if (x % only.multiple_of)
+      r_.fail(*it, (only.multiple_of == 2 ? std::string("must be even") : "must be a multiple of " + std::to_string(only.multiple_of)) +
+                       (*only.why ? std::string(" (") + only.why + ")" : "") + ", got " + std::to_string(x));
+  }
+  void boolean(const settings::Field& f, bool& x) {
+    if (const Item* it = get(f)) x = r_.boolean(*it);
+  }
+  template <class E>
+  void choice(const settings::Field& f, E& x, const settings::EnumNames<E>& names) {
+    const Item* it = get(f);
+    if (!it) return;
+    const std::string v = r_.string(*it);
+    if (!settings::valueOf(names, v, x)) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + std::string(n.name);
+      r_.fail(*it, "unknown value " + quote(v) + " (allowed: " + list + ")");
+    }
+  }
+  void text(const settings::Field& f, std::string& x, const settings::TextRule& rule) {
+    const Item* it = get(f);
+    if (!it) return;
+    const std::string v = r_.string(*it);
+    if (rule.non_empty && v.empty()) r_.fail(*it, "must not be empty");
+    if (!rule.one_of.empty() && std::find(rule.one_of.begin(), rule.one_of.end(), v) == rule.one_of.end()) {
+      std::string list;
+      for (const auto& n : rule.one_of) list += (list.empty() ? "" : ", ") + n;
+      r_.fail(*it, "unknown value " + quote(v) + " (allowed: " + list + ")");
+    }
+    x = v;
+  }
+  template <std::size_t N>
+  void numbers(const settings::Field& f, std::array<double, N>& x) {
+    const Item* it = get(f);
+    if (!it) return;
+    const std::vector<Item> v = r_.list(*it);
+    if (v.size() != N) r_.fail(*it, "needs " + std::to_string(N) + " values, got " + std::to_string(v.size()));
+    for (std::size_t i = 0; i < N; ++i) x[i] = r_.number(v[i]);
+  }
+  template <class T>
+  void internal(const settings::Field&, T&) {}
+
+ private:
+  const Item* get(const settings::Field& f) {
+    const Item* it = all_ ? &r_.need(m_, f.key) : m_.get(f.key);
+    if (it && origin_) (*origin_)[prefix_ + f.key] = r_.loc(*it);
+    return it;
+  }
+  const Reader& r_;
+  const MapView& m_;
+  bool all_, ranges_;
+  Origins* origin_;
+  std::string prefix_;
+};
+
+// The map at `item` with the keys S declares; reads them into `s`.
+template <class S>
+MapView readDeclared(const Reader& r, const Item& item, S& s, bool all = false, Origins* origin = nullptr,
+                     const std::string& origin_prefix = "", bool check_ranges = true) {
+  static const std::vector<std::string> keys = declaredKeys<S>();
+  const MapView m = r.map(item, keys);
+  YamlFields v(r, m, all, check_ranges, origin, origin_prefix);
+  declareFields(v, s);
+  return m;
+}
+
+// Robot parts: ranges are checked by validate() (robot_params.cc, the same declarations), with
+// each message at the value that set it (origin).
+void readQuadruped(const Reader& r, const Item& item, bool all, QuadrupedParams& q, Origins& origin) {
+  // A robot file gives every key but com_height_m (added later, default 0.15 m: the MuJoCo body height).
+  const MapView m = readDeclared(r, item, q, false, &origin, "quadruped.", false);
+  if (all)
+    for (const std::string& k : declaredKeys<QuadrupedParams>())
+      if (k != "com_height_m") r.need(m, k);
+}
+void readFriction(const Reader& r, const Item& item, bool all, FrictionParams& fp, Origins& origin) {
+  readDeclared(r, item, fp, all, &origin, "friction.", false);
 }
 
 // One tail link {mass_kg, izz_kgm2, length_m, com_offset_m?}; origins under "tail link <i> ".
 TailLink readLink(const Reader& r, const Item& item, int index, Origins& origin) {
-  const MapView m = r.map(item, TAILSIM_LINK_KEYS);
   TailLink l;
+  l.com_offset_m = -1.0;  // absent: 0.5 length_m (Table 2: COM at mid-length)
   const std::string pre = "tail link " + std::to_string(index) + " ";
-  const Item& mass = r.need(m, "mass_kg");
-  const Item& izz = r.need(m, "izz_kgm2");
-  const Item& len = r.need(m, "length_m");
-  l.mass_kg = r.number(mass);
-  l.izz_kgm2 = r.number(izz);
-  l.length_m = r.number(len);
-  origin[pre + "mass_kg"] = r.loc(mass);
-  origin[pre + "izz_kgm2"] = r.loc(izz);
-  origin[pre + "length_m"] = r.loc(len);
-  if (const Item* c = m.get("com_offset_m")) {
-    l.com_offset_m = r.number(*c);
-    origin[pre + "com_offset_m"] = r.loc(*c);
-  } else {
-    l.com_offset_m = 0.5 * l.length_m;  // Table 2: COM at mid-length
-    origin[pre + "com_offset_m"] = r.loc(len);
+  const MapView m = readDeclared(r, item, l, false, &origin, pre, false);
+  for (const char* k : {"mass_kg", "izz_kgm2", "length_m"}) r.need(m, k);
+  if (!m.get("com_offset_m")) {
+    l.com_offset_m = 0.5 * l.length_m;
+    origin[pre + "com_offset_m"] = r.loc(r.need(m, "length_m"));
   }
   return l;
 }
@@ -642,8 +742,8 @@ std::unique_ptr<RobotFile> readRobotFile(const std::string& abs) {
   const Reader r(&rf->file, nullptr);
   const Item root = r.root(doc);
   const MapView top = r.map(root, {"quadruped", "friction", "gravity_mps2", "tails"});
-  readQuadruped(r, r.map(r.need(top, "quadruped"), TAILSIM_QUAD_KEYS), true, rf->base.quadruped, rf->origin);
-  readFriction(r, r.map(r.need(top, "friction"), TAILSIM_FRICTION_KEYS), true, rf->base.friction, rf->origin);
+  readQuadruped(r, r.need(top, "quadruped"), true, rf->base.quadruped, rf->origin);
+  readFriction(r, r.need(top, "friction"), true, rf->base.friction, rf->origin);
   const Item& g = r.need(top, "gravity_mps2");
   rf->base.gravity_mps2 = r.number(g);
   rf->origin["gravity_mps2"] = r.loc(g);
@@ -847,45 +947,12 @@ PoseSpec readPose(const Reader& r, const Item& item, int n) {
   return p;
 }
 
-AnalyticSettings readAnalytic(const Reader& r, const Item& item) {
-  const MapView m = r.map(item, {"solver", "rel_tol", "abs_tol", "fixed_dt_s", "event_tol_s", "max_step_s",
-                                 "v_stop_mps", "coupling"});
-  AnalyticSettings s;
-  if (const Item* x = m.get("solver")) s.solver = r.choice(*x, {"adaptive", "fixed"});
-  if (const Item* x = m.get("rel_tol")) s.rel_tol = r.positive(*x);
-  if (const Item* x = m.get("abs_tol")) s.abs_tol = r.positive(*x);
-  if (const Item* x = m.get("fixed_dt_s")) s.fixed_dt_s = r.positive(*x);
-  if (const Item* x = m.get("event_tol_s")) s.event_tol_s = r.positive(*x);
-  if (const Item* x = m.get("max_step_s")) s.max_step_s = r.nonNegative(*x);
-  if (const Item* x = m.get("v_stop_mps")) s.v_stop_mps = r.positive(*x);
-  if (const Item* x = m.get("coupling"))
-    s.coupling = r.choice(*x, {"paper", "exact"}) == "paper" ? Coupling::kPaper : Coupling::kExact;
-  return s;
-}
-
 MujocoSettings readMujoco(const Reader& r, const Item& item) {
-  const MapView m = r.map(item, {"timestep_s", "integrator", "solver", "iterations", "tolerance", "cone",
-                                 "noslip_iterations", "condim", "impratio", "solref", "solimp", "mu", "kp", "kv",
-                                 "velocity_feedforward", "inverse_dynamics_feedforward", "servo_wn_dt", "body_height_m",
-                                 "foot_radius_m", "settle_s", "stop_phidot_radps", "max_tilt_deg",
-                                 "max_all_feet_off_s"});
   MujocoSettings s;
-  if (const Item* x = m.get("timestep_s")) s.timestep_s = r.positive(*x);
-  if (const Item* x = m.get("integrator")) s.integrator = r.choice(*x, {"Euler", "RK4", "implicit"});
-  if (const Item* x = m.get("solver")) s.solver = r.choice(*x, {"Newton", "CG", "PGS"});
-  if (const Item* x = m.get("iterations")) s.iterations = r.integer(*x, 1);
-  if (const Item* x = m.get("tolerance")) s.tolerance = r.nonNegative(*x);
-  if (const Item* x = m.get("cone")) s.cone = r.choice(*x, {"pyramidal", "elliptic"});
-  if (const Item* x = m.get("noslip_iterations")) s.noslip_iterations = r.integer(*x, 0);
-  if (const Item* x = m.get("condim")) {
-    s.condim = r.integer(*x, 1, 6);
-    if (s.condim == 2 || s.condim == 5) r.fail(*x, "must be one of 1, 3, 4, 6, got " + std::to_string(s.condim));
-  }
-  if (const Item* x = m.get("impratio")) s.impratio = r.positive(*x);
+  const MapView m = readDeclared(r, item, s);
+  // MuJoCo's own rules on solref and solimp (element by element).
   if (const Item* x = m.get("solref")) {
     const std::vector<Item> v = r.list(*x);
-    if (v.size() != 2) r.fail(*x, "needs 2 values [timeconst, dampratio], got " + std::to_string(v.size()));
-    for (int i = 0; i < 2; ++i) s.solref[i] = r.number(v[i]);
     // MuJoCo: both > 0 (time constant, damping ratio) or direct (-stiffness, -damping).
     if (s.solref[0] > 0.0 && !(s.solref[1] > 0.0)) r.fail(v[1], "damping ratio must be > 0 when solref[0] > 0");
     if (s.solref[0] < 0.0 && s.solref[1] > 0.0) r.fail(v[1], "must be <= 0 (-damping) when solref[0] < 0");
@@ -893,53 +960,18 @@ MujocoSettings readMujoco(const Reader& r, const Item& item) {
   }
   if (const Item* x = m.get("solimp")) {
     const std::vector<Item> v = r.list(*x);
-    if (v.size() != 5) r.fail(*x, "needs 5 values [dmin, dmax, width, midpoint, power], got " + std::to_string(v.size()));
-    for (int i = 0; i < 5; ++i) s.solimp[i] = r.number(v[i]);
     for (int i : {0, 1, 3})
       if (!(s.solimp[i] > 0.0 && s.solimp[i] < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(s.solimp[i]));
     if (!(s.solimp[2] > 0.0)) r.fail(v[2], "width must be > 0, got " + fmtG(s.solimp[2]));
     if (!(s.solimp[4] >= 1.0)) r.fail(v[4], "power must be >= 1, got " + fmtG(s.solimp[4]));
   }
-  if (const Item* x = m.get("mu")) s.mu = r.nonNegative(*x);
-  if (const Item* x = m.get("kp")) s.kp = r.nonNegative(*x);
-  if (const Item* x = m.get("kv")) s.kv = r.nonNegative(*x);
-  if (const Item* x = m.get("velocity_feedforward")) s.velocity_feedforward = r.boolean(*x);
-  if (const Item* x = m.get("inverse_dynamics_feedforward")) s.inverse_dynamics_feedforward = r.boolean(*x);
-  if (const Item* x = m.get("servo_wn_dt")) s.servo_wn_dt = r.positive(*x);
-  if (const Item* x = m.get("body_height_m")) s.body_height_m = r.positive(*x);
-  if (const Item* x = m.get("foot_radius_m")) s.foot_radius_m = r.positive(*x);
-  if (const Item* x = m.get("settle_s")) s.settle_s = r.nonNegative(*x);
-  if (const Item* x = m.get("stop_phidot_radps")) s.stop_phidot_radps = r.positive(*x);
-  if (const Item* x = m.get("max_tilt_deg")) s.max_tilt_deg = r.nonNegative(*x);
-  if (const Item* x = m.get("max_all_feet_off_s")) s.max_all_feet_off_s = r.nonNegative(*x);
   return s;
-}
-
-Effects readEffects(const Reader& r, const Item& item) {
-  const MapView m =
-      r.map(item, {"friction", "translation", "gravity", "ground_contact", "foot_loads", "load_decomposition"});
-  Effects e;
-  if (const Item* x = m.get("friction")) {
-    const std::string f = r.choice(*x, {"none", "stiction", "continuous"});
-    e.friction = f == "none" ? FrictionLaw::kNone : f == "stiction" ? FrictionLaw::kStiction : FrictionLaw::kContinuous;
-  }
-  if (const Item* x = m.get("translation")) e.translation = r.boolean(*x);
-  if (const Item* x = m.get("gravity")) e.gravity = r.boolean(*x);
-  if (const Item* x = m.get("ground_contact")) e.ground_contact = r.boolean(*x);
-  if (const Item* x = m.get("foot_loads"))
-    e.foot_loads = r.choice(*x, {"distributed", "constant"}) == "distributed" ? FootLoadModel::kDistributed
-                                                                              : FootLoadModel::kConstant;
-  if (const Item* x = m.get("load_decomposition")) e.load_decomposition = r.boolean(*x);
-  return e;
 }
 
 // tail_end_s: when the tail stops (kind: simulate), or < 0 (kind: pose, no time series).
 OutputSettings readOutput(const Reader& r, const Item& item, double tail_end_s) {
-  const MapView m = r.map(item, {"sample_dt_s", "duration_s", "settle_s"});
   OutputSettings o;
-  if (const Item* x = m.get("sample_dt_s")) o.sample_dt_s = r.positive(*x);
-  if (const Item* x = m.get("duration_s")) o.duration_s = r.nonNegative(*x);
-  if (const Item* x = m.get("settle_s")) o.settle_s = r.nonNegative(*x);
+  const MapView m = readDeclared(r, item, o);
   // The time series needs at least 2 rows (t = 0 and the end); a longer spacing is a mistake.
   const double t_end = o.duration_s > 0 ? o.duration_s : tail_end_s + o.settle_s;
   if (tail_end_s >= 0 && o.sample_dt_s > t_end) {
@@ -951,26 +983,17 @@ OutputSettings readOutput(const Reader& r, const Item& item, double tail_end_s) 
 }
 
 // run_end_s: simulated seconds of the run (the video shows at most that), or < 0 when unknown.
-// Limits: render_settings.h, the same the renderer checks.
+// Field limits: render_settings.h, the same the renderer checks.
 RenderSettings readRender(const Reader& r, const Item& item, double run_end_s) {
   RenderSettings s;
   s.enabled = true;  // the section's presence asks for a video
   if (item.node.IsNull() && !r.pick(item)) return s;  // `render:` with nothing: all defaults
-  const MapView m = r.map(item, {"width", "height", "fps", "slowmo", "duration_s", "camera", "shadows",
-                                 "reflections", "msaa", "ghost", "ffmpeg", "crf", "preset"});
-  for (const char* k : {"width", "height"})
-    if (const Item* x = m.get(k)) {
-      const int v = r.integer(*x, kRenderMinSize, kRenderMaxSize);
-      if (v % 2) r.fail(*x, "must be even (H.264 yuv420p), got " + std::to_string(v));
-      (std::string(k) == "width" ? s.width : s.height) = v;
-    }
-  if (const Item* x = m.get("fps")) s.fps = r.integer(*x, kRenderMinFps, kRenderMaxFps);
-  if (const Item* x = m.get("slowmo")) {
-    s.slowmo = r.number(*x);
-    if (!(s.slowmo >= kRenderMinSlowmo && s.slowmo <= kRenderMaxSlowmo))
-      r.fail(*x, "must lie in [" + fmtG(kRenderMinSlowmo) + ", " + fmtG(kRenderMaxSlowmo) + "], got " + fmtG(s.slowmo));
+  const MapView m = readDeclared(r, item, s);
+  if (const Item* x = m.get("size")) {  // a frame-size preset (render_settings.h)
+    if (m.get("width") || m.get("height")) r.fail(*x, "give either size or width/height, not both");
+    for (const RenderSizePreset& p : kRenderSizePresets)
+      if (s.size == p.name) s.width = p.width, s.height = p.height;
   }
-  if (const Item* x = m.get("duration_s")) s.duration_s = r.nonNegative(*x);
   if (run_end_s >= 0.0) {
     const double span = s.duration_s > 0.0 ? std::min(s.duration_s, run_end_s) : run_end_s;
     const double frames = renderFrameCount(span, s);
@@ -981,19 +1004,6 @@ RenderSettings readRender(const Reader& r, const Item& item, double run_end_s) {
                       fmtG(kRenderMaxFrames) + ": lower fps, slowmo or render.duration_s");
     }
   }
-  if (const Item* x = m.get("camera")) s.camera = r.choice(*x, {"top", "perspective"});
-  if (const Item* x = m.get("shadows")) s.shadows = r.boolean(*x);
-  if (const Item* x = m.get("reflections")) s.reflections = r.boolean(*x);
-  if (const Item* x = m.get("msaa")) s.msaa = r.integer(*x, 0, kRenderMaxMsaa);
-  if (const Item* x = m.get("ghost")) s.ghost = r.boolean(*x);
-  if (const Item* x = m.get("ffmpeg")) {
-    s.ffmpeg = r.string(*x);
-    if (s.ffmpeg.empty()) r.fail(*x, "needs the ffmpeg executable (name or path)");
-  }
-  if (const Item* x = m.get("crf")) s.crf = r.integer(*x, kRenderMinCrf, kRenderMaxCrf);  // libx264 range
-  if (const Item* x = m.get("preset"))
-    s.preset = r.choice(*x, {"ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
-                             "veryslow", "placebo"});
   return s;
 }
 
@@ -1021,8 +1031,8 @@ void checkCaseWork(const Reader& r, const MapView& top, const ExperimentCase& c)
 ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
   const Item root = r.root(doc);
   const MapView top = r.map(root, {"name", "description", "robot", "kind", "tail", "quadruped", "friction",
-                                   "gravity_mps2", "trajectory", "pose", "models", "analytic", "mujoco", "effects",
-                                   "output", "render"});
+                                   "gravity_mps2", "trajectory", "pose", "models", "analytic", "perfoot", "mujoco",
+                                   "effects", "output", "render"});
   ExperimentCase c;
   c.source_file = source;
   const Item& name = r.need(top, "name");
@@ -1048,7 +1058,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   c.robot = rf.base;
   Origins origin = rf.origin;
 
-  if (const Item* k = top.get("kind")) c.kind = r.choice(*k, {"simulate", "pose"});
+  if (const Item* k = top.get("kind")) c.kind = r.choice(*k, kindNames());
 
   if (const Item* t = top.get("tail")) {
     const MapView tm = r.map(*t, {"links", "custom"});
@@ -1075,9 +1085,8 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     c.robot.tail = {f->second};
     origin.insert(rf.tail_origin.at(1).begin(), rf.tail_origin.at(1).end());
   }
-  if (const Item* q = top.get("quadruped"))
-    readQuadruped(r, r.map(*q, TAILSIM_QUAD_KEYS), false, c.robot.quadruped, origin);
-  if (const Item* f = top.get("friction")) readFriction(r, r.map(*f, TAILSIM_FRICTION_KEYS), false, c.robot.friction, origin);
+  if (const Item* q = top.get("quadruped")) readQuadruped(r, *q, false, c.robot.quadruped, origin);
+  if (const Item* f = top.get("friction")) readFriction(r, *f, false, c.robot.friction, origin);
   if (const Item* g = top.get("gravity_mps2")) {
     c.robot.gravity_mps2 = r.number(*g);
     origin["gravity_mps2"] = r.loc(*g);
@@ -1088,7 +1097,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
 
   const Item* traj = top.get("trajectory");
   const Item* pose = top.get("pose");
-  if (c.kind == "simulate") {
+  if (c.kind == CaseKind::kSimulate) {
     if (pose) r.fail(*pose, "only used with kind: pose");
     if (!traj) tailsim::fail(r.locAt(root, "trajectory"), "required for kind: simulate");
     c.joints = readTrajectory(r, *traj, n);
@@ -1099,23 +1108,27 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
 
   if (const Item* m = top.get("models")) {
     const std::vector<Item> v = r.list(*m);
-    if (v.empty()) r.fail(*m, "needs at least one model (analytic, mujoco)");
+    if (v.empty()) r.fail(*m, "needs at least one model (analytic, perfoot, mujoco)");
     for (const Item& x : v) {
-      const std::string s = r.choice(x, {"analytic", "mujoco"});
+      const std::string s = r.choice(x, {"analytic", "perfoot", "mujoco"});
       if (std::find(c.models.begin(), c.models.end(), s) != c.models.end()) r.fail(x, "'" + s + "' is listed twice");
       c.models.push_back(s);
     }
   } else {
     c.models = {"analytic"};
   }
-  if (const Item* x = top.get("analytic")) c.analytic = readAnalytic(r, *x);
+  if (const Item* x = top.get("analytic")) readDeclared(r, *x, c.analytic);
+  if (const Item* x = top.get("perfoot")) readDeclared(r, *x, c.perfoot);
   if (const Item* x = top.get("mujoco")) c.mujoco = readMujoco(r, *x);
-  if (const Item* x = top.get("effects")) c.effects = readEffects(r, *x);
+  // The MuJoCo body stands at the robot's COM height unless mujoco.body_height_m says otherwise.
+  const Item* mj = top.get("mujoco");
+  if (!(mj && mj->node.IsMap() && mj->node["body_height_m"])) c.mujoco.body_height_m = c.robot.quadruped.com_height_m;
+  if (const Item* x = top.get("effects")) readDeclared(r, *x, c.effects);
   if (const Item* x = top.get("output"))
-    c.output = readOutput(r, *x, c.kind == "simulate" ? c.trajectory().endTime() : -1.0);
+    c.output = readOutput(r, *x, c.kind == CaseKind::kSimulate ? c.trajectory().endTime() : -1.0);
   if (const Item* x = top.get("render")) {
     const double run_end =
-        c.kind != "simulate" ? -1.0 : c.output.duration_s > 0 ? c.output.duration_s : c.trajectory().endTime() + c.output.settle_s;
+        c.kind != CaseKind::kSimulate ? -1.0 : c.output.duration_s > 0 ? c.output.duration_s : c.trajectory().endTime() + c.output.settle_s;
     c.render = readRender(r, *x, run_end);
   }
   checkCaseWork(r, top, c);

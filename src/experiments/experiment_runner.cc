@@ -1,8 +1,11 @@
 #include "experiments/experiment_runner.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
+#include <sys/eventfd.h>
 #include <sys/file.h>
+#include <sys/signalfd.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -25,9 +28,15 @@
 #include <thread>
 
 #include "analytic_model/analytic_simulation.h"
+#include "experiments/folder_inputs.h"
+#include "experiments/model_registry.h"
 #include "experiments/render_case.h"
+#include "experiments/sharding.h"
+#include "experiments/results_table.h"
+#include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "results/atomic_file.h"
+#include "results/columns.h"
 #include "results/sha256.h"
 #include "tailsim_version.h"
 
@@ -37,12 +46,16 @@ using json = nlohmann::json;
 
 namespace {
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+// A file descriptor closed when it goes out of scope (the run's signalfd and eventfd).
+struct PollFd {
+  explicit PollFd(int f) : fd(f) {}
+  ~PollFd() {
+    if (fd >= 0) ::close(fd);
+  }
+  PollFd(const PollFd&) = delete;
+  PollFd& operator=(const PollFd&) = delete;
+  int fd;
+};
 
 json summaryJson(const RunSummary& s) {
   json j;
@@ -70,156 +83,10 @@ std::string fmtSeconds(double s) {
 
 }  // namespace
 
-// ---- Resume key -------------------------------------------------------------------------
-// A canonical text of everything a case's results depend on, one "key=value" line each, numbers
-// with 17 significant digits (exact for doubles). If a field is added to one of these structs,
-// the static_asserts below fail: add the field to the text, then update the size.
-namespace {
-
-static_assert(sizeof(QuadrupedParams) == 48 && sizeof(FrictionParams) == 48 && sizeof(TailLink) == 32 &&
-                  sizeof(RobotParams) == 128,
-              "a robot parameter was added: add it to caseKeyText, then update this size");
-static_assert(sizeof(SplitCycleParams) == 40, "a trajectory parameter was added: add it to caseKeyText");
-static_assert(sizeof(AnalyticSettings) == 96, "an analytic setting was added: add it to caseKeyText");
-static_assert(sizeof(MujocoSettings) == 288, "a MuJoCo setting was added: add it to caseKeyText");
-static_assert(sizeof(Effects) == 16, "an effect was added: add it to caseKeyText");
-static_assert(sizeof(OutputSettings) == 24, "an output setting was added: add it to caseKeyText");
-static_assert(sizeof(RenderSettings) == 152, "a render setting was added: add it to caseKeyText");
-static_assert(sizeof(PoseSpec) == 72 && sizeof(ExperimentCase) == 1032,
-              "a case field was added: add it to caseKeyText if results depend on it");
-
-struct KeyText {
-  std::string s;
-  void add(const std::string& k, double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.17g", v);
-    s += k + "=" + b + "\n";
-  }
-  void add(const std::string& k, int v) { s += k + "=" + std::to_string(v) + "\n"; }
-  void add(const std::string& k, bool v) { s += k + "=" + (v ? "true" : "false") + "\n"; }
-  void add(const std::string& k, const std::string& v) {
-    s += k + "=" + std::to_string(v.size()) + ":" + v + "\n";  // length-prefixed: no ambiguity
-  }
-  void add(const std::string& k, const char* v) { add(k, std::string(v)); }
-  void add(const std::string& k, const std::vector<double>& v) {
-    add(k + ".size", static_cast<int>(v.size()));
-    for (size_t i = 0; i < v.size(); ++i) add(k + "[" + std::to_string(i) + "]", v[i]);
-  }
-};
-
-}  // namespace
-
-std::string caseKeyText(const ExperimentCase& c, bool render) {
-  KeyText t;
-  t.add("tailsim.version", kVersion);
-  t.add("tailsim.git_commit", kGitCommit);
-  t.add("experiment", c.experiment);
-  t.add("case", c.name);
-  t.add("sweep.size", static_cast<int>(c.sweep_values.size()));
-  for (const auto& [k, v] : c.sweep_values) t.add("sweep." + k, v);
-  t.add("kind", c.kind);
-  t.add("pose.theta_rad", c.pose.theta_rad);
-  t.add("pose.thetadot_radps", c.pose.thetadot_radps);
-  t.add("pose.thetaddot_radps2", c.pose.thetaddot_radps2);
-  const RobotParams& r = c.robot;  // the resolved values, not the robot file's name
-  t.add("quadruped.mass_kg", r.quadruped.mass_kg);
-  t.add("quadruped.izz_kgm2", r.quadruped.izz_kgm2);
-  t.add("quadruped.d_Q2C_m", r.quadruped.d_Q2C_m);
-  t.add("quadruped.d_Q2B_m", r.quadruped.d_Q2B_m);
-  t.add("quadruped.l_F_m", r.quadruped.l_F_m);
-  t.add("quadruped.w_F_m", r.quadruped.w_F_m);
-  t.add("tail.links", r.numLinks());
-  for (size_t i = 0; i < r.tail.size(); ++i) {
-    const std::string k = "tail[" + std::to_string(i) + "].";
-    t.add(k + "mass_kg", r.tail[i].mass_kg);
-    t.add(k + "izz_kgm2", r.tail[i].izz_kgm2);
-    t.add(k + "length_m", r.tail[i].length_m);
-    t.add(k + "com_offset_m", r.tail[i].com_offset_m);
-  }
-  t.add("friction.mu_s", r.friction.mu_s);
-  t.add("friction.mu_d", r.friction.mu_d);
-  t.add("friction.phidot_s_radps", r.friction.phidot_s_radps);
-  t.add("friction.phidot_d_radps", r.friction.phidot_d_radps);
-  t.add("friction.v_s_mps", r.friction.v_s_mps);
-  t.add("friction.v_d_mps", r.friction.v_d_mps);
-  t.add("gravity_mps2", r.gravity_mps2);
-  t.add("joints.size", static_cast<int>(c.joints.size()));
-  for (size_t i = 0; i < c.joints.size(); ++i) {
-    const std::string k = "joint[" + std::to_string(i) + "].";
-    t.add(k + "theta0_rad", c.joints[i].theta0_rad);
-    t.add(k + "dtheta_rad", c.joints[i].dtheta_rad);
-    t.add(k + "dT_s", c.joints[i].dT_s);
-    t.add(k + "w_ss", c.joints[i].w_ss);
-    t.add(k + "t0_s", c.joints[i].t0_s);
-  }
-  std::string models;
-  for (const std::string& m : c.models) models += m + ";";
-  t.add("models", models);  // after a --models filter: `run X --models analytic` then `run X` computes MuJoCo
-  const AnalyticSettings& a = c.analytic;
-  t.add("analytic.solver", a.solver);
-  t.add("analytic.rel_tol", a.rel_tol);
-  t.add("analytic.abs_tol", a.abs_tol);
-  t.add("analytic.fixed_dt_s", a.fixed_dt_s);
-  t.add("analytic.event_tol_s", a.event_tol_s);
-  t.add("analytic.max_step_s", a.max_step_s);
-  t.add("analytic.v_stop_mps", a.v_stop_mps);
-  t.add("analytic.coupling", static_cast<int>(a.coupling));
-  t.add("analytic.max_steps", static_cast<double>(a.max_steps));
-  const MujocoSettings& m = c.mujoco;
-  t.add("mujoco.timestep_s", m.timestep_s);
-  t.add("mujoco.integrator", m.integrator);
-  t.add("mujoco.solver", m.solver);
-  t.add("mujoco.iterations", m.iterations);
-  t.add("mujoco.tolerance", m.tolerance);
-  t.add("mujoco.cone", m.cone);
-  t.add("mujoco.noslip_iterations", m.noslip_iterations);
-  t.add("mujoco.condim", m.condim);
-  t.add("mujoco.impratio", m.impratio);
-  t.add("mujoco.solref", std::vector<double>(m.solref.begin(), m.solref.end()));
-  t.add("mujoco.solimp", std::vector<double>(m.solimp.begin(), m.solimp.end()));
-  t.add("mujoco.mu", m.mu);
-  t.add("mujoco.kp", m.kp);
-  t.add("mujoco.kv", m.kv);
-  t.add("mujoco.velocity_feedforward", m.velocity_feedforward);
-  t.add("mujoco.inverse_dynamics_feedforward", m.inverse_dynamics_feedforward);
-  t.add("mujoco.servo_wn_dt", m.servo_wn_dt);
-  t.add("mujoco.body_height_m", m.body_height_m);
-  t.add("mujoco.foot_radius_m", m.foot_radius_m);
-  t.add("mujoco.settle_s", m.settle_s);
-  t.add("mujoco.stop_phidot_radps", m.stop_phidot_radps);
-  t.add("mujoco.max_tilt_deg", m.max_tilt_deg);
-  t.add("mujoco.max_all_feet_off_s", m.max_all_feet_off_s);
-  t.add("mujoco.max_steps", static_cast<double>(m.max_steps));
-  const Effects& e = c.effects;
-  t.add("effects.friction", static_cast<int>(e.friction));
-  t.add("effects.translation", e.translation);
-  t.add("effects.gravity", e.gravity);
-  t.add("effects.ground_contact", e.ground_contact);
-  t.add("effects.foot_loads", static_cast<int>(e.foot_loads));
-  t.add("effects.load_decomposition", e.load_decomposition);
-  t.add("output.sample_dt_s", c.output.sample_dt_s);
-  t.add("output.duration_s", c.output.duration_s);
-  t.add("output.settle_s", c.output.settle_s);
-  t.add("render", render);  // --no-render: a later run with rendering renders the case
-  if (render) {
-    const RenderSettings& v = c.render;
-    t.add("render.width", v.width);
-    t.add("render.height", v.height);
-    t.add("render.fps", v.fps);
-    t.add("render.slowmo", v.slowmo);
-    t.add("render.duration_s", v.duration_s);
-    t.add("render.camera", v.camera);
-    t.add("render.shadows", v.shadows);
-    t.add("render.reflections", v.reflections);
-    t.add("render.msaa", v.msaa);
-    t.add("render.ghost", v.ghost);
-    t.add("render.ffmpeg", v.ffmpeg);
-    t.add("render.crf", v.crf);
-    t.add("render.preset", v.preset);
-  }
-  return t.s;
-}
-
+// ---- Resume key ----------------------------------------------------------------------------
+// The SHA-256 of the canonical resolved case (settings_json.h: every declared setting, so a new
+// setting is in the key by being declared), the models run, the render switch and settings, and
+// the tailsim version and git commit.
 std::string caseKey(const ExperimentCase& c, bool render) { return sha256Hex(caseKeyText(c, render)); }
 
 // A name made only of [A-Za-z0-9.=,_-], not starting with '.' or '-', at most kMaxPlainDirName
@@ -244,28 +111,17 @@ std::string caseDirName(const std::string& name) {
 
 std::vector<RunResult> runCase(const ExperimentCase& c) {
   std::vector<RunResult> out;
-  if (c.kind == "pose") {
+  if (c.kind == CaseKind::kPose) {
     std::vector<JointState> js(c.robot.numLinks());
     for (size_t i = 0; i < js.size(); ++i)
       js[i] = {c.pose.theta_rad.at(i), c.pose.thetadot_radps.at(i), c.pose.thetaddot_radps2.at(i)};
     out.push_back(evaluatePose(c.robot, js, c.effects));
     return out;
   }
-  const TailTrajectory traj = c.trajectory();
   for (const std::string& m : c.models) {
-    if (m == "analytic") {
-      out.push_back(simulateAnalytic(c.robot, traj, c.analytic, c.effects, c.output));
-    } else if (m == "mujoco") {
-      try {
-        out.push_back(simulateMujoco(c.robot, traj, c.mujoco, c.effects, c.output));
-      } catch (const std::exception& e) {
-        RunResult r;
-        r.summary.model = "mujoco";
-        r.summary.ok = false;
-        r.summary.error = e.what();
-        out.push_back(std::move(r));
-      }
-    }
+    const ModelEntry* model = findModel(m);
+    if (!model) throw std::invalid_argument("unknown model '" + m + "'");  // the loader refuses it first
+    out.push_back(model->run(c));
   }
   return out;
 }
@@ -281,6 +137,7 @@ struct Job {
   std::vector<std::string> dirs;  // per case: caseDirName()
   std::vector<json> entries;      // per case; null = not finished
   std::vector<size_t> todo;       // case indices to run now
+  std::string source;             // recordedSource(*e), as found before the folder is written
   int total = 0, resumed = 0;
 };
 
@@ -352,8 +209,26 @@ bool holdsResults(const fs::path& root) {
 
 // The entries tailsim writes into a result folder (docs/ARCHITECTURE.md); nothing else is touched.
 void clearResultFolder(const fs::path& root) {
-  for (const char* entry : {"summary.json", "experiment.yaml", "report.md", "cases", "renders", "plots"})
+  for (const char* entry :
+       {"summary.json", "results.csv", "experiment.yaml", "robot.yaml", "mjcf", "report.md", "cases", "renders", "plots"})
     fs::remove_all(root / entry);
+  std::error_code ec;
+  for (const auto& f : fs::directory_iterator(root, ec)) {  // a swept robot's copies: robot-<k>.yaml
+    const std::string n = f.path().filename().string();
+    if (n.size() > 11 && n.compare(0, 6, "robot-") == 0 && n.compare(n.size() - 5, 5, ".yaml") == 0 &&
+        std::all_of(n.begin() + 6, n.end() - 5, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); }))
+      fs::remove(f.path(), ec);
+  }
+}
+
+// The experiment file a folder's results come from: e's file, unless e is run from the copy in a
+// result folder (DIR/experiment.yaml), whose results name the original; so a folder re-run from
+// its own copy reproduces its files (docs/ARCHITECTURE.md "Result folder").
+std::string recordedSource(const Experiment& e) {
+  const fs::path p(e.source_file);
+  if (p.filename() != "experiment.yaml") return e.source_file;
+  const auto [name, source] = resultOwner(p.parent_path());
+  return name == e.name && !source.empty() ? source : e.source_file;
 }
 
 // Result folders of experiments inside DIR (a suite's layout: DIR/<experiment>/summary.json).
@@ -375,13 +250,13 @@ std::vector<fs::path> memberFolders(const fs::path& root) {
 // With fresh, the other results are removed first (tailsim's own entries only).
 void claimFolder(const Experiment& e, const fs::path& root, bool fresh) {
   const auto [name, source] = resultOwner(root);
-  const bool foreign = !name.empty() && (name != e.name || source != e.source_file);
+  const bool foreign = !name.empty() && (name != e.name || source != recordedSource(e));
   std::vector<fs::path> members = memberFolders(root);  // a suite's results where one experiment goes
   if (!foreign && members.empty()) return;
   if (!fresh) {
     const std::string what = foreign ? "the results of experiment '" + name + "' (" + source + ")"
                                      : "the results of a suite (" + members.front().string() + ", ...)";
-    throw std::runtime_error(root.string() + " holds " + what + ", not of '" + e.name + "' (" + e.source_file +
+    throw std::runtime_error(root.string() + " holds " + what + ", not of '" + e.name + "' (" + recordedSource(e) +
                              "); choose another --out, or add --fresh to delete them");
   }
   if (foreign) clearResultFolder(root);
@@ -448,13 +323,16 @@ int removeStaleTemps(const fs::path& root) {
   return removed;
 }
 
-Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root) {
+// in_shard: per case, whether it belongs to this process's shard (--shard K/N; empty = all).
+Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, const std::vector<char>& in_shard = {}) {
   Job job;
   job.e = &e;
   job.root = root;
+  job.source = recordedSource(e);
   std::vector<size_t> todo_all;
   for (size_t i = 0; i < e.cases.size(); ++i)
-    if (opt.only_case.empty() || e.cases[i].name == opt.only_case) todo_all.push_back(i);
+    if ((opt.only_case.empty() || e.cases[i].name == opt.only_case) && (in_shard.empty() || in_shard[i]))
+      todo_all.push_back(i);
   job.total = static_cast<int>(todo_all.size());
   // Render prerequisites are checked before anything runs (issue 5).
   job.render = opt.render && !e.cases.empty() && e.cases.front().render.enabled;
@@ -471,7 +349,8 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root) {
   if (!opt.resume && opt.only_case.empty()) clearResultFolder(root);  // --fresh: no stale case folders
   removeStaleTemps(root);
   fs::create_directories(root / "cases");
-  writeFileAtomic((root / "experiment.yaml").string(), readText(e.source_file));
+  // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
+  for (const auto& [name, text] : folderInputs(e)) writeFileAtomic((root / name).string(), text);
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
   job.entries.resize(e.cases.size());
   for (size_t i : todo_all) {  // finished cases of an earlier, interrupted run
@@ -486,6 +365,9 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root) {
         continue;
       }
     }
+    if (opt.merge_only)
+      throw std::runtime_error("merge: case '" + e.cases[i].name + "' of experiment " + e.name +
+                               " is finished in none of the shard folders (run its shard, or the shard again)");
     job.todo.push_back(i);
   }
   return job;
@@ -501,44 +383,76 @@ json runAndWrite(const Job& job, size_t i, int& failed_runs) {
   j["name"] = c.name;
   j["dir"] = job.dirs[i];
   j["experiment"] = job.e->name;
-  j["source"] = job.e->source_file;
+  j["source"] = job.source;
   j["key"] = job.keys[i];
+  j["tailsim_version"] = kVersion;
+  if (*kGitCommit) j["tailsim_git_commit"] = kGitCommit;
+  j["resolved"] = resolvedJson(c);  // every parameter the run used, defaults included
+  // ... but not where they were read from: a folder re-run from its own copies (robot.yaml,
+  // experiment.yaml) must write the same result.json; "source" above names the original input.
+  j["resolved"].erase("source_file");
+  j["resolved"].erase("robot_file");
   j["sweep"] = json::object();
   for (const auto& [key, v] : c.sweep_values) j["sweep"][key] = v;
   j["runs"] = json::object();
   for (const RunResult& r : runs) {
-    writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), r.series);
+    // Every model's CSV in the one column order (docs/ARCHITECTURE.md "Time-series columns").
+    writeCsvAtomic((dir / (r.summary.model + ".csv")).string(),
+                   col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series))));
     j["runs"][r.summary.model] = summaryJson(r.summary);
     if (!r.summary.ok) ++failed_runs;
+  }
+  // The MJCF the MuJoCo run simulated, once per distinct model (mjcf/<hash>.xml); none when the
+  // model could not be built (the run's error says why).
+  if (c.kind != CaseKind::kPose && std::find(c.models.begin(), c.models.end(), "mujoco") != c.models.end()) {
+    std::string xml;
+    try {
+      xml = generateMjcf(c.robot, c.mujoco, c.effects);
+    } catch (const std::exception&) {
+    }
+    if (!xml.empty()) {
+      const std::string name = mjcfFileName(xml);
+      fs::create_directories(job.root / "mjcf");
+      if (!fs::exists(job.root / name)) writeFileAtomic((job.root / name).string(), xml);
+      j["mjcf"] = name;
+    }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
   writeFileAtomic((dir / "result.json").string(), j.dump(1));
   return j;
 }
 
-void writeSummary(const Job& job) {
+// Writes DIR/summary.json and DIR/results.csv (from the same entries: every finished case,
+// resumed ones included) and returns the summary.
+json writeSummary(const Job& job) {
   const Experiment& e = *job.e;
   json s;
   s["experiment"] = e.name;
   s["tailsim_version"] = kVersion;
   if (*kGitCommit) s["tailsim_git_commit"] = kGitCommit;
   s["description"] = e.description;
-  s["source"] = e.source_file;
-  s["kind"] = e.cases.empty() ? "simulate" : e.cases.front().kind;
+  s["source"] = job.source;
+  s["kind"] = e.cases.empty() ? "simulate" : name(e.cases.front().kind);
   s["swept_keys"] = e.swept_keys;
   s["cases"] = json::array();
   for (json entry : job.entries)
     if (!entry.is_null()) {
       entry.erase("experiment");  // said once, above
       entry.erase("source");
+      entry.erase("tailsim_version");
+      entry.erase("tailsim_git_commit");
       s["cases"].push_back(std::move(entry));
     }
   writeFileAtomic((job.root / "summary.json").string(), s.dump(1));
+  writeFileAtomic((job.root / "results.csv").string(), resultsCsv({s}));
+  return s;
 }
 
 // All cases of all experiments share one pool of workers (workers share nothing mutable but
 // the task counter; each writes only its own case folder and entry).
-RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::string& label) {
+// suite_root: a suite's folder, which gets the results.csv of all members.
+RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::string& label,
+                 const fs::path& suite_root = {}) {
   const auto wall0 = std::chrono::steady_clock::now();
   RunStats stats;
   struct Task {
@@ -556,19 +470,35 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   std::stable_sort(tasks.begin(), tasks.end(), [](const Task& a, const Task& b) {
     auto heavy = [](const Task& t) {
       const auto& m = t.job->e->cases[t.i].models;
-      return std::find(m.begin(), m.end(), "mujoco") != m.end();
+      return std::any_of(m.begin(), m.end(), [](const std::string& name) {
+        const ModelEntry* e = findModel(name);
+        return e && e->long_running;
+      });
     };
     return heavy(a) && !heavy(b);
   });
 
   // Ctrl-C (opt.stop_on_sigint): SIGINT is blocked in this thread before the workers start (they
-  // inherit the mask, and so do ffmpeg/gnuplot children), and taken here with sigtimedwait: no
+  // inherit the mask, and so do ffmpeg/gnuplot children), and read here from a signalfd: no
   // handler, no global flag. The first stops new cases, the in-flight ones finish and are saved; a
   // second terminates the process at once (finished cases stay saved: each is written whole).
+  // The main thread sleeps in poll() on that signalfd and on an eventfd the workers write after each
+  // case, so it wakes the moment the last case is done (a fixed sleep cost every run up to 100 ms).
   sigset_t int_set, old_mask;
   sigemptyset(&int_set);
   sigaddset(&int_set, SIGINT);
   if (opt.stop_on_sigint) pthread_sigmask(SIG_BLOCK, &int_set, &old_mask);
+  const PollFd sig_fd(opt.stop_on_sigint ? ::signalfd(-1, &int_set, SFD_CLOEXEC | SFD_NONBLOCK) : -1);
+  const PollFd wake_fd(::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  if ((opt.stop_on_sigint && sig_fd.fd < 0) || wake_fd.fd < 0) {
+    if (opt.stop_on_sigint) pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+    throw std::system_error(errno, std::generic_category(), "cannot create the run's signalfd/eventfd");
+  }
+  auto wakeMain = [&wake_fd]() {
+    const uint64_t one = 1;
+    while (::write(wake_fd.fd, &one, sizeof one) < 0 && errno == EINTR) {
+    }
+  };
 
   std::atomic<size_t> next{0};
   std::atomic<int> done{0}, failed{0}, running{0};
@@ -601,10 +531,14 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
       }
       ++done;
       cv.notify_all();
+      wakeMain();
     }
-    std::lock_guard<std::mutex> lock(mu);
-    --running;
-    cv.notify_all();
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      --running;
+      cv.notify_all();
+    }
+    wakeMain();
   };
   const int n_threads = std::max(1, std::min<int>(opt.threads > 0 ? opt.threads : std::thread::hardware_concurrency(),
                                                   static_cast<int>(tasks.size())));
@@ -647,14 +581,16 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
     std::fflush(stderr);
   };
   for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mu);
-      if (running.load() == 0) break;
-      if (!opt.stop_on_sigint) cv.wait_for(lock, std::chrono::milliseconds(100));
+    if (running.load() == 0) break;
+    pollfd fds[2] = {{wake_fd.fd, POLLIN, 0}, {sig_fd.fd, POLLIN, 0}};
+    const int n_fds = opt.stop_on_sigint ? 2 : 1;
+    if (::poll(fds, n_fds, show ? static_cast<int>(period.count()) : -1) > 0) {
+      uint64_t count = 0;
+      if (fds[0].revents & POLLIN) (void)!::read(wake_fd.fd, &count, sizeof count);
     }
-    if (opt.stop_on_sigint) {
-      const timespec wait{0, 100 * 1000 * 1000};
-      if (sigtimedwait(&int_set, nullptr, &wait) == SIGINT) {
+    if (opt.stop_on_sigint && (fds[1].revents & POLLIN)) {
+      signalfd_siginfo info{};
+      if (::read(sig_fd.fd, &info, sizeof info) == static_cast<ssize_t>(sizeof info) && info.ssi_signo == SIGINT) {
         if (line_open) std::fprintf(stderr, "\n");
         line_open = false;
         if (!stop.exchange(true)) {
@@ -678,7 +614,9 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   else if (line_open) std::fprintf(stderr, "\n");
   stats.interrupted = stop.load();
   try {
-    for (const Job& job : jobs) writeSummary(job);  // also after a failure: finished cases count
+    std::vector<json> summaries;
+    for (const Job& job : jobs) summaries.push_back(writeSummary(job));  // also after a failure: finished cases count
+    if (!suite_root.empty()) writeFileAtomic((suite_root / "results.csv").string(), resultsCsv(summaries));
   } catch (const std::exception&) {
     if (first_error.empty()) throw;  // else report the first error (a full disk fails the summary too)
   }
@@ -694,8 +632,10 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
 RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
   if (opt.resume) claimFolder(e, opt.out_dir, false);  // refuse before the lock file is created
   const RunLock lock(opt.out_dir);
-  std::vector<Job> jobs{prepare(e, opt, opt.out_dir)};
-  if (jobs.front().total == 0) throw std::runtime_error("experiment " + e.name + " has no case named '" + opt.only_case + "'");
+  const std::vector<std::vector<char>> in_shard =
+      opt.shard_count > 1 ? shardMembership({e}, {opt.shard_index, opt.shard_count}) : std::vector<std::vector<char>>(1);
+  std::vector<Job> jobs{prepare(e, opt, opt.out_dir, in_shard.front())};
+  if (jobs.front().total == 0 && !opt.only_case.empty()) throw std::runtime_error("experiment " + e.name + " has no case named '" + opt.only_case + "'");
   return runJobs(jobs, opt, e.name);
 }
 
@@ -707,9 +647,14 @@ RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& opt) {
   }
   const RunLock lock(opt.out_dir);  // one lock for the suite's folder and its members
   claimSuiteFolder(opt.out_dir, !opt.resume);
+  const std::vector<std::vector<char>> in_shard = opt.shard_count > 1
+                                                      ? shardMembership(suite, {opt.shard_index, opt.shard_count})
+                                                      : std::vector<std::vector<char>>(suite.size());
   std::vector<Job> jobs;
-  for (const Experiment& e : suite) jobs.push_back(prepare(e, opt, fs::path(opt.out_dir) / e.name));
-  return runJobs(jobs, opt, fs::path(opt.out_dir).filename().string());
+  for (size_t k = 0; k < suite.size(); ++k)
+    jobs.push_back(prepare(suite[k], opt, fs::path(opt.out_dir) / suite[k].name, in_shard[k]));
+  writeFileAtomic((fs::path(opt.out_dir) / "experiment.yaml").string(), suiteFolderFile(suite));
+  return runJobs(jobs, opt, fs::path(opt.out_dir).filename().string(), opt.out_dir);
 }
 
 }  // namespace tailsim

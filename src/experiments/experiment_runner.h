@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "experiments/experiment_config.h"
+#include "experiments/settings_json.h"
 #include "experiments/experiment_loader.h"
 #include "results/time_series.h"
 
@@ -26,6 +27,9 @@ struct RunOptions {
   long max_new_cases = -1;       // stop after this many newly run cases (tests of resuming)
   bool stop_on_sigint = false;   // Ctrl-C: start no new case, let running ones finish and save them
                                  // (RunStats::interrupted); a second Ctrl-C terminates the process
+  int shard_index = 1;           // --shard K/N: run only the cases assigned to shard K (sharding.h)
+  int shard_count = 1;
+  bool merge_only = false;       // run nothing: every case must be finished in out_dir (tailsim merge)
 };
 
 struct RunStats {
@@ -45,10 +49,9 @@ std::vector<RunResult> runCase(const ExperimentCase& c);
 // its own folder; any other gets a sanitized, shortened form + "~" + 16 hex digits of its SHA-256.
 std::string caseDirName(const std::string& case_name);
 
-// The resume key of a case: SHA-256 of caseKeyText, a canonical text of everything the case's
-// results depend on (resolved robot, trajectory, model/output/effects settings, the models run,
-// rendering on or off, tailsim version). A finished case is reused only when its key matches.
-std::string caseKeyText(const ExperimentCase& c, bool render);
+// The resume key of a case: SHA-256 of caseKeyText (settings_json.h), the canonical resolved case
+// (every declared setting, the models run, rendering on or off and its settings, tailsim version
+// and git commit). A finished case is reused only when its key matches.
 std::string caseKey(const ExperimentCase& c, bool render);
 
 RunStats runExperiment(const Experiment& e, const RunOptions& options);

@@ -37,7 +37,7 @@ void append(std::vector<std::string>& a, const std::vector<std::string>& b) { a.
 
 WorkEstimate estimateWork(const ExperimentCase& c) {
   WorkEstimate w;
-  if (c.kind != "simulate") return w;
+  if (c.kind != CaseKind::kSimulate) return w;
   const int n = c.robot.numLinks();
   const TailTrajectory traj = c.trajectory();
   const double tail_end = traj.endTime();
@@ -50,7 +50,7 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
     // 1/8 of the shortest acceleration or deceleration phase; the fixed step is fixed_dt_s.
     double shortest = std::numeric_limits<double>::infinity();
     for (const SplitCycleParams& p : c.joints) shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
-    const double h = c.analytic.solver == "fixed" ? c.analytic.fixed_dt_s
+    const double h = c.analytic.solver == AnalyticSolver::kFixed ? c.analytic.fixed_dt_s
                      : c.analytic.max_step_s > 0 ? c.analytic.max_step_s
                                                  : shortest / 8.0;
     w.analytic_steps = std::min(tail_end, w.sim_time_s) / h;
@@ -69,7 +69,7 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
 
 WorkExcess checkWork(const ExperimentCase& c) {
   WorkExcess x;
-  if (c.kind != "simulate") return x;
+  if (c.kind != CaseKind::kSimulate) return x;
   const WorkEstimate w = estimateWork(c);
   const std::string see = " (docs/experiment-format.md \"Limits\")";
   const std::string span = g(w.sim_time_s) + " s simulated";
@@ -86,7 +86,7 @@ WorkExcess checkWork(const ExperimentCase& c) {
     return x;
   }
   if (!(w.analytic_steps <= limits::kMaxAnalyticSteps)) {
-    const bool fixed = c.analytic.solver == "fixed";
+    const bool fixed = c.analytic.solver == AnalyticSolver::kFixed;
     x.keys = {fixed ? "analytic.fixed_dt_s" : "analytic.max_step_s", "trajectory.t0_s", "trajectory.dT_s"};
     x.what = "the analytic model would take at least " + g(w.analytic_steps) + " steps (tail motion until t = " +
              g(std::min(c.trajectory().endTime(), w.sim_time_s)) + " s / step " +

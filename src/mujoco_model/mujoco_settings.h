@@ -5,16 +5,41 @@
 #include <string>
 
 #include "results/work_limits.h"
+#include "settings/fields.h"
 
 namespace tailsim {
 
+enum class MujocoIntegrator { kEuler, kRK4, kImplicit };
+enum class MujocoSolver { kNewton, kCG, kPGS };
+enum class MujocoCone { kPyramidal, kElliptic };
+
+// Their names, as in YAML and in MJCF's <option> attributes.
+inline const settings::EnumNames<MujocoIntegrator>& integratorNames() {
+  static const settings::EnumNames<MujocoIntegrator> k = {
+      {MujocoIntegrator::kEuler, "Euler"}, {MujocoIntegrator::kRK4, "RK4"}, {MujocoIntegrator::kImplicit, "implicit"}};
+  return k;
+}
+inline const settings::EnumNames<MujocoSolver>& solverNames() {
+  static const settings::EnumNames<MujocoSolver> k = {
+      {MujocoSolver::kNewton, "Newton"}, {MujocoSolver::kCG, "CG"}, {MujocoSolver::kPGS, "PGS"}};
+  return k;
+}
+inline const settings::EnumNames<MujocoCone>& coneNames() {
+  static const settings::EnumNames<MujocoCone> k = {{MujocoCone::kPyramidal, "pyramidal"},
+                                                     {MujocoCone::kElliptic, "elliptic"}};
+  return k;
+}
+inline const char* name(MujocoIntegrator v) { return settings::nameOf(integratorNames(), v); }
+inline const char* name(MujocoSolver v) { return settings::nameOf(solverNames(), v); }
+inline const char* name(MujocoCone v) { return settings::nameOf(coneNames(), v); }
+
 struct MujocoSettings {
   double timestep_s = 2e-4;             // physics step  [s]
-  std::string integrator = "implicit";  // Euler | RK4 | implicit
-  std::string solver = "Newton";        // Newton | CG | PGS
+  MujocoIntegrator integrator = MujocoIntegrator::kImplicit;
+  MujocoSolver solver = MujocoSolver::kNewton;
   int iterations = 100;                 // constraint solver iterations
   double tolerance = 1e-10;             // constraint solver tolerance
-  std::string cone = "elliptic";        // pyramidal | elliptic
+  MujocoCone cone = MujocoCone::kElliptic;
   int noslip_iterations = 0;            // MuJoCo noslip post-processing iterations
   int condim = 3;                       // 1 (frictionless), 3 (sliding), 4 (+torsional), 6
   double impratio = 1.0;                // frictional-to-normal impedance ratio
@@ -41,5 +66,46 @@ struct MujocoSettings {
   // Step budget of the main loop: a run needing more mj_step calls fails (not a loader key).
   long max_steps = static_cast<long>(limits::kMaxMujocoSteps);
 };
+
+// The YAML/JSON keys of MujocoSettings (settings/fields.h), declared once.
+template <class V, class S>
+settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.number(Field{"timestep_s", "physics step [s]"}, s.timestep_s, Limits::positive());
+  v.choice(Field{"integrator", "MuJoCo integrator"}, s.integrator, integratorNames());
+  v.choice(Field{"solver", "constraint solver"}, s.solver, solverNames());
+  v.integer(Field{"iterations", "constraint solver iterations"}, s.iterations, Limits::atLeast(1));
+  v.number(Field{"tolerance", "constraint solver tolerance"}, s.tolerance, Limits::nonNegative());
+  v.choice(Field{"cone", "friction cone"}, s.cone, coneNames());
+  v.integer(Field{"noslip_iterations", "noslip post-processing iterations"}, s.noslip_iterations, Limits::atLeast(0));
+  v.integer(Field{"condim", "contact dimensionality: 1 frictionless, 3 sliding, 4 +torsional, 6 +rolling"}, s.condim,
+            Limits::closed(1, 6), settings::IntSet{1, 3, 4, 6});
+  v.number(Field{"impratio", "frictional-to-normal impedance ratio"}, s.impratio, Limits::positive());
+  v.numbers(Field{"solref", "[timeconst > 0, dampratio > 0] or direct [-stiffness, -damping]"}, s.solref);
+  v.numbers(Field{"solimp", "[dmin, dmax, width, midpoint, power]: dmin, dmax, midpoint in (0, 1), width > 0, power >= 1"},
+            s.solimp);
+  v.number(Field{"mu", "contact friction; absent (-1 in the resolved case) = max(mu_s, mu_d)"}, s.mu,
+           Limits::nonNegative());
+  v.number(Field{"kp", "tail position gain [N m/rad]; 0 = from servo_wn_dt and the link inertia"}, s.kp,
+           Limits::nonNegative());
+  v.number(Field{"kv", "tail velocity gain [N m s/rad]; 0 = critically damped"}, s.kv, Limits::nonNegative());
+  v.boolean(Field{"velocity_feedforward", "add kv * theta_dot_ref"}, s.velocity_feedforward);
+  v.boolean(Field{"inverse_dynamics_feedforward", "add MuJoCo's inverse-dynamics joint torque"},
+            s.inverse_dynamics_feedforward);
+  v.number(Field{"servo_wn_dt", "kp = 0: servo natural frequency * timestep"}, s.servo_wn_dt, Limits::positive());
+  v.number(Field{"body_height_m", "quadruped COM (= tail plane) height above the ground [m]"}, s.body_height_m,
+           Limits::positive());
+  v.number(Field{"foot_radius_m", "foot spheres [m]"}, s.foot_radius_m, Limits::positive());
+  v.number(Field{"settle_s", "pre-roll with the tail held at theta(0) so the feet settle [s]"}, s.settle_s,
+           Limits::nonNegative());
+  v.number(Field{"stop_phidot_radps", "t_stop: |phi_dot| below this from then on [rad/s]"}, s.stop_phidot_radps,
+           Limits::positive());
+  v.number(Field{"max_tilt_deg", "tipping over: largest body tilt; 0 = off [deg]"}, s.max_tilt_deg,
+           Limits::nonNegative());
+  v.number(Field{"max_all_feet_off_s", "tipping over: longest time with no foot loaded; 0 = off [s]"},
+           s.max_all_feet_off_s, Limits::nonNegative());
+  v.internal(Field{"max_steps", "step budget (results/work_limits.h); not a YAML key"}, s.max_steps);
+}
 
 }  // namespace tailsim

@@ -1,8 +1,11 @@
 #include "mujoco_model/mujoco_simulation.h"
 
+#include "results/columns.h"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <deque>
 #include <limits>
 #include <map>
 #include <cmath>
@@ -57,28 +60,28 @@ struct Columns {
 
 Columns makeColumns(TimeSeries& ts, int n) {
   Columns c;
-  c.t = ts.addColumn("t_s");
-  for (int i = 1; i <= n; ++i) c.theta.push_back(ts.addColumn("theta" + std::to_string(i) + "_deg"));
-  for (int i = 1; i <= n; ++i) c.thetadot.push_back(ts.addColumn("thetadot" + std::to_string(i) + "_dps"));
-  for (int i = 1; i <= n; ++i) c.thetaddot.push_back(ts.addColumn("thetaddot" + std::to_string(i) + "_dps2"));
-  c.x = ts.addColumn("x_m");
-  c.y = ts.addColumn("y_m");
-  c.phi = ts.addColumn("phi_deg");
-  c.phidot = ts.addColumn("phidot_dps");
-  c.phiddot = ts.addColumn("phiddot_dps2");
-  c.mzt = ts.addColumn("MzT_Nm");
-  c.mzf = ts.addColumn("MzF_Nm");
-  c.izz = ts.addColumn("Izz_kgm2");
-  c.izz_phiddot = ts.addColumn("Izz_phiddot_Nm");
-  c.ftx = ts.addColumn("FTx_N");
-  c.fty = ts.addColumn("FTy_N");
-  c.ffx = ts.addColumn("FFx_N");
-  c.ffy = ts.addColumn("FFy_N");
+  c.t = ts.addColumn(col::kT);
+  for (int i = 1; i <= n; ++i) c.theta.push_back(ts.addColumn(col::theta(i)));
+  for (int i = 1; i <= n; ++i) c.thetadot.push_back(ts.addColumn(col::thetadot(i)));
+  for (int i = 1; i <= n; ++i) c.thetaddot.push_back(ts.addColumn(col::thetaddot(i)));
+  c.x = ts.addColumn(col::kX);
+  c.y = ts.addColumn(col::kY);
+  c.phi = ts.addColumn(col::kPhi);
+  c.phidot = ts.addColumn(col::kPhidot);
+  c.phiddot = ts.addColumn(col::kPhiddot);
+  c.mzt = ts.addColumn(col::kMzT);
+  c.mzf = ts.addColumn(col::kMzF);
+  c.izz = ts.addColumn(col::kIzz);
+  c.izz_phiddot = ts.addColumn(col::kIzzPhiddot);
+  c.ftx = ts.addColumn(col::kFTx);
+  c.fty = ts.addColumn(col::kFTy);
+  c.ffx = ts.addColumn(col::kFFx);
+  c.ffy = ts.addColumn(col::kFFy);
   for (int k = 1; k <= 4; ++k) {
-    c.fn[k - 1] = ts.addColumn("foot" + std::to_string(k) + "_Fn_N");
-    c.ft[k - 1] = ts.addColumn("foot" + std::to_string(k) + "_Ft_N");
+    c.fn[k - 1] = ts.addColumn(col::footFn(k));
+    c.ft[k - 1] = ts.addColumn(col::footFt(k));
   }
-  for (int i = 1; i <= n; ++i) c.track_err.push_back(ts.addColumn("track_err" + std::to_string(i) + "_deg"));
+  for (int i = 1; i <= n; ++i) c.track_err.push_back(ts.addColumn(col::trackErr(i)));
   return c;
 }
 
@@ -95,28 +98,28 @@ double worldZ(const mjData* d, int body, const mjtNum* w) {
   return R[6] * w[0] + R[7] * w[1] + R[8] * w[2];
 }
 
-// Fills one output row. Kinematics, contacts, qacc in d belong to the state (qpos, qvel) at time t
-// (the step that started at t has just run, only d->qpos / d->qvel / d->time moved on).
-void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, const TailController& ctrl,
-             const std::vector<mjtNum>& qpos, const std::vector<mjtNum>& qvel, const std::vector<mjtNum>& qacc,
-             double t_grid, double phi, std::vector<mjtNum>& scratch, std::vector<double>& row) {
-  const int n = static_cast<int>(L.tail_qposadr.size());
-  row[c.t] = t_grid;
-  for (int i = 0; i < n; ++i) {
-    row[c.theta[i]] = qpos[L.tail_qposadr[i]] * kRad2Deg;
-    row[c.thetadot[i]] = qvel[L.tail_dofadr[i]] * kRad2Deg;
-    row[c.thetaddot[i]] = qacc[L.tail_dofadr[i]] * kRad2Deg;  // actual, not the reference
-    row[c.track_err[i]] = ctrl.lastError(i) * kRad2Deg;
-  }
-  row[c.x] = d->xpos[3 * L.quad_body];  // quadruped COM = body origin
-  row[c.y] = d->xpos[3 * L.quad_body + 1];
-  row[c.phi] = phi * kRad2Deg;
-  const double phidot = worldZ(d, L.quad_body, qvel.data() + L.root_dofadr);
-  const double phiddot = worldZ(d, L.quad_body, qacc.data() + L.root_dofadr);
-  row[c.phidot] = phidot * kRad2Deg;
-  row[c.phiddot] = phiddot * kRad2Deg;
+// The loads of one MuJoCo step (the forces of the state the step started from, applied over the
+// step): the columns that are impulse-averaged over each output interval (docs/mujoco-model.md
+// "Force and moment columns").
+enum LoadIndex { kPhiddot, kIzzPhiddot, kMzT, kFTx, kFTy, kMzF, kFFx, kFFy, kFn1, kFt1 = kFn1 + 4, kNumLoads = kFt1 + 4 };
+using Loads = std::array<double, kNumLoads>;
 
-  // System COM and Izz about it (Eq. 11, full 3-D inertia tensors, tilt included).
+int loadColumn(const Columns& c, int j) {
+  switch (j) {
+    case kPhiddot: return c.phiddot;
+    case kIzzPhiddot: return c.izz_phiddot;
+    case kMzT: return c.mzt;
+    case kFTx: return c.ftx;
+    case kFTy: return c.fty;
+    case kMzF: return c.mzf;
+    case kFFx: return c.ffx;
+    case kFFy: return c.ffy;
+    default: return j < kFt1 ? c.fn[j - kFn1] : c.ft[j - kFt1];
+  }
+}
+
+// Izz of the whole robot about the system COM (Eq. 11, full 3-D inertia tensors, tilt included).
+double systemIzz(const mjModel* m, const mjData* d, const Layout& L) {
   const mjtNum* com = d->subtree_com + 3 * L.quad_body;
   double izz = 0.0;
   for (int b = L.quad_body; b < m->nbody; ++b) {
@@ -127,14 +130,25 @@ void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, con
     const double dx = d->xipos[3 * b] - com[0], dy = d->xipos[3 * b + 1] - com[1];
     izz += m->body_mass[b] * (dx * dx + dy * dy);
   }
-  row[c.izz] = izz;
-  row[c.izz_phiddot] = izz * phiddot;
+  return izz;
+}
+
+// Kinematics, contacts and constraint forces in d belong to the state (qvel, qacc applied) at the
+// step's start time (the step has just run, only d->qpos / d->qvel / d->time moved on).
+Loads computeLoads(const mjModel* m, mjData* d, const Layout& L, const std::vector<mjtNum>& qvel,
+                   const std::vector<mjtNum>& qacc, std::vector<mjtNum>& scratch) {
+  Loads out{};
+  const double phiddot = worldZ(d, L.quad_body, qacc.data() + L.root_dofadr);
+  out[kPhiddot] = phiddot * kRad2Deg;
+
+  out[kIzzPhiddot] = systemIzz(m, d, L) * phiddot;
+  const mjtNum* com = d->subtree_com + 3 * L.quad_body;  // the system COM
 
   // Tail load on the body: minus the interaction force of the tail's first link with its parent.
   // cfrc_int is (torque, force) at subtree_com of the root body = the system COM, world axes, so
   // its z torque is already M_z,T about the system COM (Eq. 13). mj_rnePostConstraint reads
-  // d->qvel and d->qacc: give it the velocities of time t and the accelerations the integrator
-  // actually applied over the step.
+  // d->qvel and d->qacc: give it the velocities of the step's start and the accelerations the
+  // integrator actually applied over the step.
   scratch.resize(2 * m->nv);
   std::copy(d->qvel, d->qvel + m->nv, scratch.begin());
   std::copy(d->qacc, d->qacc + m->nv, scratch.begin() + m->nv);
@@ -144,13 +158,11 @@ void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, con
   std::copy(scratch.begin(), scratch.begin() + m->nv, d->qvel);
   std::copy(scratch.begin() + m->nv, scratch.end(), d->qacc);
   const mjtNum* fint = d->cfrc_int + 6 * L.link1_body;
-  row[c.mzt] = -fint[2];
-  row[c.ftx] = -fint[3];
-  row[c.fty] = -fint[4];
+  out[kMzT] = -fint[2];
+  out[kFTx] = -fint[3];
+  out[kFTy] = -fint[4];
 
   // Foot contact forces (world), their friction moment about the system COM.
-  std::array<double, 4> fn{}, ft{};
-  double mzf = 0.0, ffx = 0.0, ffy = 0.0;
   for (int i = 0; i < d->ncon; ++i) {
     const mjContact& con = d->contact[i];
     int k = -1;
@@ -165,21 +177,84 @@ void fillRow(const mjModel* m, mjData* d, const Layout& L, const Columns& c, con
     double F[3];
     for (int a = 0; a < 3; ++a)
       F[a] = sign * (f6[0] * con.frame[a] + f6[1] * con.frame[3 + a] + f6[2] * con.frame[6 + a]);
-    fn[k] += f6[0];
-    ft[k] += std::hypot(f6[1], f6[2]);
+    out[kFn1 + k] += f6[0];
+    out[kFt1 + k] += std::hypot(f6[1], f6[2]);
     const double rx = con.pos[0] - com[0], ry = con.pos[1] - com[1];
-    mzf += rx * F[1] - ry * F[0];
-    ffx += F[0];
-    ffy += F[1];
+    out[kMzF] += rx * F[1] - ry * F[0];
+    out[kFFx] += F[0];
+    out[kFFy] += F[1];
   }
-  row[c.mzf] = mzf;
-  row[c.ffx] = ffx;
-  row[c.ffy] = ffy;
-  for (int k = 0; k < 4; ++k) {
-    row[c.fn[k]] = fn[k];
-    row[c.ft[k]] = ft[k];
-  }
+  return out;
 }
+
+// Fills one output row: the state at time t and the loads of the step that starts there (the
+// load columns are replaced by their interval averages once the interval's steps have run).
+void fillRow(const mjModel* m, const mjData* d, const Layout& L, const Columns& c, const TailController& ctrl,
+             const std::vector<mjtNum>& qpos, const std::vector<mjtNum>& qvel, const std::vector<mjtNum>& qacc,
+             const Loads& loads, double t_grid, double phi, std::vector<double>& row) {
+  const int n = static_cast<int>(L.tail_qposadr.size());
+  row[c.t] = t_grid;
+  for (int i = 0; i < n; ++i) {
+    row[c.theta[i]] = qpos[L.tail_qposadr[i]] * kRad2Deg;
+    row[c.thetadot[i]] = qvel[L.tail_dofadr[i]] * kRad2Deg;
+    row[c.thetaddot[i]] = qacc[L.tail_dofadr[i]] * kRad2Deg;  // actual, not the reference
+    row[c.track_err[i]] = ctrl.lastError(i) * kRad2Deg;
+  }
+  row[c.x] = d->xpos[3 * L.quad_body];  // quadruped COM = body origin
+  row[c.y] = d->xpos[3 * L.quad_body + 1];
+  row[c.phi] = phi * kRad2Deg;
+  row[c.phidot] = worldZ(d, L.quad_body, qvel.data() + L.root_dofadr) * kRad2Deg;
+  row[c.izz] = systemIzz(m, d, L);
+  for (int j = 0; j < kNumLoads; ++j) row[loadColumn(c, j)] = loads[j];
+}
+
+// Impulse averages of the load columns over the output intervals: row k owns the steps that start
+// in [t_k - dt/2, t_k + dt/2) (row 0: [0, dt/2); the last row: up to the end of the run), and its
+// value is the sum of (load * h) over those steps divided by their total time. A row that owns no
+// step (sample_dt < timestep) keeps the loads of the step it falls in. Rows wait here until their
+// interval has run, then go into the series whole.
+class ImpulseAverager {
+ public:
+  ImpulseAverager(double sample_dt, double h, long rows, const Columns& c, TimeSeries& ts)
+      : dt_(sample_dt), h_(h), rows_(rows), c_(c), ts_(ts) {}
+  void addRow(long k, const std::vector<double>& row) { pending_.push_back({k, row}); }
+  // The loads of the step that starts at t_step.
+  void addStep(double t_step, const Loads& loads) {
+    const long k = std::clamp(static_cast<long>(std::floor((t_step + 1e-6 * h_) / dt_ + 0.5)), 0L, rows_ - 1);
+    if (k != bucket_) flushBucket();
+    bucket_ = k;
+    for (int j = 0; j < kNumLoads; ++j) sum_[j] += loads[j] * h_;
+    time_ += h_;
+  }
+  // At the end of the run: the last interval, every row still waiting.
+  void finish() {
+    flushBucket();
+    for (const auto& p : pending_) ts_.appendRow(p.second);
+    pending_.clear();
+  }
+
+ private:
+  void flushBucket() {
+    if (bucket_ < 0) return;
+    for (auto& [k, row] : pending_)
+      if (k == bucket_ && time_ > 0.0)
+        for (int j = 0; j < kNumLoads; ++j) row[loadColumn(c_, j)] = sum_[j] / time_;
+    while (!pending_.empty() && pending_.front().first <= bucket_) {
+      ts_.appendRow(pending_.front().second);
+      pending_.pop_front();
+    }
+    sum_ = Loads{};
+    time_ = 0.0;
+  }
+  double dt_, h_;
+  long rows_;
+  const Columns& c_;
+  TimeSeries& ts_;
+  std::deque<std::pair<long, std::vector<double>>> pending_;
+  long bucket_ = -1;
+  Loads sum_{};
+  double time_ = 0.0;
+};
 
 // ADAMS law (Fig. 4): each foot's coefficient from its horizontal slip speed. Uses d->cvel of the
 // last evaluated state (one step old).
@@ -202,7 +277,7 @@ class StandingMonitor {
         z_ref_(s.body_height_m),
         h_(s.timestep_s),
         enforce_(e.gravity && e.ground_contact),
-        pyramid_rows_(s.cone == "pyramidal"),
+        pyramid_rows_(s.cone == MujocoCone::kPyramidal),
         cos_limit_(s.max_tilt_deg > 0.0 ? std::cos(s.max_tilt_deg * M_PI / 180.0) : -2.0),
         off_limit_steps_(s.max_all_feet_off_s > 0.0 ? static_cast<long>(std::ceil(s.max_all_feet_off_s / h_ - 1e-9))
                                                     : -1),
@@ -267,7 +342,7 @@ std::string instabilityMessage(const mjData* d, double t, const MujocoSettings& 
   os << "MuJoCo became unstable at t=" << t << " s (" << describeWarnings(d) << "): timestep_s=" << s.timestep_s
      << " too large for kp=" << *std::max_element(g.kp.begin(), g.kp.end())
      << " N m/rad (servo_wn_dt=" << s.servo_wn_dt << ") or contact solref=[" << s.solref[0] << ", " << s.solref[1]
-     << "] with integrator=" << s.integrator;
+     << "] with integrator=" << name(s.integrator);
   return os.str();
 }
 
@@ -304,7 +379,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   const Layout L = makeLayout(m, n, effects.translation);
   const ServoGains gains = tailServoGains(robot, settings);
   const bool continuous = effects.friction == FrictionLaw::kContinuous && effects.ground_contact;
-  const bool rk4 = settings.integrator == "RK4";
+  const bool rk4 = settings.integrator == MujocoIntegrator::kRK4;
 
   RunResult result;
   RunSummary& sum = result.summary;
@@ -326,11 +401,20 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
     sum.ok = false;
     sum.error = why + (messages.text().empty() ? "" : " [" + messages.text() + "]");
   };
-  auto step = [&](double t_ref, bool record) {
+  std::vector<mjtNum> qvel_s(m->nv), qacc_s(m->nv), scratch;
+  Loads loads{};
+  // One step. RK4 with `rk4_loads`: also the loads of the state the step starts from (RK4 overwrites
+  // the intermediate fields, so they are taken before it; the step's impulse is then h times them).
+  auto step = [&](double t_ref, bool record, Loads* rk4_loads) {
     if (continuous) updateFootFriction(m, d, L, robot.friction);
     if (rk4) {
       mj_forward(m, d);  // M, bias at this state for the feed-forward; ctrl is held over the RK4 step
       ctrl.apply(m, d, t_ref, record);
+      if (rk4_loads) {
+        std::copy(d->qvel, d->qvel + m->nv, qvel_s.begin());
+        std::copy(d->qacc, d->qacc + m->nv, qacc_s.begin());
+        *rk4_loads = computeLoads(m, d, L, qvel_s, qacc_s, scratch);
+      }
       mj_step(m, d);
     } else {
       mj_step1(m, d);
@@ -348,7 +432,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   };
   while (d->time < settings.settle_s - 0.5 * settings.timestep_s && sum.ok) {
     const double t_state = d->time - settings.settle_s;
-    step(0.0, false);
+    step(0.0, false, nullptr);
     if (warningCount(d) > 0) fail(instabilityMessage(d, d->time - settings.settle_s, settings, gains) + " (settling)");
     else if (!standing.update(d, t_state)) fail(standing.why() + " (while settling with the tail held at theta(0))");
   }
@@ -363,7 +447,8 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   const long num_samples = static_cast<long>(rows);
   const double eps = 1e-6 * h;
   long k = 0;
-  std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv), qacc_t(m->nv), scratch;
+  std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv), qacc_t(m->nv);
+  ImpulseAverager averager(output.sample_dt_s, h, num_samples, cols, ts);
   double phi = yawOf(d, L.quad_body), yaw_prev = phi, phi0 = phi;
   long steps = 0;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -372,6 +457,7 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   while (k < num_samples || d->time < duration - eps) {
     const double t = d->time;
     const bool sample = k < num_samples && t >= k * output.sample_dt_s - eps;
+    const bool averaged = t < duration - eps;  // the step lies inside the run: its impulse counts
     if (sample) {
       if (observer) observer(k * output.sample_dt_s, m, d);
       std::copy(d->qpos, d->qpos + m->nq, qpos_t.begin());
@@ -386,14 +472,18 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       phi += wrapPi(yaw - yaw_prev);
       yaw_prev = yaw;
       std::copy(d->qacc, d->qacc + m->nv, qacc_t.begin());
+      loads = computeLoads(m, d, L, qvel_t, qacc_t, scratch);
       while (k < num_samples && t >= k * output.sample_dt_s - eps) {
-        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, qacc_t, k * output.sample_dt_s, phi, scratch, row);
-        ts.appendRow(row);
+        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, qacc_t, loads, k * output.sample_dt_s, phi, row);
+        averager.addRow(k, row);
         ++k;
       }
       mj_step(m, d);
+    } else if (rk4) {
+      step(t, true, &loads);
     } else {
-      step(t, true);
+      std::copy(d->qvel, d->qvel + m->nv, qvel_s.begin());
+      step(t, true, nullptr);
     }
     ++steps;
     if (steps > settings.max_steps) {
@@ -427,16 +517,21 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
       phi += wrapPi(yaw - yaw_prev);
       yaw_prev = yaw;
     }
-    if (sample && !rk4) {
+    if (!rk4) {
       // The acceleration the integrator applied (implicit: (M - h D)^-1 f, not d->qacc's explicit one).
-      for (int v = 0; v < m->nv; ++v) qacc_t[v] = (d->qvel[v] - qvel_t[v]) / h;
+      for (int v = 0; v < m->nv; ++v) qacc_s[v] = (d->qvel[v] - qvel_s[v]) / h;
+      loads = computeLoads(m, d, L, qvel_s, qacc_s, scratch);
+    }
+    if (sample && !rk4) {
       while (k < num_samples && t >= k * output.sample_dt_s - eps) {
-        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, qacc_t, k * output.sample_dt_s, phi, scratch, row);
-        ts.appendRow(row);
+        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_s, qacc_s, loads, k * output.sample_dt_s, phi, row);
+        averager.addRow(k, row);
         ++k;
       }
     }
+    if (averaged) averager.addStep(t, loads);
   }
+  averager.finish();
   sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   sum.solver_steps = steps;
 

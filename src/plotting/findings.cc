@@ -1,7 +1,5 @@
 #include "plotting/findings.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +10,10 @@
 #include <optional>
 #include <sstream>
 
+#include "analytic_model/system_loads.h"
+#include "results/columns.h"
+#include "experiments/model_registry.h"
+
 namespace tailsim {
 
 namespace fs = std::filesystem;
@@ -20,7 +22,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
-const std::vector<std::string> kModels = {"analytic", "mujoco"};
+const std::vector<std::string> kModels = modelNames();
 
 std::string fmt(const char* f, double v) {
   char buf[64];
@@ -146,14 +148,9 @@ void twoAxisTrend(Finding& f, const ExperimentResults* r, const std::string& alo
   }
 }
 
-std::optional<double> yamlNumber(const ExperimentResults& r, const std::string& section, const std::string& key) {
-  try {
-    const YAML::Node n = YAML::LoadFile((fs::path(r.dir) / "experiment.yaml").string());
-    const YAML::Node s = section.empty() ? n[key] : n[section][key];
-    if (s && s.IsScalar()) return s.as<double>();
-  } catch (const std::exception&) {
-  }
-  return std::nullopt;
+// Why a folder has no resolved cases (for n/a verdicts).
+std::string unresolved(const ExperimentResults& r) {
+  return "the cases as run are not readable from " + r.dir + "/experiment.yaml: " + r.resolve_error;
 }
 
 // Index of a column's max |value| and that value; -1 if absent.
@@ -178,13 +175,15 @@ Finding splitCycle(const std::vector<ExperimentResults>& all) {
   for (const std::string& m : modelsOf(r)) {
     if (!r) { f.verdicts.push_back(na(m, "fig07 not in the results")); continue; }
     if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
-    const auto dT = yamlNumber(*r, "trajectory", "dT_s"), dth = yamlNumber(*r, "trajectory", "dtheta_deg"),
-               w = yamlNumber(*r, "trajectory", "w_ss"), th0 = yamlNumber(*r, "trajectory", "theta0_deg");
-    const double t0 = yamlNumber(*r, "trajectory", "t0_s").value_or(0.0);
-    if (!dT || !dth || !w || !th0) {
-      f.verdicts.push_back(na(m, "experiment.yaml lacks scalar trajectory dT_s, dtheta_deg, w_ss, theta0_deg"));
+    // Joint 1's trajectory as the case ran it (resolved: defaults, per-joint lists, rule: eq25).
+    const ExperimentCase* rc = r->cases.empty() ? nullptr : r->resolvedCase(r->cases.front());
+    if (!rc || rc->joints.empty()) {
+      f.verdicts.push_back(na(m, r->cases.empty() ? "fig07 has no case" : unresolved(*r)));
       continue;
     }
+    const SplitCycleParams& j1 = rc->joints.front();
+    const double dT = j1.dT_s, dth = j1.dtheta_rad * 180 / kPi, w = j1.w_ss, th0 = j1.theta0_rad * 180 / kPi;
+    const double t0 = j1.t0_s;
     TimeSeries s;
     try {
       s = r->series(r->cases.front(), m);
@@ -192,24 +191,24 @@ Finding splitCycle(const std::vector<ExperimentResults>& all) {
       f.verdicts.push_back(na(m, e.what()));
       continue;
     }
-    if (!s.has("t_s") || !s.has("thetadot1_dps") || !s.has("theta1_deg") || s.numRows() < 3) {
+    if (!s.has(col::kT) || !s.has("thetadot1_dps") || !s.has("theta1_deg") || s.numRows() < 3) {
       f.verdicts.push_back(na(m, "CSV lacks t_s, theta1_deg, thetadot1_dps"));
       continue;
     }
-    const auto& t = s.values("t_s");
+    const auto& t = s.values(col::kT);
     const double dt = t[1] - t[0];
     const auto [ip, peak] = peakAbs(s, "thetadot1_dps");
-    const double want_peak = 2.0 * std::fabs(*dth) / *dT, want_t = t0 + *w * *dT;
+    const double want_peak = 2.0 * std::fabs(dth) / dT, want_t = t0 + w * dT;
     const double th_start = s.values("theta1_deg").front(), th_end = s.values("theta1_deg").back();
     const double peak_err = std::fabs(peak - want_peak) / want_peak, t_err = std::fabs(t[ip] - want_t);
-    const double th_err = std::max(std::fabs(th_start - *th0), std::fabs(th_end - (*th0 + *dth)));
-    const bool ok = peak_err <= 0.01 && t_err <= std::max(2.0 * dt, 0.02 * *dT) && th_err <= 0.5;
+    const double th_err = std::max(std::fabs(th_start - th0), std::fabs(th_end - (th0 + dth)));
+    const bool ok = peak_err <= 0.01 && t_err <= std::max(2.0 * dt, 0.02 * dT) && th_err <= 0.5;
     f.verdicts.push_back({m, ok ? Verdict::kYes : Verdict::kNo,
                           "peak " + fmt("%.1f", peak) + " deg/s at t = " + fmt("%.4f", t[ip]) + " s (expected " +
                               fmt("%.1f", want_peak) + " deg/s at " + fmt("%.4f", want_t) + " s; tolerance 1 %, " +
-                              fmt("%.4f", std::max(2.0 * dt, 0.02 * *dT)) + " s); theta " + fmt("%.2f", th_start) +
-                              " -> " + fmt("%.2f", th_end) + " deg (expected " + fmt("%.2f", *th0) + " -> " +
-                              fmt("%.2f", *th0 + *dth) + ", tolerance 0.5 deg)"});
+                              fmt("%.4f", std::max(2.0 * dt, 0.02 * dT)) + " s); theta " + fmt("%.2f", th_start) +
+                              " -> " + fmt("%.2f", th_end) + " deg (expected " + fmt("%.2f", th0) + " -> " +
+                              fmt("%.2f", th0 + dth) + ", tolerance 0.5 deg)"});
   }
   return f;
 }
@@ -230,13 +229,13 @@ Finding fig07Phases(const std::vector<ExperimentResults>& all) {
       f.verdicts.push_back(na(m, e.what()));
       continue;
     }
-    if (!s.has("t_s") || !s.has("phidot_dps") || !s.has("MzT_Nm") || s.numRows() < 3) {
+    if (!s.has(col::kT) || !s.has(col::kPhidot) || !s.has(col::kMzT) || s.numRows() < 3) {
       f.verdicts.push_back(na(m, "CSV lacks t_s, phidot_dps, MzT_Nm"));
       continue;
     }
-    const auto& t = s.values("t_s");
-    const auto& w = s.values("phidot_dps");
-    const auto& mz = s.values("MzT_Nm");
+    const auto& t = s.values(col::kT);
+    const auto& w = s.values(col::kPhidot);
+    const auto& mz = s.values(col::kMzT);
     size_t imax = 0, imin = 0, first_neg_mz = mz.size();
     for (size_t i = 0; i < w.size(); ++i) {
       if (w[i] > w[imax]) imax = i;
@@ -274,7 +273,6 @@ Finding eq25(const std::vector<ExperimentResults>& all) {
     const SweepAxis* a = findAxis(*r, "links");
     if (!a) { f.verdicts.push_back(na(m, "fig14 has no sweep over links")); continue; }
     if (!r->hasModel(m)) { f.verdicts.push_back(na(m, notRun(*r, m))); continue; }
-    const double vmax = yamlNumber(*r, "trajectory", "thetadot_max_dps").value_or(600.0);
     bool ok = true;
     double worst_angle = 0, worst_speed = 0;
     std::string d;
@@ -290,10 +288,19 @@ Finding eq25(const std::vector<ExperimentResults>& all) {
         d += (d.empty() ? "" : "; ") + ("n=" + a->values[i] + ": no data");
         continue;
       }
+      // The peak speed the case was given (Eq. 25 makes it the same on every joint): 2|dtheta|/dT of
+      // joint 1 as run; the paper's table below is checked against it.
+      const ExperimentCase* rc = r->resolvedCase(*c);
+      if (!rc || rc->joints.empty()) {
+        ok = false;
+        d += (d.empty() ? "" : "; ") + ("n=" + a->values[i] + ": " + unresolved(*r));
+        continue;
+      }
+      const double vmax = 2.0 * std::fabs(rc->joints.front().dtheta_rad) / rc->joints.front().dT_s * 180 / kPi;
       const double want = 360.0 / (n + 1);  // |dtheta|; theta goes +want/2 -> -want/2
       double dth1 = kNaN, peak1 = kNaN;
       for (int j = 1; j <= n; ++j) {
-        const std::string th = "theta" + std::to_string(j) + "_deg", thd = "thetadot" + std::to_string(j) + "_dps";
+        const std::string th = col::theta(j), thd = col::thetadot(j);
         if (!s.has(th) || !s.has(thd) || s.numRows() == 0) { ok = false; continue; }
         const double a0 = s.values(th).front(), a1 = s.values(th).back();
         const double pk = peakAbs(s, thd).second;
@@ -310,34 +317,6 @@ Finding eq25(const std::vector<ExperimentResults>& all) {
                               fmt("%.2f", 100 * worst_speed) + " %; tolerance 0.5 deg, 1 %)"});
   }
   return f;
-}
-
-// Robot numbers for Eq. (24): m_Q, one-link tail m_L, L_L, I_zz,L from the robot file named by
-// the experiment, d_Q2B from the experiment (or the robot file).
-struct OneLinkParams {
-  double mQ, mL, L, IzzL, d;
-};
-std::optional<OneLinkParams> oneLinkParams(const ExperimentResults& r) {
-  try {
-    const YAML::Node e = YAML::LoadFile((fs::path(r.dir) / "experiment.yaml").string());
-    fs::path robot = e["robot"].as<std::string>();
-    if (robot.is_relative()) {
-      if (r.source.empty()) return std::nullopt;
-      robot = fs::path(r.source).parent_path() / robot;
-    }
-    const YAML::Node rb = YAML::LoadFile(robot.string());
-    OneLinkParams p;
-    p.mQ = rb["quadruped"]["mass_kg"].as<double>();
-    p.mL = rb["tails"][1]["mass_kg"].as<double>();
-    p.L = rb["tails"][1]["length_m"].as<double>();
-    p.IzzL = rb["tails"][1]["izz_kgm2"].as<double>();
-    p.d = rb["quadruped"]["d_Q2B_m"].as<double>();
-    if (e["quadruped"] && e["quadruped"]["d_Q2B_m"] && e["quadruped"]["d_Q2B_m"].IsScalar())
-      p.d = e["quadruped"]["d_Q2B_m"].as<double>();
-    return p;
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
 }
 
 std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
@@ -363,21 +342,33 @@ std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
       peaks.verdicts.push_back(na(m, why));
       continue;
     }
-    const double thd = yamlNumber(*r, "pose", "thetadot_radps").value_or(kNaN);
-    const double thdd = yamlNumber(*r, "pose", "thetaddot_radps2").value_or(kNaN);
-    const auto p = oneLinkParams(*r);
+    // Eq. (24) from the analytic model's code, with each pose's robot and rates as run.
     std::vector<double> th, tan, cen, tot;
+    std::vector<Eq24Terms> want;
+    std::string why_no_eq24;
+    double Ieff = kNaN, d_Q2B = kNaN;
     bool cols = true;
     for (size_t i = 0; i < a->values.size(); ++i) {
       const CaseRecord* c = r->find({{a->key, a->values[i]}});
       try {
         if (!c) throw std::runtime_error("missing");
         const TimeSeries s = r->series(*c, m);
-        if (!s.has("MzT_tan_Nm") || !s.has("MzT_cen_Nm") || s.numRows() == 0) { cols = false; break; }
+        if (!s.has(col::kMzTTan) || !s.has(col::kMzTCen) || s.numRows() == 0) { cols = false; break; }
         th.push_back(a->number(i) * kPi / 180);
-        tan.push_back(s.values("MzT_tan_Nm")[0]);
-        cen.push_back(s.values("MzT_cen_Nm")[0]);
-        tot.push_back(s.has("MzT_Nm") ? s.values("MzT_Nm")[0] : kNaN);
+        const ExperimentCase* rc = r->resolvedCase(*c);
+        if (!rc) why_no_eq24 = unresolved(*r);
+        else if (rc->robot.numLinks() != 1 || rc->pose.theta_rad.size() != 1)
+          why_no_eq24 = "Eq. (24) is for a one-link tail; case " + c->name + " has " +
+                        std::to_string(rc->robot.numLinks()) + " links";
+        else {
+          want.push_back(eq24OneLinkMoment(rc->robot, rc->pose.theta_rad[0], rc->pose.thetadot_radps[0],
+                                           rc->pose.thetaddot_radps2[0]));
+          Ieff = eq24OneLinkMoment(rc->robot, 0, 0, -1).tangential;  // -Ieff thetaddot cos(theta) at 0, -1
+          d_Q2B = rc->robot.quadruped.d_Q2B_m;
+        }
+        tan.push_back(s.values(col::kMzTTan)[0]);
+        cen.push_back(s.values(col::kMzTCen)[0]);
+        tot.push_back(s.has(col::kMzT) ? s.values(col::kMzT)[0] : kNaN);
       } catch (const std::exception&) {
         cols = false;
         break;
@@ -407,27 +398,24 @@ std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
                                   fmt("%.1f", th_t) + " deg; max |M_zT,cen| = " + fmt("%.4g", std::fabs(cen[ic])) +
                                   " N m at theta = " + fmt("%.1f", th_c) + " deg (grid " + a->values.front() + " .. " +
                                   a->values.back() + " deg)"});
-    if (!p || !std::isfinite(thd) || !std::isfinite(thdd)) {
-      eq.verdicts.push_back(na(m, "robot parameters or pose rates not readable from experiment.yaml / robot file"));
+    if (!why_no_eq24.empty() || want.size() != th.size()) {
+      eq.verdicts.push_back(na(m, why_no_eq24));
       continue;
     }
-    const double mtot = p->mQ + p->mL;
-    const double Ieff = p->mQ * p->mL / (2 * mtot) * p->L * p->d;
-    const double rot = -(p->IzzL + 0.25 * p->mL * p->L * p->L * p->mQ / mtot) * thdd;
     double err = 0, scale = 1e-12;
     bool have_total = true;
     for (size_t i = 0; i < th.size(); ++i) {
-      const double wt = -Ieff * thdd * std::cos(th[i]), wc = Ieff * thd * thd * std::sin(th[i]);
+      const double wt = want[i].tangential, wc = want[i].centripetal, rot = want[i].rotational;
       err = std::max({err, std::fabs(tan[i] - wt), std::fabs(cen[i] - wc)});
       scale = std::max({scale, std::fabs(wt), std::fabs(wc), std::fabs(rot)});
-      if (std::isfinite(tot[i])) err = std::max(err, std::fabs(tot[i] - (rot + wt + wc)));
+      if (std::isfinite(tot[i])) err = std::max(err, std::fabs(tot[i] - want[i].total()));
       else have_total = false;
     }
     const double rel = err / scale;
     eq.verdicts.push_back({m, rel <= 1e-6 ? Verdict::kYes : Verdict::kNo,
                            "max deviation from Eq. (24) " + fmt("%.3g", err) + " N m = " + fmt("%.2g", rel) +
                                " of the largest term (I_eff = " + fmt("%.5g", Ieff) + " kg m^2, d_Q2B = " +
-                               fmt("%.4g", p->d) + " m; " + std::to_string(th.size()) + " poses" +
+                               fmt("%.4g", d_Q2B) + " m; " + std::to_string(th.size()) + " poses" +
                                (have_total ? ", tangential, centripetal and total" : ", tangential and centripetal") +
                                "; tolerance 1e-6)"});
   }
@@ -511,8 +499,8 @@ Finding lfVariation(const std::vector<ExperimentResults>& all) {
     for (const CaseRecord& c : r->cases) {
       try {
         const TimeSeries s = r->series(c, m);
-        if (s.has("LF_m") && s.numRows() > 0 && std::isfinite(s.values("LF_m")[0]))
-          lf.emplace_back(s.values("LF_m")[0], &c);
+        if (s.has(col::kLF) && s.numRows() > 0 && std::isfinite(s.values(col::kLF)[0]))
+          lf.emplace_back(s.values(col::kLF)[0], &c);
       } catch (const std::exception&) {
       }
     }

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "plotting/figure_sheet.h"
+#include "results/columns.h"
 #include "plotting/gnuplot.h"
 #include "plotting/style.h"
 
@@ -99,7 +100,7 @@ std::pair<double, double> span(const std::vector<double>& v, double margin) {
 
 std::vector<std::string> jointSpeedColumns(const TimeSeries& s) {
   std::vector<std::string> cols;
-  for (int i = 1; s.has("thetadot" + std::to_string(i) + "_dps"); ++i) cols.push_back("thetadot" + std::to_string(i) + "_dps");
+  for (int i = 1; s.has(col::thetadot(i)); ++i) cols.push_back(col::thetadot(i));
   return cols;
 }
 
@@ -107,13 +108,13 @@ std::vector<std::string> jointSpeedColumns(const TimeSeries& s) {
 // than `rel` times the peak joint speed (NaN if the CSV has no joint speeds).
 std::pair<double, double> tailMotion(const TimeSeries& s, double rel) {
   const auto cols = jointSpeedColumns(s);
-  if (cols.empty() || !s.has("t_s")) return {kNaN, kNaN};
+  if (cols.empty() || !s.has(col::kT)) return {kNaN, kNaN};
   double peak = 0;
   for (const auto& c : cols)
     for (double v : s.values(c))
       if (std::isfinite(v)) peak = std::max(peak, std::fabs(v));
   if (!(peak > 0)) return {kNaN, kNaN};
-  const auto& t = s.values("t_s");
+  const auto& t = s.values(col::kT);
   double first = kNaN, last = kNaN;
   for (size_t k = 0; k < t.size(); ++k)
     for (const auto& c : cols)
@@ -129,8 +130,8 @@ std::pair<double, double> tailMotion(const TimeSeries& s, double rel) {
 double timeAxisEnd(const std::vector<const TimeSeries*>& series, const std::vector<double>& t_stops) {
   double last = 0, data_end = 0, dt = 0;
   for (const TimeSeries* s : series) {
-    if (!s->has("t_s") || s->numRows() < 2) continue;
-    const auto& t = s->values("t_s");
+    if (!s->has(col::kT) || s->numRows() < 2) continue;
+    const auto& t = s->values(col::kT);
     data_end = std::max(data_end, t.back());
     dt = std::max(dt, t[1] - t[0]);
     const double end = tailMotion(*s, 0.01).second;  // 1 %: a servo's jitter is not motion
@@ -154,10 +155,10 @@ struct Phases {
 Phases findPhases(const TimeSeries& s) {
   Phases p;
   const auto cols = jointSpeedColumns(s);
-  if (cols.empty() || !s.has("t_s") || !s.has("phidot_dps") || !s.has("rot_state") || s.numRows() < 4) return p;
-  const auto& t = s.values("t_s");
-  const auto& w = s.values("phidot_dps");
-  const auto& rot = s.values("rot_state");
+  if (cols.empty() || !s.has(col::kT) || !s.has(col::kPhidot) || !s.has(col::kRotState) || s.numRows() < 4) return p;
+  const auto& t = s.values(col::kT);
+  const auto& w = s.values(col::kPhidot);
+  const auto& rot = s.values(col::kRotState);
   const auto& th = s.values(cols[0]);
   size_t ipk = 0;
   for (size_t k = 0; k < th.size(); ++k)
@@ -231,7 +232,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   for (const std::string& m : r.models) {
     try {
       TimeSeries s = r.series(c, m);
-      if (s.has("t_s") && s.has("phi_deg")) {
+      if (s.has(col::kT) && s.has(col::kPhi)) {
         ts[m] = std::move(s);
         models.push_back(m);
       }
@@ -262,10 +263,10 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     const TimeSeries& s = ts[m];
     const std::string stem = stem_prefix + "_phi_" + m;
     std::vector<std::vector<double>> rows;
-    const auto& t = s.values("t_s");
-    const auto& phi = s.values("phi_deg");
+    const auto& t = s.values(col::kT);
+    const auto& phi = s.values(col::kPhi);
     for (size_t k = 0; k < t.size(); ++k) rows.push_back({t[k], phi[k]});
-    writeDataFile(ctx.data(stem), {"t_s", "phi_deg"}, rows);
+    writeDataFile(ctx.data(stem), {col::kT, col::kPhi}, rows);
     const double net = r.phiNet(c, m);
     std::string title = gpText(modelTitle(m));
     if (std::isfinite(net)) title += ", φ_{net} = " + fmt("%.2f", net) + "°";
@@ -280,7 +281,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
 
   // Moments over time, one panel per model, one y scale (Fig. 7b).
   static const std::vector<std::pair<std::string, std::string>> cols = {
-      {"MzT_Nm", "M_{z,T} (tail)"}, {"MzF_Nm", "M_{z,F} (friction)"}, {"Izz_phiddot_Nm", "I_{zz} φ̈ (inertial)"}};
+      {col::kMzT, "M_{z,T} (tail)"}, {col::kMzF, "M_{z,F} (friction)"}, {col::kIzzPhiddot, "I_{zz} φ̈ (inertial)"}};
   std::vector<std::string> mm;
   for (const std::string& m : models)
     for (const auto& [col, label] : cols)
@@ -289,21 +290,15 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
         break;
       }
   if (mm.empty()) return;
-  // The y range: the analytic curves' with a margin (MuJoCo's sampled contact moments chatter far
-  // beyond the signal and are clipped); without an analytic run, the 2nd-98th percentile.
+  // The y range: every panel's values with a margin, nothing clipped (MuJoCo's loads are impulse
+  // averages over each output interval, docs/mujoco-model.md "Force and moment columns").
   std::vector<double> yv;
-  const bool from_analytic = std::find(mm.begin(), mm.end(), "analytic") != mm.end();
   for (const std::string& m : mm) {
-    if (from_analytic && m != "analytic") continue;
     const TimeSeries& s = ts[m];
     for (const auto& [col, label] : cols)
       if (s.has(col))
         for (size_t k = 0; k < s.numRows(); ++k)
-          if (s.values("t_s")[k] <= t_end) yv.push_back(s.values(col)[k]);
-  }
-  if (!from_analytic && yv.size() > 50) {
-    std::sort(yv.begin(), yv.end());
-    yv = {yv[yv.size() / 50], yv[yv.size() - 1 - yv.size() / 50]};
+          if (s.values(col::kT)[k] <= t_end) yv.push_back(s.values(col)[k]);
   }
   const auto [ylo, yhi] = span(yv, 0.12);
   const Txt mom_title = ctx.title(W("moments about the system COM") + ctx.tail);
@@ -313,17 +308,17 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   for (const std::string& m : mm) {
     const TimeSeries& s = ts[m];
     const std::string stem = stem_prefix + "_moments_" + m;
-    std::vector<std::string> names = {"t_s"};
+    std::vector<std::string> names = {col::kT};
     for (const auto& [col, label] : cols) names.push_back(col);
     std::vector<std::vector<double>> rows;
     for (size_t k = 0; k < s.numRows(); ++k) {
-      std::vector<double> row = {s.values("t_s")[k]};
+      std::vector<double> row = {s.values(col::kT)[k]};
       for (const auto& [col, label] : cols) row.push_back(s.has(col) ? s.values(col)[k] : kNaN);
       rows.push_back(row);
     }
     writeDataFile(ctx.data(stem), names, rows);
     std::string panel = gpText(modelTitle(m));
-    if (m == "mujoco") panel += ": sampled contact moments, clipped to the analytic range";
+    if (m == "mujoco") panel += ": impulse-averaged over each output interval";
     mb << "set grid\nset key bottom right box opaque\nset title " << gpQuote(panel)
        << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
     int n = 0;
@@ -339,11 +334,9 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
                     ". Tail moment M_z,T (Eq. 13), friction moment M_z,F and inertial moment I_zz φ̈ over time, one "
                     "panel per model, same scales.";
   if (ts.count("mujoco") && std::find(mm.begin(), mm.end(), "mujoco") != mm.end())
-    cap += from_analytic ? " MuJoCo's moments are single samples of the contact forces at each output instant (not "
-                           "averaged), so they chatter; the y range is the analytic curves' with a 12 % margin and "
-                           "MuJoCo values beyond it are clipped."
-                         : " MuJoCo's moments are single samples at each output instant; the y range is their 2nd to "
-                           "98th percentile.";
+    cap += " MuJoCo's moments are impulse averages: the contact and joint impulses of the MuJoCo steps in each "
+           "output interval (t ± Δt/2) summed and divided by the interval's length, not single samples of the "
+           "chattering contact forces; the y range holds every value of both panels.";
   ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1000,
              60 + 430 * static_cast<int>(mm.size()));
 }
@@ -471,12 +464,12 @@ void plotOneKey(Ctx& ctx) {
       } catch (const std::exception&) {
         continue;
       }
-      if (!s.has("t_s") || !s.has("phi_deg")) continue;
+      if (!s.has(col::kT) || !s.has(col::kPhi)) continue;
       const std::string dstem = r.name + "_phi_t_" + m + "_" + std::to_string(i);
       std::vector<std::vector<double>> rr;
-      for (size_t k = 0; k < s.numRows(); ++k) rr.push_back({s.values("t_s")[k], s.values("phi_deg")[k]});
-      writeDataFile(ctx.data(dstem), {"t_s", "phi_deg"}, rr);
-      for (double v : s.values("phi_deg")) phis.push_back(v);
+      for (size_t k = 0; k < s.numRows(); ++k) rr.push_back({s.values(col::kT)[k], s.values(col::kPhi)[k]});
+      writeDataFile(ctx.data(dstem), {col::kT, col::kPhi}, rr);
+      for (double v : s.values(col::kPhi)) phis.push_back(v);
       if (auto it = c->runs.find(m); it != c->runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
       loaded.push_back(std::move(s));
       curves.push_back({dstem + ".dat", i});
@@ -622,20 +615,20 @@ void plotPoseOneKey(Ctx& ctx) {
     std::string col, gp, plain;
   };
   std::vector<Part> parts;
-  if (probe.has("MzT_tan_Nm") && probe.has("MzT_cen_Nm"))
+  if (probe.has(col::kMzTTan) && probe.has(col::kMzTCen))
     parts = {{"MzT_tan_Nm", "(a) tangential M_{z,T,tan} / I_{zz}", "tangential M_z,T,tan / I_zz"},
              {"MzT_cen_Nm", "(b) centripetal M_{z,T,cen} / I_{zz}", "centripetal M_z,T,cen / I_zz"}};
-  else if (probe.has("MzT_acc_Nm") && probe.has("MzT_speed_Nm"))
+  else if (probe.has(col::kMzTAcc) && probe.has(col::kMzTSpeed))
     parts = {{"MzT_acc_Nm", "(a) acceleration-driven M_{z,T,acc} / I_{zz}", "acceleration-driven M_z,T,acc / I_zz"},
              {"MzT_speed_Nm", "(b) speed-driven M_{z,T,speed} / I_{zz}", "speed-driven M_z,T,speed / I_zz"}};
-  const bool perIzz = probe.has("Izz_kgm2");
+  const bool perIzz = probe.has(col::kIzz);
   const double xs = a.numeric ? kd.scale : 1.0;
   if (!parts.empty()) {
     const std::string stem = r.name + "_contributions";
     std::vector<std::vector<double>> rows;
     for (size_t i = 0; i < a.values.size(); ++i) {
       const CaseRecord* c = r.find({{a.key, a.values[i]}});
-      const double izz = perIzz ? poseValue(r, c, model, "Izz_kgm2") : 1.0;
+      const double izz = perIzz ? poseValue(r, c, model, col::kIzz) : 1.0;
       rows.push_back({a.number(i) * xs, poseValue(r, c, model, parts[0].col) / izz,
                       poseValue(r, c, model, parts[1].col) / izz});
     }
@@ -654,11 +647,11 @@ void plotPoseOneKey(Ctx& ctx) {
                    modelTitle(model) + ").",
                1600, 690);
   }
-  if (probe.has("LF_m")) {
+  if (probe.has(col::kLF)) {
     const std::string stem = r.name + "_LF";
     std::vector<std::vector<double>> rows;
     for (size_t i = 0; i < a.values.size(); ++i)
-      rows.push_back({a.number(i) * xs, 1e3 * poseValue(r, r.find({{a.key, a.values[i]}}), model, "LF_m")});
+      rows.push_back({a.number(i) * xs, 1e3 * poseValue(r, r.find({{a.key, a.values[i]}}), model, col::kLF)});
     writeDataFile(ctx.data(stem), {leafKey(a.key), "LF_mm"}, rows);
     const Txt title = ctx.title(W("friction moment arm L_F over ") + K(a.key) + ctx.tail);
     std::ostringstream b;
@@ -678,7 +671,7 @@ void plotPoseTwoKeys(Ctx& ctx) {
     bool any = false;
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       for (size_t ix = 0; ix < ax.values.size(); ++ix) {
-        g[iy][ix] = 1e3 * poseValue(r, r.find({{ay.key, ay.values[iy]}, {ax.key, ax.values[ix]}}), m, "LF_m");
+        g[iy][ix] = 1e3 * poseValue(r, r.find({{ay.key, ay.values[iy]}, {ax.key, ax.values[ix]}}), m, col::kLF);
         any = any || std::isfinite(g[iy][ix]);
       }
     if (any) grids.emplace_back(m, g);

@@ -1,6 +1,5 @@
 #include "plotting/result_folder.h"
 
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -9,7 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/model_registry.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {
@@ -117,21 +118,6 @@ json readJson(const fs::path& p) {
   }
 }
 
-// Top-level `kind:` (and `description:` / `name:`) of the copied experiment file, if readable.
-void readExperimentYaml(const fs::path& p, ExperimentResults& r) {
-  if (!fs::exists(p)) return;
-  try {
-    const YAML::Node n = YAML::LoadFile(p.string());
-    if (n["kind"]) r.kind = n["kind"].as<std::string>();
-    if (n["tail"] && n["tail"].IsMap() && n["tail"]["links"] && n["tail"]["links"].IsScalar())
-      r.links = n["tail"]["links"].as<int>();
-    if (r.description.empty() && n["description"]) r.description = n["description"].as<std::string>();
-    if (r.name.empty() && n["name"]) r.name = n["name"].as<std::string>();
-  } catch (const YAML::Exception&) {
-    // a copy we cannot parse only costs the defaults
-  }
-}
-
 }  // namespace
 
 std::string ExperimentResults::csvPath(const CaseRecord& c, const std::string& model) const {
@@ -146,6 +132,11 @@ double ExperimentResults::phiNet(const CaseRecord& c, const std::string& model) 
   auto it = c.runs.find(model);
   if (it == c.runs.end() || !it->second.ok) return NAN;
   return it->second.phi_net_deg;
+}
+
+const ExperimentCase* ExperimentResults::resolvedCase(const CaseRecord& c) const {
+  const auto it = resolved.find(c.name);
+  return it == resolved.end() ? nullptr : &it->second;
 }
 
 bool ExperimentResults::hasModel(const std::string& model) const {
@@ -184,19 +175,35 @@ ExperimentResults loadResults(const std::string& dir) {
     for (const auto& e : fs::directory_iterator(root / "cases"))
       if (fs::exists(e.path() / "result.json")) files.push_back(e.path() / "result.json");
     std::sort(files.begin(), files.end());
-    for (const fs::path& f : files) r.cases.push_back(parseCase(readJson(f)));
+    for (const fs::path& f : files) {
+      const json j = readJson(f);
+      if (r.name.empty()) r.name = j.value("experiment", std::string());  // as the runner writes it
+      if (r.source.empty()) r.source = j.value("source", std::string());
+      r.cases.push_back(parseCase(j));
+    }
   } else {
     throw std::runtime_error(dir + " is not a result folder (no summary.json, no cases/)");
   }
   const bool kind_given = !r.kind.empty();
   if (!kind_given) r.kind = "simulate";
-  ExperimentResults fromYaml;
-  fromYaml.kind = r.kind;
-  readExperimentYaml(root / "experiment.yaml", fromYaml);
-  if (!kind_given) r.kind = fromYaml.kind;
-  if (r.description.empty()) r.description = fromYaml.description;
-  r.links = fromYaml.links;
-  if (r.name.empty()) r.name = fromYaml.name.empty() ? root.filename().string() : fromYaml.name;
+  // The cases as run, from the folder's own copies (experiment.yaml -> robot.yaml).
+  if (fs::exists(root / "experiment.yaml")) {
+    try {
+      const Experiment e = loadExperiment((root / "experiment.yaml").string());
+      for (const ExperimentCase& c : e.cases) r.resolved.emplace(c.name, c);
+      if (!kind_given && !e.cases.empty()) r.kind = name(e.cases.front().kind);
+      if (r.description.empty()) r.description = e.description;
+      if (r.name.empty()) r.name = e.name;
+      r.links = e.cases.empty() ? 0 : e.cases.front().robot.numLinks();
+      for (const ExperimentCase& c : e.cases)
+        if (c.robot.numLinks() != e.cases.front().robot.numLinks()) r.links = 0;
+    } catch (const std::exception& ex) {
+      r.resolve_error = ex.what();
+    }
+  } else {
+    r.resolve_error = (root / "experiment.yaml").string() + " is missing";
+  }
+  if (r.name.empty()) r.name = root.filename().string();
 
   // Keys: summary order first, then any others found in the cases.
   for (const CaseRecord& c : r.cases)
@@ -220,7 +227,8 @@ ExperimentResults loadResults(const std::string& dir) {
     for (const auto& [m, run] : c.runs)
       if (!r.hasModel(m)) r.models.push_back(m);
   std::stable_sort(r.models.begin(), r.models.end(), [](const std::string& a, const std::string& b) {
-    auto rank = [](const std::string& m) { return m == "analytic" ? 0 : m == "mujoco" ? 1 : 2; };
+    const std::vector<std::string> names = modelNames();  // registry order, unknown ones last
+    auto rank = [&](const std::string& m) { return std::find(names.begin(), names.end(), m) - names.begin(); };
     return rank(a) < rank(b);
   });
   return r;

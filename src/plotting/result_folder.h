@@ -1,6 +1,8 @@
 // Reading a result folder (docs/ARCHITECTURE.md "Result folder") back for plots and reports:
-// DIR/summary.json, DIR/cases/<dir>/<model>.csv, DIR/experiment.yaml. A suite folder holds one
-// such folder per experiment (DIR/<experiment>/summary.json).
+// DIR/summary.json, DIR/cases/<dir>/<model>.csv, and the cases as run: DIR/experiment.yaml read by
+// the experiments layer's loader (its robot: names the folder's copy DIR/robot.yaml), never the
+// input files the folder was made from. A suite folder holds one such folder per experiment
+// (DIR/<experiment>/summary.json).
 #pragma once
 
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/experiment_config.h"
 #include "results/time_series.h"
 
 namespace tailsim {
@@ -45,10 +48,15 @@ struct ExperimentResults {
   std::string description;
   std::string source;       // YAML file it was run from
   std::string kind = "simulate";  // "simulate" | "pose"
-  int links = 0;                    // tail links when experiment.yaml gives one number, else 0
+  int links = 0;                    // tail links when every case has the same number, else 0
   std::vector<std::string> models;  // every model that has a run, "analytic" first
   std::vector<SweepAxis> axes;      // swept keys with more than one value, in summary order
   std::vector<CaseRecord> cases;
+  // Every case as run (all values resolved: sweeps, defaults, per-joint lists, rule: eq25, custom
+  // tails), by case name, from DIR/experiment.yaml. Empty when it cannot be loaded (a folder of
+  // an older tailsim without its robot copy): resolve_error says why.
+  std::map<std::string, ExperimentCase> resolved;
+  std::string resolve_error;
 
   // DIR/cases/<case.dir>/<model>.csv; throws std::runtime_error if unreadable.
   std::string csvPath(const CaseRecord& c, const std::string& model) const;
@@ -56,6 +64,8 @@ struct ExperimentResults {
   // phi_net of a run, NaN if the model did not run or failed.
   double phiNet(const CaseRecord& c, const std::string& model) const;
   bool hasModel(const std::string& model) const;
+  // The case as run, or nullptr (resolve_error says why).
+  const ExperimentCase* resolvedCase(const CaseRecord& c) const;
   // The case with these axis values (value strings as in SweepAxis::values), or nullptr.
   const CaseRecord* find(const std::map<std::string, std::string>& sweep) const;
 };

@@ -7,22 +7,22 @@
 #include <utility>
 #include <vector>
 
+#include "experiments/model_registry.h"
 #include "plotting/result_folder.h"
 
 namespace tailsim {
 
 namespace oi = okabe_ito;
 
+// Title and colour are the model's registry entry (experiments/model_registry.cc).
 std::string modelColor(const std::string& model) {
-  if (model == "analytic") return oi::kBlue;
-  if (model == "mujoco") return oi::kVermillion;
-  return oi::kGreen;
+  const ModelEntry* m = findModel(model);
+  return m ? m->color : oi::kGreen;
 }
 
 std::string modelTitle(const std::string& model) {
-  if (model == "analytic") return "analytic (stiction)";
-  if (model == "mujoco") return "MuJoCo (contact)";
-  return model;
+  const ModelEntry* m = findModel(model);
+  return m ? m->title : model;
 }
 
 namespace {

@@ -8,19 +8,11 @@
 
 #include <string>
 
+#include "results/palette.h"
+
 namespace tailsim {
 
-// ---- colours (Okabe & Ito 2008, "Color Universal Design") -----------------------------------
-namespace okabe_ito {
-inline constexpr const char* kBlack = "#000000";
-inline constexpr const char* kOrange = "#E69F00";
-inline constexpr const char* kSkyBlue = "#56B4E9";
-inline constexpr const char* kGreen = "#009E73";   // bluish green
-inline constexpr const char* kYellow = "#F0E442";  // too light for lines on white: not used for lines
-inline constexpr const char* kBlue = "#0072B2";
-inline constexpr const char* kVermillion = "#D55E00";
-inline constexpr const char* kPurple = "#CC79A7";  // reddish purple
-}  // namespace okabe_ito
+// ---- colours: the Okabe-Ito palette, results/palette.h (shared with the videos) -------------
 
 // Fixed colour per model in every plot: analytic blue, MuJoCo vermillion, others bluish green.
 std::string modelColor(const std::string& model);

@@ -8,6 +8,10 @@
 
 namespace tailsim {
 
+// True when libOSMesa is mapped into this process. It is loaded by the first OsMesaContext, never at
+// start-up, so a process that renders nothing does not pay for it (tests check this).
+bool osMesaLoaded();
+
 // OSMesaCreateContextExt(OSMESA_RGBA, 24 depth, 8 stencil) + OSMesaMakeCurrent on a w x h buffer.
 // Throws std::runtime_error when OSMesa cannot create or bind the context.
 class OsMesaContext {

@@ -5,15 +5,27 @@
 #include <string>
 
 #include "results/work_limits.h"
+#include "settings/fields.h"
 
 namespace tailsim {
 
+enum class RenderCamera {
+  kTop,          // from above, tracking the body
+  kPerspective,  // angled, tracking the body
+};
+inline const settings::EnumNames<RenderCamera>& cameraNames() {
+  static const settings::EnumNames<RenderCamera> k = {{RenderCamera::kTop, "top"},
+                                                       {RenderCamera::kPerspective, "perspective"}};
+  return k;
+}
+
 struct RenderSettings {
   bool enabled = false;
+  std::string size;  // a frame-size preset name (kRenderSizePresets) or "" (width, height as given)
   int width = 640, height = 480, fps = 30;
   double slowmo = 4.0;        // video seconds per simulated second
   double duration_s = 0.0;    // simulated seconds to show; 0 = whole run
-  std::string camera = "top"; // top (tracking) | perspective (angled, tracking)
+  RenderCamera camera = RenderCamera::kTop;
   // Quality. Defaults chosen by measured cost on llvmpipe (docs/rendering.md, 640x480 bare
   // loop): msaa 0 -> 4 halves the frame rate (163 -> 81 fps) and smooths the thin tail;
   // reflections cost 1.4x more, shadows 2.5x more (and hide under the body in the top view).
@@ -35,6 +47,43 @@ constexpr double kRenderMinSlowmo = 1e-3, kRenderMaxSlowmo = 1e3;  // video seco
 constexpr int kRenderMaxMsaa = 16;                                  // 0..16 multisamples
 constexpr int kRenderMinCrf = 0, kRenderMaxCrf = 51;                // libx264
 constexpr double kRenderMaxFrames = limits::kMaxRenderFrames;  // declared with the other work limits
+
+// Frame-size presets (`render.size`): the default 640x480 and 720p for talks.
+struct RenderSizePreset {
+  const char* name;
+  int width, height;
+};
+inline constexpr RenderSizePreset kRenderSizePresets[] = {{"640x480", 640, 480}, {"1280x720", 1280, 720}};
+
+// The keys of the render section (settings/fields.h), declared once; the renderer checks the same.
+template <class V, class S>
+settings::For<S, RenderSettings> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.internal(Field{"enabled", "a video is made (the render section is present); not a YAML key"}, s.enabled);
+  const auto even = settings::IntSet::multiple(2, "H.264 yuv420p");
+  v.text(Field{"size", "frame-size preset, 640x480 or 1280x720: sets width and height (give one or the other)"},
+         s.size, settings::TextRule{false, {"640x480", "1280x720"}});
+  v.integer(Field{"width", "frame width, even [pixels]"}, s.width, Limits::closed(kRenderMinSize, kRenderMaxSize), even);
+  v.integer(Field{"height", "frame height, even [pixels]"}, s.height, Limits::closed(kRenderMinSize, kRenderMaxSize),
+            even);
+  v.integer(Field{"fps", "video frames per second"}, s.fps, Limits::closed(kRenderMinFps, kRenderMaxFps));
+  v.number(Field{"slowmo", "video seconds per simulated second"}, s.slowmo,
+           Limits::closed(kRenderMinSlowmo, kRenderMaxSlowmo));
+  v.number(Field{"duration_s", "simulated seconds to show; 0 = whole run [s]"}, s.duration_s, Limits::nonNegative());
+  v.choice(Field{"camera", "top: from above; perspective: angled (both track the body)"}, s.camera, cameraNames());
+  v.boolean(Field{"shadows", "shadows (2.5x the cost)"}, s.shadows);
+  v.boolean(Field{"reflections", "floor reflections (1.4x the cost)"}, s.reflections);
+  v.integer(Field{"msaa", "offscreen multisamples; 0 = off"}, s.msaa, Limits::closed(0, kRenderMaxMsaa));
+  v.boolean(Field{"ghost", "translucent analytic-model ghost"}, s.ghost);
+  v.text(Field{"ffmpeg", "encoder executable: looked up on PATH unless it contains a '/'"}, s.ffmpeg,
+         settings::TextRule{true, {}});
+  v.integer(Field{"crf", "libx264 constant rate factor (lower = better, bigger)"}, s.crf,
+            Limits::closed(kRenderMinCrf, kRenderMaxCrf));
+  v.text(Field{"preset", "libx264 preset (ultrafast: least CPU next to llvmpipe)"}, s.preset,
+         settings::TextRule{false, {"ultrafast", "superfast", "veryfast", "faster", "fast", "medium", "slow", "slower",
+                                    "veryslow", "placebo"}});
+}
 
 // Frames of a video showing `span_s` simulated seconds (a double: compare with kRenderMaxFrames
 // before converting, so a huge span or slowmo never overflows).

@@ -1,6 +1,7 @@
 #include "rendering/replay.h"
 
 #include "mujoco_model/mjcf_generator.h"
+#include "results/columns.h"
 
 #include <mujoco/mujoco.h>
 
@@ -18,11 +19,11 @@ PlanarStateSampler::PlanarStateSampler(const TimeSeries& ts, int n_links, const 
     if (!ts.has(name)) throw std::invalid_argument(what + " time series has no column " + name);
     return &ts.values(name);
   };
-  t_ = col("t_s");
-  x_ = col("x_m");
-  y_ = col("y_m");
-  phi_ = col("phi_deg");
-  for (int i = 1; i <= n_links; ++i) theta_.push_back(col("theta" + std::to_string(i) + "_deg"));
+  t_ = col(col::kT);
+  x_ = col(col::kX);
+  y_ = col(col::kY);
+  phi_ = col(col::kPhi);
+  for (int i = 1; i <= n_links; ++i) theta_.push_back(col(col::theta(i)));
   if (t_->empty()) throw std::invalid_argument(what + " time series has no rows");
   for (size_t r = 1; r < t_->size(); ++r)
     if (!((*t_)[r] > (*t_)[r - 1]))

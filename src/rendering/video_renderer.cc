@@ -20,10 +20,12 @@
 #include <vector>
 
 #include "mujoco_model/mjcf_generator.h"
+#include "results/columns.h"
 #include "mujoco_model/mujoco_handles.h"
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/gl_context.h"
 #include "rendering/replay.h"
+#include "results/palette.h"
 #include "results/work_limits.h"
 
 namespace tailsim {
@@ -40,26 +42,13 @@ std::string fmtG(double v) {
   return b;
 }
 
+// The declared limits of every render setting (render_settings.h), the same the loader applies.
 void checkSettings(const RenderSettings& s) {
-  auto bad = [](const std::string& what) { throw std::runtime_error("render settings: " + what); };
-  const std::string size = std::to_string(s.width) + "x" + std::to_string(s.height);
-  if (s.width < kRenderMinSize || s.height < kRenderMinSize || s.width > kRenderMaxSize || s.height > kRenderMaxSize)
-    bad("width and height must lie in [" + std::to_string(kRenderMinSize) + ", " + std::to_string(kRenderMaxSize) +
-        "], got " + size);
-  if (s.width % 2 || s.height % 2) bad("width and height must be even (H.264 yuv420p), got " + size);
-  if (s.fps < kRenderMinFps || s.fps > kRenderMaxFps)
-    bad("fps must lie in [" + std::to_string(kRenderMinFps) + ", " + std::to_string(kRenderMaxFps) + "], got " +
-        std::to_string(s.fps));
-  if (!(s.slowmo >= kRenderMinSlowmo && s.slowmo <= kRenderMaxSlowmo))
-    bad("slowmo must lie in [" + fmtG(kRenderMinSlowmo) + ", " + fmtG(kRenderMaxSlowmo) + "], got " + fmtG(s.slowmo));
-  if (!(s.duration_s >= 0.0) || !std::isfinite(s.duration_s)) bad("duration_s must be >= 0 (0 = whole run)");
-  if (s.camera != "top" && s.camera != "perspective")
-    bad("camera must be top or perspective, got '" + s.camera + "'");
-  if (s.msaa < 0 || s.msaa > kRenderMaxMsaa)
-    bad("msaa must lie in [0, " + std::to_string(kRenderMaxMsaa) + "], got " + std::to_string(s.msaa));
-  if (s.crf < kRenderMinCrf || s.crf > kRenderMaxCrf)
-    bad("crf must lie in [" + std::to_string(kRenderMinCrf) + ", " + std::to_string(kRenderMaxCrf) + "], got " +
-        std::to_string(s.crf));
+  try {
+    settings::validateFields(s, "render.");
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("render settings: ") + e.what());
+  }
 }
 
 std::string requireFfmpeg(const RenderSettings& s) {
@@ -146,41 +135,61 @@ GhostShape ghostShape(const mjModel* m, mjData* d, const MujocoReplayLayout& L, 
   return g;
 }
 
-void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, const PlanarState& s) {
-  static constexpr float kRgba[4] = {0.15f, 0.75f, 1.0f, 0.4f};      // tail: distinct cyan
-  static constexpr float kBodyRgba[4] = {0.15f, 0.75f, 1.0f, 0.3f};  // body: the torso shows through
+// Colours of the models, the same as in every plot (results/palette.h): MuJoCo vermillion (its
+// own geoms, solid), analytic blue (an outline ghost).
+constexpr Rgb kMujocoRgb = rgbOf(kMujocoColor);
+constexpr Rgb kAnalyticRgb = rgbOf(kAnalyticColor);
+
+// One ghost edge: an opaque capsule of radius r from a to b.
+void addEdge(mjvScene& scn, const mjtNum* cam, double r, const mjtNum a[3], const mjtNum b[3]) {
+  if (scn.ngeom >= scn.maxgeom) return;
+  static constexpr float kRgba[4] = {kAnalyticRgb.r, kAnalyticRgb.g, kAnalyticRgb.b, 1.0f};
+  mjvGeom* geom = scn.geoms + scn.ngeom;
+  mjv_initGeom(geom, mjGEOM_CAPSULE, nullptr, nullptr, nullptr, kRgba);
+  mjv_makeConnector(geom, mjGEOM_CAPSULE, r, a[0], a[1], a[2], b[0], b[1], b[2]);
+  geom->category = mjCAT_DECOR;
+  geom->specular = 0.1f;
+  geom->camdist = static_cast<float>(mju_dist3(cam, std::array<mjtNum, 3>{geom->pos[0], geom->pos[1], geom->pos[2]}.data()));
+  ++scn.ngeom;
+}
+
+// The analytic model as an outline (wireframe) ghost: the 12 edges of its body box and, per tail
+// link, the outline of the link seen from above (two sides and the two ends), lines of radius
+// line_r. The box is kGrow larger than the model's torso and the tail outline lies on top of the
+// model's tail, one line width outside it: where both models agree, the outline frames the
+// vermillion MuJoCo model instead of covering it.
+void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, const PlanarState& s, double line_r) {
   const mjtNum cam[3] = {0.5 * (scn.camera[0].pos[0] + scn.camera[1].pos[0]),
                          0.5 * (scn.camera[0].pos[1] + scn.camera[1].pos[1]),
                          0.5 * (scn.camera[0].pos[2] + scn.camera[1].pos[2])};
-  auto finish = [&](mjvGeom* geom) {
-    geom->category = mjCAT_DECOR;
-    geom->transparent = 1;
-    geom->specular = 0.2f;
-    geom->camdist = static_cast<float>(mju_dist3(cam, std::array<mjtNum, 3>{geom->pos[0], geom->pos[1], geom->pos[2]}.data()));
-    ++scn.ngeom;
-  };
   const double c = std::cos(s.phi), sn = std::sin(s.phi);
-  // The ghost body is a shell kGrow larger than the model's torso: where both models agree it
-  // wraps the model instead of z-fighting with it. The ghost tail is half as thick as the
-  // model's and rides on top of it, so the model's orange tail stays visible around it.
   constexpr double kGrow = 0.006;  // [m]
-  if (scn.ngeom < scn.maxgeom) {  // body box: centre p_Q + R_Q offset
-    const mjtNum size[3] = {g.body_half[0] + kGrow, g.body_half[1] + kGrow, g.body_half[2] + kGrow};
-    const mjtNum pos[3] = {s.x + c * g.body_offset[0] - sn * g.body_offset[1],
-                           s.y + sn * g.body_offset[0] + c * g.body_offset[1], g.body_z};
-    const mjtNum mat[9] = {c, -sn, 0, sn, c, 0, 0, 0, 1};
-    mjvGeom* geom = scn.geoms + scn.ngeom;
-    mjv_initGeom(geom, mjGEOM_BOX, size, pos, mat, kBodyRgba);
-    finish(geom);
-  }
+  const double hx = g.body_half[0] + kGrow, hy = g.body_half[1] + kGrow, hz = g.body_half[2] + kGrow;
+  const double cx = s.x + c * g.body_offset[0] - sn * g.body_offset[1];
+  const double cy = s.y + sn * g.body_offset[0] + c * g.body_offset[1];
+  auto corner = [&](int i, mjtNum p[3]) {  // i: bit 0 x, bit 1 y, bit 2 z
+    const double lx = (i & 1 ? hx : -hx), ly = (i & 2 ? hy : -hy);
+    p[0] = cx + c * lx - sn * ly;
+    p[1] = cy + sn * lx + c * ly;
+    p[2] = g.body_z + (i & 4 ? hz : -hz);
+  };
+  for (int i = 0; i < 8; ++i)
+    for (int bit = 1; bit < 8; bit <<= 1)
+      if (!(i & bit)) {
+        mjtNum a[3], b[3];
+        corner(i, a);
+        corner(i | bit, b);
+        addEdge(scn, cam, line_r, a, b);
+      }
   const PlanarTailPose tail = planarTailPose(robot, s);
-  for (size_t i = 0; i + 1 < tail.joints.size() && scn.ngeom < scn.maxgeom; ++i) {
-    mjvGeom* geom = scn.geoms + scn.ngeom;
-    mjv_initGeom(geom, mjGEOM_CAPSULE, nullptr, nullptr, nullptr, kRgba);
-    const double z = g.tail_z + g.tail_radius;
-    mjv_makeConnector(geom, mjGEOM_CAPSULE, 0.5 * g.tail_radius, tail.joints[i][0], tail.joints[i][1], z,
-                      tail.joints[i + 1][0], tail.joints[i + 1][1], z);
-    finish(geom);
+  const double w = g.tail_radius + line_r;  // half width of the link outline
+  const double z = g.tail_z + g.tail_radius + line_r;
+  for (size_t i = 0; i + 1 < tail.joints.size(); ++i) {
+    const double ux = std::cos(tail.link_yaw[i]), uy = std::sin(tail.link_yaw[i]);
+    const double x0 = tail.joints[i][0], y0 = tail.joints[i][1], x1 = tail.joints[i + 1][0], y1 = tail.joints[i + 1][1];
+    const mjtNum p[4][3] = {{x0 - uy * w, y0 + ux * w, z}, {x1 - uy * w, y1 + ux * w, z},
+                            {x1 + uy * w, y1 - ux * w, z}, {x0 + uy * w, y0 - ux * w, z}};
+    for (int e = 0; e < 4; ++e) addEdge(scn, cam, line_r, p[e], p[(e + 1) % 4]);
   }
 }
 
@@ -200,7 +209,62 @@ void adjustVisuals(mjModel* m) {
     const int mat = m->geom_matid[floor];
     // builtin checker: 2 x 2 squares per texture repeat; texuniform: repeats per metre.
     if (m->mat_texuniform[mat]) m->mat_texrepeat[2 * mat] = m->mat_texrepeat[2 * mat + 1] = 5.0f;
+    // A neutral grey checker: the models' colours (vermillion, blue) stand out on it.
+    const int tex = m->mat_texid[mat];
+    if (tex >= 0) {
+      const int end = tex + 1 < m->ntex ? m->tex_adr[tex + 1] : m->ntexdata;
+      for (int i = m->tex_adr[tex]; i + 2 < end; i += 3) {
+        const double lum = (m->tex_rgb[i] + m->tex_rgb[i + 1] + m->tex_rgb[i + 2]) / (3.0 * 255.0);
+        const auto grey = static_cast<mjtByte>(std::clamp(255.0 * (0.45 + 1.2 * lum), 0.0, 255.0));
+        m->tex_rgb[i] = m->tex_rgb[i + 1] = m->tex_rgb[i + 2] = grey;
+      }
+    }
   }
+  // The MuJoCo model in its plot colour, vermillion: the tail links alternate full and lighter
+  // vermillion (the joints show), the torso and legs are a light tint of it, the feet stay dark.
+  const int root = mj_name2id(m, mjOBJ_BODY, mjcf::kQuadrupedBody);
+  for (int i = 0; i < m->ngeom; ++i) {
+    const int b = m->geom_bodyid[i];
+    if (root < 0 || m->body_rootid[b] != root || m->geom_type[i] == mjGEOM_SPHERE) continue;
+    const bool tail = b != root;
+    const float mix = tail ? ((b - root) % 2 ? 0.0f : 0.25f) : (m->geom_type[i] == mjGEOM_BOX ? 0.45f : 0.3f);
+    float* rgba = m->geom_rgba + 4 * i;
+    rgba[0] = kMujocoRgb.r + mix * (1.0f - kMujocoRgb.r);
+    rgba[1] = kMujocoRgb.g + mix * (1.0f - kMujocoRgb.g);
+    rgba[2] = kMujocoRgb.b + mix * (1.0f - kMujocoRgb.b);
+    rgba[3] = 1.0f;
+    m->geom_matid[i] = -1;
+  }
+}
+
+// The frame's layout: the 3-D scene on the left under a title strip, a panel on the right with
+// the text (time, tail phase), the colour key (one label per model, in its colour) and the
+// inset plot of phi(t). The panel is wide enough for its text in the context's font.
+struct FrameLayout {
+  mjrRect scene, title, panel, key[2], inset;
+};
+
+int textWidth(const mjrContext& con, const std::string& s) {
+  int w = 0;
+  for (unsigned char ch : s) w += ch < 127 ? con.charWidth[ch] : con.charWidth[static_cast<int>('x')];
+  return w;
+}
+
+FrameLayout frameLayout(int W, int H, const mjrContext& con) {
+  FrameLayout L;
+  const int ch = con.charHeight, pad = std::max(4, ch / 3);
+  const int need = textWidth(con, "analytic (outline)  +000.00 deg") + 2 * pad;
+  const int pw = std::min(W / 2, std::max(static_cast<int>(std::lround(0.3 * W)), need));
+  const int title_h = ch + 2 * pad;
+  L.scene = {0, 0, W - pw, H - title_h};
+  L.title = {0, H - title_h, W - pw, title_h};
+  L.panel = {W - pw, 0, pw, H};
+  const int text_h = 2 * ch + 3 * pad;  // two lines of text at the top of the panel
+  const int lab_h = ch + 2 * pad;
+  L.key[0] = {W - pw + pad, H - text_h - lab_h, pw - 2 * pad, lab_h};
+  L.key[1] = {W - pw + pad, L.key[0].bottom - pad - lab_h, pw - 2 * pad, lab_h};
+  L.inset = {W - pw + pad / 2, pad, pw - pad, std::max(1, L.key[1].bottom - 2 * pad)};
+  return L;
 }
 
 // Everything one render needs, set up before the first frame. Members are destroyed in
@@ -215,8 +279,95 @@ struct RenderRig {
   mjvCamera cam;
   GhostShape ghost;
   double look_z = 0.1;
+  double look_offset[2] = {0, 0};  // camera target minus the quadruped COM (world x, y)
+  double line_r = 0.002;           // ghost outline radius [m] (~1.3 px)
+  FrameLayout layout2d;
+  std::unique_ptr<mjvFigure> figure;  // the phi(t) inset (mjvFigure is ~1 MB: on the heap)
   std::vector<uint8_t> pixels;
 };
+
+// Every point of the robot's outline (body box corners, tail joints) relative to the tracked
+// quadruped COM, over the frames of the video, for both models: the camera frames this box.
+struct Extent {
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  void add(double x, double y) {
+    lo[0] = std::min(lo[0], x), hi[0] = std::max(hi[0], x);
+    lo[1] = std::min(lo[1], y), hi[1] = std::max(hi[1], y);
+  }
+};
+
+Extent robotExtent(const RenderRig& r, const RobotParams& robot, double t0, double t1) {
+  Extent e;
+  const int samples = 200;
+  for (int k = 0; k <= samples; ++k) {
+    const double t = t0 + (t1 - t0) * k / samples;
+    const PlanarState ref = r.mujoco->at(t);
+    for (const std::optional<PlanarStateSampler>* smp : {&r.mujoco, &r.analytic}) {
+      if (!*smp) continue;
+      const PlanarState s = (*smp)->at(t);
+      const double c = std::cos(s.phi), sn = std::sin(s.phi);
+      for (int i = 0; i < 4; ++i) {
+        const double lx = r.ghost.body_offset[0] + (i & 1 ? 1 : -1) * r.ghost.body_half[0];
+        const double ly = r.ghost.body_offset[1] + (i & 2 ? 1 : -1) * r.ghost.body_half[1];
+        e.add(s.x + c * lx - sn * ly - ref.x, s.y + sn * lx + c * ly - ref.y);
+      }
+      for (const auto& j : planarTailPose(robot, s).joints) {
+        const double rr = r.ghost.tail_radius;
+        e.add(j[0] - ref.x - rr, j[1] - ref.y - rr);
+        e.add(j[0] - ref.x + rr, j[1] - ref.y + rr);
+      }
+    }
+  }
+  return e;
+}
+
+// The phi(t) inset: both models' phi over the shown time, the time cursor (the figure's
+// selection line) set per frame.
+void setupFigure(RenderRig& r, double t0, double t1, int height) {
+  r.figure = std::make_unique<mjvFigure>();
+  mjvFigure& f = *r.figure;
+  mjv_defaultFigure(&f);
+  f.flg_legend = 0;  // the colour key above the inset says which line is which model
+  f.flg_ticklabel[0] = f.flg_ticklabel[1] = 1;
+  f.flg_extend = 0;
+  f.flg_selection = 1;
+  f.linewidth = std::max(1.5f, 2.0f * height / 480.0f);
+  f.gridsize[0] = 3;
+  f.gridsize[1] = 3;
+  const float fig_rgba[4] = {0.10f, 0.10f, 0.12f, 1.0f}, pane_rgba[4] = {0.16f, 0.16f, 0.18f, 1.0f};
+  std::copy(fig_rgba, fig_rgba + 4, f.figurergba);
+  std::copy(pane_rgba, pane_rgba + 4, f.panergba);
+  f.gridrgb[0] = f.gridrgb[1] = f.gridrgb[2] = 0.35f;
+  f.textrgb[0] = f.textrgb[1] = f.textrgb[2] = 0.92f;
+  std::snprintf(f.title, sizeof f.title, "phi [deg]");
+  std::snprintf(f.xlabel, sizeof f.xlabel, "t [s]");
+  std::snprintf(f.xformat, sizeof f.xformat, "%%.2f");
+  std::snprintf(f.yformat, sizeof f.yformat, "%%.0f");
+  std::snprintf(f.minwidth, sizeof f.minwidth, "-00");
+  double lo = 0.0, hi = 0.0;
+  int line = 0;
+  for (const auto& [smp, rgb] : {std::pair{&r.mujoco, kMujocoRgb}, std::pair{&r.analytic, kAnalyticRgb}}) {
+    if (!*smp) continue;
+    // About one point per 2 px: llvmpipe drops sub-pixel segments of wide lines (a flat line
+    // drawn from 400 points over 160 px came out dotted).
+    const int pts = std::clamp(r.layout2d.inset.width / 2, 50, mjMAXLINEPNT);
+    for (int k = 0; k < pts; ++k) {
+      const double t = t0 + (t1 - t0) * k / (pts - 1);
+      const double phi = (*smp)->at(t).phi * 180.0 / M_PI;
+      f.linedata[line][2 * k] = static_cast<float>(t);
+      f.linedata[line][2 * k + 1] = static_cast<float>(phi);
+      lo = std::min(lo, phi), hi = std::max(hi, phi);
+    }
+    f.linepnt[line] = pts;
+    f.linergb[line][0] = rgb.r, f.linergb[line][1] = rgb.g, f.linergb[line][2] = rgb.b;
+    ++line;
+  }
+  const double margin = 0.08 * std::max(hi - lo, 1.0);
+  f.range[0][0] = static_cast<float>(t0);
+  f.range[0][1] = static_cast<float>(std::max(t1, t0 + 1e-6));
+  f.range[1][0] = static_cast<float>(lo - margin);
+  f.range[1][1] = static_cast<float>(hi + margin);
+}
 
 void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
   if (!in.robot || !in.mujoco) throw std::invalid_argument("rendering: RenderInputs needs robot and mujoco");
@@ -242,26 +393,49 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
   mj_kinematics(m, d);
   r.ghost = ghostShape(m, d, r.layout, *in.robot);
   r.look_z = r.ghost.body_z;
+  const double t0 = r.mujoco->startTime();
+  const double t1 = s.duration_s > 0.0 ? std::min(r.mujoco->endTime(), t0 + s.duration_s) : r.mujoco->endTime();
 
-  // Tracking camera: it looks at the quadruped COM (set per frame); the distance keeps a circle
-  // of the body plus the stretched tail in view whatever the yaw.
-  const QuadrupedParams& q = in.robot->quadruped;
-  double tail_len = 0.0;
-  for (const TailLink& l : in.robot->tail) tail_len += l.length_m;
-  const double body_r = std::hypot(std::max(r.ghost.body_half[0], 0.5 * q.l_F_m), std::max(r.ghost.body_half[1], 0.5 * q.w_F_m));
-  const double radius = std::max(q.d_Q2B_m + tail_len, body_r) + 0.05;
-  const double half_fov = 0.5 * m->vis.global.fovy * M_PI / 180.0;
+  // Tracking camera: it follows the quadruped COM (set per frame) with a fixed offset; the
+  // offset and distance frame the box that every point of both models' outlines stays in over
+  // the video (relative to the COM), with a 6 % margin, in the scene part of the frame.
+  r.layout2d = frameLayout(s.width, s.height, r.gl->context());
+  const double aspect = static_cast<double>(r.layout2d.scene.width) / r.layout2d.scene.height;
+  const Extent e = robotExtent(r, *in.robot, t0, t1);
+  r.look_offset[0] = 0.5 * (e.lo[0] + e.hi[0]);
+  r.look_offset[1] = 0.5 * (e.lo[1] + e.hi[1]);
+  const double half_w = 0.5 * (e.hi[0] - e.lo[0]) * 1.06 + 0.01, half_h = 0.5 * (e.hi[1] - e.lo[1]) * 1.06 + 0.01;
+  const double tan_half = std::tan(0.5 * m->vis.global.fovy * M_PI / 180.0);
   mjv_defaultFreeCamera(m, &r.cam);
   r.cam.type = mjCAMERA_FREE;
-  if (s.camera == "top") {
-    r.cam.elevation = -90.0;  // straight down; azimuth 90: world x right, world y up on screen
-    r.cam.azimuth = 90.0;
-    r.cam.distance = 1.15 * radius / std::tan(half_fov) + r.look_z;
+  if (s.camera == RenderCamera::kTop) {
+    // Straight down; azimuth 0: world x (the body's heading at phi = 0) up on screen, world y to
+    // the left, so the long axis of body + tail runs along the frame's height. A rotation of the
+    // view, not a mirror: a positive (counter-clockwise) phi turns the body counter-clockwise.
+    r.cam.elevation = -90.0;
+    r.cam.azimuth = 0.0;
+    r.cam.distance = std::max(half_w, half_h / aspect) / tan_half;
   } else {
+    // From behind and to the right (-x, -y), 35 deg down: the tail is in front of the body. The
+    // box's circumscribed circle fits the smaller field of view.
     r.cam.elevation = -35.0;
-    r.cam.azimuth = 45.0;  // from behind and to the right (-x, -y): the tail is in front of the body
-    r.cam.distance = 1.35 * radius / std::tan(half_fov);
+    r.cam.azimuth = 45.0;
+    r.cam.distance = 1.05 * std::hypot(half_w, half_h) / (tan_half * std::min(1.0, aspect));
   }
+  // Scale at the robot: metres per pixel. The ghost's lines are ~1.3 px in radius, the model's
+  // tail at least 4 px (visual only: the renderer's own copy of the model).
+  const double m_per_px = 2.0 * r.cam.distance * tan_half / r.layout2d.scene.height;
+  r.line_r = 1.3 * m_per_px;
+  const double tail_r = std::max(r.ghost.tail_radius, 4.0 * m_per_px);
+  for (int i = 0; i < m->ngeom; ++i) {
+    const int b = m->geom_bodyid[i];
+    if (b == r.layout.root_body || m->body_rootid[b] != r.layout.root_body) continue;
+    if (m->geom_type[i] != mjGEOM_CAPSULE && m->geom_type[i] != mjGEOM_CYLINDER) continue;
+    r.model->geom_size[3 * i] = tail_r;
+    r.model->geom_rbound[i] = std::max(r.model->geom_rbound[i], tail_r + r.model->geom_size[3 * i + 1]);
+  }
+  r.ghost.tail_radius = tail_r;
+  setupFigure(r, t0, t1, s.height);
   r.pixels.resize(static_cast<size_t>(s.width) * s.height * 3);
 }
 
@@ -271,6 +445,34 @@ double since(Clock::time_point& t0) {
   const double s = std::chrono::duration<double>(t1 - t0).count();
   t0 = t1;
   return s;
+}
+
+// The 2-D parts of a frame: title strip, text, colour key and the phi(t) inset with its cursor.
+void drawPanel(RenderRig& r, const RenderInputs& in, const RenderSettings& s, double t, const PlanarState& st,
+               const std::optional<PlanarState>& ghost) {
+  const FrameLayout& L = r.layout2d;
+  const mjrContext& con = r.gl->context();
+  constexpr double kRad2Deg = 180.0 / M_PI;
+  char buf[256];
+  mjr_rectangle(L.title, 0.10f, 0.10f, 0.12f, 1.0f);
+  mjr_rectangle(L.panel, 0.10f, 0.10f, 0.12f, 1.0f);
+  std::snprintf(buf, sizeof buf, "%gx slow motion", s.slowmo);
+  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.title, in.title.c_str(), nullptr, &con);
+  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, L.title, buf, nullptr, &con);
+  std::string text = "t = ";
+  std::snprintf(buf, sizeof buf, "%.3f s", t);
+  text += buf;
+  if (in.trajectory) text += std::string("\ntail ") + tailPhaseName(tailPhase(*in.trajectory, t));
+  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.panel, text.c_str(), nullptr, &con);
+  // Colour key: one label per model in its colour, with its phi now.
+  std::snprintf(buf, sizeof buf, "MuJoCo (solid)  %+.2f deg", st.phi * kRad2Deg);
+  mjr_label(L.key[0], mjFONT_NORMAL, buf, kMujocoRgb.r, kMujocoRgb.g, kMujocoRgb.b, 1.0f, 1, 1, 1, &con);
+  if (ghost) {
+    std::snprintf(buf, sizeof buf, "analytic (outline)  %+.2f deg", ghost->phi * kRad2Deg);
+    mjr_label(L.key[1], mjFONT_NORMAL, buf, kAnalyticRgb.r, kAnalyticRgb.g, kAnalyticRgb.b, 1.0f, 1, 1, 1, &con);
+  }
+  r.figure->selection = static_cast<float>(t);
+  mjr_figure(L.inset, r.figure.get(), &con);
 }
 
 // Poses the model (and ghost) for simulated time t and renders into the off-screen buffer.
@@ -284,43 +486,21 @@ void renderFrame(RenderRig& r, const RenderInputs& in, const RenderSettings& s, 
   mj_kinematics(m, d);
   mj_comPos(m, d);
   mj_camlight(m, d);
-  r.cam.lookat[0] = st.x;
-  r.cam.lookat[1] = st.y;
+  r.cam.lookat[0] = st.x + r.look_offset[0];
+  r.cam.lookat[1] = st.y + r.look_offset[1];
   r.cam.lookat[2] = r.look_z;
   mjvScene& scn = r.gl->scene();
   mjv_updateScene(m, d, &r.opt, nullptr, &r.cam, mjCAT_ALL, &scn);
   std::optional<PlanarState> ghost;
   if (r.analytic) {
     ghost = r.analytic->at(t);
-    addGhost(scn, r.ghost, *in.robot, *ghost);
+    addGhost(scn, r.ghost, *in.robot, *ghost, r.line_r);
   }
   if (stats) stats->pose_s += since(tic);
-  const mjrRect vp = r.gl->viewport();
-  mjr_render(vp, &scn, &r.gl->context());
-
-  // On-frame text.
-  char left[512], right[512];
-  const double rad2deg = 180.0 / M_PI;
-  std::string l = in.title.empty() ? "" : in.title + "\n";
-  std::string v = in.title.empty() ? "" : " \n";
-  std::snprintf(left, sizeof(left), "t\nphi MuJoCo\n");
-  std::snprintf(right, sizeof(right), "%.3f s\n%+.2f deg\n", t, st.phi * rad2deg);
-  l += left;
-  v += right;
-  if (ghost) {
-    std::snprintf(right, sizeof(right), "%+.2f deg\n", ghost->phi * rad2deg);
-    l += "phi analytic (ghost)\n";
-    v += right;
-  }
-  if (in.trajectory) {
-    l += "tail\n";
-    v += std::string(tailPhaseName(tailPhase(*in.trajectory, t))) + "\n";
-  }
-  l.pop_back();
-  v.pop_back();
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, vp, l.c_str(), v.c_str(), &r.gl->context());
-  std::snprintf(left, sizeof(left), "%gx slow motion", s.slowmo);
-  mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMRIGHT, vp, left, nullptr, &r.gl->context());
+  const FrameLayout& L = r.layout2d;
+  const mjrContext& con = r.gl->context();
+  mjr_render(L.scene, &scn, &con);
+  drawPanel(r, in, s, t, st, ghost);
   if (stats) stats->render_s += since(tic);
 }
 
@@ -336,11 +516,11 @@ struct FrameTimes {
 };
 
 FrameTimes frameTimes(const TimeSeries& mujoco, const RenderSettings& s) {
-  if (!mujoco.has("t_s") || mujoco.numRows() == 0)
+  if (!mujoco.has(col::kT) || mujoco.numRows() == 0)
     throw std::invalid_argument("rendering: the MuJoCo time series has no t_s rows");
   FrameTimes f;
-  f.t_start = mujoco.values("t_s").front();
-  f.t_end = mujoco.values("t_s").back();
+  f.t_start = mujoco.values(col::kT).front();
+  f.t_end = mujoco.values(col::kT).back();
   if (s.duration_s > 0.0) f.t_end = std::min(f.t_end, f.t_start + s.duration_s);
   const double frames = renderFrameCount(f.t_end - f.t_start, s);
   if (!(frames >= 1.0 && frames <= kRenderMaxFrames))
@@ -530,7 +710,7 @@ double benchBareRenderLoop(const RenderInputs& in, const RenderSettings& setting
   const mjrRect vp = rig.gl->viewport();
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < frames; ++k) {
-    mjr_render(vp, &scn, &rig.gl->context());
+    mjr_render(rig.layout2d.scene, &scn, &rig.gl->context());
     mjr_readPixels(rig.pixels.data(), nullptr, vp, &rig.gl->context());
   }
   const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

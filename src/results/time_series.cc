@@ -24,6 +24,10 @@ void TimeSeries::appendRow(const std::vector<double>& row) {
   for (size_t i = 0; i < row.size(); ++i) data_[i].push_back(row[i]);
 }
 
+void TimeSeries::reserveRows(size_t rows) {
+  for (auto& col : data_) col.reserve(rows);
+}
+
 const std::vector<double>& TimeSeries::values(const std::string& name) const {
   const int c = column(name);
   if (c < 0) throw std::out_of_range("no time-series column " + name);

@@ -17,6 +17,7 @@ class TimeSeries {
   int column(const std::string& name) const;  // -1 if absent
   bool has(const std::string& name) const { return column(name) >= 0; }
   void appendRow(const std::vector<double>& row);  // row.size() == numColumns()
+  void reserveRows(size_t rows);                   // capacity for `rows` rows (no reallocation while appending)
   const std::vector<std::string>& names() const { return names_; }
   size_t numColumns() const { return names_.size(); }
   size_t numRows() const { return names_.empty() ? 0 : data_[0].size(); }

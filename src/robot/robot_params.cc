@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace tailsim {
 
@@ -24,10 +25,6 @@ namespace {
 void requireFinite(double v, const std::string& what) {
   if (!std::isfinite(v)) throw std::invalid_argument(what + " must be finite");
 }
-void requirePositive(double v, const std::string& what) {
-  requireFinite(v, what);
-  if (!(v > 0.0)) throw std::invalid_argument(what + " must be > 0, got " + std::to_string(v));
-}
 void requireNonNegative(double v, const std::string& what) {
   requireFinite(v, what);
   if (v < 0.0) throw std::invalid_argument(what + " must be >= 0, got " + std::to_string(v));
@@ -35,26 +32,11 @@ void requireNonNegative(double v, const std::string& what) {
 }  // namespace
 
 void validate(const RobotParams& p) {
-  const QuadrupedParams& q = p.quadruped;
-  requirePositive(q.mass_kg, "quadruped.mass_kg");
-  requirePositive(q.izz_kgm2, "quadruped.izz_kgm2");
-  requireFinite(q.d_Q2C_m, "quadruped.d_Q2C_m");
-  requireNonNegative(q.d_Q2B_m, "quadruped.d_Q2B_m");
-  requirePositive(q.l_F_m, "quadruped.l_F_m");
-  requirePositive(q.w_F_m, "quadruped.w_F_m");
+  settings::validateFields(p.quadruped, "quadruped.");  // the declared ranges (robot_params.h)
   if (p.tail.empty()) throw std::invalid_argument("tail must have at least one link (n >= 1)");
-  for (size_t i = 0; i < p.tail.size(); ++i) {
-    const std::string k = "tail link " + std::to_string(i + 1);
-    requirePositive(p.tail[i].mass_kg, k + " mass_kg");
-    requirePositive(p.tail[i].izz_kgm2, k + " izz_kgm2");
-    requirePositive(p.tail[i].length_m, k + " length_m");
-    requireNonNegative(p.tail[i].com_offset_m, k + " com_offset_m");
-  }
+  for (size_t i = 0; i < p.tail.size(); ++i) settings::validateFields(p.tail[i], "tail link " + std::to_string(i + 1) + " ");
+  settings::validateFields(p.friction, "friction.");
   const FrictionParams& f = p.friction;
-  requireNonNegative(f.mu_s, "friction.mu_s");
-  requireNonNegative(f.mu_d, "friction.mu_d");
-  requirePositive(f.phidot_s_radps, "friction.phidot_s_radps");
-  requirePositive(f.v_s_mps, "friction.v_s_mps");
   if (!(f.phidot_d_radps > f.phidot_s_radps))
     throw std::invalid_argument("friction.phidot_d_radps must exceed friction.phidot_s_radps");
   if (!(f.v_d_mps > f.v_s_mps)) throw std::invalid_argument("friction.v_d_mps must exceed friction.v_s_mps");

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "settings/fields.h"
+
 namespace tailsim {
 
 // One rigid tail link (paper Table 2). Link i turns about joint i (a z hinge).
@@ -22,6 +24,9 @@ struct QuadrupedParams {
   double d_Q2B_m = 0.125;   // distance quadruped COM -> tail base, behind (-x)  [m]
   double l_F_m = 0.3;       // foot spacing along body x  [m]
   double w_F_m = 0.26;      // foot spacing along body y  [m]
+  // Height of the COM above the foot contacts  [m]: the per-foot model's load transfer and the
+  // MuJoCo body height (unless mujoco.body_height_m is given); the paper's models ignore it.
+  double com_height_m = 0.15;
 };
 
 // Foot-ground friction (paper Table 1, Fig. 4; paper-notes points 1 and 6).
@@ -45,6 +50,47 @@ struct RobotParams {
   double systemMass() const { return quadruped.mass_kg + tailMass(); }  // Eq. (10)
 };
 
+// The YAML/JSON keys of the robot's parts (settings/fields.h), declared once. Ranges: those of
+// validate(); the masses' work limits [kMinMassKg, kMaxMassKg] are checked by the loader.
+template <class V, class S>
+settings::For<S, QuadrupedParams> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.number(Field{"mass_kg", "m_Q, quadruped mass [kg]"}, s.mass_kg, Limits::positive());
+  v.number(Field{"izz_kgm2", "I_zz,Q about the quadruped COM [kg m^2]"}, s.izz_kgm2, Limits::positive());
+  v.number(Field{"d_Q2C_m", "x offset quadruped COM -> foot centroid, body frame [m]"}, s.d_Q2C_m, Limits::any());
+  v.number(Field{"d_Q2B_m", "distance quadruped COM -> tail base, behind (-x) [m]"}, s.d_Q2B_m, Limits::nonNegative());
+  v.number(Field{"l_F_m", "foot spacing along body x [m]"}, s.l_F_m, Limits::positive());
+  v.number(Field{"w_F_m", "foot spacing along body y [m]"}, s.w_F_m, Limits::positive());
+  v.number(Field{"com_height_m", "COM height above the foot contacts [m]: per-foot load transfer, MuJoCo body "
+                                 "height (optional in a robot file; default 0.15)"},
+           s.com_height_m, Limits::positive());
+}
+template <class V, class S>
+settings::For<S, FrictionParams> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.number(Field{"mu_s", "static coefficient (Table 1)"}, s.mu_s, Limits::nonNegative());
+  v.number(Field{"mu_d", "dynamic coefficient (Table 1)"}, s.mu_d, Limits::nonNegative());
+  v.number(Field{"phidot_s_radps", "continuous law: mu reaches mu_s at this yaw rate [rad/s]"}, s.phidot_s_radps,
+           Limits::positive());
+  v.number(Field{"phidot_d_radps", "continuous law: mu reaches mu_d at this yaw rate (> phidot_s_radps) [rad/s]"},
+           s.phidot_d_radps, Limits::positive());
+  v.number(Field{"v_s_mps", "continuous law, translation: mu_s at this slip speed [m/s]"}, s.v_s_mps,
+           Limits::positive());
+  v.number(Field{"v_d_mps", "continuous law, translation: mu_d at this slip speed (> v_s_mps) [m/s]"}, s.v_d_mps,
+           Limits::positive());
+}
+template <class V, class S>
+settings::For<S, TailLink> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.number(Field{"mass_kg", "m_L,i, link mass [kg]"}, s.mass_kg, Limits::positive());
+  v.number(Field{"izz_kgm2", "I_zz,L,i about the link COM [kg m^2]"}, s.izz_kgm2, Limits::positive());
+  v.number(Field{"length_m", "joint i to joint i+1 [m]"}, s.length_m, Limits::positive());
+  v.number(Field{"com_offset_m", "joint i to the link COM along the link; absent = 0.5 length_m [m]"}, s.com_offset_m,
+           Limits::nonNegative());
+}
 // Paper Table 2: the n-link tail (n = 1..6), 300 mm and 2.4 kg in all.
 TailLink paperTailLink(int n);
 

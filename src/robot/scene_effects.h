@@ -1,6 +1,8 @@
 // Which physical effects a scene simulates (issue 6). Both models read this.
 #pragma once
 
+#include "settings/fields.h"
+
 
 namespace tailsim {
 
@@ -24,5 +26,23 @@ struct Effects {
   FootLoadModel foot_loads = FootLoadModel::kDistributed;
   bool load_decomposition = true;   // compute M_zT's acceleration-/speed-driven parts
 };
+
+// The YAML/JSON keys of Effects (settings/fields.h), declared once.
+template <class V, class S>
+settings::For<S, Effects> declareFields(V& v, S& s) {
+  using settings::Field;
+  static const settings::EnumNames<FrictionLaw> kLaws = {
+      {FrictionLaw::kNone, "none"}, {FrictionLaw::kStiction, "stiction"}, {FrictionLaw::kContinuous, "continuous"}};
+  static const settings::EnumNames<FootLoadModel> kLoads = {{FootLoadModel::kDistributed, "distributed"},
+                                                            {FootLoadModel::kConstant, "constant"}};
+  v.choice(Field{"friction", "foot friction: none; stiction (Eqs. 14-16, stick/slip events); continuous (mu of slip speed)"},
+           s.friction, kLaws);
+  v.boolean(Field{"translation", "false: x, y locked"}, s.translation);
+  v.boolean(Field{"gravity", "false: no weight, hence no friction"}, s.gravity);
+  v.boolean(Field{"ground_contact", "MuJoCo: feet touch a ground plane"}, s.ground_contact);
+  v.choice(Field{"foot_loads", "distributed: L_F follows the COM (Eqs. A1-A5); constant: L_F of the initial pose"},
+           s.foot_loads, kLoads);
+  v.boolean(Field{"load_decomposition", "compute M_zT's acceleration- and speed-driven parts"}, s.load_decomposition);
+}
 
 }  // namespace tailsim

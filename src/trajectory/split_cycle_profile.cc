@@ -7,7 +7,7 @@
 
 namespace tailsim {
 
-SplitCycleProfile::SplitCycleProfile(const SplitCycleParams& p) : p_(p) {
+JointProfile::JointProfile(const SplitCycleParams& p) : p_(p) {
   if (!std::isfinite(p.dT_s) || p.dT_s <= 0.0)
     throw std::invalid_argument("dT_s must be > 0, got " + std::to_string(p.dT_s));
   if (!std::isfinite(p.w_ss) || p.w_ss <= 0.0 || p.w_ss >= 1.0)
@@ -21,7 +21,80 @@ SplitCycleProfile::SplitCycleProfile(const SplitCycleParams& p) : p_(p) {
   B_ = M_PI * p.dtheta_rad / ((1.0 - p.w_ss) * T2);  // Eq. (23); A Delta_a = B Delta_d
 }
 
-JointState SplitCycleProfile::at(double t) const {
+JointProfile::JointProfile(const SplineParams& s) : s_(s) {
+  const std::size_t N = s.knots_rad.size();
+  if (N < 2) throw std::invalid_argument("a spline needs at least 2 knots (start and end), got " + std::to_string(N));
+  if (!std::isfinite(s.dT_s) || s.dT_s <= 0.0)
+    throw std::invalid_argument("dT_s must be > 0, got " + std::to_string(s.dT_s));
+  if (!std::isfinite(s.t0_s)) throw std::invalid_argument("t0 must be finite");
+  for (double y : s.knots_rad)
+    if (!std::isfinite(y)) throw std::invalid_argument("spline knots must be finite");
+  knots_ = s.knots_rad;
+  h_ = s.dT_s / static_cast<double>(N - 1);
+  // Clamped cubic spline (zero slope at both ends): tridiagonal system for the second
+  // derivatives m_k, solved by the Thomas algorithm.
+  std::vector<double> a(N, 1.0), b(N, 4.0), c(N, 1.0), d(N, 0.0);
+  b[0] = 2.0;
+  b[N - 1] = 2.0;
+  d[0] = 6.0 / (h_ * h_) * (knots_[1] - knots_[0]);
+  d[N - 1] = -6.0 / (h_ * h_) * (knots_[N - 1] - knots_[N - 2]);
+  for (std::size_t k = 1; k + 1 < N; ++k) d[k] = 6.0 / (h_ * h_) * (knots_[k + 1] - 2.0 * knots_[k] + knots_[k - 1]);
+  for (std::size_t k = 1; k < N; ++k) {
+    const double w = a[k] / b[k - 1];
+    b[k] -= w * c[k - 1];
+    d[k] -= w * d[k - 1];
+  }
+  m_.assign(N, 0.0);
+  m_[N - 1] = d[N - 1] / b[N - 1];
+  for (std::size_t k = N - 1; k-- > 0;) m_[k] = (d[k] - c[k] * m_[k + 1]) / b[k];
+  p_.theta0_rad = knots_.front();
+  p_.dtheta_rad = knots_.back() - knots_.front();
+  p_.dT_s = s.dT_s;
+  p_.w_ss = 1.0 / static_cast<double>(N - 1);
+  p_.t0_s = s.t0_s;
+  // Peak |speed|: the speed is quadratic on each piece, so its extremes are at knots or at the
+  // piece's vertex (where the acceleration, linear on the piece, is zero).
+  double best_t = s.t0_s;
+  for (std::size_t k = 0; k + 1 < N; ++k) {
+    std::vector<double> cand{s.t0_s + h_ * static_cast<double>(k)};
+    if ((m_[k] > 0) != (m_[k + 1] > 0) && m_[k] != m_[k + 1]) cand.push_back(cand[0] + h_ * m_[k] / (m_[k] - m_[k + 1]));
+    for (double t : cand) {
+      const double v = splineAt(t).theta_dot;
+      if (std::abs(v) > std::abs(peak_)) {
+        peak_ = v;
+        best_t = t;
+      }
+    }
+  }
+  da_ = best_t - s.t0_s;
+  dd_ = s.dT_s - da_;
+}
+
+JointState JointProfile::splineAt(double t) const {
+  const std::size_t N = knots_.size();
+  const double tau = t - p_.t0_s;
+  if (tau <= 0.0) return {knots_.front(), 0.0, 0.0};
+  if (tau >= p_.dT_s) return {knots_.back(), 0.0, 0.0};
+  std::size_t k = std::min(static_cast<std::size_t>(tau / h_), N - 2);
+  const double b = tau - h_ * static_cast<double>(k), a = h_ - b;
+  const double ya = knots_[k] - m_[k] * h_ * h_ / 6.0, yb = knots_[k + 1] - m_[k + 1] * h_ * h_ / 6.0;
+  return {m_[k] * a * a * a / (6.0 * h_) + m_[k + 1] * b * b * b / (6.0 * h_) + (ya * a + yb * b) / h_,
+          -m_[k] * a * a / (2.0 * h_) + m_[k + 1] * b * b / (2.0 * h_) + (yb - ya) / h_,
+          (m_[k] * a + m_[k + 1] * b) / h_};
+}
+
+void JointProfile::breakpoints(std::vector<double>& out) const {
+  if (!isSpline()) {
+    out.push_back(p_.t0_s);
+    out.push_back(t1());
+    out.push_back(t2());
+    return;
+  }
+  for (std::size_t k = 0; k < knots_.size(); ++k) out.push_back(p_.t0_s + h_ * static_cast<double>(k));
+}
+
+JointState JointProfile::at(double t) const {
+  if (isSpline()) return splineAt(t);
   const double tau = t - p_.t0_s;
   if (tau <= 0.0) return {p_.theta0_rad, 0.0, 0.0};
   if (tau >= p_.dT_s) return {p_.theta0_rad + p_.dtheta_rad, 0.0, 0.0};
@@ -58,11 +131,7 @@ double TailTrajectory::endTime() const {
 
 std::vector<double> TailTrajectory::breakpoints() const {
   std::vector<double> b;
-  for (const auto& j : joints) {
-    b.push_back(j.params().t0_s);
-    b.push_back(j.t1());
-    b.push_back(j.t2());
-  }
+  for (const auto& j : joints) j.breakpoints(b);
   std::sort(b.begin(), b.end());
   b.erase(std::unique(b.begin(), b.end()), b.end());
   return b;

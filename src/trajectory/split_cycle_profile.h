@@ -1,8 +1,11 @@
 // Split-cycle joint trajectories (paper Sec. 3.3, Eqs. 20-23) and the equal-peak-speed rule
-// of Sec. 4.7 (Eq. 25).
+// of Sec. 4.7 (Eq. 25). A joint profile may also be a clamped cubic spline (issue 12's smooth
+// stroke family): JointProfile is either; SplitCycleProfile is its historical name.
 #pragma once
 
 #include <vector>
+
+#include "settings/fields.h"
 
 namespace tailsim {
 
@@ -15,38 +18,73 @@ struct SplitCycleParams {
   double t0_s = 0.0;        // start time t0  [s]
 };
 
+// A joint's resolved move as the resolved case (result.json "resolved") keeps it, in SI units (the
+// YAML trajectory section, with its degrees, per-joint lists and rule: eq25, is read by the loader).
+template <class V, class S>
+settings::For<S, SplitCycleParams> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.number(Field{"theta0_rad", "theta_0: angle at t0 [rad]"}, s.theta0_rad, Limits::any());
+  v.number(Field{"dtheta_rad", "Delta theta: displacement [rad]"}, s.dtheta_rad, Limits::any());
+  v.number(Field{"dT_s", "Delta T = t2 - t0 [s]"}, s.dT_s, Limits::positive());
+  v.number(Field{"w_ss", "split-cycle parameter, Delta_a = w_ss Delta T"}, s.w_ss, Limits::open(0, 1));
+  v.number(Field{"t0_s", "start time [s]"}, s.t0_s, Limits::nonNegative());
+}
+
 struct JointState {
   double theta = 0.0;       // [rad]
   double theta_dot = 0.0;   // [rad/s]
   double theta_ddot = 0.0;  // [rad/s^2]
 };
 
-// Eq. (20): half-sine acceleration A sin(pi (t-t0)/Delta_a) on [t0, t1], then
-// -B sin(pi (t-t1)/Delta_d) on (t1, t2]; at rest before t0 and after t2.
-class SplitCycleProfile {
- public:
-  explicit SplitCycleProfile(const SplitCycleParams& p);  // throws std::invalid_argument
-
-  JointState at(double t) const;
-  const SplitCycleParams& params() const { return p_; }
-  double accelAmplitude() const { return A_; }  // A of Eq. (23)  [rad/s^2]
-  double decelAmplitude() const { return B_; }  // B of Eq. (23)  [rad/s^2]
-  double t1() const { return p_.t0_s + da_; }
-  double t2() const { return p_.t0_s + p_.dT_s; }
-  double peakSpeed() const { return 2.0 * p_.dtheta_rad / p_.dT_s; }  // signed, at t1
-
- private:
-  SplitCycleParams p_;
-  double da_, dd_, A_, B_;
+// One joint's smooth stroke: a cubic spline through K + 2 equally spaced knots on [t0, t0 + dT]
+// (the first and last are the start and end angles), with zero speed at both ends (clamped);
+// at rest before t0 and after t0 + dT. Angles in radians.
+struct SplineParams {
+  std::vector<double> knots_rad;  // theta at t0 + k dT / (K + 1), k = 0..K+1 (at least 2)
+  double dT_s = 0.25;             // stroke duration  [s]
+  double t0_s = 0.0;              // start time  [s]
 };
 
-// All joints of a tail: one profile per joint.
+// Eq. (20): half-sine acceleration A sin(pi (t-t0)/Delta_a) on [t0, t1], then
+// -B sin(pi (t-t1)/Delta_d) on (t1, t2]; at rest before t0 and after t2.
+// Or (a spline profile) the clamped cubic spline of SplineParams.
+class JointProfile {
+ public:
+  explicit JointProfile(const SplitCycleParams& p);  // split-cycle; throws std::invalid_argument
+  explicit JointProfile(const SplineParams& s);      // spline; throws std::invalid_argument
+
+  bool isSpline() const { return !knots_.empty(); }
+  JointState at(double t) const;
+  // Split-cycle: its parameters. Spline: the envelope (theta0 = first knot, dtheta = last - first,
+  // dT, t0, and w_ss = knot spacing / dT, so w_ss dT is the shortest smooth piece).
+  const SplitCycleParams& params() const { return p_; }
+  const SplineParams& spline() const { return s_; }  // spline profiles only (empty knots otherwise)
+  double accelAmplitude() const { return A_; }  // A of Eq. (23)  [rad/s^2] (0 for a spline)
+  double decelAmplitude() const { return B_; }  // B of Eq. (23)  [rad/s^2] (0 for a spline)
+  double t1() const { return p_.t0_s + da_; }   // split-cycle: end of acceleration; spline: peak |speed|
+  double t2() const { return p_.t0_s + p_.dT_s; }
+  double peakSpeed() const { return isSpline() ? peak_ : 2.0 * p_.dtheta_rad / p_.dT_s; }  // signed, at t1
+  // Times where the acceleration changes formula: t0, t1, t2 (split-cycle) or every knot (spline).
+  void breakpoints(std::vector<double>& out) const;
+
+ private:
+  JointState splineAt(double t) const;
+  SplitCycleParams p_;
+  double da_ = 0, dd_ = 0, A_ = 0, B_ = 0;
+  SplineParams s_;
+  std::vector<double> knots_, m_;  // spline: knot values and second derivatives
+  double h_ = 0, peak_ = 0;
+};
+using SplitCycleProfile = JointProfile;
+
+// All joints of a tail: one profile per joint (split-cycle or spline).
 struct TailTrajectory {
   std::vector<SplitCycleProfile> joints;
   void evaluate(double t, std::vector<JointState>& out) const;
   double startTime() const;  // earliest t0
   double endTime() const;    // latest t2: the tail is at rest afterwards
-  // Times where some joint's acceleration changes formula (t0, t1, t2 of every joint), sorted.
+  // Times where some joint's acceleration changes formula (JointProfile::breakpoints), sorted.
   std::vector<double> breakpoints() const;
 };
 

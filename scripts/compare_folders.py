@@ -1,0 +1,49 @@
+#!/usr/bin/env python3
+"""Are two tailsim result folders the same, measured wall times aside?  usage: compare_folders.py A B
+Every file under A and B (except .tailsim.lock) must exist in both; JSON files are compared with every
+"wall_time_s" removed, results.csv files without their wall_time_s column, everything else byte for byte.
+Prints the differences and exits 1, or "identical: N files" and 0."""
+import csv, io, json, os, sys
+
+def walk(root):
+    out = set()
+    for d, _, files in os.walk(root):
+        for f in files:
+            rel = os.path.relpath(os.path.join(d, f), root)
+            if os.path.basename(rel) != ".tailsim.lock":
+                out.add(rel)
+    return out
+
+def strip(j):
+    if isinstance(j, dict):
+        return {k: strip(v) for k, v in j.items() if k != "wall_time_s"}
+    if isinstance(j, list):
+        return [strip(v) for v in j]
+    return j
+
+def table(path):
+    rows = list(csv.reader(open(path, newline="")))
+    if not rows:
+        return rows
+    drop = [i for i, h in enumerate(rows[0]) if h == "wall_time_s"]
+    return [[c for i, c in enumerate(r) if i not in drop] for r in rows]
+
+a, b = sys.argv[1], sys.argv[2]
+fa, fb = walk(a), walk(b)
+bad = [f"only in {a}: {f}" for f in sorted(fa - fb)] + [f"only in {b}: {f}" for f in sorted(fb - fa)]
+for rel in sorted(fa & fb):
+    pa, pb = os.path.join(a, rel), os.path.join(b, rel)
+    if rel.endswith(".json"):
+        same = strip(json.load(open(pa))) == strip(json.load(open(pb)))
+    elif os.path.basename(rel) == "results.csv":
+        same = table(pa) == table(pb)
+    else:
+        same = open(pa, "rb").read() == open(pb, "rb").read()
+    if not same:
+        bad.append(f"differs: {rel}")
+for line in bad[:30]:
+    print(line)
+if bad:
+    print(f"{len(bad)} differences")
+    sys.exit(1)
+print(f"identical: {len(fa)} files (wall times aside)")

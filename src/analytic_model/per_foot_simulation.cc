@@ -1,0 +1,545 @@
+// The per-foot friction model in time (per_foot_model.h; docs/per-foot-model.md).
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "analytic_model/analytic_simulation.h"
+#include "analytic_model/per_foot_model.h"
+#include "robot/friction_law.h"
+
+namespace tailsim {
+namespace {
+
+namespace odeint = boost::numeric::odeint;
+
+// State: x, y (quadruped COM, world), phi, and their rates.
+using State = std::array<double, 6>;
+enum { kX = 0, kY, kPhi, kVx, kVy, kW };
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Everything the model computes at one instant.
+struct Eval {
+  SystemLoads loads;
+  Vec2 FT_W = Vec2::Zero();
+  Vec2 c_W = Vec2::Zero();            // system COM relative to the quadruped COM, world
+  FootDiscs discs;                    // feet relative to the system COM (world), c_i = mu N_i
+  std::array<double, 4> N{};          // normal loads  [N]
+  std::array<Vec2, 4> Ff = zeros4();   // per-foot friction, world  [N]
+  Wrench2 friction;                   // their sum, moment about the system COM
+  double L_F = kNaN;                  // the paper's arm at the system COM (Eq. 19), for comparison
+  double load_factor = kNaN;          // stuck: s of the required wrench (held iff s <= 1)
+  Vec2 a_Q = Vec2::Zero();
+  double phi_ddot = 0.0;
+};
+
+class Model {
+ public:
+  Model(const RobotParams& r, const TailTrajectory& tr, const PerFootSettings& s, const Effects& e)
+      : robot_(r), traj_(tr), s_(s), e_(e) {
+    weight_ = r.systemMass() * (e.gravity ? r.gravity_mps2 : 0.0);
+    mu_break_ = breakawayCoefficient(r.friction);
+    const QuadrupedParams& q = r.quadruped;
+    static const double kXs[4] = {0.5, 0.5, -0.5, -0.5}, kYs[4] = {0.5, -0.5, -0.5, 0.5};
+    for (int i = 0; i < 4; ++i) foot_Q_[i] = Vec2(q.d_Q2C_m + kXs[i] * q.l_F_m, kYs[i] * q.w_F_m);
+    if (e.foot_loads == FootLoadModel::kConstant && hasFriction()) {
+      std::vector<JointState> j0;
+      traj_.evaluate(0.0, j0);
+      SystemLoads sl;
+      systemMassProperties(robot_, tailKinematics(robot_.tail, j0), sl);
+      fC_const_ = footLoads(q, sl.p_QC).f_C;
+    }
+  }
+
+  bool hasFriction() const { return e_.friction != FrictionLaw::kNone && weight_ > 0.0; }
+  bool stiction() const { return e_.friction == FrictionLaw::kStiction && weight_ > 0.0 && mu_break_ > 0.0; }
+  bool translation() const { return e_.translation; }
+  double weight() const { return weight_; }
+  const Effects& effects() const { return e_; }
+  void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
+
+  // stuck: the body is held (twist zero); the friction is the wrench that holds it and
+  // load_factor says whether the discs can supply it. Otherwise per-foot sliding friction.
+  Eval evaluate(double t, const State& y, bool stuck, bool decompose = false) const {
+    Eval ev;
+    std::vector<JointState>& js = js_;
+    traj_.evaluate(t, js);
+    systemLoads(robot_, js, decompose, ev.loads, scratch_);
+    if (!std::isfinite(ev.loads.MzT) || !std::isfinite(ev.loads.Izz_kgm2))
+      throw std::runtime_error("the tail loads became non-finite at t=" + std::to_string(t) + " s");
+    const double phi = y[kPhi], w = stuck ? 0.0 : y[kW];
+    ev.FT_W = rotate(phi, ev.loads.F_T_Q);
+    Eigen::Matrix3d A;
+    Eigen::Vector3d r0;
+    exactCoupling(js, phi, w, ev, A, r0);
+    for (int i = 0; i < 4; ++i) ev.discs.r[i] = rotate(phi, foot_Q_[i]) - ev.c_W;
+    if (hasFriction()) ev.L_F = footLoads(robot_.quadruped, ev.loads.p_QC).L_F;
+
+    if (stuck) {
+      // z = 0 in A z = r0 + E f: f = -E^-1 r0 (E: identity, plus c x F in the moment row).
+      Wrench2 req;
+      req.F = -Vec2(r0[0], r0[1]);
+      req.M = -r0[2] - cross2(ev.c_W, req.F);
+      if (!translation()) {
+        // x, y locked: a pin at the quadruped COM takes any force; the feet must supply the moment
+        // about it, -r0_z, at most sum c_i |rho_i| (every foot tangential).
+        normalLoads(ev, phi, Vec2::Zero());
+        double D = 0.0;
+        for (int i = 0; i < 4; ++i) {
+          ev.discs.c[i] = mu_break_ * ev.N[i];
+          D += ev.discs.c[i] * (ev.discs.r[i] + ev.c_W).norm();
+        }
+        const double MQ = -r0[2];
+        ev.load_factor = D > 0 ? std::abs(MQ) / D : (MQ == 0 ? 0.0 : std::numeric_limits<double>::infinity());
+        for (int i = 0; i < 4; ++i) {
+          const Vec2 rho = ev.discs.r[i] + ev.c_W;
+          if (D > 0 && rho.norm() > 0) ev.Ff[i] = MQ / D * ev.discs.c[i] * perp(rho) / rho.norm();
+          ev.friction.M += cross2(ev.discs.r[i], ev.Ff[i]);
+        }
+        return ev;
+      }
+      // Load transfer: a held body's friction is at most mu W (s >= |F| / (mu W) > 1 beyond, the
+      // loads cannot hold it anyway); the centre of pressure takes the force capped there, so a
+      // probe of a fast slide's holding wrench neither tips nor jumps.
+      const double F_cap = mu_break_ * weight_;
+      const double Fn = req.F.norm();
+      normalLoads(ev, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
+      for (int i = 0; i < 4; ++i) ev.discs.c[i] = mu_break_ * ev.N[i];
+      ev.load_factor = loadFactor(ev.discs, req).s;
+      ev.Ff = heldFootForces(ev.discs, req);
+      ev.friction = req;
+      return ev;
+    }
+
+    // Sliding: foot i's friction -mu_i N_i v_i / |v_i| (regularized below v_stop for stiction).
+    const Vec2 vQ = translation() ? Vec2(y[kVx], y[kVy]) : Vec2::Zero();
+    std::array<Vec2, 4> dir = zeros4();  // F_i = N_i dir_i
+    const FrictionParams& fp = robot_.friction;
+    if (hasFriction()) {
+      for (int i = 0; i < 4; ++i) {
+        const Vec2 vi = vQ + w * perp(rotate(phi, foot_Q_[i]));
+        const double sp = vi.norm();
+        if (e_.friction == FrictionLaw::kStiction) {
+          dir[i] = -fp.mu_d * vi / std::max(sp, s_.v_stop_mps);
+        } else if (sp > 0.0) {
+          dir[i] = -adamsFrictionCoefficient(sp, fp.v_s_mps, fp.v_d_mps, fp.mu_s, fp.mu_d) * vi / sp;
+        }
+      }
+    }
+    // Load transfer: N depends on the summed friction, which depends on N: fixed point (a
+    // contraction of factor ~ mu h / l_F).
+    Vec2 F = Vec2::Zero();
+    normalLoads(ev, phi, F);
+    if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction()) {
+      for (int it = 0;; ++it) {
+        F.setZero();
+        for (int i = 0; i < 4; ++i) F += ev.N[i] * dir[i];
+        const std::array<double, 4> N_old = ev.N;
+        normalLoads(ev, phi, F);
+        double change = 0.0;
+        for (int i = 0; i < 4; ++i) change = std::max(change, std::abs(ev.N[i] - N_old[i]));
+        if (change <= 1e-13 * weight_) break;
+        if (it > 200) throw std::runtime_error("the load-transfer fixed point does not converge");
+      }
+    }
+    for (int i = 0; i < 4; ++i) {
+      ev.discs.c[i] = (e_.friction == FrictionLaw::kStiction ? fp.mu_d : 0.0) * ev.N[i];
+      ev.Ff[i] = ev.N[i] * dir[i];
+      ev.friction.F += ev.Ff[i];
+      ev.friction.M += cross2(ev.discs.r[i], ev.Ff[i]);
+    }
+    if (!translation()) {
+      // x, y locked: the lock takes the force; solve rotation alone (A(2,2) w_dot = r0_2 + M_Q).
+      const double MQ = ev.friction.M + cross2(ev.c_W, ev.friction.F);
+      ev.phi_ddot = (r0[2] + MQ) / A(2, 2);
+      ev.friction.F.setZero();
+      return ev;
+    }
+    Eigen::Vector3d rhs = r0;
+    rhs[0] += ev.friction.F.x();
+    rhs[1] += ev.friction.F.y();
+    rhs[2] += ev.friction.M + cross2(ev.c_W, ev.friction.F);
+    const Eigen::Vector3d z = A.ldlt().solve(rhs);
+    ev.a_Q = Vec2(z[0], z[1]);
+    ev.phi_ddot = z[2];
+    return ev;
+  }
+
+  // Fastest foot's slip speed at state y.
+  double maxFootSpeed(const State& y) const {
+    const Vec2 vQ = translation() ? Vec2(y[kVx], y[kVy]) : Vec2::Zero();
+    double m = 0.0;
+    for (int i = 0; i < 4; ++i) m = std::max(m, (vQ + y[kW] * perp(rotate(y[kPhi], foot_Q_[i]))).norm());
+    return m;
+  }
+
+  void derivative(double t, const State& y, State& dy) const {
+    const Eval ev = evaluate(t, y, false);
+    const bool tr = translation();
+    dy[kX] = tr ? y[kVx] : 0.0;
+    dy[kY] = tr ? y[kVy] : 0.0;
+    dy[kPhi] = y[kW];
+    dy[kVx] = ev.a_Q.x();
+    dy[kVy] = ev.a_Q.y();
+    dy[kW] = ev.phi_ddot;
+  }
+
+ private:
+  // Normal loads from the Appendix distribution at the system COM, or (load transfer) at the
+  // centre of pressure shifted by -h F / W. Throws TippingError outside the support rectangle.
+  void normalLoads(Eval& ev, double phi, const Vec2& F_W) const {
+    if (!hasFriction()) {
+      ev.N.fill(0.0);
+      return;
+    }
+    std::array<double, 4> f;
+    if (e_.foot_loads == FootLoadModel::kConstant) {
+      f = fC_const_;
+    } else {
+      Vec2 p = ev.loads.p_QC;
+      if (s_.normal_loads == NormalLoadModel::kLoadTransfer) p += rotate(-phi, Vec2(-robot_.quadruped.com_height_m * F_W / weight_));
+      f = footLoads(robot_.quadruped, p).f_C;
+    }
+    for (int i = 0; i < 4; ++i) ev.N[i] = weight_ * f[i];
+  }
+
+  // The planar multibody with the base moving (paper-notes point 3, as analytic.coupling: exact):
+  // A z = r0 + E f with z = (a_Qx, a_Qy, phi_ddot), angular momentum about the quadruped COM.
+  void exactCoupling(const std::vector<JointState>& js, double phi, double w, Eval& ev, Eigen::Matrix3d& A,
+                     Eigen::Vector3d& r0) const {
+    TailKinematics& kin = kin_;
+    tailKinematics(robot_.tail, js, kin);
+    const Vec2 p_QB(-robot_.quadruped.d_Q2B_m, 0.0);
+    Vec2 S = Vec2::Zero(), lin = Vec2::Zero();
+    double J = robot_.quadruped.izz_kgm2, ang = 0.0;
+    for (size_t i = 0; i < robot_.tail.size(); ++i) {
+      const TailLink& l = robot_.tail[i];
+      const Vec2 rho = rotate(phi, Vec2(p_QB - kin.p_L[i]));
+      const Vec2 rho_dot_rel = rotate(phi, Vec2(-kin.v_L[i]));
+      const Vec2 rho_ddot_rel = rotate(phi, Vec2(-kin.a_L[i]));
+      const Vec2 b = -w * w * rho + 2.0 * w * perp(rho_dot_rel) + rho_ddot_rel;
+      S += l.mass_kg * rho;
+      J += l.izz_kgm2 + l.mass_kg * rho.squaredNorm();
+      lin += l.mass_kg * b;
+      ang += l.mass_kg * cross2(rho, b) + l.izz_kgm2 * kin.alpha[i];
+    }
+    const double m = ev.loads.mass_kg;
+    A << m, 0, -S.y(), 0, m, S.x(), -S.y(), S.x(), J;
+    r0 << -lin.x(), -lin.y(), -ang;
+    ev.c_W = S / m;
+  }
+
+  const RobotParams& robot_;
+  const TailTrajectory& traj_;
+  PerFootSettings s_;
+  Effects e_;
+  double weight_ = 0, mu_break_ = 0;
+  std::array<Vec2, 4> foot_Q_ = zeros4();
+  std::array<double, 4> fC_const_{};
+  mutable std::vector<JointState> js_;
+  mutable LoadScratch scratch_;
+  mutable TailKinematics kin_;
+};
+
+// Event margin: > 0 no switch. Stuck: 1 - s (the discs hold the required wrench while s < 1).
+// Sliding: max(fastest foot - v_stop, s_probe - 1), s_probe of the wrench that would hold it now.
+double margin(const Model& model, double t, const State& y, bool stuck, double v_stop) {
+  if (stuck) return 1.0 - model.evaluate(t, y, true).load_factor;
+  const double fast = model.maxFootSpeed(y) - v_stop;
+  if (fast > 0) return fast;
+  return std::max(fast, model.evaluate(t, y, true).load_factor - 1.0);
+}
+
+// Illinois (modified regula falsi) on g over [a, b] with g(a) > 0 >= g(b).
+template <class G>
+double illinois(const G& g, double a, double b, double ga, double gb, double tol) {
+  if (!(ga > 0)) return a + std::min(tol, b - a);
+  int side = 0;
+  for (int it = 0; it < 100 && b - a > tol; ++it) {
+    double c = (a * gb - b * ga) / (gb - ga);
+    if (!(c > a && c < b)) c = 0.5 * (a + b);
+    const double gc = g(c);
+    if (gc > 0) {
+      a = c; ga = gc;
+      if (side == -1) gb *= 0.5;
+      side = -1;
+    } else {
+      b = c; gb = gc;
+      if (side == +1) ga *= 0.5;
+      side = +1;
+    }
+  }
+  return b;
+}
+
+template <class G>
+std::pair<double, double> goldenMin(const G& g, double a, double b, double tol) {
+  const double r = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c = b - r * (b - a), d = a + r * (b - a);
+  double gc = g(c), gd = g(d);
+  for (int it = 0; it < 60 && b - a > tol; ++it) {
+    if (gc < gd) { b = d; d = c; gd = gc; c = b - r * (b - a); gc = g(c); }
+    else { a = c; c = d; gc = gd; d = a + r * (b - a); gd = g(d); }
+  }
+  return gc < gd ? std::make_pair(c, gc) : std::make_pair(d, gd);
+}
+
+// First switch in [ta, tb]: margins sampled every h_scan; a crossing is located by Illinois; a dip
+// of a stuck margin between samples by golden section. Returns +inf if none.
+template <class StateAt>
+double findSwitch(const Model& model, bool stuck, double v_stop, double ta, double tb, double h_scan, double tol,
+                  const StateAt& stateAt) {
+  const int k = std::max(2, static_cast<int>(std::ceil((tb - ta) / h_scan)));
+  State y;
+  auto g = [&](double t) {
+    stateAt(t, y);
+    return margin(model, t, y, stuck, v_stop);
+  };
+  double g_prev = g(ta), g_prev2 = g_prev, t_prev = ta, t_prev2 = ta;
+  if ((stuck && g_prev <= 0) || (!stuck && g_prev < 0)) return ta;
+  for (int i = 1; i <= k; ++i) {
+    const double t = ta + (tb - ta) * i / k;
+    const double gt = g(t);
+    if ((g_prev > 0 && gt <= 0) || (!stuck && g_prev >= 0 && gt < 0)) return illinois(g, t_prev, t, g_prev, gt, tol);
+    if (stuck && i >= 2 && g_prev < g_prev2 && g_prev < gt && g_prev > 0) {
+      const auto [tm, gm] = goldenMin(g, t_prev2, t, tol * 1e3);
+      if (gm <= 0) return illinois(g, t_prev2, tm, g_prev2, gm, tol);
+    }
+    t_prev2 = t_prev; g_prev2 = g_prev;
+    t_prev = t; g_prev = gt;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+class Recorder {
+ public:
+  Recorder(const Model& model, int n_links, double dt, long n_samples) : model_(model), dt_(dt), n_samples_(n_samples) {
+    ts_.addColumn("t_s");
+    for (const char* p : {"theta", "thetadot", "thetaddot"})
+      for (int i = 1; i <= n_links; ++i)
+        ts_.addColumn(p + std::to_string(i) + (std::string(p) == "theta" ? "_deg" : std::string(p) == "thetadot" ? "_dps" : "_dps2"));
+    for (const char* c : {"x_m", "y_m", "phi_deg", "phidot_dps", "phiddot_dps2", "MzT_Nm", "MzT_acc_Nm",
+                          "MzT_speed_Nm", "MzT_tan_Nm", "MzT_cen_Nm", "MzF_Nm", "Izz_phiddot_Nm", "Izz_kgm2",
+                          "LF_m", "FTx_N", "FTy_N", "FFx_N", "FFy_N", "rot_state", "trans_state", "F1x_N", "F1y_N",
+                          "F2x_N", "F2y_N", "F3x_N", "F3y_N", "F4x_N", "F4y_N", "N1_N", "N2_N", "N3_N", "N4_N",
+                          "load_factor"})
+      ts_.addColumn(c);
+  }
+  double nextTime() const { return next_ < n_samples_ ? next_ * dt_ : std::numeric_limits<double>::infinity(); }
+  bool done() const { return next_ >= n_samples_; }
+
+  void record(double t, const State& y, bool stuck) {
+    const bool decomp = model_.effects().load_decomposition;
+    const Eval ev = model_.evaluate(t, y, stuck, decomp);
+    model_.joints(t, js_);
+    row_.clear();
+    row_.push_back(t);
+    const double d = 180.0 / M_PI;
+    for (const auto& j : js_) row_.push_back(j.theta * d);
+    for (const auto& j : js_) row_.push_back(j.theta_dot * d);
+    for (const auto& j : js_) row_.push_back(j.theta_ddot * d);
+    const double state = model_.stiction() ? (stuck ? 0.0 : 1.0) : kNaN;
+    const bool tr = model_.translation();
+    row_.insert(row_.end(), {y[kX], y[kY], y[kPhi] * d, (stuck ? 0.0 : y[kW]) * d, ev.phi_ddot * d, ev.loads.MzT,
+                             decomp ? ev.loads.MzT_acc : kNaN, decomp ? ev.loads.MzT_speed : kNaN,
+                             decomp ? ev.loads.MzT_tan : kNaN, decomp ? ev.loads.MzT_cen : kNaN, ev.friction.M,
+                             ev.loads.Izz_kgm2 * ev.phi_ddot, ev.loads.Izz_kgm2, ev.L_F, ev.FT_W.x(), ev.FT_W.y(),
+                             ev.friction.F.x(), ev.friction.F.y(), state, tr ? state : kNaN});
+    for (int i = 0; i < 4; ++i) row_.insert(row_.end(), {ev.Ff[i].x(), ev.Ff[i].y()});
+    for (int i = 0; i < 4; ++i) row_.push_back(ev.N[i]);
+    row_.push_back(stuck ? ev.load_factor : kNaN);
+    ts_.appendRow(row_);
+    ++next_;
+  }
+  void repeatLastUntilDone() {
+    if (ts_.numRows() == 0) return;
+    while (!done()) {
+      row_[0] = nextTime();
+      ts_.appendRow(row_);
+      ++next_;
+    }
+  }
+  TimeSeries take() { return std::move(ts_); }
+
+ private:
+  const Model& model_;
+  double dt_;
+  long n_samples_ = 0, next_ = 0;
+  TimeSeries ts_;
+  std::vector<double> row_;
+  std::vector<JointState> js_;
+};
+
+std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) {
+  std::ostringstream os;
+  os.precision(4);
+  os << "the body is still moving when the run ends at t = " << t_end << " s (|phi_dot| " << phidot_dps
+     << " deg/s, speed " << speed_mps << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
+     << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
+  return os.str();
+}
+
+}  // namespace
+
+RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                          const Effects& effects, const OutputSettings& output) {
+  if (!(settings.rel_tol > 0) || !(settings.abs_tol > 0)) throw std::invalid_argument("perfoot tolerances must be > 0");
+  if (!(settings.event_tol_s > 0)) throw std::invalid_argument("perfoot event_tol_s must be > 0");
+  if (!(settings.v_stop_mps > 0)) throw std::invalid_argument("perfoot v_stop_mps must be > 0");
+  if (!(settings.max_step_s >= 0)) throw std::invalid_argument("perfoot max_step_s must be >= 0");
+  for (double v : settings.initial_velocity)
+    if (!std::isfinite(v)) throw std::invalid_argument("perfoot initial_velocity must be finite");
+  if (!(output.sample_dt_s > 0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
+  const double t_end = output.duration_s > 0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  if (output.sample_dt_s > t_end) throw std::invalid_argument("output.sample_dt_s is longer than the run");
+  const double rows = std::floor(t_end / output.sample_dt_s + 1e-9) + 1;
+  if (!(rows <= limits::kMaxRowsPerRun)) throw std::invalid_argument("the run would write too many rows");
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  RunResult result;
+  RunSummary& sum = result.summary;
+  sum.model = "perfoot";
+  const double tail_end = trajectory.endTime();
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const auto& j : trajectory.joints)
+    shortest = std::min({shortest, j.params().w_ss * j.params().dT_s, (1 - j.params().w_ss) * j.params().dT_s});
+  if (!std::isfinite(shortest)) shortest = t_end;
+  const double h_scan = shortest / 32.0;
+  const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
+
+  try {
+    const Model model(robot, trajectory, settings, effects);
+    Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
+    const double v_stop = settings.v_stop_mps;
+    State y{};
+    y[kVx] = settings.initial_velocity[0];
+    y[kVy] = settings.initial_velocity[1];
+    y[kW] = settings.initial_velocity[2];
+    double t = 0.0, t_stop = 0.0, max_load_factor = 0.0;
+    bool stuck = model.stiction() && model.maxFootSpeed(y) == 0.0;
+    int switches = 0, breakaways = 0;
+    long steps = 0;
+
+    // Makes the mode consistent with (t, y): a held wrench outside the limit surface breaks away, a
+    // slide slower than v_stop whose holding wrench is inside sticks (twist set to zero).
+    auto settle = [&]() {
+      if (!model.stiction()) return;
+      for (int n = 0;; ++n) {
+        if (n > 8) throw std::runtime_error("stick/slip modes do not settle at t=" + std::to_string(t) + " s");
+        const double g = margin(model, t, y, stuck, v_stop);
+        if (stuck && g <= 0) {
+          stuck = false;
+          ++breakaways;
+        } else if (!stuck && g < 0) {
+          stuck = true;
+          y[kVx] = y[kVy] = y[kW] = 0.0;
+          t_stop = t;
+        } else {
+          return;
+        }
+        ++switches;
+      }
+    };
+    settle();
+    auto settled = [&](double tt) { return tt >= tail_end && stuck; };
+    auto recordUpTo = [&](double t_hi, auto&& stateAt) {
+      State ys;
+      while (!rec.done() && rec.nextTime() <= t_hi + 1e-12) {
+        const double ts = std::min(rec.nextTime(), t_end);
+        stateAt(ts, ys);
+        rec.record(ts, ys, stuck);
+      }
+    };
+    const std::vector<double> bps = trajectory.breakpoints();
+    auto nextBreak = [&](double tt) {
+      for (double b : bps)
+        if (b > tt + 1e-14) return std::min(b, t_end);
+      return t_end;
+    };
+    auto rhs = [&](const State& x, State& dx, double tt) { model.derivative(tt, x, dx); };
+
+    while (t < t_end - 1e-15) {
+      if (settled(t)) {
+        if (!rec.done()) {
+          rec.record(std::min(rec.nextTime(), t_end), y, stuck);
+          rec.repeatLastUntilDone();
+        }
+        t = t_end;
+        break;
+      }
+      const double seg_end = nextBreak(t);
+      if (stuck) {
+        // Nothing moves: scan the load factor up to the next breakpoint (h_max at a time).
+        const double tb = std::min(seg_end, t + h_max);
+        auto stateAt = [&](double, State& ys) { ys = y; };
+        max_load_factor = std::max(max_load_factor, 1.0 - margin(model, tb, y, true, v_stop));
+        const double ts = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt);
+        const double t_cut = std::min(ts, tb);
+        recordUpTo(t_cut, stateAt);
+        t = t_cut;
+        ++steps;
+        if (ts <= tb) settle();
+        if (steps > settings.max_steps) throw std::runtime_error("step budget exhausted");
+        continue;
+      }
+      const double max_dt = t < tail_end ? h_max : t_end - t;
+      auto stepper = odeint::make_dense_output(settings.abs_tol, settings.rel_tol, max_dt,
+                                               odeint::runge_kutta_dopri5<State>());
+      stepper.initialize(y, t, std::min(max_dt, 1e-4));
+      bool restart = false;
+      while (!restart) {
+        const auto [ta, tb_raw] = stepper.do_step(rhs);
+        ++steps;
+        if (steps > settings.max_steps)
+          throw std::runtime_error("step budget of " + std::to_string(settings.max_steps) + " steps exhausted at t=" +
+                                   std::to_string(t) + " s");
+        const double tb = std::min(tb_raw, seg_end);
+        auto stateAt = [&](double tt, State& ys) { stepper.calc_state(tt, ys); };
+        double ts = std::numeric_limits<double>::infinity();
+        if (model.stiction()) ts = findSwitch(model, false, v_stop, ta, tb, h_scan, settings.event_tol_s, stateAt);
+        const double t_cut = std::min(ts, tb);
+        recordUpTo(t_cut, stateAt);
+        stepper.calc_state(t_cut, y);
+        t = t_cut;
+        for (double v : y)
+          if (!std::isfinite(v)) throw std::runtime_error("state became non-finite at t=" + std::to_string(t) + " s");
+        if (ts <= tb) {
+          settle();
+          restart = true;
+        }
+        if (tb_raw >= seg_end - 1e-15 || t >= t_end - 1e-15 || stepper.current_time() > t + 1e-15) restart = true;
+      }
+    }
+    recordUpTo(t_end, [&](double, State& ys) { ys = y; });
+
+    result.series = rec.take();
+    sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
+    sum.t_stop_s = stuck ? t_stop : t_end;
+    sum.stick_slip_events = switches;
+    sum.solver_steps = steps;
+    const double phidot_dps = std::abs(y[kW]) * 180.0 / M_PI, speed = std::hypot(y[kVx], y[kVy]);
+    sum.extra["final_x_m"] = y[kX];
+    sum.extra["final_y_m"] = y[kY];
+    sum.extra["final_phidot_dps"] = y[kW] * 180.0 / M_PI;
+    sum.extra["final_speed_mps"] = speed;
+    sum.extra["breakaways"] = breakaways;
+    if (model.stiction()) sum.extra["max_load_factor_stuck"] = max_load_factor;
+    sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
+    if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
+  } catch (const TippingError& e) {
+    sum.ok = false;
+    sum.error = e.what();
+  } catch (const std::runtime_error& e) {
+    sum.ok = false;
+    sum.error = std::string("perfoot model failed: ") + e.what();
+  }
+  sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return result;
+}
+
+}  // namespace tailsim

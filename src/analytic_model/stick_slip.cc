@@ -1,0 +1,39 @@
+#include "analytic_model/stick_slip.h"
+
+#include "robot/friction_law.h"
+
+namespace tailsim {
+
+SlidingFriction slidingFriction(FrictionLaw law, const FrictionParams& fp, double weight, double L_F,
+                                double rot_dir, double phi_dot, const Vec2& v, double v_reg) {
+  SlidingFriction f;
+  const double speed = v.norm();
+  switch (law) {
+    case FrictionLaw::kNone:
+      break;
+    case FrictionLaw::kStiction:
+      f.MzF = -fp.mu_d * weight * L_F * rot_dir;                                // Eq. (16), sliding
+      if (speed > 0.0) f.FF = -fp.mu_d * weight * v / std::max(speed, v_reg);  // Eq. (15), sliding
+      break;
+    case FrictionLaw::kContinuous: {
+      const double w = phi_dot;
+      const double mu_r = adamsFrictionCoefficient(std::abs(w), fp.phidot_s_radps, fp.phidot_d_radps, fp.mu_s, fp.mu_d);
+      f.MzF = -mu_r * weight * L_F * (w > 0 ? 1.0 : (w < 0 ? -1.0 : 0.0));
+      if (speed > 0.0)
+        f.FF = -adamsFrictionCoefficient(speed, fp.v_s_mps, fp.v_d_mps, fp.mu_s, fp.mu_d) * weight * v / speed;
+      break;
+    }
+  }
+  return f;
+}
+
+int dofToSwitch(const Modes& m, const Margins& g, bool translation) {
+  int which = -1;
+  for (int w : {kRot, kTrans})
+    if (m.stuck[w] && g[w] <= 0) which = w;
+  if (which < 0 && translation && !m.stuck[kTrans] && g[kTrans] < 0) which = kTrans;
+  if (which < 0 && !m.stuck[kRot] && g[kRot] < 0) which = kRot;
+  return which;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,267 @@
+#include "design/optimize_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+#include "experiments/experiment_loader.h"
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kRadPerDeg = M_PI / 180.0;
+constexpr std::uintmax_t kMaxFileBytes = 1u << 20;
+
+std::string fmtG(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// One value with where it came from.
+struct Val {
+  YAML::Node node;
+  std::string key;
+  YAML::Mark mark;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+  [[noreturn]] void fail(const YAML::Mark& m, const std::string& key, const std::string& what) const {
+    std::string s = file_;
+    if (!m.is_null()) s += ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
+    s += ": ";
+    if (!key.empty()) s += key + ": ";
+    throw ConfigError(s + what);
+  }
+  [[noreturn]] void fail(const Val& v, const std::string& what) const { fail(v.mark, v.key, what); }
+
+  // The map's entries; a key not in `allowed` (or twice) is an error at the key.
+  std::vector<std::pair<std::string, Val>> map(const Val& v, std::initializer_list<const char*> allowed) const {
+    if (!v.node.IsMap()) fail(v, "expected a map of key: value");
+    std::vector<std::pair<std::string, Val>> out;
+    std::string names;
+    for (const char* a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
+    for (const auto& kv : v.node) {
+      const std::string key = v.key.empty() ? kv.first.Scalar() : v.key + "." + kv.first.Scalar();
+      if (!kv.first.IsScalar()) fail(kv.first.Mark(), v.key, "keys must be plain names");
+      const std::string k = kv.first.Scalar();
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }))
+        fail(kv.first.Mark(), key, "unknown key (allowed here: " + names + ")");
+      for (const auto& e : out)
+        if (e.first == k) fail(kv.first.Mark(), key, "duplicate key");
+      const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
+      out.emplace_back(k, Val{kv.second, key, empty ? kv.first.Mark() : kv.second.Mark()});
+    }
+    return out;
+  }
+  static const Val* get(const std::vector<std::pair<std::string, Val>>& m, const std::string& k) {
+    for (const auto& e : m)
+      if (e.first == k) return &e.second;
+    return nullptr;
+  }
+  double number(const Val& v) const {
+    if (!v.node.IsScalar()) fail(v, "expected a number");
+    double x = 0;
+    try {
+      x = v.node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(v, "expected a number, got '" + v.node.Scalar() + "'");
+    }
+    if (!std::isfinite(x)) fail(v, "must be finite");
+    return x;
+  }
+  double inRange(const Val& v, double lo, double hi) const {
+    const double x = number(v);
+    if (!(x >= lo && x <= hi)) fail(v, "must lie in [" + fmtG(lo) + ", " + fmtG(hi) + "], got " + fmtG(x));
+    return x;
+  }
+  int integer(const Val& v, int lo, int hi) const {
+    const double x = number(v);
+    if (x != std::floor(x)) fail(v, "must be a whole number, got " + fmtG(x));
+    if (!(x >= lo && x <= hi)) fail(v, "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + fmtG(x));
+    return static_cast<int>(x);
+  }
+  std::string choice(const Val& v, std::initializer_list<const char*> options) const {
+    std::string names;
+    for (const char* o : options) names += (names.empty() ? "" : ", ") + std::string(o);
+    if (!v.node.IsScalar()) fail(v, "expected one of: " + names);
+    const std::string s = v.node.Scalar();
+    if (std::none_of(options.begin(), options.end(), [&](const char* o) { return s == o; }))
+      fail(v, "'" + s + "' is not one of: " + names);
+    return s;
+  }
+  bool boolean(const Val& v) const {
+    const std::string s = choice(v, {"true", "false"});
+    return s == "true";
+  }
+  std::string text(const Val& v) const {
+    if (!v.node.IsScalar()) fail(v, "expected a string");
+    return v.node.Scalar();
+  }
+  std::vector<Val> list(const Val& v, std::size_t min, std::size_t max) const {
+    if (!v.node.IsSequence()) fail(v, "expected a list [a, b, ...]");
+    if (v.node.size() < min || v.node.size() > max)
+      fail(v, "expected " + (min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max)) +
+                  " values, got " + std::to_string(v.node.size()));
+    std::vector<Val> out;
+    for (std::size_t i = 0; i < v.node.size(); ++i)
+      out.push_back(Val{v.node[i], v.key + "[" + std::to_string(i) + "]", v.node[i].Mark().is_null() ? v.mark : v.node[i].Mark()});
+    return out;
+  }
+  // [lo, hi] with lo <= hi, both in [min, max].
+  std::pair<double, double> interval(const Val& v, double min, double max) const {
+    const std::vector<Val> l = list(v, 2, 2);
+    const double a = inRange(l[0], min, max), b = inRange(l[1], min, max);
+    if (a > b) fail(v, "expected [low, high] with low <= high, got [" + fmtG(a) + ", " + fmtG(b) + "]");
+    return {a, b};
+  }
+
+ private:
+  std::string file_;
+};
+
+YAML::Node loadYaml(const std::string& abs) {
+  std::error_code ec;
+  const auto size = fs::file_size(abs, ec);
+  if (ec) throw ConfigError(abs + ": cannot read: " + ec.message());
+  if (size > kMaxFileBytes) throw ConfigError(abs + ": file is larger than 1 MiB");
+  try {
+    return YAML::LoadFile(abs);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(abs + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+}
+
+}  // namespace
+
+bool isOptimizeFile(const std::string& path) {
+  try {
+    const YAML::Node doc = loadYaml(fs::absolute(path).lexically_normal().string());
+    return doc.IsMap() && doc["kind"] && doc["kind"].IsScalar() && doc["kind"].Scalar() == "optimize";
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+OptimizeSpec loadOptimizeSpec(const std::string& path) {
+  OptimizeSpec s;
+  s.source_file = fs::absolute(path).lexically_normal().string();
+  const Reader r(s.source_file);
+  const Val root{loadYaml(s.source_file), "", YAML::Mark()};
+  if (!root.node.IsMap()) r.fail(root, "the file must be a map of key: value");
+  const auto top = r.map(root, {"name", "description", "kind", "base", "optimize"});
+  auto need = [&](const std::vector<std::pair<std::string, Val>>& m, const Val& parent, const char* k) -> const Val& {
+    const Val* v = Reader::get(m, k);
+    if (!v) r.fail(parent.mark, parent.key.empty() ? k : parent.key + "." + k, "required key is missing");
+    return *v;
+  };
+  s.name = r.text(need(top, root, "name"));
+  if (s.name.empty() || s.name.size() > 100 || s.name.find_first_of("/\\") != std::string::npos || s.name == "." ||
+      s.name == ".." || s.name[0] == '-')
+    r.fail(need(top, root, "name"), "must be one safe path component (no / or \\, not . or .., no leading -, 1..100 characters)");
+  if (const Val* d = Reader::get(top, "description")) s.description = r.text(*d);
+  r.choice(need(top, root, "kind"), {"optimize"});
+  const Val& base = need(top, root, "base");
+  s.base_file = (fs::path(s.source_file).parent_path() / r.text(base)).lexically_normal().string();
+  if (!fs::is_regular_file(s.base_file)) r.fail(base, "no such experiment file: " + s.base_file);
+  const Val& opt = need(top, root, "optimize");
+  const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
+                             "generations", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
+  StrokeSpace& sp = s.problem.space;
+  sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
+                                                                                        : StrokeFamily::kSplitCycle;
+  if (const Val* k = Reader::get(o, "knots")) {
+    if (sp.family != StrokeFamily::kSpline) r.fail(*k, "only used with family: spline");
+    sp.knots = r.integer(*k, 0, kMaxKnots);
+  }
+  if (const Val* v = Reader::get(o, "objective")) {
+    const std::string ob = r.choice(*v, {"phi_net", "phi_net_per_torque", "phi_net_per_energy"});
+    s.problem.objective = ob == "phi_net" ? StrokeObjective::kPhiNet
+                          : ob == "phi_net_per_torque" ? StrokeObjective::kPhiNetPerTorque
+                                                       : StrokeObjective::kPhiNetPerEnergy;
+  }
+  const Val& lv = need(o, opt, "limits");
+  const auto l = r.map(lv, {"theta_deg", "thetadot_max_dps", "torque_max_Nm", "end", "dT_s", "w_ss", "start_delay_s"});
+  StrokeLimits& L = sp.limits;
+  {
+    const Val& th = need(l, lv, "theta_deg");
+    const auto [a, b] = r.interval(th, -360.0, 360.0);
+    if (!(b > a)) r.fail(th, "the range must not be empty");
+    L.theta_min_rad = a * kRadPerDeg;
+    L.theta_max_rad = b * kRadPerDeg;
+  }
+  {
+    const Val& w = need(l, lv, "thetadot_max_dps");
+    L.thetadot_max_radps = r.inRange(w, 1.0, 36000.0) * kRadPerDeg;
+  }
+  const Val* torque = Reader::get(l, "torque_max_Nm");
+  if (torque && !(torque->node.IsScalar() && torque->node.Scalar() == "base")) {
+    L.torque_max_Nm = r.number(*torque);
+    if (!(L.torque_max_Nm > 0.0))
+      r.fail(*torque, "must be > 0 or base (leave it out for no torque limit), got " + fmtG(L.torque_max_Nm));
+  }
+  if (const Val* e = Reader::get(l, "end")) {
+    L.end = r.choice(*e, {"rest", "start"}) == "start" ? StrokeEnd::kAtStart : StrokeEnd::kAtRest;
+    if (L.end == StrokeEnd::kAtStart && sp.family == StrokeFamily::kSplitCycle)
+      r.fail(*e, "a split-cycle stroke moves by dtheta and cannot end where it started: use family: spline");
+  }
+  if (const Val* d = Reader::get(l, "dT_s")) {
+    const auto [a, b] = r.interval(*d, 0.01, 10.0);
+    L.dT_min_s = a;
+    L.dT_max_s = b;
+  }
+  if (const Val* w = Reader::get(l, "w_ss")) {
+    if (sp.family != StrokeFamily::kSplitCycle) r.fail(*w, "only used with family: split_cycle");
+    const auto [a, b] = r.interval(*w, 0.01, 0.99);
+    L.w_ss_min = a;
+    L.w_ss_max = b;
+  }
+  if (const Val* t = Reader::get(l, "start_delay_s")) L.t0_max_s = r.inRange(*t, 0.0, 10.0);
+
+  OptimizerSettings& os = s.optimizer;
+  if (const Val* v = Reader::get(o, "algorithm")) os.algorithm = r.choice(*v, {"cmaes", "de"});
+  if (const Val* v = Reader::get(o, "islands")) os.islands = r.integer(*v, 1, kMaxIslands);
+  if (const Val* v = Reader::get(o, "population")) os.population = r.integer(*v, 5, kMaxPopulation);
+  if (const Val* v = Reader::get(o, "generations")) os.generations = r.integer(*v, 1, kMaxGenerations);
+  if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
+  if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
+  if (const Val* v = Reader::get(o, "seeds")) {
+    s.seeds.clear();
+    for (const Val& e : r.list(*v, 1, kMaxSeeds)) {
+      const int x = r.integer(e, 0, 1000000000);
+      if (std::find(s.seeds.begin(), s.seeds.end(), static_cast<std::uint64_t>(x)) != s.seeds.end())
+        r.fail(e, "duplicate seed " + std::to_string(x));
+      s.seeds.push_back(static_cast<std::uint64_t>(x));
+    }
+  }
+  if (const Val* v = Reader::get(o, "pareto_points")) {
+    s.pareto_points = r.integer(*v, 0, kMaxParetoPoints);
+    if (s.pareto_points == 1) r.fail(*v, "a front needs 0 (none) or at least 2 points");
+  }
+  if (const Val* v = Reader::get(o, "mujoco_check")) s.mujoco_check = r.boolean(*v);
+
+  // The base experiment, through the loader (its errors name the base file).
+  const Experiment e = loadExperiment(s.base_file);
+  if (e.cases.size() != 1)
+    r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
+  s.base = e.cases.front();
+  if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
+  sp.n_links = s.base.robot.numLinks();
+  if (torque && L.torque_max_Nm == 0.0) {  // torque_max_Nm: base -- the base stroke's own peak joint torque
+    L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
+    if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");
+  }
+  s.problem.base = s.base;
+  return s;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,45 @@
+// Issue 12: `kind: optimize` experiment files (docs/design-a-tail-stroke.md). The file names a
+// one-case base experiment (robot, tail, effects, solver settings, and the start trajectory),
+// read by the experiment loader, and an `optimize:` section read here with the loader's
+// conventions: ConfigError "<file>:<line>:<col>: <key>: <what>", unknown keys refused, every
+// range checked before any work.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "design/stroke_family.h"
+#include "design/stroke_optimizer.h"
+#include "experiments/experiment_config.h"
+
+namespace tailsim {
+
+struct OptimizeSpec {
+  std::string name, description;
+  std::string source_file;  // absolute path of the optimize file
+  std::string base_file;    // absolute path of the base experiment
+  ExperimentCase base;      // its one case
+  StrokeProblem problem;    // base + stroke space + objective
+  OptimizerSettings optimizer;
+  std::vector<std::uint64_t> seeds{1};  // one optimisation per seed; the best is the result
+  int pareto_points = 0;                // > 0: phi_net vs peak torque front with this many points
+  bool mujoco_check = true;             // re-simulate the optimum in MuJoCo
+};
+
+// Limits of the optimize section (documented in docs/design-a-tail-stroke.md).
+constexpr int kMaxKnots = 12;
+constexpr int kMaxIslands = 64;
+constexpr int kMaxPopulation = 1000;
+constexpr int kMaxGenerations = 10000;
+constexpr int kMaxPolishEvaluations = 100000;
+constexpr int kMaxSeeds = 20;
+constexpr int kMaxParetoPoints = 20;
+
+// Throws ConfigError (experiments/experiment_loader.h) before any optimisation.
+OptimizeSpec loadOptimizeSpec(const std::string& path);
+
+// True when the YAML file is a `kind: optimize` file (for the command line's checks).
+bool isOptimizeFile(const std::string& path);
+
+}  // namespace tailsim

@@ -1,0 +1,312 @@
+#include "design/optimize_experiment.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "analytic_model/analytic_simulation.h"
+#include "mujoco_model/mujoco_simulation.h"
+#include "plotting/gnuplot.h"
+#include "results/atomic_file.h"
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDegPerRad = 180.0 / M_PI;
+
+std::string g17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+// Full-resolution re-run on the base's output grid.
+OutputSettings fullOutput(const ExperimentCase& c, const TailTrajectory& t) {
+  OutputSettings o = c.output;
+  o.duration_s = 0.0;  // tail end + settle
+  (void)t;
+  return o;
+}
+
+TimeSeries trajectorySeries(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt, double t_end) {
+  TimeSeries ts;
+  const int n = static_cast<int>(traj.joints.size());
+  ts.addColumn("t_s");
+  for (const char* q : {"theta", "thetadot", "thetaddot", "tau"})
+    for (int i = 1; i <= n; ++i)
+      ts.addColumn(std::string(q) + std::to_string(i) +
+                   (std::string(q) == "theta" ? "_deg" : std::string(q) == "thetadot" ? "_dps" : std::string(q) == "tau" ? "_Nm" : "_dps2"));
+  std::vector<JointState> js;
+  for (long k = 0; k * dt <= t_end + 1e-12; ++k) {
+    const double t = k * dt;
+    traj.evaluate(t, js);
+    const std::vector<double> tau = jointTorques(links, js);
+    std::vector<double> row{t};
+    for (const auto& j : js) row.push_back(j.theta * kDegPerRad);
+    for (const auto& j : js) row.push_back(j.theta_dot * kDegPerRad);
+    for (const auto& j : js) row.push_back(j.theta_ddot * kDegPerRad);
+    for (double x : tau) row.push_back(x);
+    ts.appendRow(row);
+  }
+  return ts;
+}
+
+}  // namespace
+
+LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSeries& ts, const StrokeLimits& L) {
+  LimitCheck c;
+  const int n = static_cast<int>(links.size());
+  const double d2r = M_PI / 180.0;
+  StrokeFigures& f = c.figures;
+  f.theta_min_rad = std::numeric_limits<double>::infinity();
+  f.theta_max_rad = -f.theta_min_rad;
+  std::vector<JointState> js(static_cast<std::size_t>(n));
+  const std::vector<double>& t = ts.values("t_s");
+  double prev_p = 0;
+  for (std::size_t r = 0; r < ts.numRows(); ++r) {
+    for (int i = 0; i < n; ++i) {
+      const std::string k = std::to_string(i + 1);
+      js[i] = {ts.at(r, ts.column("theta" + k + "_deg")) * d2r, ts.at(r, ts.column("thetadot" + k + "_dps")) * d2r,
+               ts.at(r, ts.column("thetaddot" + k + "_dps2")) * d2r};
+    }
+    const std::vector<double> tau = jointTorques(links, js);
+    double p = 0;
+    for (int i = 0; i < n; ++i) {
+      f.theta_min_rad = std::min(f.theta_min_rad, js[i].theta);
+      f.theta_max_rad = std::max(f.theta_max_rad, js[i].theta);
+      f.peak_speed_radps = std::max(f.peak_speed_radps, std::abs(js[i].theta_dot));
+      f.peak_torque_Nm = std::max(f.peak_torque_Nm, std::abs(tau[i]));
+      p += std::abs(tau[i] * js[i].theta_dot);
+    }
+    if (r > 0) f.energy_J += 0.5 * (p + prev_p) * (t[r] - t[r - 1]);
+    prev_p = p;
+    if (r + 1 == ts.numRows() && r > 0)
+      for (int i = 0; i < n; ++i)
+        f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js[i].theta - ts.at(0, ts.column("theta" + std::to_string(i + 1) + "_deg")) * d2r));
+  }
+  const double tol = 1e-9;
+  auto over = [&](double v, double lim) { return v > lim + tol * std::max(1.0, std::abs(lim)); };
+  if (over(f.theta_max_rad, L.theta_max_rad) || over(L.theta_min_rad, f.theta_min_rad))
+    c.violations.push_back("joint angle " + std::to_string(f.theta_min_rad * kDegPerRad) + ".." +
+                           std::to_string(f.theta_max_rad * kDegPerRad) + " deg outside the range");
+  if (over(f.peak_speed_radps, L.thetadot_max_radps))
+    c.violations.push_back("peak joint speed " + std::to_string(f.peak_speed_radps * kDegPerRad) + " deg/s over the limit");
+  if (L.torque_max_Nm > 0 && over(f.peak_torque_Nm, L.torque_max_Nm))
+    c.violations.push_back("peak joint torque " + std::to_string(f.peak_torque_Nm) + " N m over the limit");
+  if (L.end == StrokeEnd::kAtStart && f.end_offset_rad > 1e-6)
+    c.violations.push_back("the tail ends " + std::to_string(f.end_offset_rad * kDegPerRad) + " deg from its start");
+  c.ok = c.violations.empty();
+  return c;
+}
+
+std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& traj) {
+  YAML::Node doc = YAML::LoadFile(spec.base_file);
+  doc["name"] = spec.name + "_best";
+  doc["description"] = "Best stroke of " + spec.name + " (tailsim optimize, " + std::string(familyName(spec.problem.space.family)) + ")";
+  doc["robot"] = spec.base.robot_file;  // absolute: the file runs from any folder
+  YAML::Node t(YAML::NodeType::Map);
+  const char* keys[] = {"theta0_deg", "dtheta_deg", "dT_s", "w_ss", "t0_s"};
+  for (const char* k : keys) {
+    YAML::Node l(YAML::NodeType::Sequence);
+    l.SetStyle(YAML::EmitterStyle::Flow);
+    for (const auto& j : traj.joints) {
+      const SplitCycleParams& p = j.params();
+      const std::string key = k;
+      const double v = key == "theta0_deg" ? p.theta0_rad * kDegPerRad
+                       : key == "dtheta_deg" ? p.dtheta_rad * kDegPerRad
+                       : key == "dT_s" ? p.dT_s : key == "w_ss" ? p.w_ss : p.t0_s;
+      l.push_back(YAML::Load(g17(v)));
+    }
+    t[k] = l;
+  }
+  doc["trajectory"] = t;
+  YAML::Node models(YAML::NodeType::Sequence);
+  models.SetStyle(YAML::EmitterStyle::Flow);
+  models.push_back("analytic");
+  models.push_back("mujoco");
+  doc["models"] = models;
+  YAML::Emitter e;
+  e << doc;
+  return "# Written by tailsim optimize from " + spec.source_file + "\n" + std::string(e.c_str()) + "\n";
+}
+
+OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  OptimizeReport rep;
+  fs::create_directories(fs::path(out_dir) / "plots");
+  const StrokeProblem& prob = spec.problem;
+
+  for (std::uint64_t seed : spec.seeds) {
+    OptimizerSettings os = spec.optimizer;
+    os.seed = seed;
+    rep.per_seed.push_back(optimizeStroke(prob, os));
+    const OptimizeResult& r = rep.per_seed.back();
+    rep.evaluations += r.evaluations;
+    if (progress)
+      std::fprintf(stderr, "seed %llu: %s = %.6g (phi_net %.4f deg), %ld evaluations, %.2f s\n",
+                   static_cast<unsigned long long>(seed), objectiveName(prob.objective), r.best.objective,
+                   r.best.phi_net_rad * kDegPerRad, r.evaluations, r.wall_s);
+  }
+  double lo = 1e300, hi = -1e300;
+  for (std::size_t i = 0; i < rep.per_seed.size(); ++i) {
+    const double v = rep.per_seed[i].best.objective;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+    if (v > rep.per_seed[rep.best_seed_index].best.objective) rep.best_seed_index = i;
+  }
+  rep.spread = hi > 0 ? (hi - lo) / hi : 0.0;
+  const OptimizeResult& best = rep.per_seed[rep.best_seed_index];
+  const TailTrajectory traj = prob.space.trajectory(best.x);
+
+  // Verification: re-simulate, check the limits on what the model ran, and run MuJoCo.
+  const OutputSettings out = fullOutput(spec.base, traj);
+  const RunResult ra = simulateAnalytic(spec.base.robot, traj, spec.base.analytic, spec.base.effects, out);
+  rep.analytic = ra.summary;
+  rep.limits_analytic = checkLimitsOnSeries(spec.base.robot.tail, ra.series, prob.space.limits);
+  writeCsvAtomic((fs::path(out_dir) / "best_analytic.csv").string(), ra.series);
+  rep.files.push_back("best_analytic.csv");
+  if (spec.mujoco_check) {
+    const RunResult rm = simulateMujoco(spec.base.robot, traj, spec.base.mujoco, spec.base.effects, out);
+    rep.mujoco = rm.summary;
+    writeCsvAtomic((fs::path(out_dir) / "best_mujoco.csv").string(), rm.series);
+    rep.files.push_back("best_mujoco.csv");
+  }
+  writeCsvAtomic((fs::path(out_dir) / "best_trajectory.csv").string(),
+                 trajectorySeries(spec.base.robot.tail, traj, 1e-3, traj.endTime()));
+  rep.files.push_back("best_trajectory.csv");
+  if (prob.space.family == StrokeFamily::kSplitCycle) {
+    writeFileAtomic((fs::path(out_dir) / "best.yaml").string(), bestExperimentYaml(spec, traj));
+    rep.files.push_back("best.yaml");
+  }
+
+  // Convergence history.
+  {
+    std::ostringstream csv;
+    csv << "seed,stage,generation,evaluations,wall_s,best_objective\n";
+    std::vector<std::vector<double>> rows;
+    for (std::size_t i = 0; i < rep.per_seed.size(); ++i)
+      for (const HistoryRow& h : rep.per_seed[i].history) {
+        csv << spec.seeds[i] << "," << h.stage << "," << h.generation << "," << h.evaluations << "," << g17(h.wall_s) << ","
+            << g17(h.best_objective) << "\n";
+      }
+    writeFileAtomic((fs::path(out_dir) / "history.csv").string(), csv.str());
+    rep.files.push_back("history.csv");
+    GnuplotFigure fig;
+    fig.stem = "history";
+    std::ostringstream b;
+    b << "set datafile separator ','\nset key bottom right\nset grid\n"
+      << "set title 'Convergence of " << spec.name << " (" << familyName(prob.space.family) << ")' noenhanced\n"
+      << "set xlabel 'analytic model runs'\nset ylabel '" << objectiveName(prob.objective)
+      << (prob.objective == StrokeObjective::kPhiNet ? " [rad]" : "") << "' noenhanced\nplot ";
+    for (std::size_t i = 0; i < spec.seeds.size(); ++i)
+      b << (i ? ", " : "") << "'../history.csv' every ::1 using ($1==" << spec.seeds[i]
+        << " ? $4 : 1/0):6 with steps lw 2 title 'seed " << spec.seeds[i] << "'";
+    b << "\n";
+    fig.body = b.str();
+    renderFigure((fs::path(out_dir) / "plots").string(), fig);
+    rep.files.push_back("plots/history.png");
+  }
+
+  // Pareto front: phi_net vs peak joint torque, by re-optimising under torque limits.
+  nlohmann::json pareto = nlohmann::json::array();
+  if (spec.pareto_points >= 2) {
+    const double tau_top = best.best.figures.peak_torque_Nm;
+    std::ostringstream csv;
+    csv << "torque_limit_Nm,peak_torque_Nm,phi_net_deg,evaluations\n";
+    for (int k = 0; k < spec.pareto_points; ++k) {
+      StrokeProblem p = prob;
+      p.objective = StrokeObjective::kPhiNet;
+      const double lim = tau_top * (0.2 + 0.8 * k / (spec.pareto_points - 1));
+      p.space.limits.torque_max_Nm = prob.space.limits.torque_max_Nm > 0 ? std::min(lim, prob.space.limits.torque_max_Nm) : lim;
+      OptimizerSettings os = spec.optimizer;
+      os.seed = spec.seeds.front();
+      const OptimizeResult r = optimizeStroke(p, os);
+      rep.evaluations += r.evaluations;
+      csv << g17(p.space.limits.torque_max_Nm) << "," << g17(r.best.figures.peak_torque_Nm) << ","
+          << g17(r.best.phi_net_rad * kDegPerRad) << "," << r.evaluations << "\n";
+      pareto.push_back({{"torque_limit_Nm", p.space.limits.torque_max_Nm}, {"peak_torque_Nm", r.best.figures.peak_torque_Nm},
+                        {"phi_net_deg", r.best.phi_net_rad * kDegPerRad}, {"feasible", r.best.feasible()}});
+      if (progress)
+        std::fprintf(stderr, "pareto %d/%d: torque <= %.4g N m: phi_net %.4f deg\n", k + 1, spec.pareto_points,
+                     p.space.limits.torque_max_Nm, r.best.phi_net_rad * kDegPerRad);
+    }
+    writeFileAtomic((fs::path(out_dir) / "pareto.csv").string(), csv.str());
+    rep.files.push_back("pareto.csv");
+    GnuplotFigure fig;
+    fig.stem = "pareto";
+    fig.body = "set datafile separator ','\nset grid\nset key off\nset title 'Net yaw vs peak joint torque (" +
+               spec.name + ")' noenhanced\nset xlabel 'peak joint torque [N m]'\nset ylabel '|{/Symbol f}_{net}| [deg]'\n"
+               "plot '../pareto.csv' every ::1 using 2:(abs($3)) with linespoints lw 2 pt 7\n";
+    renderFigure((fs::path(out_dir) / "plots").string(), fig);
+    rep.files.push_back("plots/pareto.png");
+  }
+
+  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  nlohmann::json j;
+  j["experiment"] = spec.name;
+  j["source"] = spec.source_file;
+  j["base"] = spec.base_file;
+  j["family"] = familyName(prob.space.family);
+  j["objective"] = objectiveName(prob.objective);
+  j["n_links"] = prob.space.n_links;
+  j["dimensions"] = prob.space.dim();
+  j["algorithm"] = spec.optimizer.algorithm;
+  j["islands"] = spec.optimizer.islands;
+  j["polish"] = spec.optimizer.polish;
+  j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
+                {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};
+  nlohmann::json seeds = nlohmann::json::array();
+  for (std::size_t i = 0; i < rep.per_seed.size(); ++i) {
+    const OptimizeResult& r = rep.per_seed[i];
+    seeds.push_back({{"seed", spec.seeds[i]}, {"objective", r.best.objective}, {"phi_net_deg", r.best.phi_net_rad * kDegPerRad},
+                     {"evaluations", r.evaluations}, {"wall_s", r.wall_s}});
+  }
+  j["seeds"] = seeds;
+  j["seed_spread"] = rep.spread;
+  const StrokeEvaluation& b = best.best;
+  nlohmann::json joints = nlohmann::json::array();
+  for (const auto& jp : traj.joints) {
+    if (jp.isSpline()) {
+      nlohmann::json k = nlohmann::json::array();
+      for (double v : jp.spline().knots_rad) k.push_back(v * kDegPerRad);
+      joints.push_back({{"knots_deg", k}, {"dT_s", jp.spline().dT_s}, {"t0_s", jp.spline().t0_s}});
+    } else {
+      const SplitCycleParams& p = jp.params();
+      joints.push_back({{"theta0_deg", p.theta0_rad * kDegPerRad}, {"dtheta_deg", p.dtheta_rad * kDegPerRad},
+                        {"dT_s", p.dT_s}, {"w_ss", p.w_ss}, {"t0_s", p.t0_s}});
+    }
+  }
+  j["best"] = {{"objective", b.objective}, {"phi_net_deg", b.phi_net_rad * kDegPerRad},
+               {"peak_speed_dps", b.figures.peak_speed_radps * kDegPerRad}, {"peak_torque_Nm", b.figures.peak_torque_Nm},
+               {"energy_J", b.figures.energy_J}, {"joints", joints}};
+  j["improvement_over_start"] = best.start.objective > 0 ? b.objective / best.start.objective - 1.0 : 0.0;
+  const LimitCheck& lc = rep.limits_analytic;
+  j["resimulated"]["analytic"] = {{"ok", rep.analytic.ok}, {"phi_net_deg", rep.analytic.phi_net_deg},
+                                  {"limits_kept", lc.ok}, {"violations", lc.violations},
+                                  {"theta_min_deg", lc.figures.theta_min_rad * kDegPerRad},
+                                  {"theta_max_deg", lc.figures.theta_max_rad * kDegPerRad},
+                                  {"peak_speed_dps", lc.figures.peak_speed_radps * kDegPerRad},
+                                  {"peak_torque_Nm", lc.figures.peak_torque_Nm}};
+  if (spec.mujoco_check)
+    j["resimulated"]["mujoco"] = {{"ok", rep.mujoco.ok}, {"phi_net_deg", rep.mujoco.phi_net_deg}, {"error", rep.mujoco.error},
+                                  {"difference_deg", rep.mujoco.phi_net_deg - rep.analytic.phi_net_deg},
+                                  {"relative_difference", rep.analytic.phi_net_deg != 0
+                                                              ? (rep.mujoco.phi_net_deg - rep.analytic.phi_net_deg) / std::abs(rep.analytic.phi_net_deg)
+                                                              : 0.0}};
+  if (!pareto.empty()) j["pareto"] = pareto;
+  j["evaluations"] = rep.evaluations;
+  j["wall_s"] = rep.wall_s;
+  j["files"] = rep.files;
+  writeFileAtomic((fs::path(out_dir) / "summary.json").string(), j.dump(2) + "\n");
+  rep.files.push_back("summary.json");
+  return rep;
+}
+
+}  // namespace tailsim

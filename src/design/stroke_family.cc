@@ -1,0 +1,161 @@
+#include "design/stroke_family.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "analytic_model/tail_dynamics.h"
+
+namespace tailsim {
+namespace {
+double clamp01(double v) { return std::isfinite(v) ? std::min(1.0, std::max(0.0, v)) : 0.5; }
+double lerp(double lo, double hi, double u) { return lo + clamp01(u) * (hi - lo); }
+double unlerp(double lo, double hi, double v) { return hi > lo ? clamp01((v - lo) / (hi - lo)) : 0.0; }
+}  // namespace
+
+int StrokeSpace::dimPerJoint() const {
+  // split-cycle: start, end, speed share, w_ss, t0; spline: start, K knots, (end), dT, t0.
+  if (family == StrokeFamily::kSplitCycle) return 5;
+  return 1 + knots + (limits.end == StrokeEnd::kAtRest ? 1 : 0) + 2;
+}
+
+TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const {
+  if (static_cast<int>(x.size()) != dim()) throw std::invalid_argument("stroke point has the wrong size");
+  const StrokeLimits& L = limits;
+  TailTrajectory t;
+  const int d = dimPerJoint();
+  for (int i = 0; i < n_links; ++i) {
+    const double* u = x.data() + static_cast<std::ptrdiff_t>(i) * d;
+    if (family == StrokeFamily::kSplitCycle) {
+      SplitCycleParams p;
+      p.theta0_rad = lerp(L.theta_min_rad, L.theta_max_rad, u[0]);
+      p.dtheta_rad = lerp(L.theta_min_rad, L.theta_max_rad, u[1]) - p.theta0_rad;
+      // Peak speed 2 |dtheta| / dT (Eq. 23) as a share of the limit: speed kept by construction
+      // unless the duration range clips dT.
+      const double share = lerp(0.05, 1.0, u[2]);
+      p.dT_s = std::min(L.dT_max_s, std::max(L.dT_min_s, 2.0 * std::abs(p.dtheta_rad) / (share * L.thetadot_max_radps)));
+      p.w_ss = lerp(L.w_ss_min, L.w_ss_max, u[3]);
+      p.t0_s = lerp(0.0, L.t0_max_s, u[4]);
+      t.joints.emplace_back(p);
+    } else {
+      SplineParams s;
+      int k = 0;
+      for (; k < 1 + knots; ++k) s.knots_rad.push_back(lerp(L.theta_min_rad, L.theta_max_rad, u[k]));
+      if (L.end == StrokeEnd::kAtRest) s.knots_rad.push_back(lerp(L.theta_min_rad, L.theta_max_rad, u[k++]));
+      else s.knots_rad.push_back(s.knots_rad.front());
+      s.dT_s = lerp(L.dT_min_s, L.dT_max_s, u[k++]);
+      s.t0_s = lerp(0.0, L.t0_max_s, u[k++]);
+      t.joints.emplace_back(s);
+    }
+  }
+  return t;
+}
+
+std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& joints) const {
+  const StrokeLimits& L = limits;
+  std::vector<double> x;
+  for (int i = 0; i < n_links; ++i) {
+    const SplitCycleParams& p = joints.at(static_cast<std::size_t>(i));
+    const double a = p.theta0_rad, b = p.theta0_rad + p.dtheta_rad;
+    if (family == StrokeFamily::kSplitCycle) {
+      const double speed = p.dT_s > 0 ? 2.0 * std::abs(p.dtheta_rad) / p.dT_s : L.thetadot_max_radps;
+      x.insert(x.end(), {unlerp(L.theta_min_rad, L.theta_max_rad, a), unlerp(L.theta_min_rad, L.theta_max_rad, b),
+                         unlerp(0.05, 1.0, speed / L.thetadot_max_radps), unlerp(L.w_ss_min, L.w_ss_max, p.w_ss),
+                         unlerp(0.0, L.t0_max_s, p.t0_s)});
+    } else {
+      // The split-cycle stroke sampled at the knots (out and back when the tail must end at its start).
+      const SplitCycleProfile prof(p);
+      const int N = knots + 2;
+      for (int k = 0; k < N - 1 + (L.end == StrokeEnd::kAtRest ? 1 : 0); ++k) {
+        double frac = static_cast<double>(k) / (N - 1);
+        if (L.end == StrokeEnd::kAtStart) frac = frac <= 0.5 ? 2 * frac : 2 - 2 * frac;
+        x.push_back(unlerp(L.theta_min_rad, L.theta_max_rad, prof.at(p.t0_s + frac * p.dT_s).theta));
+      }
+      x.push_back(unlerp(L.dT_min_s, L.dT_max_s, L.end == StrokeEnd::kAtStart ? 2 * p.dT_s : p.dT_s));
+      x.push_back(unlerp(0.0, L.t0_max_s, p.t0_s));
+    }
+  }
+  return x;
+}
+
+std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints) {
+  // Eqs. (5)-(7) from the tip to the base, as tailBaseLoad, keeping every joint's moment.
+  const TailKinematics k = tailKinematics(links, joints);
+  const int n = static_cast<int>(links.size());
+  std::vector<double> tau(static_cast<std::size_t>(n));
+  Vec2 F_next = Vec2::Zero();
+  double M_next = 0.0;
+  for (int i = n - 1; i >= 0; --i) {
+    const Vec2 F = F_next + links[i].mass_kg * k.a_L[i];
+    double M = M_next + links[i].izz_kgm2 * k.alpha[i] - cross2(k.p_J[i] - k.p_L[i], F);
+    if (i + 1 < n) M += cross2(k.p_J[i + 1] - k.p_L[i], F_next);
+    F_next = F;
+    M_next = M;
+    tau[i] = M;
+  }
+  return tau;
+}
+
+StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt) {
+  StrokeFigures f;
+  const double t_a = traj.startTime(), t_b = traj.endTime();
+  std::vector<double> ts;
+  for (long k = static_cast<long>(std::floor(t_a / dt)); k * dt <= t_b + dt; ++k) ts.push_back(k * dt);
+  for (double b : traj.breakpoints()) ts.push_back(b);
+  std::sort(ts.begin(), ts.end());
+  std::vector<JointState> js, js0, js1;
+  traj.evaluate(t_a - 1.0, js0);
+  traj.evaluate(t_b + 1.0, js1);
+  f.theta_min_rad = f.theta_max_rad = js0.empty() ? 0.0 : js0[0].theta;
+  double prev_t = ts.empty() ? 0.0 : ts.front(), prev_p = 0.0;
+  for (double t : ts) {
+    traj.evaluate(t, js);
+    const std::vector<double> tau = jointTorques(links, js);
+    double p = 0.0;
+    for (std::size_t i = 0; i < js.size(); ++i) {
+      f.theta_min_rad = std::min(f.theta_min_rad, js[i].theta);
+      f.theta_max_rad = std::max(f.theta_max_rad, js[i].theta);
+      f.peak_speed_radps = std::max(f.peak_speed_radps, std::abs(js[i].theta_dot));
+      f.peak_torque_Nm = std::max(f.peak_torque_Nm, std::abs(tau[i]));
+      p += std::abs(tau[i] * js[i].theta_dot);
+    }
+    f.energy_J += 0.5 * (p + prev_p) * (t - prev_t);  // trapezoid
+    prev_t = t;
+    prev_p = p;
+  }
+  for (std::size_t i = 0; i < js0.size(); ++i) f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js1[i].theta - js0[i].theta));
+  for (const auto& j : traj.joints)
+    if (j.isSpline()) f.peak_speed_radps = std::max(f.peak_speed_radps, std::abs(j.peakSpeed()));
+  return f;
+}
+
+double limitViolation(const StrokeFigures& f, const StrokeLimits& L) {
+  const double range = std::max(L.theta_max_rad - L.theta_min_rad, 1e-9);
+  double v = std::max(0.0, (f.theta_max_rad - L.theta_max_rad) / range) + std::max(0.0, (L.theta_min_rad - f.theta_min_rad) / range);
+  v += std::max(0.0, f.peak_speed_radps / L.thetadot_max_radps - 1.0);
+  if (L.torque_max_Nm > 0) v += std::max(0.0, f.peak_torque_Nm / L.torque_max_Nm - 1.0);
+  if (L.end == StrokeEnd::kAtStart) v += f.end_offset_rad / range;
+  return v;
+}
+
+double objectiveValue(StrokeObjective o, double phi_net_rad, const StrokeFigures& f) {
+  const double a = std::abs(phi_net_rad);
+  switch (o) {
+    case StrokeObjective::kPhiNet: return a;
+    case StrokeObjective::kPhiNetPerTorque: return a / std::max(f.peak_torque_Nm, 1e-9);
+    case StrokeObjective::kPhiNetPerEnergy: return a / std::max(f.energy_J, 1e-9);
+  }
+  return a;
+}
+
+const char* objectiveName(StrokeObjective o) {
+  switch (o) {
+    case StrokeObjective::kPhiNet: return "phi_net";
+    case StrokeObjective::kPhiNetPerTorque: return "phi_net_per_torque";
+    case StrokeObjective::kPhiNetPerEnergy: return "phi_net_per_energy";
+  }
+  return "?";
+}
+const char* familyName(StrokeFamily f) { return f == StrokeFamily::kSplitCycle ? "split_cycle" : "spline"; }
+
+}  // namespace tailsim

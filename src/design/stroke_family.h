@@ -1,0 +1,68 @@
+// Issue 12: tail-stroke families for the optimiser, the limits a stroke must keep, and the
+// stroke's figures (peak joint speed, angle range, peak joint torque, energy) measured on a
+// sampled trajectory. SI units inside (radians); degrees only in the YAML (optimize_config.h).
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "robot/robot_params.h"
+#include "trajectory/split_cycle_profile.h"
+
+namespace tailsim {
+
+enum class StrokeFamily { kSplitCycle, kSpline };
+enum class StrokeEnd { kAtRest, kAtStart };  // the tail ends at rest anywhere, or where it started
+enum class StrokeObjective { kPhiNet, kPhiNetPerTorque, kPhiNetPerEnergy };
+
+// What the search may vary and what a stroke must keep. Every joint's angle stays in
+// [theta_min, theta_max]; its speed within thetadot_max; every joint torque within torque_max.
+struct StrokeLimits {
+  double theta_min_rad = -M_PI / 2, theta_max_rad = M_PI / 2;
+  double thetadot_max_radps = 600.0 * M_PI / 180.0;
+  double torque_max_Nm = 0.0;  // 0 = no torque limit
+  StrokeEnd end = StrokeEnd::kAtRest;
+  double dT_min_s = 0.05, dT_max_s = 1.0;      // stroke duration range  [s]
+  double w_ss_min = 0.05, w_ss_max = 0.95;     // split-cycle only
+  double t0_max_s = 0.0;                       // start delay range [0, t0_max]  [s]
+};
+
+// A family maps a point x of the unit box [0, 1]^dim to a trajectory of n joints.
+struct StrokeSpace {
+  StrokeFamily family = StrokeFamily::kSplitCycle;
+  int n_links = 1;
+  int knots = 3;  // spline: interior knots K per joint
+  StrokeLimits limits;
+
+  int dimPerJoint() const;
+  int dim() const { return n_links * dimPerJoint(); }
+  TailTrajectory trajectory(const std::vector<double>& x) const;  // x in [0, 1]^dim (clamped)
+  // The unit-box point of a split-cycle trajectory (the search's start); entries are clamped.
+  std::vector<double> pointOf(const std::vector<SplitCycleParams>& joints) const;
+};
+
+// Joint torques tau_i = M_J,i (the Newton-Euler recursion of Eqs. 5-7, tail base held still).
+std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
+
+struct StrokeFigures {
+  double theta_min_rad = 0, theta_max_rad = 0;  // over all joints and samples
+  double peak_speed_radps = 0;                  // max |thetadot_i|
+  double peak_torque_Nm = 0;                    // max |tau_i|
+  double energy_J = 0;                          // sum_i integral |tau_i thetadot_i| dt
+  double end_offset_rad = 0;                    // max_i |theta_i(end) - theta_i(start)|
+};
+
+// Figures on the absolute grid t = k dt covering the stroke, plus every breakpoint; the grid
+// dt = 0.5 ms holds the 1 ms output grid, so the re-simulated series never shows more.
+StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt = 5e-4);
+
+// Relative excess over each limit (0 when all are kept): the sum of max(0, value/limit - 1).
+double limitViolation(const StrokeFigures& f, const StrokeLimits& lim);
+
+// The objective's value for a signed phi_net [rad] (the optimiser maximises |phi_net| / divisor).
+double objectiveValue(StrokeObjective o, double phi_net_rad, const StrokeFigures& f);
+const char* objectiveName(StrokeObjective o);
+const char* familyName(StrokeFamily f);
+
+}  // namespace tailsim

@@ -1,0 +1,200 @@
+#include "design/stroke_optimizer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <nlopt.hpp>
+#include <pagmo/algorithm.hpp>
+#include <pagmo/algorithms/cmaes.hpp>
+#include <pagmo/algorithms/de.hpp>
+#include <pagmo/archipelago.hpp>
+#include <pagmo/island.hpp>
+#include <pagmo/islands/thread_island.hpp>
+#include <pagmo/population.hpp>
+#include <pagmo/problem.hpp>
+#include <stdexcept>
+
+#include "analytic_model/analytic_simulation.h"
+
+namespace tailsim {
+
+double StrokeEvaluation::fitness() const {
+  if (!ok) return 10.0;
+  return violation > 0.0 ? violation : -objective;
+}
+
+StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj) {
+  StrokeEvaluation e;
+  e.figures = strokeFigures(p.base.robot.tail, traj);
+  e.violation = limitViolation(e.figures, p.space.limits);
+  OutputSettings out;
+  out.sample_dt_s = 0.01;  // phi_net does not depend on the output grid; fewer rows
+  out.settle_s = p.base.output.settle_s;
+  out.duration_s = 0.0;
+  const RunResult r = simulateAnalytic(p.base.robot, traj, p.base.analytic, p.base.effects, out);
+  e.ok = r.summary.ok && std::isfinite(r.summary.phi_net_deg);
+  e.error = r.summary.error;
+  if (e.ok) {
+    e.phi_net_rad = r.summary.phi_net_deg * M_PI / 180.0;
+    e.objective = objectiveValue(p.objective, e.phi_net_rad, e.figures);
+  }
+  return e;
+}
+
+StrokeEvaluation evaluateStroke(const StrokeProblem& p, const std::vector<double>& x) {
+  return evaluateStroke(p, p.space.trajectory(x));
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Shared by every island's copy of the problem: counts runs and keeps the best feasible point.
+struct Tracker {
+  std::mutex mu;
+  long evaluations = 0;
+  double best_objective = 0.0;
+  bool have_best = false;
+  std::vector<double> best_x;
+  StrokeEvaluation best;
+
+  void record(const std::vector<double>& x, const StrokeEvaluation& e) {
+    std::lock_guard<std::mutex> lock(mu);
+    ++evaluations;
+    if (e.feasible() && (!have_best || e.objective > best_objective ||
+                         (e.objective == best_objective && x < best_x))) {  // ties: deterministic
+      have_best = true;
+      best_objective = e.objective;
+      best_x = x;
+      best = e;
+    }
+  }
+};
+
+struct PagmoStroke {
+  std::shared_ptr<const StrokeProblem> p;
+  std::shared_ptr<Tracker> tracker;
+  pagmo::vector_double fitness(const pagmo::vector_double& x) const {
+    const StrokeEvaluation e = evaluateStroke(*p, x);
+    tracker->record(x, e);
+    return {e.fitness()};
+  }
+  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
+    const auto d = static_cast<std::size_t>(p ? p->space.dim() : 1);
+    return {pagmo::vector_double(d, 0.0), pagmo::vector_double(d, 1.0)};
+  }
+  std::string get_name() const { return "tailsim stroke"; }
+};
+
+pagmo::algorithm makeAlgorithm(const OptimizerSettings& s, unsigned seed) {
+  if (s.algorithm == "cmaes")
+    return pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, 0.3, 1e-9, 1e-9, true, true, seed));
+  if (s.algorithm == "de") return pagmo::algorithm(pagmo::de(1u, 0.8, 0.9, 2u, 1e-9, 1e-9, seed));
+  throw std::invalid_argument("unknown algorithm '" + s.algorithm + "' (cmaes, de)");
+}
+
+}  // namespace
+
+OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s) {
+  if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0)
+    throw std::invalid_argument("optimizer settings out of range");
+  const auto t_start = Clock::now();
+  auto shared = std::make_shared<const StrokeProblem>(prob);
+  auto tracker = std::make_shared<Tracker>();
+  OptimizeResult res;
+
+  // The start: the base experiment's own trajectory (e.g. Eq. 25), in every island's population.
+  const std::vector<double> x0 = prob.space.pointOf(prob.base.joints);
+  res.start = evaluateStroke(prob, prob.base.trajectory());
+  tracker->record(x0, evaluateStroke(prob, x0));
+
+  pagmo::problem pp{PagmoStroke{shared, tracker}};
+  pagmo::archipelago archi;
+  for (int i = 0; i < s.islands; ++i) {
+    const unsigned seed = static_cast<unsigned>(s.seed * 1000003u + static_cast<unsigned>(i) * 7919u);
+    pagmo::population pop(pp, static_cast<pagmo::population::size_type>(s.population), seed);
+    pop.set_x(0, x0);
+    archi.push_back(pagmo::thread_island{}, makeAlgorithm(s, seed + 1u), std::move(pop));
+  }
+  auto snapshot = [&](int gen, const char* stage) {
+    std::lock_guard<std::mutex> lock(tracker->mu);
+    res.history.push_back({gen, tracker->evaluations, std::chrono::duration<double>(Clock::now() - t_start).count(),
+                           tracker->have_best ? tracker->best_objective : 0.0, stage});
+  };
+  snapshot(0, "global");
+  for (int g = 1; g <= s.generations; ++g) {
+    archi.evolve(1);
+    archi.wait_check();
+    snapshot(g, "global");
+  }
+
+  // Polish from the best feasible point (NLopt works on the same unit box).
+  if (s.polish != "none" && s.polish_evaluations > 0 && tracker->have_best) {
+    const unsigned d = static_cast<unsigned>(prob.space.dim());
+    nlopt::opt opt(s.polish == "cobyla" ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, d);
+    opt.set_lower_bounds(std::vector<double>(d, 0.0));
+    opt.set_upper_bounds(std::vector<double>(d, 1.0));
+    opt.set_maxeval(s.polish_evaluations);
+    opt.set_xtol_rel(1e-7);
+    opt.set_initial_step(0.02);
+    struct Ctx {
+      const StrokeProblem* p;
+      Tracker* t;
+      std::vector<double> last_x;
+      StrokeEvaluation last;
+      bool bobyqa;
+      const StrokeEvaluation& eval(const std::vector<double>& x) {
+        if (x != last_x || last_x.empty()) {
+          last = evaluateStroke(*p, x);
+          last_x = x;
+          t->record(x, last);
+        }
+        return last;
+      }
+    } ctx{&prob, tracker.get(), {}, {}, s.polish == "bobyqa"};
+    opt.set_max_objective(
+        [](const std::vector<double>& x, std::vector<double>&, void* data) {
+          auto* c = static_cast<Ctx*>(data);
+          const StrokeEvaluation& e = c->eval(x);
+          if (!e.ok) return -10.0;
+          return c->bobyqa ? -e.fitness() : e.objective;
+        },
+        &ctx);
+    if (s.polish == "cobyla")
+      opt.add_inequality_constraint(
+          [](const std::vector<double>& x, std::vector<double>&, void* data) {
+            const StrokeEvaluation& e = static_cast<Ctx*>(data)->eval(x);
+            return e.ok ? e.violation : 1.0;
+          },
+          &ctx, 0.0);
+    std::vector<double> x;
+    {
+      std::lock_guard<std::mutex> lock(tracker->mu);
+      x = tracker->best_x;
+    }
+    double f = 0.0;
+    try {
+      opt.optimize(x, f);
+    } catch (const std::exception&) {
+      // NLopt's roundoff/forced stops: the tracker holds the best feasible point seen.
+    }
+    snapshot(s.generations + 1, "polish");
+  }
+
+  res.evaluations = tracker->evaluations;
+  res.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
+  if (tracker->have_best) {
+    res.x = tracker->best_x;
+    res.best = tracker->best;
+  } else {
+    res.x = x0;
+    res.best = evaluateStroke(prob, x0);
+  }
+  return res;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,65 @@
+// Issue 12: the stroke optimiser. pagmo2 (CMA-ES or differential evolution on parallel
+// thread islands) searches the unit box of a StrokeSpace; NLopt (COBYLA with the limits as
+// constraints, or BOBYQA on the penalised objective) polishes the best point. Every point is
+// judged by running the analytic model (simulateAnalytic) on its trajectory.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "design/stroke_family.h"
+#include "experiments/experiment_config.h"
+
+namespace tailsim {
+
+struct OptimizerSettings {
+  std::string algorithm = "cmaes";  // "cmaes" | "de" (pagmo2)
+  int islands = 2;                  // thread islands, evolved in parallel, no migration
+  int population = 16;              // per island
+  int generations = 60;             // per island
+  std::string polish = "cobyla";    // "cobyla" | "bobyqa" | "none" (NLopt)
+  int polish_evaluations = 200;
+  std::uint64_t seed = 1;
+};
+
+struct StrokeProblem {
+  ExperimentCase base;  // robot, effects, analytic settings; its trajectory is the search's start
+  StrokeSpace space;
+  StrokeObjective objective = StrokeObjective::kPhiNet;
+};
+
+struct StrokeEvaluation {
+  bool ok = false;           // the analytic run succeeded
+  std::string error;
+  double phi_net_rad = 0.0;  // signed
+  double objective = 0.0;    // objectiveValue (|phi_net| based)
+  StrokeFigures figures;
+  double violation = 0.0;    // limitViolation (0: feasible)
+  bool feasible() const { return ok && violation == 0.0; }
+  double fitness() const;    // minimised: -objective when feasible, else violation (> any feasible), 10 when failed
+};
+
+StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj);
+StrokeEvaluation evaluateStroke(const StrokeProblem& p, const std::vector<double>& x);
+
+struct HistoryRow {
+  int generation = 0;        // pagmo generation; polish rows continue the count
+  long evaluations = 0;      // analytic runs so far
+  double wall_s = 0.0;
+  double best_objective = 0.0;  // best feasible so far (0 when none yet)
+  std::string stage;         // "global" | "polish"
+};
+
+struct OptimizeResult {
+  std::vector<double> x;  // best feasible point (the start point when nothing feasible beat it)
+  StrokeEvaluation best;
+  StrokeEvaluation start;  // the base trajectory's own evaluation
+  std::vector<HistoryRow> history;
+  long evaluations = 0;
+  double wall_s = 0.0;
+};
+
+OptimizeResult optimizeStroke(const StrokeProblem& p, const OptimizerSettings& s);
+
+}  // namespace tailsim

@@ -1,0 +1,79 @@
+#include "experiments/model_registry.h"
+
+#include <algorithm>
+
+#include "analytic_model/analytic_simulation.h"
+#include "analytic_model/per_foot_model.h"
+#include "mujoco_model/mujoco_simulation.h"
+#include "results/columns.h"
+
+namespace tailsim {
+
+namespace {
+
+// A model whose run throws (bad settings found late) fails that run, not the case.
+RunResult failedRun(const std::string& model, const std::string& why) {
+  RunResult r;
+  r.summary.model = model;
+  r.summary.ok = false;
+  r.summary.error = why;
+  return r;
+}
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+}  // namespace
+
+const std::vector<ModelEntry>& modelRegistry() {
+  static const std::vector<ModelEntry> kModels = {
+      {"analytic", "analytic (stiction)", "#0072B2", false,
+       [](const ExperimentCase& c) {
+         return simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, c.output);
+       },
+       [](int n) { return concat(col::shared(n), col::analyticOnly()); }},
+      {"perfoot", "per-foot (Coulomb per foot)", "#009E73", false,
+       [](const ExperimentCase& c) {
+         try {
+           return simulatePerFoot(c.robot, c.trajectory(), c.perfoot, c.effects, c.output);
+         } catch (const std::exception& e) {
+           return failedRun("perfoot", e.what());
+         }
+       },
+       [](int n) { return concat(concat(col::shared(n), col::analyticOnly()), col::perfootOnly()); }},
+      {"mujoco", "MuJoCo (contact)", "#D55E00", true,
+       [](const ExperimentCase& c) {
+         try {
+           return simulateMujoco(c.robot, c.trajectory(), c.mujoco, c.effects, c.output);
+         } catch (const std::exception& e) {
+           return failedRun("mujoco", e.what());
+         }
+       },
+       [](int n) { return concat(col::shared(n), col::mujocoOnly(n)); }},
+  };
+  return kModels;
+}
+
+const ModelEntry* findModel(const std::string& name) {
+  for (const ModelEntry& m : modelRegistry())
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+std::vector<std::string> modelNames() {
+  std::vector<std::string> n;
+  for (const ModelEntry& m : modelRegistry()) n.push_back(m.name);
+  return n;
+}
+
+std::vector<std::string> modelColumnOrder(int links) {
+  std::vector<std::string> order = col::shared(links);
+  for (const ModelEntry& m : modelRegistry())
+    for (const std::string& c : m.columns(links))
+      if (std::find(order.begin(), order.end(), c) == order.end()) order.push_back(c);
+  return order;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,70 @@
+#include "experiments/results_table.h"
+
+#include <algorithm>
+#include <set>
+
+namespace tailsim {
+using json = nlohmann::json;
+
+namespace {
+
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char ch : s) q += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return q + "\"";
+}
+
+// A JSON value as a CSV cell: null empty, strings as they are, numbers and booleans as JSON text.
+std::string cell(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_array()) {
+    std::string s;
+    for (const json& x : v) s += (s.empty() ? "" : "; ") + cell(x);
+    return s;
+  }
+  return v.dump();
+}
+
+const json& field(const json& o, const char* key) {
+  static const json kNull;
+  if (!o.is_object()) return kNull;
+  const auto it = o.find(key);
+  return it == o.end() ? kNull : *it;
+}
+
+}  // namespace
+
+std::string resultsCsv(const std::vector<json>& summaries) {
+  static const char* const kSummaryFields[] = {"phi_net_deg", "t_stop_s", "stick_slip_events", "solver_steps",
+                                               "wall_time_s", "ok",       "error",             "at_rest",
+                                               "warnings"};
+  std::vector<std::string> swept;
+  std::set<std::string> extras;
+  for (const json& s : summaries) {
+    for (const json& k : field(s, "swept_keys"))
+      if (k.is_string() && std::find(swept.begin(), swept.end(), k.get<std::string>()) == swept.end())
+        swept.push_back(k.get<std::string>());
+    for (const json& c : field(s, "cases"))
+      for (const auto& [model, run] : field(c, "runs").items())
+        for (const auto& [name, v] : field(run, "extra").items()) extras.insert(name);
+  }
+  std::string out = "experiment,case,model";
+  for (const std::string& k : swept) out += "," + csvField(k);
+  for (const char* f : kSummaryFields) out += std::string(",") + f;
+  for (const std::string& x : extras) out += "," + csvField(x);
+  out += "\n";
+  for (const json& s : summaries)
+    for (const json& c : field(s, "cases"))
+      for (const auto& [model, run] : field(c, "runs").items()) {
+        out += csvField(cell(field(s, "experiment"))) + "," + csvField(cell(field(c, "name"))) + "," + csvField(model);
+        for (const std::string& k : swept) out += "," + csvField(cell(field(field(c, "sweep"), k.c_str())));
+        for (const char* f : kSummaryFields) out += "," + csvField(cell(field(run, f)));
+        for (const std::string& x : extras) out += "," + csvField(cell(field(field(run, "extra"), x.c_str())));
+        out += "\n";
+      }
+  return out;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,21 @@
+// DIR/results.csv: one row per case and model of one or more experiments (docs/ARCHITECTURE.md
+// "Result folder"), built from their summary.json objects, so a resumed run rebuilds it whole.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace tailsim {
+
+// Columns: experiment, case, model; every swept key of any of the experiments (dotted, as in
+// swept_keys, value as written: numbers stay numbers); phi_net_deg, t_stop_s, stick_slip_events,
+// solver_steps, wall_time_s, ok, error, at_rest, warnings ("; "-joined); then every model-specific
+// extra figure, sorted by name. Empty: null (a failed run's phi_net_deg and at_rest, a non-finite
+// extra) or absent (a key another experiment sweeps, an extra another model writes). Numbers as
+// summary.json writes them (shortest text that reads back to the same double), booleans
+// true/false, RFC 4180 quoting. `summaries`: summary.json objects ({"experiment", "swept_keys",
+// "cases": [{"name", "sweep", "runs"}]}).
+std::string resultsCsv(const std::vector<nlohmann::json>& summaries);
+
+}  // namespace tailsim

@@ -1,0 +1,168 @@
+#include "experiments/settings_json.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "tailsim_version.h"
+
+namespace tailsim {
+namespace {
+
+using json = nlohmann::json;
+
+// Writes the declared fields of a struct into a JSON object (SI values; enums by name).
+struct JsonWriter {
+  json& j;
+  void number(const settings::Field& f, double x, const settings::Limits&) { j[f.si_key ? f.si_key : f.key] = x; }
+  void integer(const settings::Field& f, int x, const settings::Limits&, const settings::IntSet& = {}) { j[f.key] = x; }
+  void boolean(const settings::Field& f, bool x) { j[f.key] = x; }
+  template <class E>
+  void choice(const settings::Field& f, E x, const settings::EnumNames<E>& names) {
+    j[f.key] = settings::nameOf(names, x);
+  }
+  void text(const settings::Field& f, const std::string& x, const settings::TextRule&) { j[f.key] = x; }
+  template <std::size_t N>
+  void numbers(const settings::Field& f, const std::array<double, N>& x) {
+    j[f.key] = json::array();
+    for (double v : x) j[f.key].push_back(v);
+  }
+  template <class T>
+  void internal(const settings::Field& f, const T& x) {
+    j[f.key] = x;
+  }
+};
+
+// Reads them back; every declared key must be there with the right type.
+struct JsonReader {
+  const json& j;
+  std::string where;
+  const json& at(const settings::Field& f) const {
+    const char* k = f.si_key ? f.si_key : f.key;
+    if (!j.is_object() || !j.contains(k)) throw std::runtime_error("resolved case: " + where + "." + k + " is missing");
+    return j.at(k);
+  }
+  template <class T>
+  T get(const settings::Field& f) const {
+    try {
+      return at(f).get<T>();
+    } catch (const json::exception& e) {
+      throw std::runtime_error("resolved case: " + where + "." + f.key + ": " + e.what());
+    }
+  }
+  void number(const settings::Field& f, double& x, const settings::Limits&) { x = get<double>(f); }
+  void integer(const settings::Field& f, int& x, const settings::Limits&, const settings::IntSet& = {}) { x = get<int>(f); }
+  void boolean(const settings::Field& f, bool& x) { x = get<bool>(f); }
+  template <class E>
+  void choice(const settings::Field& f, E& x, const settings::EnumNames<E>& names) {
+    const std::string s = get<std::string>(f);
+    if (!settings::valueOf(names, s, x))
+      throw std::runtime_error("resolved case: " + where + "." + f.key + ": unknown value '" + s + "'");
+  }
+  void text(const settings::Field& f, std::string& x, const settings::TextRule&) { x = get<std::string>(f); }
+  template <std::size_t N>
+  void numbers(const settings::Field& f, std::array<double, N>& x) {
+    const auto v = get<std::vector<double>>(f);
+    if (v.size() != N) throw std::runtime_error("resolved case: " + where + "." + f.key + ": wrong length");
+    for (std::size_t i = 0; i < N; ++i) x[i] = v[i];
+  }
+  template <class T>
+  void internal(const settings::Field& f, T& x) {
+    x = get<T>(f);
+  }
+};
+
+template <class S>
+json toJson(const S& s) {
+  json j = json::object();
+  JsonWriter w{j};
+  declareFields(w, s);
+  return j;
+}
+template <class S>
+S fromJson(const json& j, const std::string& where) {
+  S s{};
+  JsonReader r{j, where};
+  declareFields(r, s);
+  return s;
+}
+const json& need(const json& j, const char* k) {
+  if (!j.is_object() || !j.contains(k)) throw std::runtime_error(std::string("resolved case: ") + k + " is missing");
+  return j.at(k);
+}
+
+}  // namespace
+
+json resolvedJson(const ExperimentCase& c) {
+  json j;
+  j["experiment"] = c.experiment;
+  j["case"] = c.name;
+  j["sweep"] = json::object();
+  for (const auto& [k, v] : c.sweep_values) j["sweep"][k] = v;
+  j["source_file"] = c.source_file;
+  j["robot_file"] = c.robot_file;
+  j["kind"] = name(c.kind);
+  j["models"] = c.models;
+  j["quadruped"] = toJson(c.robot.quadruped);
+  j["friction"] = toJson(c.robot.friction);
+  j["gravity_mps2"] = c.robot.gravity_mps2;
+  j["tail"] = json::array();
+  for (const TailLink& l : c.robot.tail) j["tail"].push_back(toJson(l));
+  j["joints"] = json::array();
+  for (const SplitCycleParams& p : c.joints) j["joints"].push_back(toJson(p));
+  j["pose"] = {{"theta_rad", c.pose.theta_rad},
+               {"thetadot_radps", c.pose.thetadot_radps},
+               {"thetaddot_radps2", c.pose.thetaddot_radps2}};
+  j["analytic"] = toJson(c.analytic);
+  // Only where the per-foot model runs: other cases' resolved case (and resume key) stay as they were.
+  if (std::find(c.models.begin(), c.models.end(), "perfoot") != c.models.end()) j["perfoot"] = toJson(c.perfoot);
+  j["mujoco"] = toJson(c.mujoco);
+  j["effects"] = toJson(c.effects);
+  j["output"] = toJson(c.output);
+  j["render"] = toJson(c.render);
+  return j;
+}
+
+ExperimentCase caseFromResolved(const json& j) {
+  ExperimentCase c;
+  try {
+    c.experiment = need(j, "experiment").get<std::string>();
+    c.name = need(j, "case").get<std::string>();
+    for (const auto& [k, v] : need(j, "sweep").items()) c.sweep_values[k] = v.get<std::string>();
+    c.source_file = j.value("source_file", std::string());  // absent in result.json (see the runner)
+    c.robot_file = j.value("robot_file", std::string());
+    const std::string kind = need(j, "kind").get<std::string>();
+    if (!settings::valueOf(kindNames(), kind, c.kind)) throw std::runtime_error("resolved case: unknown kind '" + kind + "'");
+    c.models = need(j, "models").get<std::vector<std::string>>();
+    c.robot.quadruped = fromJson<QuadrupedParams>(need(j, "quadruped"), "quadruped");
+    c.robot.friction = fromJson<FrictionParams>(need(j, "friction"), "friction");
+    c.robot.gravity_mps2 = need(j, "gravity_mps2").get<double>();
+    for (const json& l : need(j, "tail")) c.robot.tail.push_back(fromJson<TailLink>(l, "tail[]"));
+    for (const json& p : need(j, "joints")) c.joints.push_back(fromJson<SplitCycleParams>(p, "joints[]"));
+    const json& pose = need(j, "pose");
+    c.pose.theta_rad = need(pose, "theta_rad").get<std::vector<double>>();
+    c.pose.thetadot_radps = need(pose, "thetadot_radps").get<std::vector<double>>();
+    c.pose.thetaddot_radps2 = need(pose, "thetaddot_radps2").get<std::vector<double>>();
+    c.analytic = fromJson<AnalyticSettings>(need(j, "analytic"), "analytic");
+    if (j.contains("perfoot")) c.perfoot = fromJson<PerFootSettings>(j.at("perfoot"), "perfoot");
+    c.mujoco = fromJson<MujocoSettings>(need(j, "mujoco"), "mujoco");
+    c.effects = fromJson<Effects>(need(j, "effects"), "effects");
+    c.output = fromJson<OutputSettings>(need(j, "output"), "output");
+    c.render = fromJson<RenderSettings>(need(j, "render"), "render");
+  } catch (const json::exception& e) {
+    throw std::runtime_error(std::string("resolved case: ") + e.what());
+  }
+  return c;
+}
+
+std::string caseKeyText(const ExperimentCase& c, bool render) {
+  json k = resolvedJson(c);
+  k.erase("source_file");  // where the values came from does not change the results
+  k.erase("robot_file");
+  if (!render) k.erase("render");  // --no-render: a later run with rendering renders the case
+  k["rendered"] = render;
+  k["tailsim_version"] = kVersion;
+  k["tailsim_git_commit"] = kGitCommit;
+  return k.dump();  // keys sorted (std::map), numbers in shortest round-trip form
+}
+
+}  // namespace tailsim

@@ -1,0 +1,261 @@
+#include "experiments/settings_schema.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+
+#include "experiments/experiment_config.h"
+#include "experiments/experiment_loader.h"
+#include "experiments/model_registry.h"
+#include "results/work_limits.h"
+
+namespace tailsim {
+namespace {
+
+using json = nlohmann::json;
+
+std::string g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
+json sweepRef() { return {{"$ref", "#/$defs/sweep"}}; }
+// A value, or a sweep replacing it.
+json orSweep(json value) { return {{"anyOf", json::array({std::move(value), sweepRef()})}}; }
+
+void limitsInto(json& s, const settings::Limits& l) {
+  if (l.hasLo()) s[l.lo_open ? "exclusiveMinimum" : "minimum"] = l.lo;
+  if (l.hasHi()) s[l.hi_open ? "exclusiveMaximum" : "maximum"] = l.hi;
+}
+
+// One declared struct -> schema properties and Markdown rows.
+struct Describer {
+  json props = json::object();
+  std::string rows;
+  void add(const settings::Field& f, json value, const std::string& allowed, const std::string& dflt) {
+    json p = orSweep(std::move(value));
+    p["description"] = f.doc;
+    props[f.key] = std::move(p);
+    std::string doc = f.doc;
+    for (char& ch : doc)
+      if (ch == '|') ch = '/';
+    rows += "| `" + std::string(f.key) + "` | " + allowed + " | " + dflt + " | " + doc + " |\n";
+  }
+  void number(const settings::Field& f, double x, const settings::Limits& l) {
+    json v = {{"type", "number"}};
+    limitsInto(v, l);
+    const std::string t = l.text();
+    add(f, v, t.empty() ? "number" : "number, " + t.substr(t.find(' ') + 1), g(x));
+  }
+  void integer(const settings::Field& f, int x, const settings::Limits& l, const settings::IntSet& only = {}) {
+    json v = {{"type", "integer"}};
+    limitsInto(v, l);
+    std::string allowed = "integer";
+    if (!l.text(true).empty()) allowed += ", " + l.text(true).substr(l.text(true).find(' ') + 1);
+    if (!only.one_of.empty()) {
+      v["enum"] = only.one_of;
+      allowed = "one of";
+      for (int k : only.one_of) allowed += " " + std::to_string(k);
+    }
+    if (only.multiple_of != 1) {
+      v["multipleOf"] = only.multiple_of;
+      allowed += only.multiple_of == 2 ? ", even" : ", multiple of " + std::to_string(only.multiple_of);
+    }
+    add(f, v, allowed, std::to_string(x));
+  }
+  void boolean(const settings::Field& f, bool x) { add(f, {{"type", "boolean"}}, "true, false", x ? "true" : "false"); }
+  template <class E>
+  void choice(const settings::Field& f, E x, const settings::EnumNames<E>& names) {
+    std::string allowed;
+    for (const auto& n : names) allowed += (allowed.empty() ? "`" : " \\| `") + std::string(n.name) + "`";
+    add(f, {{"type", "string"}, {"enum", settings::namesOf(names)}}, allowed,
+        "`" + std::string(settings::nameOf(names, x)) + "`");
+  }
+  void text(const settings::Field& f, const std::string& x, const settings::TextRule& rule) {
+    json v = {{"type", "string"}};
+    std::string allowed = "string";
+    if (rule.non_empty) {
+      v["minLength"] = 1;
+      allowed = "non-empty string";
+    }
+    if (!rule.one_of.empty()) {
+      v["enum"] = rule.one_of;
+      allowed = "`" + rule.one_of.front() + "` .. `" + rule.one_of.back() + "`";
+    }
+    add(f, v, allowed, "`" + x + "`");
+  }
+  template <std::size_t N>
+  void numbers(const settings::Field& f, const std::array<double, N>& x) {
+    json item = orSweep({{"type", "number"}});
+    json v = {{"type", "array"}, {"items", item}, {"minItems", N}, {"maxItems", N}};
+    std::string d = "[";
+    for (std::size_t i = 0; i < N; ++i) d += (i ? ", " : "") + g(x[i]);
+    // An array cannot be swept as a whole; its elements can.
+    json p = v;
+    p["description"] = f.doc;
+    props[f.key] = p;
+    rows += "| `" + std::string(f.key) + "` | " + std::to_string(N) + " numbers | " + d + "] | " + f.doc + " |\n";
+  }
+  template <class T>
+  void internal(const settings::Field&, const T&) {}
+};
+
+template <class S>
+Describer describe(const S& s = S{}) {
+  Describer d;
+  declareFields(d, s);
+  return d;
+}
+
+json section(const json& props, const std::vector<std::string>& required = {}) {
+  json s = {{"type", "object"}, {"additionalProperties", false}, {"properties", props}};
+  if (!required.empty()) s["required"] = required;
+  return s;
+}
+template <class S>
+std::vector<std::string> allKeys() {
+  std::vector<std::string> v;
+  for (const auto& [k, _] : describe<S>().props.items()) v.push_back(k);
+  return v;
+}
+
+json defs() {
+  json d;
+  d["sweep"] = {{"type", "object"},
+                {"description", "{sweep: [v1, v2, ...]} or {range: [start, stop, step]} (docs/experiment-format.md)"},
+                {"minProperties", 1},
+                {"maxProperties", 1},
+                {"additionalProperties", false},
+                {"properties",
+                 {{"sweep", {{"type", "array"}, {"minItems", 1}, {"items", {{"type", {"number", "string", "boolean"}}}}}},
+                  {"range", {{"type", "array"}, {"minItems", 3}, {"maxItems", 3}, {"items", {{"type", "number"}}}}}}}};
+  return d;
+}
+
+// A number for all joints, or one per joint.
+json perJoint(json value, const std::string& doc) {
+  json one = orSweep(value);
+  return {{"description", doc},
+          {"anyOf", json::array({value, sweepRef(), {{"type", "array"}, {"minItems", 1}, {"items", one}}})}};
+}
+
+}  // namespace
+
+json experimentSchema() {
+  const json num = {{"type", "number"}};
+  json link = section(describe<TailLink>().props, {"mass_kg", "izz_kgm2", "length_m"});
+  json traj = section({
+      {"theta0_deg", perJoint({{"type", "number"}, {"minimum", -limits::kMaxAbsTheta0Deg}, {"maximum", limits::kMaxAbsTheta0Deg}},
+                              "start angle theta_0 [deg]")},
+      {"dtheta_deg", perJoint({{"type", "number"}, {"minimum", -limits::kMaxAbsDthetaDeg}, {"maximum", limits::kMaxAbsDthetaDeg}},
+                              "displacement Delta theta [deg]")},
+      {"dT_s", perJoint({{"type", "number"}, {"minimum", limits::kMinDT_s}}, "duration Delta T [s]")},
+      {"peak_speed_dps", perJoint({{"type", "number"}, {"exclusiveMinimum", 0}}, "peak joint speed; sets dT [deg/s]")},
+      {"w_ss", perJoint({{"type", "number"}, {"minimum", limits::kMinWss}, {"maximum", limits::kMaxWss}},
+                        "split-cycle parameter")},
+      {"t0_s", perJoint({{"type", "number"}, {"minimum", 0}}, "start time [s]")},
+      {"rule", orSweep({{"type", "string"}, {"enum", {"eq25"}}})},
+      {"thetadot_max_dps", orSweep({{"type", "number"}, {"exclusiveMinimum", 0}})},
+      {"thetadot_max_radps", orSweep({{"type", "number"}, {"exclusiveMinimum", 0}})},
+  });
+  json pose = section({{"theta_deg", perJoint(num, "joint angles [deg]")},
+                       {"thetadot_radps", perJoint(num, "joint speeds [rad/s]")},
+                       {"thetaddot_radps2", perJoint(num, "joint accelerations [rad/s^2]")}});
+  json tail = {{"type", "object"},
+               {"additionalProperties", false},
+               {"properties",
+                {{"links", orSweep({{"type", "integer"}, {"minimum", 1}, {"maximum", 6}})},
+                 {"custom", {{"type", "array"}, {"minItems", 1}, {"items", link}}}}},
+               {"minProperties", 1},
+               {"maxProperties", 1}};
+  json render = section(describe<RenderSettings>().props);
+  json exp = section(
+      {{"name", {{"type", "string"}, {"minLength", 1}, {"maxLength", 100}, {"pattern", "^[^/\\\\-][^/\\\\]*$"}}},
+       {"description", {{"type", "string"}}},
+       {"robot", orSweep({{"type", "string"}, {"minLength", 1}})},
+       {"kind", orSweep({{"type", "string"}, {"enum", settings::namesOf(kindNames())}})},
+       {"tail", tail},
+       {"quadruped", section(describe<QuadrupedParams>().props)},
+       {"friction", section(describe<FrictionParams>().props)},
+       {"gravity_mps2", orSweep({{"type", "number"}, {"minimum", 0}})},
+       {"trajectory", traj},
+       {"pose", pose},
+       {"models", {{"type", "array"}, {"minItems", 1}, {"uniqueItems", true},
+                   {"items", orSweep({{"type", "string"}, {"enum", modelNames()}})}}},
+       {"analytic", section(describe<AnalyticSettings>().props)},
+       {"perfoot", section(describe<PerFootSettings>().props)},
+       {"mujoco", section(describe<MujocoSettings>().props)},
+       {"effects", section(describe<Effects>().props)},
+       {"output", section(describe<OutputSettings>().props)},
+       {"render", {{"anyOf", json::array({{{"type", "null"}}, render})}}}},
+      {"name", "robot"});
+  json suite = section({{"experiments", {{"type", "array"}, {"minItems", 1}, {"items", {{"type", "string"}}}}},
+                        {"description", {{"type", "string"}}}},
+                       {"experiments"});
+  json s = {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
+            {"title", "tailsim experiment or suite file (docs/experiment-format.md)"},
+            {"$defs", defs()},
+            {"oneOf", json::array({exp, suite})}};
+  return s;
+}
+
+json robotSchema() {
+  // Robot files hold no sweeps: the plain declared types.
+  auto plain = [](json props) {
+    for (auto& [k, p] : props.items())
+      if (p.contains("anyOf")) {
+        json v = p["anyOf"][0];
+        v["description"] = p["description"];
+        p = v;
+      }
+    return props;
+  };
+  json link = section(plain(describe<TailLink>().props), {"mass_kg", "izz_kgm2", "length_m"});
+  json tails = {{"type", "object"}, {"additionalProperties", false}, {"minProperties", 1}, {"properties", json::object()}};
+  for (int n = 1; n <= 6; ++n) tails["properties"][std::to_string(n)] = link;
+  return {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
+          {"title", "tailsim robot file (docs/experiment-format.md \"Robot file\")"},
+          {"type", "object"},
+          {"additionalProperties", false},
+          {"required", {"quadruped", "friction", "gravity_mps2", "tails"}},
+          {"properties",
+           {{"quadruped", section(plain(describe<QuadrupedParams>().props), [] {
+              std::vector<std::string> k = allKeys<QuadrupedParams>();  // com_height_m is optional
+              k.erase(std::remove(k.begin(), k.end(), "com_height_m"), k.end());
+              return k;
+            }())},
+            {"friction", section(plain(describe<FrictionParams>().props), allKeys<FrictionParams>())},
+            {"gravity_mps2", {{"type", "number"}, {"minimum", 0}}},
+            {"tails", tails}}}};
+}
+
+std::string settingsMarkdown() {
+  std::ostringstream o;
+  const char* head = "| key | value | default | meaning |\n|---|---|---|---|\n";
+  auto table = [&](const char* title, const char* note, const std::string& rows) {
+    o << "### " << title << "\n\n" << note << "\n\n" << head << rows << "\n";
+  };
+  table("quadruped", "Overrides of the robot file's values (defaults: `robot: paper`, Table 1).",
+        describe<QuadrupedParams>().rows);
+  table("friction", "Overrides of the robot file's values (defaults: `robot: paper`, Table 1).",
+        describe<FrictionParams>().rows);
+  table("tail links", "Each entry of `tail: {custom: [...]}` and of a robot file's `tails.n`; `mass_kg`, "
+                      "`izz_kgm2`, `length_m` required.",
+        describe<TailLink>().rows);
+  table("analytic", "Solver and modelling settings of the analytic model.", describe<AnalyticSettings>().rows);
+  table("perfoot", "Solver and modelling settings of the per-foot model (docs/per-foot-model.md); its friction "
+                   "law is `effects.friction`.",
+        describe<PerFootSettings>().rows);
+  table("mujoco", "Settings of the MuJoCo contact model (docs/mujoco-model.md).", describe<MujocoSettings>().rows);
+  table("effects", "Which physical effects a scene simulates; the defaults reproduce the paper.",
+        describe<Effects>().rows);
+  table("output", "The output time grid both models sample on.", describe<OutputSettings>().rows);
+  table("render", "The section's presence turns video on (`render: {}` = defaults); docs/rendering.md.",
+        describe<RenderSettings>().rows);
+  std::string s = o.str();
+  while (s.size() >= 2 && s[s.size() - 1] == '\n' && s[s.size() - 2] == '\n') s.pop_back();
+  return s;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,18 @@
+// The experiment format described from the settings declarations (settings/fields.h): a JSON
+// Schema (`tailsim schema`, `tailsim schema --robot`) and the key tables of
+// docs/experiment-format.md (`tailsim schema --markdown`, checked by CTest docs_keys_current).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace tailsim {
+
+// Experiment and suite files (oneOf). Any single value may be a sweep ({sweep: [...]} / {range: [a, b, step]}).
+nlohmann::json experimentSchema();
+// Robot files (configs/robots/*.yaml).
+nlohmann::json robotSchema();
+// The generated key tables, Markdown.
+std::string settingsMarkdown();
+
+}  // namespace tailsim

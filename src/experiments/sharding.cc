@@ -1,0 +1,188 @@
+#include "experiments/sharding.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+#include "experiments/experiment_runner.h"
+
+namespace tailsim {
+
+namespace {
+bool parsePositive(const std::string& s, int& out) {
+  if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return false;
+  out = std::atoi(s.c_str());
+  return out >= 1;
+}
+}  // namespace
+
+ShardSpec parseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  ShardSpec s;
+  if (slash == std::string::npos || !parsePositive(text.substr(0, slash), s.index) ||
+      !parsePositive(text.substr(slash + 1), s.count) || s.index > s.count || s.count > kMaxShards)
+    throw std::invalid_argument("--shard " + text + ": want K/N with 1 <= K <= N <= " + std::to_string(kMaxShards) +
+                                " (e.g. 3/8: the third of 8 shards)");
+  return s;
+}
+
+double expectedCaseCostS(const WorkEstimate& w, bool analytic, bool mujoco) {
+  double c = 0.0;
+  if (analytic) c += 1e-3 + 2e-6 * w.rows;
+  if (mujoco) c += 1e-5 * w.mujoco_steps;
+  c += 5e-3 * w.render_frames;
+  return c;
+}
+
+std::vector<int> assignShards(const std::vector<double>& cost, int n_shards) {
+  if (n_shards < 1) throw std::invalid_argument("assignShards: n_shards must be >= 1");
+  std::vector<size_t> order(cost.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return cost[a] > cost[b]; });
+  std::vector<double> load(static_cast<size_t>(n_shards), 0.0);
+  std::vector<int> shard(cost.size(), 0);
+  for (size_t i : order) {
+    const int s = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());  // first minimum
+    shard[i] = s;
+    load[static_cast<size_t>(s)] += std::max(0.0, cost[i]);
+  }
+  return shard;
+}
+
+std::vector<std::vector<char>> shardMembership(const std::vector<Experiment>& suite, ShardSpec shard) {
+  std::vector<double> cost;
+  for (const Experiment& e : suite)
+    for (const ExperimentCase& c : e.cases) {
+      const bool analytic = std::find(c.models.begin(), c.models.end(), "analytic") != c.models.end();
+      const bool mujoco = std::find(c.models.begin(), c.models.end(), "mujoco") != c.models.end();
+      cost.push_back(expectedCaseCostS(estimateWork(c), analytic || c.models.size() > (mujoco ? 1u : 0u), mujoco));
+    }
+  const std::vector<int> a = assignShards(cost, shard.count);
+  std::vector<std::vector<char>> in(suite.size());
+  size_t k = 0;
+  for (size_t i = 0; i < suite.size(); ++i)
+    for (size_t j = 0; j < suite[i].cases.size(); ++j) in[i].push_back(a[k++] == shard.index - 1);
+  return in;
+}
+
+namespace {
+namespace fs = std::filesystem;
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// Files a run writes about the whole folder (rebuilt by the merge) or that belong to no case.
+bool rebuiltOrTransient(const fs::path& rel) {
+  const std::string n = rel.filename().string();
+  if (n == ".tailsim.lock" || n == "summary.json" || n == "results.csv" || n == "report.md" || n == "figures.html")
+    return true;
+  if (n.find(".tmp.") != std::string::npos) return true;  // an interrupted writer's temporary
+  for (const auto& part : rel)
+    if (part == "plots") return true;
+  return false;
+}
+
+// Per-case outputs (cases/<dir>/..., renders/<dir>.*): the first shard that has the case wins.
+bool perCase(const fs::path& rel) {
+  for (const auto& part : rel)
+    if (part == "cases" || part == "renders") return true;
+  return false;
+}
+
+// The folder a case's files live in (for "first shard wins" of a whole case): <...>/cases/<dir>.
+fs::path caseFolderOf(const fs::path& rel) {
+  fs::path out;
+  bool next = false;
+  for (const auto& part : rel) {
+    out /= part;
+    if (next) return out;
+    next = part == "cases";
+  }
+  return rel;  // renders/<file>: the file itself
+}
+}  // namespace
+
+MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads) {
+  if (shard_dirs.empty()) throw std::runtime_error("merge: no shard folders given");
+  MergeStats st;
+  st.shards = static_cast<int>(shard_dirs.size());
+  const fs::path out = fs::absolute(out_dir).lexically_normal();
+  std::error_code ec;
+  if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
+    throw std::runtime_error("merge: " + out_dir + " exists and is not empty (merge into a new folder)");
+  // Every shard must come from the same inputs: their experiment.yaml copies are byte-identical.
+  std::string exp_text;
+  for (const std::string& d : shard_dirs) {
+    const fs::path e = fs::path(d) / "experiment.yaml";
+    if (!fs::is_regular_file(e, ec))
+      throw std::runtime_error("merge: " + d + " is not a tailsim result folder (no experiment.yaml)");
+    if (fs::absolute(d).lexically_normal() == out) throw std::runtime_error("merge: --out must not be a shard folder");
+    const std::string t = readAll(e);
+    if (exp_text.empty()) exp_text = t;
+    else if (t != exp_text)
+      throw std::runtime_error("merge: " + d + "/experiment.yaml differs from " + shard_dirs.front() +
+                               "/experiment.yaml: the shards are not of the same run");
+  }
+  const fs::path stage = out.parent_path() / (out.filename().string() + ".merge.tmp." + std::to_string(::getpid()));
+  fs::remove_all(stage, ec);
+  try {
+    fs::create_directories(stage);
+    std::vector<fs::path> taken_cases;
+    for (const std::string& d : shard_dirs) {
+      const fs::path root(d);
+      std::vector<fs::path> this_shard_cases;
+      for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
+        if (!it->is_regular_file()) continue;
+        const fs::path rel = it->path().lexically_relative(root);
+        if (rebuiltOrTransient(rel)) continue;
+        const fs::path dst = stage / rel;
+        if (perCase(rel)) {
+          const fs::path cf = caseFolderOf(rel);
+          if (std::find(taken_cases.begin(), taken_cases.end(), cf) != taken_cases.end()) continue;  // earlier shard's
+          if (std::find(this_shard_cases.begin(), this_shard_cases.end(), cf) == this_shard_cases.end())
+            this_shard_cases.push_back(cf);
+        } else if (fs::exists(dst, ec)) {  // inputs and MJCF copies: the same in every shard
+          if (readAll(dst) != readAll(it->path()))
+            throw std::runtime_error("merge: " + (root / rel).string() + " differs from the same file of an earlier shard");
+          continue;
+        }
+        fs::create_directories(dst.parent_path());
+        fs::copy_file(it->path(), dst, fs::copy_options::overwrite_existing);
+        ++st.files_copied;
+      }
+      taken_cases.insert(taken_cases.end(), this_shard_cases.begin(), this_shard_cases.end());
+    }
+    // The summary and results table are written by the runner itself, resuming every case and
+    // running none (a case in no shard is an error): the same code as a single-process run.
+    const std::vector<Experiment> suite = loadExperimentSuite((stage / "experiment.yaml").string());
+    RunOptions o;
+    o.out_dir = stage.string();
+    o.threads = threads;
+    o.progress = false;
+    o.render = true;
+    o.merge_only = true;
+    const RunStats rs = runSuite(suite, o);
+    st.cases = rs.total;
+    fs::remove(stage / ".tailsim.lock", ec);
+    for (const Experiment& e : suite) fs::remove(stage / e.name / ".tailsim.lock", ec);
+    if (fs::exists(out, ec)) fs::remove(out);  // empty (checked above)
+    fs::rename(stage, out);
+  } catch (...) {
+    fs::remove_all(stage, ec);
+    throw;
+  }
+  return st;
+}
+
+}  // namespace tailsim

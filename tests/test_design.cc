@@ -1,0 +1,290 @@
+// Issue 12: the stroke optimiser (src/design/): spline profiles, limits kept on the re-simulated
+// optimum, a brute-force optimum found, `kind: optimize` errors at file:line:col, the best
+// stroke as a ready-to-run experiment.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <string>
+
+#include "analytic_model/analytic_simulation.h"
+#include "analytic_model/tail_dynamics.h"
+#include "design/optimize_config.h"
+#include "design/optimize_experiment.h"
+#include "experiments/experiment_loader.h"
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = M_PI / 180.0;
+const std::string kSourceDir = TAILSIM_SOURCE_DIR;
+
+// The Fig. 14 base case with n links (Eq. 25 at 600 deg/s).
+ExperimentCase baseCase(int n) {
+  return loadExperiment(kSourceDir + "/configs/design/base/eq25_n" + std::to_string(n) + ".yaml").cases.at(0);
+}
+
+OptimizerSettings smallBudget(std::uint64_t seed = 1) {
+  OptimizerSettings s;
+  s.islands = 2;
+  s.population = 8;
+  s.generations = 12;
+  s.polish_evaluations = 60;
+  s.seed = seed;
+  return s;
+}
+
+TEST(SplineProfile, PassesThroughItsKnotsAtRestAtBothEnds) {
+  SplineParams sp;
+  sp.knots_rad = {0.5, 0.2, -0.7, -0.4, -1.0};
+  sp.dT_s = 0.4;
+  sp.t0_s = 0.1;
+  const JointProfile p(sp);
+  ASSERT_TRUE(p.isSpline());
+  for (std::size_t k = 0; k < sp.knots_rad.size(); ++k)
+    EXPECT_NEAR(p.at(sp.t0_s + sp.dT_s * k / 4.0).theta, sp.knots_rad[k], 1e-12) << "knot " << k;
+  EXPECT_EQ(p.at(0.0).theta, 0.5);
+  EXPECT_EQ(p.at(0.0).theta_dot, 0.0);
+  EXPECT_NEAR(p.at(sp.t0_s + 1e-9).theta_dot, 0.0, 1e-6);    // clamped: zero speed at the start
+  EXPECT_NEAR(p.at(sp.t0_s + sp.dT_s - 1e-9).theta_dot, 0.0, 1e-6);
+  EXPECT_EQ(p.at(1.0).theta, -1.0);
+  EXPECT_EQ(p.at(1.0).theta_dot, 0.0);
+  // Speed is the derivative of the angle, acceleration of the speed (central differences).
+  for (double t = 0.11; t < 0.5; t += 0.013) {
+    const double h = 1e-6;
+    EXPECT_NEAR((p.at(t + h).theta - p.at(t - h).theta) / (2 * h), p.at(t).theta_dot, 1e-5);
+    EXPECT_NEAR((p.at(t + h).theta_dot - p.at(t - h).theta_dot) / (2 * h), p.at(t).theta_ddot, 1e-3);
+  }
+  // Peak speed: no sample is faster.
+  double peak = 0;
+  for (double t = 0.1; t <= 0.5; t += 1e-5) peak = std::max(peak, std::abs(p.at(t).theta_dot));
+  EXPECT_NEAR(std::abs(p.peakSpeed()), peak, 1e-6);
+  EXPECT_THROW(JointProfile(SplineParams{{0.1}, 0.3, 0.0}), std::invalid_argument);
+}
+
+TEST(StrokeDesign, JointOneTorqueIsTheBaseMoment) {
+  const ExperimentCase c = baseCase(3);
+  const TailTrajectory t = c.trajectory();
+  std::vector<JointState> js;
+  t.evaluate(0.1, js);
+  EXPECT_NEAR(jointTorques(c.robot.tail, js)[0], tailBaseLoad(c.robot.tail, js).M_J1, 1e-12);
+}
+
+// A returned optimum keeps every limit on the trajectory the model actually ran (its CSV columns),
+// not as the optimiser claims: both families, with a torque limit that binds.
+TEST(StrokeDesign, LimitsNeverViolatedOnTheResimulatedOptimum) {
+  for (StrokeFamily fam : {StrokeFamily::kSplitCycle, StrokeFamily::kSpline}) {
+    StrokeProblem p;
+    p.base = baseCase(2);
+    p.space.family = fam;
+    p.space.n_links = 2;
+    p.space.knots = 2;
+    p.space.limits.theta_min_rad = -60 * kDeg;
+    p.space.limits.theta_max_rad = 70 * kDeg;
+    p.space.limits.thetadot_max_radps = 500 * kDeg;
+    p.space.limits.torque_max_Nm = 6.0;
+    p.space.limits.t0_max_s = 0.05;
+    const OptimizeResult r = optimizeStroke(p, smallBudget());
+    ASSERT_TRUE(r.best.feasible()) << familyName(fam);
+    const TailTrajectory traj = p.space.trajectory(r.x);
+    const RunResult run = simulateAnalytic(p.base.robot, traj, p.base.analytic, p.base.effects, p.base.output);
+    ASSERT_TRUE(run.summary.ok);
+    const LimitCheck lc = checkLimitsOnSeries(p.base.robot.tail, run.series, p.space.limits);
+    EXPECT_TRUE(lc.ok) << familyName(fam) << ": " << (lc.violations.empty() ? "" : lc.violations[0]);
+    EXPECT_LE(lc.figures.peak_torque_Nm, 6.0 + 1e-9);
+    EXPECT_LE(lc.figures.peak_speed_radps, 500 * kDeg * (1 + 1e-9));
+    EXPECT_GE(lc.figures.theta_min_rad, -60 * kDeg - 1e-12);
+    EXPECT_LE(lc.figures.theta_max_rad, 70 * kDeg + 1e-12);
+    // The limit binds: the optimum uses most of the torque allowed.
+    EXPECT_GT(lc.figures.peak_torque_Nm, 3.0) << familyName(fam);
+    EXPECT_GT(std::abs(run.summary.phi_net_deg), 0.01);  // it turns (little: 6 N m is tight)
+  }
+}
+
+// A tiny problem solved by brute force: n = 1, w_ss and start fixed, so the free parameters are
+// the start angle, the end angle and the speed share. The optimiser must reach the best point of
+// a 14^3 grid (it may beat it: the grid is coarse).
+TEST(StrokeDesign, FindsTheBruteForceOptimum) {
+  StrokeProblem p;
+  p.base = baseCase(1);
+  p.space.n_links = 1;
+  p.space.limits.theta_min_rad = -90 * kDeg;
+  p.space.limits.theta_max_rad = 90 * kDeg;
+  p.space.limits.w_ss_min = p.space.limits.w_ss_max = 0.25;
+  p.space.limits.t0_max_s = 0.0;
+  p.space.limits.torque_max_Nm = 12.0;
+  double grid_best = 0;
+  const int N = 14;
+  for (int a = 0; a < N; ++a)
+    for (int b = 0; b < N; ++b)
+      for (int s = 0; s < N; ++s) {
+        const StrokeEvaluation e = evaluateStroke(p, std::vector<double>{a / (N - 1.0), b / (N - 1.0), s / (N - 1.0), 0.0, 0.0});
+        if (e.feasible()) grid_best = std::max(grid_best, e.objective);
+      }
+  ASSERT_GT(grid_best, 0.0);
+  OptimizerSettings os = smallBudget();
+  os.generations = 25;
+  os.polish_evaluations = 150;
+  const OptimizeResult r = optimizeStroke(p, os);
+  EXPECT_TRUE(r.best.feasible());
+  EXPECT_GE(r.best.objective, grid_best * (1 - 1e-3)) << "grid " << grid_best << " optimiser " << r.best.objective;
+  EXPECT_GE(r.best.objective, r.start.objective);  // never worse than where it started (Eq. 25)
+}
+
+TEST(StrokeDesign, SameSeedSameResult) {
+  StrokeProblem p;
+  p.base = baseCase(1);
+  p.space.family = StrokeFamily::kSpline;
+  p.space.knots = 1;
+  p.space.limits.torque_max_Nm = 8.0;
+  OptimizerSettings os = smallBudget(7);
+  os.generations = 5;
+  const OptimizeResult a = optimizeStroke(p, os), b = optimizeStroke(p, os);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.best.objective, b.best.objective);
+  EXPECT_EQ(a.evaluations, b.evaluations);
+}
+
+class OptimizeFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "tailsim_design_XXXXXX").string();
+    ASSERT_NE(mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+    std::ofstream(dir_ / "base.yaml") << "name: b\nrobot: " << kSourceDir
+                                       << "/configs/robots/paper_quadruped.yaml\ntail: {links: 1}\n"
+                                          "trajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\nmodels: [analytic]\n";
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string write(const std::string& optimize_section, const std::string& head = "name: o\nkind: optimize\nbase: base.yaml\n") {
+    const fs::path p = dir_ / "opt.yaml";
+    std::ofstream(p) << head << "optimize:\n" << optimize_section;
+    return p.string();
+  }
+  std::string error(const std::string& file) {
+    try {
+      loadOptimizeSpec(file);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  fs::path dir_;
+};
+
+constexpr const char* kLimits = "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n";
+
+TEST_F(OptimizeFileTest, GoodFileLoads) {
+  const OptimizeSpec s = loadOptimizeSpec(write(std::string("  family: spline\n  knots: 2\n") + kLimits +
+                                                "  seeds: [1, 2]\n  islands: 3\n  objective: phi_net_per_energy\n"));
+  EXPECT_EQ(s.problem.space.family, StrokeFamily::kSpline);
+  EXPECT_EQ(s.problem.space.knots, 2);
+  EXPECT_EQ(s.problem.space.n_links, 1);
+  EXPECT_EQ(s.optimizer.islands, 3);
+  EXPECT_EQ(s.seeds.size(), 2u);
+  EXPECT_EQ(s.problem.objective, StrokeObjective::kPhiNetPerEnergy);
+  EXPECT_NEAR(s.problem.space.limits.thetadot_max_radps, 600 * kDeg, 1e-12);
+  EXPECT_EQ(s.problem.space.limits.torque_max_Nm, 0.0);  // no torque limit unless given
+  // torque_max_Nm: base is the base stroke's own peak joint torque (Eq. 25, n = 1: about 8.4 N m).
+  const OptimizeSpec t = loadOptimizeSpec(write("  family: spline\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: base}\n"));
+  EXPECT_NEAR(t.problem.space.limits.torque_max_Nm,
+              strokeFigures(t.base.robot.tail, t.base.trajectory()).peak_torque_Nm, 1e-12);
+  EXPECT_GT(t.problem.space.limits.torque_max_Nm, 8.0);
+  EXPECT_LT(t.problem.space.limits.torque_max_Nm, 9.0);
+}
+
+TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
+  const std::string f = (dir_ / "opt.yaml").string();
+  struct Bad {
+    std::string section;
+    std::string where;  // line:col: key:
+    std::string what;
+  };
+  const std::vector<Bad> cases = {
+      {"  family: split_cycle\n" + std::string(kLimits) + "  islands: 0\n", "7:12: optimize.islands: ", "must lie in [1, 64]"},
+      {"  family: spline\n" + std::string(kLimits) + "  populaton: 10\n", "7:3: optimize.populaton: ", "unknown key"},
+      {"  family: spline\n  limits: {theta_deg: [90, -90], thetadot_max_dps: 600}\n", "6:23: optimize.limits.theta_deg: ",
+       "low <= high"},
+      {"  family: spline\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, w_ss: [0.1, 0.3]}\n",
+       "6:63: optimize.limits.w_ss: ", "only used with family: split_cycle"},
+      {"  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, end: start}\n",
+       "6:62: optimize.limits.end: ", "cannot end where it started"},
+      {"  family: spline\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: -5}\n", "6:52: optimize.limits.thetadot_max_dps: ",
+       "must lie in"},
+      {"  family: spline\n  limits: {theta_deg: [-90, 90]}\n", "6:11: optimize.limits.thetadot_max_dps: ", "required key is missing"},
+      {"  family: bspline\n" + std::string(kLimits), "5:11: optimize.family: ", "not one of: split_cycle, spline"},
+      {"  family: spline\n" + std::string(kLimits) + "  seeds: [1, 1]\n", "7:14: optimize.seeds[1]: ", "duplicate seed"},
+      {"  family: spline\n" + std::string(kLimits) + "  pareto_points: 1\n", "7:18: optimize.pareto_points: ", "at least 2"},
+  };
+  for (const Bad& b : cases) {
+    const std::string msg = error(write(b.section));
+    EXPECT_EQ(msg.rfind(f + ":" + b.where, 0), 0u) << msg;
+    EXPECT_NE(msg.find(b.what), std::string::npos) << msg;
+  }
+  // The base experiment's own errors name the base file (the experiment loader's message).
+  std::ofstream(dir_ / "base.yaml") << "name: b\nrobot: paper\ntail: {links: 9}\ntrajectory: {rule: eq25, thetadot_max_dps: 600}\n";
+  const std::string msg = error(write(std::string("  family: spline\n") + kLimits));
+  EXPECT_EQ(msg.rfind((dir_ / "base.yaml").string() + ":3:", 0), 0u) << msg;
+}
+
+// Every kind: optimize file shipped in configs/design loads (their bases load with the experiment loader).
+TEST(ShippedConfigs, OptimizeFilesLoad) {
+  int loaded = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(kSourceDir) / "configs/design")) {
+    if (entry.path().extension() != ".yaml") continue;
+    try {
+      const OptimizeSpec s = loadOptimizeSpec(entry.path().string());
+      EXPECT_EQ(s.problem.space.n_links, s.base.robot.numLinks());
+    } catch (const ConfigError& e) {
+      ADD_FAILURE() << e.what();
+    }
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 19);
+}
+
+int runCommand(const std::string& cmd, std::string& out) {
+  std::unique_ptr<FILE, int (*)(FILE*)> p(popen((cmd + " 2>&1").c_str(), "r"), pclose);
+  char buf[4096];
+  std::size_t k;
+  while ((k = fread(buf, 1, sizeof buf, p.get())) > 0) out.append(buf, k);
+  const int rc = pclose(p.release());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+// `tailsim optimize` writes the best stroke as an experiment that `tailsim run` runs as it is,
+// with the same phi_net; the history CSV and plot exist.
+TEST_F(OptimizeFileTest, BestStrokeIsAReadyToRunExperiment) {
+  const std::string f = write(std::string("  family: split_cycle\n") + kLimits +
+                              "  islands: 2\n  population: 8\n  generations: 6\n  polish_evaluations: 30\n  seeds: [3]\n");
+  const std::string bin = std::string(TAILSIM_BINARY_DIR) + "/tailsim";
+  std::string out;
+  ASSERT_EQ(runCommand(bin + " optimize " + f + " --out " + (dir_ / "res").string() + " --quiet", out), 0) << out;
+  EXPECT_NE(out.find("limits kept"), std::string::npos) << out;
+  for (const char* file : {"best.yaml", "history.csv", "plots/history.png", "summary.json", "best_analytic.csv"})
+    EXPECT_TRUE(fs::is_regular_file(dir_ / "res" / file)) << file;
+  nlohmann::json opt;
+  std::ifstream(dir_ / "res/summary.json") >> opt;
+  std::string out2;
+  ASSERT_EQ(runCommand(bin + " run " + (dir_ / "res/best.yaml").string() + " --out " + (dir_ / "run").string() + " --quiet",
+                       out2), 0) << out2;
+  nlohmann::json run;
+  std::ifstream(dir_ / "run/summary.json") >> run;
+  const double phi_run = run["cases"][0]["runs"]["analytic"]["phi_net_deg"].get<double>();
+  EXPECT_NEAR(phi_run, opt["resimulated"]["analytic"]["phi_net_deg"].get<double>(), 1e-9);
+  EXPECT_NEAR(phi_run, opt["best"]["phi_net_deg"].get<double>(), 1e-9);
+  EXPECT_GT(std::abs(phi_run), 2.43);  // beats the Eq. (25) start (2.44 deg) or equals it
+}
+
+}  // namespace
+}  // namespace tailsim

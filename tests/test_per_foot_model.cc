@@ -1,0 +1,332 @@
+// The per-foot friction model (issue 11 item 1; docs/per-foot-model.md) against closed forms and
+// against the exact-coupling analytic model.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "analytic_model/per_foot_model.h"
+#include "analytic_test_util.h"
+
+using namespace tailsim;
+using namespace tailsim::testing;
+
+namespace {
+
+constexpr double kG = 9.81;
+
+// Feet of the paper's quadruped relative to a system COM at p_QC (in Q), discs mu N_i from the
+// Appendix distribution (the same code as L_F).
+FootDiscs paperDiscs(const Vec2& p_QC, double mu, double weight, double* L_F = nullptr) {
+  const FootLoads fl = footLoads(QuadrupedParams{}, p_QC);
+  FootDiscs d;
+  for (int i = 0; i < 4; ++i) {
+    d.r[i] = fl.p_F[i];
+    d.c[i] = mu * weight * fl.f_C[i];
+  }
+  if (L_F) *L_F = fl.L_F;
+  return d;
+}
+
+// Brute force min over instantaneous centres p of sum c_i |r_i - p| (grid, then finer grids).
+double bruteForceWeberMin(const FootDiscs& d) {
+  Vec2 best = Vec2::Zero();
+  double span = 0.4, bestD = 1e300;
+  for (int level = 0; level < 12; ++level) {
+    const Vec2 centre = best;
+    for (int i = -40; i <= 40; ++i)
+      for (int j = -40; j <= 40; ++j) {
+        const Vec2 p = centre + Vec2(i, j) * (span / 40);
+        double D = 0;
+        for (int k = 0; k < 4; ++k) D += d.c[k] * (d.r[k] - p).norm();
+        if (D < bestD) bestD = D, best = p;
+      }
+    span /= 8;
+  }
+  return bestD;
+}
+
+PerFootSettings slideSettings(double vx) {
+  PerFootSettings s;
+  s.initial_velocity = {vx, 0.0, 0.0};
+  return s;
+}
+
+}  // namespace
+
+// Symmetric loads (COM on the foot centroid): a pure moment about the COM breaks away exactly at
+// sum mu N_i r_i, which is the paper's mu m g L_F there; the breakaway twist is a pure rotation.
+TEST(PerFootLimitSurface, PureMomentSymmetricBreaksAtSumMuNr) {
+  const double W = 10.858 * kG, mu = 0.3;
+  double L_F = 0;
+  const FootDiscs d = paperDiscs(Vec2(QuadrupedParams{}.d_Q2C_m, 0.0), mu, W, &L_F);
+  double sum = 0;
+  for (int i = 0; i < 4; ++i) sum += d.c[i] * d.r[i].norm();
+  EXPECT_NEAR(sum, mu * W * L_F, 1e-12 * sum);
+  const LoadFactor lf = loadFactor(d, {Vec2::Zero(), sum});
+  EXPECT_NEAR(lf.s, 1.0, 1e-12);
+  EXPECT_NEAR(lf.direction.v.norm(), 0.0, 1e-9);
+  EXPECT_GT(lf.direction.w, 0.0);
+  EXPECT_NEAR(loadFactor(d, {Vec2::Zero(), -0.5 * sum}).s, 0.5, 1e-12);
+}
+
+// Unequal loads (tail swung aside: COM off the centroid): a pure moment about the COM breaks
+// away at min_p sum mu N_i |r_i - p| (turning about the weighted geometric median, not the COM),
+// below the paper's mu m g L_F = sum mu N_i |r_i|. Checked against a brute-force grid.
+TEST(PerFootLimitSurface, PureMomentOffsetComBreaksBelowPaperArm) {
+  const double W = 10.858 * kG, mu = 0.3;
+  for (const Vec2& p_QC : {Vec2(-0.06, 0.05), Vec2(0.02, -0.09), Vec2(-0.1, 0.0)}) {
+    double L_F = 0;
+    const FootDiscs d = paperDiscs(p_QC, mu, W, &L_F);
+    const double M_break = 1.0 / loadFactor(d, {Vec2::Zero(), 1.0}).s;
+    const double brute = bruteForceWeberMin(d);
+    EXPECT_NEAR(M_break, brute, 1e-9 * brute) << p_QC.transpose();
+    EXPECT_LE(M_break, mu * W * L_F * (1 + 1e-12));
+    if (p_QC.y() != 0) {
+      EXPECT_LT(M_break, 0.999 * mu * W * L_F) << "paper arm " << L_F << " m";
+    }
+  }
+}
+
+// A pure force at the COM breaks away at mu m g in every direction, for any Appendix loads (their
+// weighted centroid is the COM), with a pure translation.
+TEST(PerFootLimitSurface, PureForceBreaksAtMuMg) {
+  const double W = 10.858 * kG, mu = 0.3;
+  for (const Vec2& p_QC : {Vec2(-0.0155, 0.0), Vec2(-0.06, 0.05), Vec2(0.03, -0.08)}) {
+    const FootDiscs d = paperDiscs(p_QC, mu, W);
+    for (int k = 0; k < 8; ++k) {
+      const double a = k * M_PI / 4 + 0.1;
+      const LoadFactor lf = loadFactor(d, {mu * W * Vec2(std::cos(a), std::sin(a)), 0.0});
+      EXPECT_NEAR(lf.s, 1.0, 1e-12);
+      EXPECT_NEAR(lf.direction.w, 0.0, 1e-9);
+    }
+  }
+}
+
+// The paper holds a moment and a force independently (each below its own limit); four discs do
+// not: 0.7 of each breaks away (0.6 of each is still held), with a certificate twist W . xi > h(xi).
+TEST(PerFootLimitSurface, CombinedLoadThePaperHoldsBreaksAway) {
+  const double W = 10.858 * kG, mu = 0.3;
+  double L_F = 0;
+  const FootDiscs d = paperDiscs(Vec2(-0.0155, 0.0), mu, W, &L_F);
+  EXPECT_LT(loadFactor(d, {Vec2(0.0, 0.6 * mu * W), 0.6 * mu * W * L_F}).s, 1.0);
+  const Wrench2 w{Vec2(0.0, 0.7 * mu * W), 0.7 * mu * W * L_F};
+  const LoadFactor lf = loadFactor(d, w);
+  EXPECT_GT(lf.s, 1.0);
+  const double power = w.F.dot(lf.direction.v) + w.M * lf.direction.w;
+  EXPECT_NEAR(power / limitSupport(d, lf.direction), lf.s, 1e-12);
+}
+
+// Every maximum-dissipation wrench lies on the surface (s = 1) with its own twist as the
+// breakaway direction, and every set of forces inside the discs gives s <= 1 (seeded, random).
+TEST(PerFootLimitSurface, SurfaceAndInsideRandom) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
+  for (int n = 0; n < 2000; ++n) {
+    const Vec2 p_QC(-0.0155 + 0.12 * u(rng), 0.1 * u(rng));
+    FootDiscs d = paperDiscs(p_QC, 0.3, 100.0);
+    const Twist2 xi{Vec2(u(rng), u(rng)), 5 * u(rng)};
+    const Wrench2 w = maxDissipationWrench(d, xi);
+    const LoadFactor lf = loadFactor(d, w);
+    ASSERT_NEAR(lf.s, 1.0, 1e-9) << n;
+    // Direction: power at the returned twist equals h there (it is a maximizer).
+    ASSERT_NEAR(w.F.dot(lf.direction.v) + w.M * lf.direction.w, limitSupport(d, lf.direction),
+                1e-8 * limitSupport(d, lf.direction)) << n;
+    Wrench2 inside;
+    for (int i = 0; i < 4; ++i) {
+      const double a = M_PI * u(rng);
+      const Vec2 f = pos(rng) * d.c[i] * Vec2(std::cos(a), std::sin(a));
+      inside.F += f;
+      inside.M += cross2(d.r[i], f);
+    }
+    ASSERT_LE(loadFactor(d, inside).s, 1.0 + 1e-12) << n;
+    // The held distribution reproduces the wrench.
+    const auto Fi = heldFootForces(d, inside);
+    Wrench2 back;
+    for (int i = 0; i < 4; ++i) back.F += Fi[i], back.M += cross2(d.r[i], Fi[i]);
+    ASSERT_NEAR((back.F - inside.F).norm(), 0.0, 1e-9);
+    ASSERT_NEAR(back.M, inside.M, 1e-9);
+  }
+}
+
+// mu = 0: no friction at any foot, so the model is the exact-coupling analytic model.
+TEST(PerFootModel, ZeroFrictionEqualsExactCouplingAnalytic) {
+  for (int n : {1, 6}) {
+    RobotParams r = paperRobot(n, 0.1405);
+    r.friction.mu_s = r.friction.mu_d = 0.0;
+    const TailTrajectory tr = sameMove(n, 0, n == 1 ? -90 : -30, 0.25, 0.25);
+    AnalyticSettings as;
+    as.coupling = Coupling::kExact;
+    const RunResult a = simulateAnalytic(r, tr, as, {}, {});
+    const RunResult p = simulatePerFoot(r, tr, {}, {}, {});
+    ASSERT_TRUE(a.summary.ok && p.summary.ok) << p.summary.error;
+    EXPECT_NEAR(p.summary.phi_net_deg, a.summary.phi_net_deg, 1e-6) << n;
+    EXPECT_NEAR(p.summary.extra.at("final_x_m"), a.summary.extra.at("final_x_m"), 1e-8);
+    EXPECT_NEAR(p.summary.extra.at("final_y_m"), a.summary.extra.at("final_y_m"), 1e-8);
+    const auto& pa = a.series.values("phi_deg");
+    const auto& pp = p.series.values("phi_deg");
+    ASSERT_EQ(pa.size(), pp.size());
+    for (size_t k = 0; k < pa.size(); ++k) ASSERT_NEAR(pp[k], pa[k], 1e-6) << k;
+  }
+}
+
+// A body sliding in pure translation decelerates at mu_d g and stops after v0^2 / (2 mu_d g),
+// at t = v0 / (mu_d g), without turning (the Appendix loads' centroid is the COM).
+TEST(PerFootModel, SlidingBodyDeceleratesAtMuG) {
+  const RobotParams r = paperRobot(1);
+  const TailTrajectory tr = sameMove(1, 0, 0, 0.25, 0.25);  // tail held straight
+  const double v0 = 0.5, a = r.friction.mu_d * kG;
+  const RunResult p = simulatePerFoot(r, tr, slideSettings(v0), {}, {});
+  ASSERT_TRUE(p.summary.ok) << p.summary.error;
+  EXPECT_NEAR(p.summary.extra.at("final_x_m"), v0 * v0 / (2 * a), 1e-6);
+  EXPECT_NEAR(p.summary.t_stop_s, v0 / a, 1e-4);
+  EXPECT_NEAR(p.summary.phi_net_deg, 0.0, 1e-9);
+  const auto& x = p.series.values("x_m");
+  const auto& t = p.series.values("t_s");
+  for (size_t k = 0; k < t.size() && t[k] < 0.15; ++k) ASSERT_NEAR(x[k], v0 * t[k] - 0.5 * a * t[k] * t[k], 1e-7) << t[k];
+  // Each foot carries mu_d N_i against the motion.
+  const auto& F1 = p.series.values("F1x_N");
+  const auto& N1 = p.series.values("N1_N");
+  EXPECT_NEAR(F1[50], -r.friction.mu_d * N1[50], 1e-9);
+}
+
+// The ADAMS law per foot: above v_d the coefficient is mu_d, so a fast slide decelerates at
+// mu_d g until v_d; mu(0) = 0, so it never sticks.
+TEST(PerFootModel, AdamsLawSlideDeceleratesAtMuDAboveVd) {
+  const RobotParams r = paperRobot(1);
+  Effects e;
+  e.friction = FrictionLaw::kContinuous;
+  const double v0 = 1.5, a = r.friction.mu_d * kG;  // reaches v_d = 0.5 m/s at t = 0.34 s
+  const RunResult p = simulatePerFoot(r, sameMove(1, 0, 0, 0.25, 0.25), slideSettings(v0), e, {});
+  ASSERT_TRUE(p.summary.ok) << p.summary.error;
+  const auto& x = p.series.values("x_m");
+  const auto& t = p.series.values("t_s");
+  for (size_t k = 0; k < t.size() && t[k] < 0.33; ++k) ASSERT_NEAR(x[k], v0 * t[k] - 0.5 * a * t[k] * t[k], 1e-7);
+  EXPECT_TRUE(std::isnan(p.series.values("rot_state")[0]));
+}
+
+// Load transfer: friction at the ground, h below the COM, moves the centre of pressure forward by
+// h mu_d g / g while braking: the front pair carries h mu_d / l_F of the weight more.
+TEST(PerFootModel, LoadTransferShiftsLoadToTheFrontWhileBraking) {
+  const RobotParams r = paperRobot(1);
+  const TailTrajectory tr = sameMove(1, 0, 0, 0.25, 0.25);
+  PerFootSettings qs = slideSettings(0.5), lt = qs;
+  lt.normal_loads = NormalLoadModel::kLoadTransfer;
+  EXPECT_EQ(r.quadruped.com_height_m, 0.15);  // the robot's COM height (default)
+  const RunResult a = simulatePerFoot(r, tr, qs, {}, {});
+  const RunResult b = simulatePerFoot(r, tr, lt, {}, {});
+  ASSERT_TRUE(a.summary.ok && b.summary.ok) << b.summary.error;
+  const double W = r.systemMass() * kG;
+  const size_t k = 50;  // t = 0.05 s, sliding
+  const double front_a = a.series.values("N1_N")[k] + a.series.values("N2_N")[k];
+  const double front_b = b.series.values("N1_N")[k] + b.series.values("N2_N")[k];
+  EXPECT_NEAR(front_b - front_a, W * 0.15 * r.friction.mu_d / r.quadruped.l_F_m, 1e-9 * W);
+  // The summed friction is still mu_d m g: the slide is the same.
+  EXPECT_NEAR(b.summary.extra.at("final_x_m"), a.summary.extra.at("final_x_m"), 1e-9);
+}
+
+// Mirror symmetry: theta0 and dtheta negated mirror the run: phi_net and y negated, x equal.
+TEST(PerFootModel, MirrorSymmetry) {
+  for (FrictionLaw law : {FrictionLaw::kStiction, FrictionLaw::kContinuous}) {
+    Effects e;
+    e.friction = law;
+    for (int n : {1, 3}) {
+      const RobotParams r = paperRobot(n);
+      const RunResult a = simulatePerFoot(r, sameMove(n, 30, -90, 0.2, 0.3), {}, e, {});
+      const RunResult b = simulatePerFoot(r, sameMove(n, -30, 90, 0.2, 0.3), {}, e, {});
+      ASSERT_TRUE(a.summary.ok && b.summary.ok) << a.summary.error << b.summary.error;
+      EXPECT_GT(std::abs(a.summary.phi_net_deg), 1.0);
+      // As the analytic model's random sweep: the adaptive steps are not mirror images bit for bit.
+      EXPECT_NEAR(b.summary.phi_net_deg, -a.summary.phi_net_deg, 1e-6 * (1 + std::abs(a.summary.phi_net_deg)));
+      EXPECT_NEAR(b.summary.extra.at("final_y_m"), -a.summary.extra.at("final_y_m"), 1e-7);
+      EXPECT_NEAR(b.summary.extra.at("final_x_m"), a.summary.extra.at("final_x_m"), 1e-7);
+      EXPECT_EQ(b.summary.stick_slip_events, a.summary.stick_slip_events);
+    }
+  }
+}
+
+// Breakaway and re-stick located to event_tol_s: phi_net converges as the tolerance tightens.
+TEST(PerFootModel, EventLocationConverges) {
+  const RobotParams r = paperRobot(1);
+  const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);  // Fig. 7
+  std::vector<double> phi;
+  for (double tol : {1e-4, 1e-6, 1e-9, 1e-12}) {
+    PerFootSettings s;
+    s.event_tol_s = tol;
+    const RunResult p = simulatePerFoot(r, tr, s, {}, {});
+    ASSERT_TRUE(p.summary.ok) << p.summary.error;
+    EXPECT_GE(p.summary.stick_slip_events, 2);
+    phi.push_back(p.summary.phi_net_deg);
+  }
+  const double ref = phi.back();
+  EXPECT_LE(std::abs(phi[2] - ref), 1e-7);
+  EXPECT_LE(std::abs(phi[2] - ref), std::abs(phi[0] - ref) + 1e-12);
+  EXPECT_LE(std::abs(phi[1] - ref), 1e-5);
+}
+
+// The time series has the analytic model's columns where they exist, plus the per-foot ones; a
+// held body's per-foot forces add up to its friction wrench.
+TEST(PerFootModel, ColumnsAndHeldForces) {
+  const RobotParams r = paperRobot(1);
+  const RunResult p = simulatePerFoot(r, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  const RunResult a = simulateAnalytic(r, sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+  for (const auto& name : a.series.names()) EXPECT_TRUE(p.series.has(name)) << name;
+  for (const char* c : {"F1x_N", "F4y_N", "N1_N", "N4_N", "load_factor"}) EXPECT_TRUE(p.series.has(c)) << c;
+  EXPECT_EQ(p.series.numRows(), a.series.numRows());
+  EXPECT_EQ(p.summary.model, "perfoot");
+  const auto& st = p.series.values("rot_state");
+  size_t k = 0;
+  while (k < st.size() && st[k] != 0.0) ++k;
+  ASSERT_LT(k, st.size());
+  double fx = 0, n = 0;
+  for (int i = 1; i <= 4; ++i) {
+    fx += p.series.values("F" + std::to_string(i) + "x_N")[k];
+    n += p.series.values("N" + std::to_string(i) + "_N")[k];
+  }
+  EXPECT_NEAR(fx, p.series.values("FFx_N")[k], 1e-9);
+  EXPECT_NEAR(n, r.systemMass() * kG, 1e-9);
+}
+
+// Seeded random sweep: no NaN, bounded step counts, the result within physical bounds.
+TEST(PerFootModel, RandomSweepNoNanBoundedSteps) {
+  std::mt19937 rng(1111);
+  std::uniform_real_distribution<double> u(0, 1);
+  int ok = 0;
+  std::vector<long> steps;
+  for (int c = 0; c < 1000; ++c) {
+    const int n = 1 + static_cast<int>(u(rng) * 6);
+    const RobotParams r = paperRobot(n, 0.05 + 0.15 * u(rng));
+    const TailTrajectory tr = sameMove(n, -90 + 180 * u(rng), (-360 + 720 * u(rng)) / n, 0.05 + 0.6 * u(rng),
+                                       0.05 + 0.9 * u(rng));
+    Effects e;
+    e.friction = u(rng) < 0.7 ? FrictionLaw::kStiction : FrictionLaw::kContinuous;
+    PerFootSettings s;
+    if (u(rng) < 0.3) s.normal_loads = NormalLoadModel::kLoadTransfer;
+    OutputSettings o;
+    o.sample_dt_s = 0.05;
+    const RunResult p = simulatePerFoot(r, tr, s, e, o);
+    if (!p.summary.ok) {
+      ASSERT_NE(p.summary.error.find("tips"), std::string::npos)
+          << c << ": " << p.summary.error << " n " << n << " law " << int(e.friction) << " loads "
+          << int(s.normal_loads) << " theta0 " << tr.joints[0].params().theta0_rad << " dtheta "
+          << tr.joints[0].params().dtheta_rad << " dT " << tr.joints[0].params().dT_s << " wss "
+          << tr.joints[0].params().w_ss << " dQ2B " << r.quadruped.d_Q2B_m;
+      continue;
+    }
+    ++ok;
+    ASSERT_TRUE(std::isfinite(p.summary.phi_net_deg)) << c;
+    ASSERT_LT(p.summary.solver_steps, 200000) << c;
+    steps.push_back(p.summary.solver_steps);
+    for (const auto& name : p.series.names())
+      for (double v : p.series.values(name))
+        if (name != "load_factor" && name != "rot_state" && name != "trans_state" && name.rfind("MzT_", 0) != 0) {
+          ASSERT_TRUE(std::isfinite(v)) << c << " " << name;
+        }
+  }
+  EXPECT_GT(ok, 900);
+  std::sort(steps.begin(), steps.end());
+  std::printf("perfoot random sweep: %d cases ran, steps median %ld, max %ld\n", ok, steps[steps.size() / 2],
+              steps.back());
+}
