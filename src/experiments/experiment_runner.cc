@@ -109,7 +109,7 @@ std::string caseDirName(const std::string& name) {
   return d + "~" + sha256Hex(name).substr(0, 16);
 }
 
-std::vector<RunResult> runCase(const ExperimentCase& c) {
+std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {
   std::vector<RunResult> out;
   if (c.kind == CaseKind::kPose) {
     std::vector<JointState> js(c.robot.numLinks());
@@ -121,7 +121,7 @@ std::vector<RunResult> runCase(const ExperimentCase& c) {
   for (const std::string& m : c.models) {
     const ModelEntry* model = findModel(m);
     if (!model) throw std::invalid_argument("unknown model '" + m + "'");  // the loader refuses it first
-    out.push_back(model->run(c));
+    out.push_back(model->run(c, ctx));
   }
   return out;
 }
@@ -374,9 +374,9 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
 }
 
 // Runs one case and writes its folder; result.json last, as the "finished" marker.
-json runAndWrite(const Job& job, size_t i, int& failed_runs) {
+json runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
   const ExperimentCase& c = job.e->cases[i];
-  const std::vector<RunResult> runs = runCase(c);
+  const std::vector<RunResult> runs = runCase(c, &ctx);
   const fs::path dir = job.root / "cases" / job.dirs[i];
   fs::create_directories(dir);
   json j;
@@ -506,6 +506,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   std::mutex mu;
   std::condition_variable cv;
   std::string first_error;
+  RunContext ctx;  // shared by the workers: the MuJoCo pre-roll once per distinct model
   auto worker = [&]() {
     for (;;) {
       if (stop.load()) break;
@@ -514,7 +515,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
       const Task& t = tasks[k];
       try {
         int f = 0;
-        json j = runAndWrite(*t.job, t.i, f);
+        json j = runAndWrite(*t.job, t.i, f, ctx);
         failed += f;
         t.job->entries[t.i] = std::move(j);  // distinct element per task: no lock needed
       } catch (const std::exception& ex) {

@@ -9,6 +9,7 @@
 #include "experiments/experiment_config.h"
 #include "experiments/settings_json.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/model_registry.h"
 #include "results/time_series.h"
 
 namespace tailsim {
@@ -42,7 +43,8 @@ struct RunStats {
 };
 
 // All models of one case (no files written). Pose cases evaluate the analytic model only.
-std::vector<RunResult> runCase(const ExperimentCase& c);
+// `ctx`: caches shared by the cases of a run (model_registry.h), or nullptr.
+std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx = nullptr);
 
 // The folder name of a case under DIR/cases/.
 // Unique by construction: a name of [A-Za-z0-9.=,_-] (not starting with . or -, <= 100 chars) is

@@ -30,12 +30,12 @@ std::vector<std::string> concat(std::vector<std::string> a, const std::vector<st
 const std::vector<ModelEntry>& modelRegistry() {
   static const std::vector<ModelEntry> kModels = {
       {"analytic", "analytic (stiction)", "#0072B2", false,
-       [](const ExperimentCase& c) {
+       [](const ExperimentCase& c, RunContext*) {
          return simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, c.output);
        },
        [](int n) { return concat(col::shared(n), col::analyticOnly()); }},
       {"perfoot", "per-foot (Coulomb per foot)", "#009E73", false,
-       [](const ExperimentCase& c) {
+       [](const ExperimentCase& c, RunContext*) {
          try {
            return simulatePerFoot(c.robot, c.trajectory(), c.perfoot, c.effects, c.output);
          } catch (const std::exception& e) {
@@ -44,9 +44,10 @@ const std::vector<ModelEntry>& modelRegistry() {
        },
        [](int n) { return concat(concat(col::shared(n), col::analyticOnly()), col::perfootOnly()); }},
       {"mujoco", "MuJoCo (contact)", "#D55E00", true,
-       [](const ExperimentCase& c) {
+       [](const ExperimentCase& c, RunContext* ctx) {
          try {
-           return simulateMujoco(c.robot, c.trajectory(), c.mujoco, c.effects, c.output);
+           return simulateMujoco(c.robot, c.trajectory(), c.mujoco, c.effects, c.output, nullptr,
+                                 ctx ? &ctx->mujoco_settle : nullptr);
          } catch (const std::exception& e) {
            return failedRun("mujoco", e.what());
          }

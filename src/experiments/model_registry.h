@@ -10,9 +10,16 @@
 #include <vector>
 
 #include "experiments/experiment_config.h"
+#include "mujoco_model/mujoco_simulation.h"
 #include "results/time_series.h"
 
 namespace tailsim {
+
+// What the cases of one run share: caches that make a sweep cheaper without changing any number
+// (each is bit-for-bit the run without it, tested). One per `tailsim run`; thread safe.
+struct RunContext {
+  MujocoSettleCache mujoco_settle;  // the MuJoCo pre-roll, once per distinct model and start pose
+};
 
 struct ModelEntry {
   std::string name;    // "analytic": YAML models: value, cases/<dir>/<name>.csv, runs.<name>
@@ -20,7 +27,8 @@ struct ModelEntry {
   std::string color;   // plot colour, "#RRGGBB"
   bool long_running;   // scheduled first (the short cases fill the gaps at the end)
   // Runs a simulate case; a failure is a RunResult with ok == false and the reason (never throws).
-  std::function<RunResult(const ExperimentCase&)> run;
+  // `ctx`: the run's shared caches, or nullptr.
+  std::function<RunResult(const ExperimentCase&, RunContext* ctx)> run;
   // The columns it writes for an n-link tail, in the CSV order (results/columns.h).
   std::function<std::vector<std::string>(int links)> columns;
 };

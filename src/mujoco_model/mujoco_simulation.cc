@@ -9,14 +9,18 @@
 #include <limits>
 #include <map>
 #include <cmath>
+#include <cstdio>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 #include <string>
 #include <vector>
 
 #include "controllers/tail_controller.h"
 #include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_handles.h"
+#include "results/sha256.h"
 #include "results/work_limits.h"
 #include "robot/friction_law.h"
 
@@ -346,10 +350,142 @@ std::string instabilityMessage(const mjData* d, double t, const MujocoSettings& 
   return os.str();
 }
 
+// What a pre-roll depends on besides the MJCF: every MuJoCo setting (settle_s, the controller's
+// feed-forward options, the standing limits), the effects, the friction law's parameters (run-time
+// foot friction) and the reference at t = 0 (held during the pre-roll; its speed and acceleration
+// enter the feed-forward terms). Written field by field from the settings' own declarations.
+class KeyWriter {
+ public:
+  void number(const settings::Field& f, double x, const settings::Limits&) { put(f, x); }
+  void integer(const settings::Field& f, int x, const settings::Limits&, const settings::IntSet& = {}) { put(f, x); }
+  void boolean(const settings::Field& f, bool x) { put(f, x ? 1.0 : 0.0); }
+  template <class E>
+  void choice(const settings::Field& f, E x, const settings::EnumNames<E>&) {
+    put(f, static_cast<double>(static_cast<int>(x)));
+  }
+  void text(const settings::Field& f, const std::string& x, const settings::TextRule&) {
+    put(f.key, x);
+  }
+  template <std::size_t N>
+  void numbers(const settings::Field& f, const std::array<double, N>& x) {
+    for (double v : x) put(f, v);
+  }
+  template <class T>
+  void internal(const settings::Field& f, const T& x) {
+    if constexpr (std::is_arithmetic_v<T>) put(f, static_cast<double>(x));
+  }
+  void put(const settings::Field& f, double x) { put(f.key, x); }
+  void put(const char* key, double x) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%a", x);  // exact
+    put(key, std::string(b));
+  }
+  void put(const char* key, const std::string& x) {
+    out += key;
+    out += "=" + x + ";";
+  }
+  std::string out;
+};
+
+std::string settleKey(const std::string& xml, const MujocoSettings& s, const Effects& e, const FrictionParams& fp,
+                      const std::vector<JointState>& ref0) {
+  KeyWriter w;
+  w.out = xml + "\n";
+  declareFields(w, s);
+  declareFields(w, e);
+  declareFields(w, fp);
+  for (const JointState& j : ref0) {
+    w.put("theta0", j.theta);
+    w.put("theta0_dot", j.theta_dot);
+    w.put("theta0_ddot", j.theta_ddot);
+  }
+  return sha256Hex(w.out);
+}
+
+// The MuJoCo state after a pre-roll: every mjData field the next mj_forward/mj_step reads as input
+// (the rest is computed from these), and the run-time foot friction written into the model.
+struct SettledState {
+  std::vector<mjtNum> qpos, act, ctrl, qfrc_applied, xfrc_applied, mocap_pos, mocap_quat, userdata, qacc_warmstart,
+      geom_friction;
+  StandingMonitor standing;
+};
+
+template <class T>
+std::vector<mjtNum> copyOf(const T* p, int n) {
+  return std::vector<mjtNum>(p, p + n);
+}
+
+SettledState saveSettled(const mjModel* m, const mjData* d, const StandingMonitor& standing) {
+  return {copyOf(d->qpos, m->nq),          copyOf(d->act, m->na),
+          copyOf(d->ctrl, m->nu),          copyOf(d->qfrc_applied, m->nv),
+          copyOf(d->xfrc_applied, 6 * m->nbody), copyOf(d->mocap_pos, 3 * m->nmocap),
+          copyOf(d->mocap_quat, 4 * m->nmocap), copyOf(d->userdata, m->nuserdata),
+          copyOf(d->qacc_warmstart, m->nv), copyOf(m->geom_friction, 3 * m->ngeom),
+          standing};
+}
+
+void restoreSettled(const SettledState& st, mjModel* m, mjData* d, StandingMonitor& standing) {
+  d->time = 0.0;
+  std::copy(st.qpos.begin(), st.qpos.end(), d->qpos);
+  std::fill(d->qvel, d->qvel + m->nv, 0.0);
+  std::copy(st.act.begin(), st.act.end(), d->act);
+  std::copy(st.ctrl.begin(), st.ctrl.end(), d->ctrl);
+  std::copy(st.qfrc_applied.begin(), st.qfrc_applied.end(), d->qfrc_applied);
+  std::copy(st.xfrc_applied.begin(), st.xfrc_applied.end(), d->xfrc_applied);
+  std::copy(st.mocap_pos.begin(), st.mocap_pos.end(), d->mocap_pos);
+  std::copy(st.mocap_quat.begin(), st.mocap_quat.end(), d->mocap_quat);
+  std::copy(st.userdata.begin(), st.userdata.end(), d->userdata);
+  std::copy(st.qacc_warmstart.begin(), st.qacc_warmstart.end(), d->qacc_warmstart);
+  std::copy(st.geom_friction.begin(), st.geom_friction.end(), m->geom_friction);
+  standing = st.standing;
+}
+
 }  // namespace
 
+struct MujocoSettleCache::Impl {
+  std::mutex mu;
+  std::map<std::string, std::shared_ptr<const SettledState>> states;
+  std::size_t max_entries = 0;
+  long hits = 0, misses = 0, settle_steps = 0;
+
+  std::shared_ptr<const SettledState> find(const std::string& key) {
+    std::lock_guard<std::mutex> lock(mu);
+    auto it = states.find(key);
+    if (it == states.end()) return nullptr;
+    ++hits;
+    return it->second;
+  }
+  void miss(long steps) {
+    std::lock_guard<std::mutex> lock(mu);
+    ++misses;
+    settle_steps += steps;
+  }
+  void keep(const std::string& key, SettledState st) {
+    std::lock_guard<std::mutex> lock(mu);
+    if (states.size() < max_entries) states.emplace(key, std::make_shared<const SettledState>(std::move(st)));
+  }
+};
+
+MujocoSettleCache::MujocoSettleCache(std::size_t max_entries) : impl_(std::make_unique<Impl>()) {
+  impl_->max_entries = max_entries;
+}
+MujocoSettleCache::~MujocoSettleCache() = default;
+long MujocoSettleCache::hits() const {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->hits;
+}
+long MujocoSettleCache::misses() const {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->misses;
+}
+long MujocoSettleCache::settleSteps() const {
+  std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->settle_steps;
+}
+
 RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
-                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer) {
+                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
+                         MujocoSettleCache* settle_cache) {
   const int n = robot.numLinks();
   if (static_cast<int>(trajectory.joints.size()) != n)
     throw std::invalid_argument("trajectory has " + std::to_string(trajectory.joints.size()) +
@@ -430,15 +566,26 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
     sum.extra["mujoco_warnings"] = warningCount(d);
     return result;
   };
-  while (d->time < settings.settle_s - 0.5 * settings.timestep_s && sum.ok) {
-    const double t_state = d->time - settings.settle_s;
-    step(0.0, false, nullptr);
-    if (warningCount(d) > 0) fail(instabilityMessage(d, d->time - settings.settle_s, settings, gains) + " (settling)");
-    else if (!standing.update(d, t_state)) fail(standing.why() + " (while settling with the tail held at theta(0))");
+  // Pre-roll (or its cached end state): the quadruped settles on its feet, the tail held at theta(0).
+  const std::string key = settle_cache ? settleKey(xml, settings, effects, robot.friction, ref0) : std::string();
+  const std::shared_ptr<const SettledState> cached = settle_cache ? settle_cache->impl().find(key) : nullptr;
+  if (cached) {
+    restoreSettled(*cached, m, d, standing);
+  } else {
+    long settle_steps = 0;
+    while (d->time < settings.settle_s - 0.5 * settings.timestep_s && sum.ok) {
+      const double t_state = d->time - settings.settle_s;
+      step(0.0, false, nullptr);
+      ++settle_steps;
+      if (warningCount(d) > 0) fail(instabilityMessage(d, d->time - settings.settle_s, settings, gains) + " (settling)");
+      else if (!standing.update(d, t_state)) fail(standing.why() + " (while settling with the tail held at theta(0))");
+    }
+    if (settle_cache) settle_cache->impl().miss(settle_steps);
+    if (!sum.ok) return failed();
+    d->time = 0.0;
+    for (int v = 0; v < m->nv; ++v) d->qvel[v] = 0.0;
+    if (settle_cache && messages.text().empty()) settle_cache->impl().keep(key, saveSettled(m, d, standing));
   }
-  if (!sum.ok) return failed();
-  d->time = 0.0;
-  for (int v = 0; v < m->nv; ++v) d->qvel[v] = 0.0;
   mj_forward(m, d);
 
   // Main loop. Row k is the state at the start of the first step with t >= t_k (exact when the
