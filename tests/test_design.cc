@@ -271,7 +271,8 @@ TEST_F(OptimizeFileTest, BestStrokeIsAReadyToRunExperiment) {
   std::string out;
   ASSERT_EQ(runCommand(bin + " optimize " + f + " --out " + (dir_ / "res").string() + " --quiet", out), 0) << out;
   EXPECT_NE(out.find("limits kept"), std::string::npos) << out;
-  for (const char* file : {"best.yaml", "history.csv", "plots/history.png", "summary.json", "best_analytic.csv"})
+  for (const char* file :
+       {"best.yaml", "history.csv", "plots/history.png", "summary.json", "best_analytic.csv", "best_perfoot.csv"})
     EXPECT_TRUE(fs::is_regular_file(dir_ / "res" / file)) << file;
   nlohmann::json opt;
   std::ifstream(dir_ / "res/summary.json") >> opt;
@@ -284,6 +285,16 @@ TEST_F(OptimizeFileTest, BestStrokeIsAReadyToRunExperiment) {
   EXPECT_NEAR(phi_run, opt["resimulated"]["analytic"]["phi_net_deg"].get<double>(), 1e-9);
   EXPECT_NEAR(phi_run, opt["best"]["phi_net_deg"].get<double>(), 1e-9);
   EXPECT_GT(std::abs(phi_run), 2.43);  // beats the Eq. (25) start (2.44 deg) or equals it
+  // The other models' re-runs in summary.json are what `tailsim run best.yaml` gives them.
+  ASSERT_TRUE(opt["resimulated"]["perfoot"]["ok"].get<bool>()) << opt["resimulated"]["perfoot"].dump();
+  EXPECT_NEAR(run["cases"][0]["runs"]["perfoot"]["phi_net_deg"].get<double>(),
+              opt["resimulated"]["perfoot"]["phi_net_deg"].get<double>(), 1e-9);
+  EXPECT_NEAR(opt["resimulated"]["perfoot"]["difference_deg"].get<double>(),
+              opt["resimulated"]["perfoot"]["phi_net_deg"].get<double>() - phi_run, 1e-9);
+  if (opt["resimulated"].contains("mujoco")) {
+    EXPECT_NEAR(run["cases"][0]["runs"]["mujoco"]["phi_net_deg"].get<double>(),
+                opt["resimulated"]["mujoco"]["phi_net_deg"].get<double>(), 1e-9);
+  }
 }
 
 }  // namespace

@@ -7,10 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "analytic_model/analytic_simulation.h"
+#include "analytic_model/per_foot_model.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
@@ -130,6 +132,7 @@ std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& t
   YAML::Node models(YAML::NodeType::Sequence);
   models.SetStyle(YAML::EmitterStyle::Flow);
   models.push_back("analytic");
+  models.push_back("perfoot");
   models.push_back("mujoco");
   doc["models"] = models;
   YAML::Emitter e;
@@ -172,6 +175,19 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   rep.limits_analytic = checkLimitsOnSeries(spec.base.robot.tail, ra.series, prob.space.limits);
   writeCsvAtomic((fs::path(out_dir) / "best_analytic.csv").string(), ra.series);
   rep.files.push_back("best_analytic.csv");
+  // The per-foot friction model (issue 11): milliseconds, always run; a failure (e.g. the robot
+  // tips) is reported, not thrown.
+  try {
+    const RunResult rp = simulatePerFoot(spec.base.robot, traj, spec.base.perfoot, spec.base.effects, out);
+    rep.perfoot = rp.summary;
+    writeCsvAtomic((fs::path(out_dir) / "best_perfoot.csv").string(), rp.series);
+    rep.files.push_back("best_perfoot.csv");
+  } catch (const std::exception& e) {
+    rep.perfoot.model = "perfoot";
+    rep.perfoot.ok = false;
+    rep.perfoot.error = e.what();
+    rep.perfoot.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+  }
   if (spec.mujoco_check) {
     const RunResult rm = simulateMujoco(spec.base.robot, traj, spec.base.mujoco, spec.base.effects, out);
     rep.mujoco = rm.summary;
@@ -300,6 +316,15 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                                   {"relative_difference", rep.analytic.phi_net_deg != 0
                                                               ? (rep.mujoco.phi_net_deg - rep.analytic.phi_net_deg) / std::abs(rep.analytic.phi_net_deg)
                                                               : 0.0}};
+  {
+    const double d = rep.perfoot.phi_net_deg - rep.analytic.phi_net_deg;
+    j["resimulated"]["perfoot"] = {{"ok", rep.perfoot.ok}, {"error", rep.perfoot.error},
+                                   {"phi_net_deg", rep.perfoot.ok ? nlohmann::json(rep.perfoot.phi_net_deg) : nlohmann::json()},
+                                   {"difference_deg", rep.perfoot.ok ? nlohmann::json(d) : nlohmann::json()},
+                                   {"relative_difference", rep.perfoot.ok && rep.analytic.phi_net_deg != 0
+                                                               ? nlohmann::json(d / std::abs(rep.analytic.phi_net_deg))
+                                                               : nlohmann::json()}};
+  }
   if (!pareto.empty()) j["pareto"] = pareto;
   j["evaluations"] = rep.evaluations;
   j["wall_s"] = rep.wall_s;

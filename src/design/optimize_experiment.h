@@ -34,6 +34,7 @@ struct OptimizeReport {
   std::size_t best_seed_index = 0;
   double spread = 0.0;  // (max - min) / max of the seeds' objectives
   RunSummary analytic, mujoco;  // re-runs of the best stroke (mujoco.model empty when not run)
+  RunSummary perfoot;           // the per-foot friction model's re-run (docs/per-foot-model.md)
   LimitCheck limits_analytic;
   long evaluations = 0;
   double wall_s = 0.0;
