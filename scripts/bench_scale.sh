@@ -17,20 +17,22 @@ TAILSIM=$BUILD/tailsim
 W=$(mktemp -d "${TMPDIR:-/tmp}/tailsim_scale.XXXXXX")
 trap 'rm -rf "$W"' EXIT
 
-printf '%-16s %8s %9s %9s %11s %10s %8s %12s %10s\n' config cases wall_s cases/s per_thread maxRSS_MB files bytes bytes/case
+echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores"
+printf '%-14s %7s %8s %8s %8s %7s %9s %9s %7s %11s %9s\n' config cases wall_s cases/s per_thr cpu_s cases/cpu_s maxRSS_MB files bytes bytes/case
 run() {  # name yaml
   local name=$1 yaml=$2
   /usr/bin/time -v -o "$W/$name.time" "$TAILSIM" run "$yaml" --out "$W/$name" --threads "$THREADS" --quiet > "$W/$name.out"
-  local cases wall rss files bytes
+  local cases wall rss files bytes cpu
   cases=$(sed -nE 's/^([0-9]+) cases: .*/\1/p' "$W/$name.out")
   wall=$(sed -nE 's/.* ([0-9.]+) s wall$/\1/p' "$W/$name.out")
   rss=$(sed -nE 's/.*Maximum resident set size \(kbytes\): ([0-9]+)/\1/p' "$W/$name.time")
+  cpu=$(awk -F': ' '/User time|System time/ { s += $2 } END { print s }' "$W/$name.time")
   rm -f "$W/$name/.tailsim.lock"
   files=$(find "$W/$name" -type f | wc -l)
   bytes=$(du -sb "$W/$name" | cut -f1)
-  awk -v n="$name" -v c="$cases" -v w="$wall" -v r="$rss" -v f="$files" -v b="$bytes" -v t="$THREADS" 'BEGIN {
-    printf "%-16s %8d %9.3f %9.0f %11.0f %10.1f %8d %12d %10.0f\n", n, c, w, c / w, c / w / t, r / 1024, f, b, b / c }'
-  echo "$name $cases $wall" >> "$W/rates"
+  awk -v n="$name" -v c="$cases" -v w="$wall" -v r="$rss" -v f="$files" -v b="$bytes" -v t="$THREADS" -v u="$cpu" 'BEGIN {
+    printf "%-14s %7d %8.3f %8.0f %8.0f %7.2f %9.0f %9.1f %7d %11d %9.0f\n", n, c, w, c / w, c / w / t, u, c / u, r / 1024, f, b, b / c }'
+  echo "$name $cases $wall $cpu" >> "$W/rates"
 }
 run analytic_none configs/scale/sweep5k_none.yaml
 run analytic_thin configs/scale/sweep5k_thin.yaml
@@ -38,12 +40,14 @@ run analytic_full configs/scale/sweep5k_full.yaml
 run mujoco_none configs/scale/mujoco40_none.yaml
 [ "$BIG" = --big ] && run analytic_100k configs/scale/sweep100k_none.yaml
 
-awk -v t="$THREADS" '{ rate[$1] = $2 / $3 / t } END {
+echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
+awk -v t="$THREADS" '{ rate[$1] = $2 / $3 / t; cpu[$1] = $2 / $4 } END {
   printf "\nnone vs full (analytic, 5,000 cases, %d threads): %.2fx the cases/s; thin vs full: %.2fx\n", t,
          rate["analytic_none"] / rate["analytic_full"], rate["analytic_thin"] / rate["analytic_full"]
-  printf "projected wall time (per-thread rate x cores, none output):\n"
+  printf "projected wall time, none output (measured per-thread rate x cores | cases per CPU second x cores):\n"
   split("2 16 64", cores, " ")
   for (i = 1; i <= 3; ++i)
-    printf "  %2d cores: 10^6 analytic %8.0f s, 10^5 MuJoCo %8.0f s\n", cores[i], 1e6 / (rate["analytic_none"] * cores[i]),
-           1e5 / (rate["mujoco_none"] * cores[i])
+    printf "  %2d cores: 10^6 analytic %7.0f s | %7.0f s;  10^5 MuJoCo %7.0f s | %7.0f s\n", cores[i],
+           1e6 / (rate["analytic_none"] * cores[i]), 1e6 / (cpu["analytic_none"] * cores[i]),
+           1e5 / (rate["mujoco_none"] * cores[i]), 1e5 / (cpu["mujoco_none"] * cores[i])
 }' "$W/rates"
