@@ -438,7 +438,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   if (!opt.resume && opt.only_case.empty()) clearResultFolder(root);  // --fresh: no stale case folders
   removeStaleTemps(root);
   const bool any_folder = std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return e.cases[i].output.caseFolder(); });
-  if (any_folder) fs::create_directories(root / "cases");
+  fs::create_directories(any_folder ? root / "cases" : root);
   // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
   for (const auto& [name, text] : folderInputs(e)) writeFileAtomic((root / name).string(), text);
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
