@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Are two tailsim result folders the same, measured wall times aside?  usage: compare_folders.py A B
 Every file under A and B (except .tailsim.lock) must exist in both; JSON files are compared with every
-"wall_time_s" removed, results.csv files without their wall_time_s column, everything else byte for byte.
+"wall_time_s" removed (also each line of cases.jsonl), results.csv files without their wall_time_s column,
+time_series.h5 by its h5dump listing (contents, not file layout), everything else byte for byte.
 Prints the differences and exits 1, or "identical: N files" and 0."""
-import csv, io, json, os, sys
+import csv, io, json, os, subprocess, sys
 
 def walk(root):
     out = set()
@@ -35,6 +36,11 @@ for rel in sorted(fa & fb):
     pa, pb = os.path.join(a, rel), os.path.join(b, rel)
     if rel.endswith(".json"):
         same = strip(json.load(open(pa))) == strip(json.load(open(pb)))
+    elif rel.endswith(".jsonl"):
+        same = [strip(json.loads(l)) for l in open(pa)] == [strip(json.loads(l)) for l in open(pb)]
+    elif rel.endswith(".h5"):
+        dump = lambda p: subprocess.run(["h5dump", p], capture_output=True, text=True, check=True).stdout.split("\n", 1)[1]
+        same = dump(pa) == dump(pb)
     elif os.path.basename(rel) == "results.csv":
         same = table(pa) == table(pb)
     else:

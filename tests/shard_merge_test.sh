@@ -16,6 +16,25 @@ python3 "$src/scripts/compare_folders.py" single par/merged || fail "4 shards by
 n=$(for k in 1 2 3 4; do python3 -c "import json,sys; print(len(json.load(open(sys.argv[1]))['cases']))" par/shards/$k-of-4/summary.json; done | sort -n | tr '\n' ' ')
 ok "fig09: 4 shards by GNU parallel (cases per shard: $n) merge identical to a single run"
 
+# Without case folders (output.time_series none: DIR/cases.jsonl; thin in hdf5: DIR/time_series.h5).
+for out in "{time_series: none}" "{time_series: thin, time_series_file: hdf5}"; do
+  cat > nf.yaml <<YAML
+name: nofolders
+robot: paper
+tail: {links: 1}
+trajectory: {theta0_deg: {range: [0, 90, 10]}, dtheta_deg: -90, dT_s: 0.25, w_ss: {sweep: [0.25, 0.5]}}
+models: [analytic]
+output: $out
+YAML
+  rm -rf nf_single nf1 nf2 nf3 nf_merged
+  "$tailsim" run nf.yaml --out nf_single --quiet --threads 2 >/dev/null
+  for k in 1 2 3; do "$tailsim" run nf.yaml --shard $k/3 --out nf$k --quiet --threads 2 >/dev/null; done
+  "$tailsim" merge nf1 nf2 nf3 --out nf_merged >/dev/null
+  [ ! -d nf_merged/cases ] || fail "$out: case folders in the merged folder"
+  python3 "$src/scripts/compare_folders.py" nf_single nf_merged || fail "$out: 3 shards merged differ from one run"
+  ok "output $out: 3 shards merged identical to a single run"
+done
+
 suite="$src/configs/paper/all.yaml"
 "$tailsim" run "$suite" --out psingle --quiet --threads 2 >/dev/null
 for k in 1 2 3; do "$tailsim" run "$suite" --shard $k/3 --out pshard$k --quiet --threads 2 >/dev/null; done

@@ -117,6 +117,16 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
   }
 }
 
+// Plots and reports of a folder whose cases kept no time series say so (on stderr): the figures
+// over time are left out, those over the swept values come from the results table.
+void printSeriesNotes(const std::string& dir) {
+  try {
+    for (const ExperimentResults& r : loadResultTree(dir))
+      if (const std::string note = r.seriesNote(); !note.empty()) std::fprintf(stderr, "note: %s\n", note.c_str());
+  } catch (const std::exception&) {  // the command itself reports an unreadable folder
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -261,7 +271,10 @@ int main(int argc, char** argv) {
         return kExitInterrupted;
       }
       if (shard_text.empty()) printCases(suite, out_dir, suite.size() > 1);  // a shard's table is mostly "not run"
-      if (plots) std::printf("report: %s\n", writeReport(out_dir).c_str());
+      if (plots) {
+        printSeriesNotes(out_dir);
+        std::printf("report: %s\n", writeReport(out_dir).c_str());
+      }
       return s.failed ? kExitRunsFailed : kExitOk;
     }
     if (*merge) {
@@ -338,12 +351,14 @@ int main(int argc, char** argv) {
       return rc == 0 ? kExitOk : kExitRunsFailed;
     }
     if (*plot) {
+      printSeriesNotes(result_dir);
       const auto files = plotResults(result_dir);
       for (const auto& f : files) std::printf("%s\n", f.png.c_str());
       std::printf("%s\n", figureSheetPath(result_dir).c_str());
       return kExitOk;
     }
     if (*report) {
+      printSeriesNotes(result_dir);
       std::printf("%s\n", writeReport(result_dir).c_str());
       return kExitOk;
     }

@@ -19,6 +19,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -33,11 +34,13 @@
 #include "experiments/render_case.h"
 #include "experiments/sharding.h"
 #include "experiments/results_table.h"
+#include "experiments/time_series_h5.h"
 #include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "results/atomic_file.h"
 #include "results/columns.h"
 #include "results/sha256.h"
+#include "results/thin_series.h"
 #include "tailsim_version.h"
 
 namespace tailsim {
@@ -128,6 +131,76 @@ std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {
 
 namespace {
 
+// DIR/cases.jsonl: the resume record of the cases that have no folder of their own (no CSV time
+// series: output.time_series none, or time_series_file hdf5). One line per finished case, the JSON
+// a case folder's result.json would hold, appended with one write() (O_APPEND) the moment the
+// case is done; no fsync (a kill -9 loses nothing the kernel has; a power cut may lose the last
+// lines, whose cases then run again). A torn last line (killed inside the write, or a full disk)
+// is cut off before the next run appends (readJournal). At the end of a run the file is rewritten
+// atomically with exactly the finished cases in case order, so it is the same whatever the order
+// the workers finished in (and after a resume).
+class CaseJournal {
+ public:
+  explicit CaseJournal(const fs::path& p) : path_(p) {}
+  ~CaseJournal() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  CaseJournal(const CaseJournal&) = delete;
+  CaseJournal& operator=(const CaseJournal&) = delete;
+  void append(const std::string& line) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (fd_ < 0) {
+      fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+      if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + path_.string());
+    }
+    size_t done = 0;
+    while (done < line.size()) {
+      const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw std::system_error(errno, std::generic_category(), "cannot append to " + path_.string());
+      done += static_cast<size_t>(n);
+    }
+  }
+  void close() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+  }
+
+ private:
+  fs::path path_;
+  std::mutex mu_;
+  int fd_ = -1;
+};
+
+// The finished cases of DIR/cases.jsonl by name (a later line wins). A last line without its
+// newline (torn by a kill or a full disk) is cut off the file, so the next append starts a line.
+std::map<std::string, json> readJournal(const fs::path& p, bool repair) {
+  std::map<std::string, json> out;
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return out;
+  std::ostringstream os;
+  os << in.rdbuf();
+  const std::string text = os.str();
+  const size_t end = text.rfind('\n');
+  const size_t whole = end == std::string::npos ? 0 : end + 1;  // bytes of complete lines
+  size_t at = 0;
+  while (at < whole) {
+    const size_t nl = text.find('\n', at);
+    json j = json::parse(text.begin() + static_cast<long>(at), text.begin() + static_cast<long>(nl), nullptr, false);
+    if (j.is_object() && j.contains("name") && j["name"].is_string()) {
+      const std::string name = j["name"].get<std::string>();  // before j is moved (C++17: right side first)
+      out[name] = std::move(j);
+    }
+    at = nl + 1;
+  }
+  if (repair && whole < text.size()) {
+    std::error_code ec;
+    fs::resize_file(p, whole, ec);
+  }
+  return out;
+}
+
 // One experiment's share of a run: its folder, what is finished, what is left.
 struct Job {
   const Experiment* e = nullptr;
@@ -139,7 +212,13 @@ struct Job {
   std::vector<size_t> todo;       // case indices to run now
   std::string source;             // recordedSource(*e), as found before the folder is written
   int total = 0, resumed = 0;
+  std::unique_ptr<CaseJournal> journal;     // DIR/cases.jsonl (cases without a folder)
+  std::vector<json> other_lines;            // per case: its journal line when not run now (else null)
+  std::unique_ptr<TimeSeriesH5Writer> h5;   // DIR/time_series.h5 (cases with time_series_file: hdf5)
 };
+
+bool keepsSeries(const ExperimentCase& c) { return c.output.time_series != TimeSeriesOutput::kNone; }
+bool inH5(const ExperimentCase& c) { return keepsSeries(c) && c.output.time_series_file == TimeSeriesFile::kHdf5; }
 
 // DIR/.tailsim.lock, flock()ed for the whole run: a second run into the same folder fails at once
 // instead of interleaving its writes. The file holds the owner's pid (for the message). The lock
@@ -199,18 +278,28 @@ std::pair<std::string, std::string> resultOwner(const fs::path& root) {
       const auto o = owner(readJsonFile(d.path() / "result.json"), "experiment");
       if (!o.first.empty()) return o;
     }
+  if (fs::exists(root / "cases.jsonl", ec)) {  // cases without a folder
+    std::ifstream in(root / "cases.jsonl");
+    std::string line;
+    if (std::getline(in, line)) {
+      const auto o = owner(json::parse(line, nullptr, false), "experiment");
+      if (!o.first.empty()) return o;
+    }
+  }
   return {};
 }
 
 bool holdsResults(const fs::path& root) {
   std::error_code ec;
-  return fs::exists(root / "summary.json", ec) || fs::is_directory(root / "cases", ec);
+  return fs::exists(root / "summary.json", ec) || fs::is_directory(root / "cases", ec) ||
+         fs::exists(root / "cases.jsonl", ec);
 }
 
 // The entries tailsim writes into a result folder (docs/ARCHITECTURE.md); nothing else is touched.
 void clearResultFolder(const fs::path& root) {
   for (const char* entry :
-       {"summary.json", "results.csv", "experiment.yaml", "robot.yaml", "mjcf", "report.md", "cases", "renders", "plots"})
+       {"summary.json", "results.csv", "experiment.yaml", "robot.yaml", "mjcf", "report.md", "cases", "cases.jsonl",
+        "time_series.h5", "renders", "plots"})
     fs::remove_all(root / entry);
   std::error_code ec;
   for (const auto& f : fs::directory_iterator(root, ec)) {  // a swept robot's copies: robot-<k>.yaml
@@ -348,27 +437,67 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   claimFolder(e, root, !opt.resume);
   if (!opt.resume && opt.only_case.empty()) clearResultFolder(root);  // --fresh: no stale case folders
   removeStaleTemps(root);
-  fs::create_directories(root / "cases");
+  const bool any_folder = std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return e.cases[i].output.caseFolder(); });
+  fs::create_directories(any_folder ? root / "cases" : root);
   // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
   for (const auto& [name, text] : folderInputs(e)) writeFileAtomic((root / name).string(), text);
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
   job.entries.resize(e.cases.size());
+  // Cases without a folder are finished when DIR/cases.jsonl has them; with their time series in
+  // DIR/time_series.h5, only when the published file also has their group with the same key
+  // (else they run again: a killed run never published its temporary file).
+  const bool any_journal =
+      std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return !e.cases[i].output.caseFolder(); });
+  const bool any_h5 = std::any_of(e.cases.begin(), e.cases.end(), [](const ExperimentCase& c) { return inH5(c); });
+  std::map<std::string, json> journal = readJournal(root / "cases.jsonl", true);
+  {  // the lines of cases not run now (--case, another shard's) are kept when the journal is rewritten
+    std::vector<char> now(e.cases.size(), 0);
+    for (size_t i : todo_all) now[i] = 1;
+    job.other_lines.resize(e.cases.size());
+    for (size_t i = 0; i < e.cases.size(); ++i)
+      if (!now[i])
+        if (auto it = journal.find(e.cases[i].name); it != journal.end()) job.other_lines[i] = it->second;
+  }
+  std::unique_ptr<TimeSeriesH5Reader> published;
+  if (any_h5) published = std::make_unique<TimeSeriesH5Reader>((root / "time_series.h5").string());
+  std::vector<size_t> copy_h5;  // resumed cases whose group is copied from the published file
   for (size_t i : todo_all) {  // finished cases of an earlier, interrupted run
-    const fs::path rj = root / "cases" / job.dirs[i] / "result.json";
-    if (opt.resume && fs::exists(rj)) {
-      json j = readJsonFile(rj);
-      // A case is reused only when everything its results depend on is unchanged (caseKey).
-      if (j.is_object() && j.value("key", std::string()) == job.keys[i] &&
-          j.value("name", std::string()) == e.cases[i].name) {
-        job.entries[i] = std::move(j);
-        ++job.resumed;
-        continue;
-      }
+    const ExperimentCase& c = e.cases[i];
+    json j;
+    if (!opt.resume) {
+    } else if (c.output.caseFolder()) {
+      const fs::path rj = root / "cases" / job.dirs[i] / "result.json";
+      if (fs::exists(rj)) j = readJsonFile(rj);
+    } else if (auto it = journal.find(c.name); it != journal.end()) {
+      j = std::move(it->second);
+    }
+    // A case is reused only when everything its results depend on is unchanged (caseKey).
+    bool reuse = j.is_object() && j.value("key", std::string()) == job.keys[i] && j.value("name", std::string()) == c.name;
+    if (reuse && inH5(c)) {
+      std::vector<std::string> models;
+      if (j.contains("runs") && j["runs"].is_object())
+        for (const auto& run : j["runs"].items()) models.push_back(run.key());
+      reuse = published && published->hasCase(job.dirs[i], job.keys[i], models);
+      if (reuse) copy_h5.push_back(i);
+    }
+    if (reuse) {
+      job.entries[i] = std::move(j);
+      ++job.resumed;
+      continue;
     }
     if (opt.merge_only)
       throw std::runtime_error("merge: case '" + e.cases[i].name + "' of experiment " + e.name +
                                " is finished in none of the shard folders (run its shard, or the shard again)");
     job.todo.push_back(i);
+  }
+  if (any_journal || !journal.empty()) job.journal = std::make_unique<CaseJournal>(root / "cases.jsonl");
+  if (any_h5) {
+    job.h5 = std::make_unique<TimeSeriesH5Writer>((root / "time_series.h5").string());
+    for (size_t i : copy_h5) job.h5->copyCase(*published, job.dirs[i]);
+    for (size_t i = 0; i < e.cases.size(); ++i)  // cases not run now keep their group
+      if (!job.other_lines[i].is_null() && inH5(e.cases[i]) &&
+          published->hasCase(job.dirs[i], job.keys[i], {}))
+        job.h5->copyCase(*published, job.dirs[i]);
   }
   return job;
 }
@@ -378,7 +507,8 @@ json runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
   const ExperimentCase& c = job.e->cases[i];
   const std::vector<RunResult> runs = runCase(c, &ctx);
   const fs::path dir = job.root / "cases" / job.dirs[i];
-  fs::create_directories(dir);
+  const bool folder = c.output.caseFolder();
+  if (folder) fs::create_directories(dir);
   json j;
   j["name"] = c.name;
   j["dir"] = job.dirs[i];
@@ -387,18 +517,30 @@ json runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
   j["key"] = job.keys[i];
   j["tailsim_version"] = kVersion;
   if (*kGitCommit) j["tailsim_git_commit"] = kGitCommit;
-  j["resolved"] = resolvedJson(c);  // every parameter the run used, defaults included
-  // ... but not where they were read from: a folder re-run from its own copies (robot.yaml,
-  // experiment.yaml) must write the same result.json; "source" above names the original input.
-  j["resolved"].erase("source_file");
-  j["resolved"].erase("robot_file");
+  // Every parameter the run used, defaults included, in a case folder's result.json. A case
+  // without a folder (a line of DIR/cases.jsonl, one of up to 10^5) leaves it out: it is 80 % of
+  // the line, and the folder's experiment.yaml resolves every case the same (ExperimentResults).
+  if (c.output.caseFolder()) {
+    j["resolved"] = resolvedJson(c);
+    // ... but not where they were read from: a folder re-run from its own copies (robot.yaml,
+    // experiment.yaml) must write the same result.json; "source" above names the original input.
+    j["resolved"].erase("source_file");
+    j["resolved"].erase("robot_file");
+  }
   j["sweep"] = json::object();
   for (const auto& [key, v] : c.sweep_values) j["sweep"][key] = v;
   j["runs"] = json::object();
+  const bool thin = c.output.time_series == TimeSeriesOutput::kThin;
+  const std::vector<double> marks = thin && c.kind == CaseKind::kSimulate ? c.trajectory().breakpoints() : std::vector<double>{};
   for (const RunResult& r : runs) {
     // Every model's CSV in the one column order (docs/ARCHITECTURE.md "Time-series columns").
-    writeCsvAtomic((dir / (r.summary.model + ".csv")).string(),
-                   col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series))));
+    if (keepsSeries(c)) {
+      TimeSeries ordered = col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series)));
+      if (thin) ordered = thinRows(ordered, marks);
+      if (folder) writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), ordered);
+      else job.h5->write(job.dirs[i], c.name, job.keys[i], c.sweep_values, r.summary.model,
+                         settings::nameOf(timeSeriesOutputNames(), c.output.time_series), ordered);
+    }
     j["runs"][r.summary.model] = summaryJson(r.summary);
     if (!r.summary.ok) ++failed_runs;
   }
@@ -418,14 +560,25 @@ json runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
     }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
-  writeFileAtomic((dir / "result.json").string(), j.dump(1));
+  if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
+  else job.journal->append(j.dump() + "\n");  // one line, one write(): the case is finished
   return j;
 }
 
 // Writes DIR/summary.json and DIR/results.csv (from the same entries: every finished case,
-// resumed ones included) and returns the summary.
-json writeSummary(const Job& job) {
+// resumed ones included) and returns the summary. The entries move into it (a sweep of 10^5
+// cases held them twice: 0.4 GB).
+json writeSummary(Job& job) {
   const Experiment& e = *job.e;
+  if (job.journal) {  // the finished cases without a folder, in case order (CaseJournal)
+    job.journal->close();
+    std::string lines;
+    for (size_t i = 0; i < job.entries.size(); ++i)
+      if (!job.entries[i].is_null() && !e.cases[i].output.caseFolder()) lines += job.entries[i].dump() + "\n";
+      else if (!job.other_lines[i].is_null()) lines += job.other_lines[i].dump() + "\n";
+    writeFileAtomic((job.root / "cases.jsonl").string(), lines);
+  }
+  if (job.h5) job.h5->publish();
   json s;
   s["experiment"] = e.name;
   s["tailsim_version"] = kVersion;
@@ -435,7 +588,7 @@ json writeSummary(const Job& job) {
   s["kind"] = e.cases.empty() ? "simulate" : name(e.cases.front().kind);
   s["swept_keys"] = e.swept_keys;
   s["cases"] = json::array();
-  for (json entry : job.entries)
+  for (json& entry : job.entries)
     if (!entry.is_null()) {
       entry.erase("experiment");  // said once, above
       entry.erase("source");
@@ -616,7 +769,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   stats.interrupted = stop.load();
   try {
     std::vector<json> summaries;
-    for (const Job& job : jobs) summaries.push_back(writeSummary(job));  // also after a failure: finished cases count
+    for (Job& job : jobs) summaries.push_back(writeSummary(job));  // also after a failure: finished cases count
     if (!suite_root.empty()) writeFileAtomic((suite_root / "results.csv").string(), resultsCsv(summaries));
   } catch (const std::exception&) {
     if (first_error.empty()) throw;  // else report the first error (a full disk fails the summary too)
@@ -635,7 +788,8 @@ RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
   const RunLock lock(opt.out_dir);
   const std::vector<std::vector<char>> in_shard =
       opt.shard_count > 1 ? shardMembership({e}, {opt.shard_index, opt.shard_count}) : std::vector<std::vector<char>>(1);
-  std::vector<Job> jobs{prepare(e, opt, opt.out_dir, in_shard.front())};
+  std::vector<Job> jobs;
+  jobs.push_back(prepare(e, opt, opt.out_dir, in_shard.front()));
   if (jobs.front().total == 0 && !opt.only_case.empty()) throw std::runtime_error("experiment " + e.name + " has no case named '" + opt.only_case + "'");
   return runJobs(jobs, opt, e.name);
 }

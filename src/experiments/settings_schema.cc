@@ -250,7 +250,8 @@ std::string settingsMarkdown() {
   table("mujoco", "Settings of the MuJoCo contact model (docs/mujoco-model.md).", describe<MujocoSettings>().rows);
   table("effects", "Which physical effects a scene simulates; the defaults reproduce the paper.",
         describe<Effects>().rows);
-  table("output", "The output time grid both models sample on.", describe<OutputSettings>().rows);
+  table("output", "The output time grid both models sample on, and which rows are kept where ([Time-series output](#time-series-output)).",
+        describe<OutputSettings>().rows);
   table("render", "The section's presence turns video on (`render: {}` = defaults); docs/rendering.md.",
         describe<RenderSettings>().rows);
   std::string s = o.str();

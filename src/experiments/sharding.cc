@@ -1,4 +1,5 @@
 #include "experiments/sharding.h"
+#include "experiments/time_series_h5.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -147,6 +148,16 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
         const fs::path rel = it->path().lexically_relative(root);
         if (rebuiltOrTransient(rel)) continue;
         const fs::path dst = stage / rel;
+        if (rel.filename() == "cases.jsonl") {  // finished cases without a folder: every shard's lines
+          fs::create_directories(dst.parent_path());
+          std::ofstream(dst, std::ios::binary | std::ios::app) << readAll(it->path());
+          continue;
+        }
+        if (rel.filename() == "time_series.h5") {  // every shard's case groups (the first shard's win)
+          fs::create_directories(dst.parent_path());
+          mergeTimeSeriesH5(it->path().string(), dst.string());
+          continue;
+        }
         if (perCase(rel)) {
           const fs::path cf = caseFolderOf(rel);
           if (std::find(taken_cases.begin(), taken_cases.end(), cf) != taken_cases.end()) continue;  // earlier shard's

@@ -11,6 +11,7 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
+#include "experiments/time_series_h5.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {
@@ -125,7 +126,24 @@ std::string ExperimentResults::csvPath(const CaseRecord& c, const std::string& m
 }
 
 TimeSeries ExperimentResults::series(const CaseRecord& c, const std::string& model) const {
+  if (const ExperimentCase* rc = resolvedCase(c)) {
+    if (rc->output.time_series == TimeSeriesOutput::kNone)
+      throw std::runtime_error("case " + c.name + " has no time series (output.time_series: none): time-series "
+                               "figures need output.time_series: full or thin; results.csv has its results");
+    if (rc->output.time_series_file == TimeSeriesFile::kHdf5)
+      return TimeSeriesH5Reader((fs::path(dir) / "time_series.h5").string()).read(c.dir, model);
+  }
   return readCsv(csvPath(c, model));
+}
+
+std::string ExperimentResults::seriesNote() const {
+  size_t none = 0;
+  for (const CaseRecord& c : cases)
+    if (const ExperimentCase* rc = resolvedCase(c); rc && rc->output.time_series == TimeSeriesOutput::kNone) ++none;
+  if (none == 0) return {};
+  return name + ": " + std::to_string(none) + " of " + std::to_string(cases.size()) +
+         " cases have no time series (output.time_series: none); figures over time need output.time_series: full "
+         "or thin, figures of phi_net over the swept values are drawn from results.csv";
 }
 
 double ExperimentResults::phiNet(const CaseRecord& c, const std::string& model) const {
@@ -170,6 +188,17 @@ ExperimentResults loadResults(const std::string& dir) {
       for (const json& key : *k) keys.push_back(key.get<std::string>());
     if (auto cs = s.find("cases"); cs != s.end() && cs->is_array())
       for (const json& c : *cs) r.cases.push_back(parseCase(c));
+  } else if (fs::exists(root / "cases.jsonl") && !fs::is_directory(root / "cases")) {
+    // an interrupted run whose cases have no folder: its journal (a torn last line is skipped)
+    std::ifstream in(root / "cases.jsonl");
+    std::string line;
+    while (std::getline(in, line)) {
+      const json j = json::parse(line, nullptr, false);
+      if (!j.is_object()) continue;
+      if (r.name.empty()) r.name = j.value("experiment", std::string());
+      if (r.source.empty()) r.source = j.value("source", std::string());
+      r.cases.push_back(parseCase(j));
+    }
   } else if (fs::is_directory(root / "cases")) {
     std::vector<fs::path> files;
     for (const auto& e : fs::directory_iterator(root / "cases"))
@@ -182,7 +211,7 @@ ExperimentResults loadResults(const std::string& dir) {
       r.cases.push_back(parseCase(j));
     }
   } else {
-    throw std::runtime_error(dir + " is not a result folder (no summary.json, no cases/)");
+    throw std::runtime_error(dir + " is not a result folder (no summary.json, no cases/, no cases.jsonl)");
   }
   const bool kind_given = !r.kind.empty();
   if (!kind_given) r.kind = "simulate";
@@ -240,7 +269,8 @@ std::vector<ExperimentResults> loadResultTree(const std::string& dir) {
   std::vector<fs::path> subs;
   if (fs::is_directory(root))
     for (const auto& e : fs::directory_iterator(root))
-      if (e.is_directory() && (fs::exists(e.path() / "summary.json") || fs::is_directory(e.path() / "cases")))
+      if (e.is_directory() && (fs::exists(e.path() / "summary.json") || fs::is_directory(e.path() / "cases") ||
+                               fs::exists(e.path() / "cases.jsonl")))
         subs.push_back(e.path());
   std::sort(subs.begin(), subs.end());
   if (subs.empty()) throw std::runtime_error(dir + " holds no result folder (no summary.json in it or its subfolders)");

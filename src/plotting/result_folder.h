@@ -60,7 +60,12 @@ struct ExperimentResults {
 
   // DIR/cases/<case.dir>/<model>.csv; throws std::runtime_error if unreadable.
   std::string csvPath(const CaseRecord& c, const std::string& model) const;
+  // The case's time series: DIR/cases/<dir>/<model>.csv, or /<dir>/<model> of DIR/time_series.h5
+  // (output.time_series_file: hdf5). Throws std::runtime_error, saying so when the case kept none
+  // (output.time_series: none).
   TimeSeries series(const CaseRecord& c, const std::string& model) const;
+  // Empty, or a sentence saying how many cases have no time series and what that means for plots.
+  std::string seriesNote() const;
   // phi_net of a run, NaN if the model did not run or failed.
   double phiNet(const CaseRecord& c, const std::string& model) const;
   bool hasModel(const std::string& model) const;

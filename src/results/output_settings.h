@@ -1,14 +1,43 @@
-// The output time grid that both models sample on, so their CSVs line up row for row.
+// The output time grid that both models sample on, so their CSVs line up row for row, and which
+// of the sampled rows are kept, and where (docs/experiment-format.md "Time-series output").
 #pragma once
 
 #include "settings/fields.h"
 
 namespace tailsim {
 
+// Which rows of the time series a case keeps (issue 13).
+enum class TimeSeriesOutput {
+  kFull,  // every sample (today's behaviour)
+  kThin,  // the rows of thinRows() (results/thin_series.h): a 10-sample grid plus events and extremes
+  kNone,  // no time series: the case's results are its row of results.csv / summary.json only
+};
+
+// Where the kept rows go.
+enum class TimeSeriesFile {
+  kCsv,   // DIR/cases/<dir>/<model>.csv, one file per case and model
+  kHdf5,  // DIR/time_series.h5, one group per case and model for the whole experiment
+};
+
+inline const settings::EnumNames<TimeSeriesOutput>& timeSeriesOutputNames() {
+  static const settings::EnumNames<TimeSeriesOutput> k = {
+      {TimeSeriesOutput::kFull, "full"}, {TimeSeriesOutput::kThin, "thin"}, {TimeSeriesOutput::kNone, "none"}};
+  return k;
+}
+inline const settings::EnumNames<TimeSeriesFile>& timeSeriesFileNames() {
+  static const settings::EnumNames<TimeSeriesFile> k = {{TimeSeriesFile::kCsv, "csv"}, {TimeSeriesFile::kHdf5, "hdf5"}};
+  return k;
+}
+
 struct OutputSettings {
   double sample_dt_s = 1e-3;  // CSV row spacing  [s]
   double duration_s = 0.0;    // simulated time; 0 = tail end time + settle_s  [s]
   double settle_s = 0.5;      // time simulated after the tail stops, when duration_s = 0  [s]
+  TimeSeriesOutput time_series = TimeSeriesOutput::kFull;
+  TimeSeriesFile time_series_file = TimeSeriesFile::kCsv;
+
+  // Whether the case gets its own folder DIR/cases/<dir>/ (CSV time series kept).
+  bool caseFolder() const { return time_series != TimeSeriesOutput::kNone && time_series_file == TimeSeriesFile::kCsv; }
 };
 
 // The YAML/JSON keys of OutputSettings (settings/fields.h), declared once.
@@ -20,6 +49,14 @@ settings::For<S, OutputSettings> declareFields(V& v, S& s) {
   v.number(Field{"duration_s", "simulated time; 0 = tail end time + settle_s [s]"}, s.duration_s, Limits::nonNegative());
   v.number(Field{"settle_s", "time simulated after the tail stops, when duration_s = 0 [s]"}, s.settle_s,
            Limits::nonNegative());
+  v.choice(Field{"time_series",
+                 "full: every sample; thin: every 10th sample plus stick/slip switches, tail phase boundaries and "
+                 "phi's turning points and extremes; none: no time series, no case folders (results.csv only)"},
+           s.time_series, timeSeriesOutputNames());
+  v.choice(Field{"time_series_file",
+                 "csv: cases/<case>/<model>.csv; hdf5: the whole experiment in DIR/time_series.h5 (one group per "
+                 "case and model), no case folders"},
+           s.time_series_file, timeSeriesFileNames());
 }
 
 }  // namespace tailsim

@@ -1,0 +1,75 @@
+// The time series of a whole experiment in one HDF5 file, DIR/time_series.h5
+// (`output.time_series_file: hdf5`, docs/experiment-format.md "Time-series output"):
+//   /<case dir>/                 one group per case (caseDirName); attributes: "case" (its name),
+//                                "key" (its resume key), and one per swept key (dotted name; a number
+//                                as a double, anything else as a string)
+//   /<case dir>/<model>/         one group per model run; attribute "time_series" (full | thin)
+//   /<case dir>/<model>/<column> one 1-D float64 dataset per CSV column, named as the CSV column,
+//                                attribute "units" ("s", "deg", "deg/s", "N m", ...; "1" for states)
+// Written to a temporary file beside the target (<file>.tmp.<pid>.h5) and renamed over it when the
+// run ends, so a killed run never leaves a torn published file. The C API's handles are wrapped
+// (H5Handle); Debian's libhdf5 is built thread-safe, and each writer also serializes its own calls.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "results/time_series.h"
+
+namespace tailsim {
+
+// The unit of a column from its name's suffix (t_s -> "s", phidot_dps -> "deg/s", MzT_Nm -> "N m").
+std::string columnUnits(const std::string& column);
+
+// Reads a published file (never written through this class).
+class TimeSeriesH5Reader {
+ public:
+  // Opens `path` read-only; ok() is false when it is absent or not an HDF5 file.
+  explicit TimeSeriesH5Reader(const std::string& path);
+  ~TimeSeriesH5Reader();
+  TimeSeriesH5Reader(const TimeSeriesH5Reader&) = delete;
+  TimeSeriesH5Reader& operator=(const TimeSeriesH5Reader&) = delete;
+  bool ok() const;
+  // Whether /<case_dir> exists with attribute "key" == key and a group per model.
+  bool hasCase(const std::string& case_dir, const std::string& key, const std::vector<std::string>& models) const;
+  // The columns of /<case_dir>/<model> in the order they were written; throws std::runtime_error.
+  TimeSeries read(const std::string& case_dir, const std::string& model) const;
+  long long handle() const;  // the file's hid_t (for TimeSeriesH5Writer::copyCase)
+
+ private:
+  long long file_ = -1;
+  std::string path_;
+};
+
+class TimeSeriesH5Writer {
+ public:
+  // Creates the temporary file beside `final_path`; throws std::runtime_error.
+  explicit TimeSeriesH5Writer(const std::string& final_path);
+  // Not published: the temporary file is closed and removed.
+  ~TimeSeriesH5Writer();
+  TimeSeriesH5Writer(const TimeSeriesH5Writer&) = delete;
+  TimeSeriesH5Writer& operator=(const TimeSeriesH5Writer&) = delete;
+
+  // /<case_dir>: created on first use with its attributes.
+  void write(const std::string& case_dir, const std::string& case_name, const std::string& key,
+             const std::map<std::string, std::string>& sweep, const std::string& model, const std::string& mode,
+             const TimeSeries& ts);
+  // Copies /<case_dir> (all its models) from a published file (H5Ocopy).
+  void copyCase(const TimeSeriesH5Reader& from, const std::string& case_dir);
+  // Closes the file and renames it over final_path.
+  void publish();
+
+ private:
+  std::mutex mu_;
+  long long file_ = -1;
+  std::string final_path_, temp_path_;
+  bool published_ = false;
+};
+
+// Copies every case group of `src` that `dst` lacks into `dst` (created when absent): joins the
+// files of shard folders (tailsim merge). Throws std::runtime_error.
+void mergeTimeSeriesH5(const std::string& src, const std::string& dst);
+
+}  // namespace tailsim
