@@ -202,6 +202,11 @@ PYBIND11_MODULE(tailsim, m) {
             "see docs/python.md.";
   m.attr("__version__") = kVersion;
   py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
+  // pybind11 sets up numpy's C API in a function-local static on the first array made. Made first by
+  // two pool threads at once, one waits in the static's guard holding nothing while the other imports
+  // numpy and waits for the GIL: a deadlock. Do it here, once, while importing the module.
+  py::module_::import("numpy");
+  (void)py::array_t<double>(0);
 
   py::class_<Simulation>(m, "Simulation", "The result of tailsim.simulate(): one model run of one case")
       .def_readonly("series", &Simulation::series, "column name -> 1-D numpy array (the CSV's columns)")
