@@ -39,6 +39,21 @@ printf 'name: installed\nrobot: paper\ntail: {links: 1}\ntrajectory: {theta0_deg
   >"$tmp/elsewhere/exp.yaml"
 (cd "$tmp/elsewhere" && "$tmp/prefix/bin/tailsim" run exp.yaml --out res --quiet >/dev/null) || fail "installed tailsim run"
 ok "installed tailsim runs an experiment with 'robot: paper' from another folder"
+# the installed Python module (when built): imported from the prefix, it finds the robots installed there
+if ls "$bin"/python/tailsim*.so >/dev/null 2>&1; then
+  py=$(grep -m1 '^_Python3_EXECUTABLE:INTERNAL=' "$bin/CMakeCache.txt" | cut -d= -f2)
+  pydir=$(grep -m1 '^TAILSIM_PYTHON_INSTALL_DIR:' "$bin/CMakeCache.txt" | cut -d= -f2)
+  ls "$tmp/prefix/$pydir"/tailsim*.so >/dev/null 2>&1 || fail "Python module not installed in $pydir"
+  got=$(cd "$tmp/elsewhere" && PYTHONPATH="$tmp/prefix/$pydir" "${py:-python3}" -c '
+import sys, tailsim
+assert tailsim.__file__.startswith(sys.argv[1]), tailsim.__file__
+assert tailsim.robot("paper")["file"] == sys.argv[1] + "/share/tailsim/robots/paper_quadruped.yaml", tailsim.robot("paper")["file"]
+r = tailsim.simulate(robot="paper", tail={"links": 1}, quadruped={"d_Q2B_m": 0.125},
+                     trajectory={"theta0_deg": 0, "dtheta_deg": -90, "dT_s": 0.25, "w_ss": 0.25})
+print("%.6f" % r.summary["phi_net_deg"])' "$tmp/prefix") || fail "installed Python module"
+  [ "$got" = "$want" ] || fail "installed Python module: phi_net $got, the CLI says $want"
+  ok "installed Python module ($pydir) uses <prefix>/share/tailsim/robots and prints phi_net $want"
+fi
 
 # (2) add_subdirectory: builds only tailsim::analytic's libraries for fig7
 cmake -S "$src/tests/downstream" -B "$tmp/sub" -DTAILSIM_SOURCE="$src" -DCMAKE_BUILD_TYPE=Release \

@@ -7,6 +7,7 @@
 // reported before any work starts. Each error names file:line:col and the dotted key.
 #include "experiments/experiment_loader.h"
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -716,8 +717,11 @@ std::string readFileBounded(const std::string& file) {
   return text;
 }
 
-YAML::Node parseYaml(const std::string* file) {
-  const std::string text = readFileBounded(*file);
+// `text` as the YAML document of `file` (the name its errors carry), within the same bounds.
+YAML::Node parseYamlText(const std::string* file, const std::string& text) {
+  if (text.size() > kMaxYamlBytes)
+    throw ConfigError(*file + ": the text is larger than " + std::to_string(kMaxYamlBytes >> 20) +
+                      " MiB; experiment, suite and robot files are small YAML files");
   try {
     {
       std::istringstream in(text);
@@ -734,6 +738,8 @@ YAML::Node parseYaml(const std::string* file) {
     fail(Loc{file, e.mark, ""}, std::string("YAML error: ") + e.what());
   }
 }
+
+YAML::Node parseYaml(const std::string* file) { return parseYamlText(file, readFileBounded(*file)); }
 
 std::unique_ptr<RobotFile> readRobotFile(const std::string& abs) {
   auto rf = std::make_unique<RobotFile>();
@@ -788,7 +794,8 @@ struct Loader {
 std::string absolutePath(const std::string& p) { return fs::absolute(fs::path(p)).lexically_normal().string(); }
 std::string resolveRelative(const std::string& base_file, const std::string& p) {
   const fs::path q(p);
-  return (q.is_absolute() ? q : fs::path(base_file).parent_path() / q).lexically_normal().string();
+  // A relative base (the label of an experiment given as text) means the working directory.
+  return fs::absolute(q.is_absolute() ? q : fs::path(base_file).parent_path() / q).lexically_normal().string();
 }
 
 // Built-in robots: `robot: paper` names the robot file packaged with tailsim, so an experiment
@@ -796,13 +803,28 @@ std::string resolveRelative(const std::string& base_file, const std::string& p) 
 // path, relative to the experiment file.
 bool isBuiltinRobotName(const std::string& v) { return v.find_first_of("/.") == std::string::npos; }
 
-// The packaged robots folder: configs/robots next to the executable's build folder (build/tailsim ->
-// configs/robots, so a moved checkout still works), then the source tree tailsim was built from.
+// The packaged robots folder, looked for from the file holding this code (the program, or the
+// Python module tailsim links into): configs/robots next to its build folder (build/tailsim ->
+// configs/robots, so a moved checkout still works); an installed copy, <a>/share/tailsim/robots for
+// the nearest of its ancestors a (<prefix>/bin/tailsim, <prefix>/lib/python3/dist-packages/tailsim.so
+// -> <prefix>/share/tailsim/robots); then the source tree tailsim was built from.
 std::vector<fs::path> builtinRobotDirs() {
   std::vector<fs::path> dirs;
   std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back((exe.parent_path().parent_path() / "configs" / "robots").lexically_normal());
+  fs::path self;
+  Dl_info info{};
+  if (dladdr(reinterpret_cast<void*>(&builtinRobotDirs), &info) && info.dli_fname && *info.dli_fname)
+    self = fs::canonical(info.dli_fname, ec);
+  if (self.empty() || ec) self = fs::read_symlink("/proc/self/exe", ec);
+  if (!self.empty()) {
+    const fs::path here = self.parent_path();
+    dirs.push_back((here.parent_path() / "configs" / "robots").lexically_normal());
+    int up = 0;
+    for (fs::path a = here; up < 4; a = a.parent_path(), ++up) {
+      dirs.push_back((a / "share" / "tailsim" / "robots").lexically_normal());
+      if (a == a.parent_path()) break;
+    }
+  }
 #ifdef TAILSIM_ROBOTS_DIR
   dirs.push_back(fs::path(TAILSIM_ROBOTS_DIR).lexically_normal());
 #endif
@@ -1232,6 +1254,26 @@ Experiment loadExperiment(const std::string& path) {
   if (isSuite(doc))
     fail(Loc{file, doc["experiments"].Mark(), "experiments"}, "this is a suite file; load it with loadExperimentSuite");
   return readExperiment(L, file, doc);
+}
+
+Experiment loadExperimentText(const std::string& text, const std::string& label) {
+  Loader L;
+  const std::string* file = L.keep(label);
+  const YAML::Node doc = parseYamlText(file, text);
+  if (isSuite(doc))
+    fail(Loc{file, doc["experiments"].Mark(), "experiments"}, "a suite is given by its file; use loadExperimentSuite");
+  return readExperiment(L, file, doc);
+}
+
+RobotFileData loadRobotFile(const std::string& name_or_path) {
+  if (name_or_path.empty()) throw ConfigError("robot: needs a built-in robot name (paper) or the path of a robot file");
+  const std::string abs = isBuiltinRobotName(name_or_path)
+                              ? builtinRobotFile(name_or_path, Loc{&name_or_path, YAML::Mark::null_mark(), ""})
+                                                           : absolutePath(name_or_path);
+  std::error_code ec;
+  if (!fs::is_regular_file(abs, ec)) throw ConfigError(abs + ": robot file not found");
+  const std::unique_ptr<RobotFile> rf = readRobotFile(abs);
+  return RobotFileData{rf->file, rf->base, rf->tails};
 }
 
 std::vector<Experiment> loadExperimentSuite(const std::string& path) {

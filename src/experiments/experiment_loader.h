@@ -2,6 +2,7 @@
 // The file format is described in docs/experiment-format.md.
 #pragma once
 
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +28,20 @@ struct Experiment {
 
 // Loads and validates every case of one experiment file before returning. Throws ConfigError.
 Experiment loadExperiment(const std::string& path);
+
+// The same for an experiment given as YAML text (e.g. built from Python dicts by the tailsim module):
+// `label` stands for the file name in errors ("<label>:line:col: key: ..."), and relative paths in
+// it (a robot file) are relative to the working directory. Throws ConfigError.
+Experiment loadExperimentText(const std::string& text, const std::string& label);
+
+// A robot file (`robot:` of an experiment): a built-in name (paper) or a path (relative to the
+// working directory), read and validated as the loader does. Throws ConfigError.
+struct RobotFileData {
+  std::string file;               // absolute path of the file read
+  RobotParams base;               // quadruped, friction, gravity; tail empty
+  std::map<int, TailLink> tails;  // tails.<n>: the link of an n-link tail (all n links alike)
+};
+RobotFileData loadRobotFile(const std::string& name_or_path);
 
 // A suite file is `experiments: [fig06.yaml, ...]` (paths relative to the suite file; entries may
 // be suites themselves). A normal experiment file yields a one-element vector. Throws ConfigError.

@@ -60,22 +60,6 @@ struct PollFd {
   int fd;
 };
 
-json summaryJson(const RunSummary& s) {
-  json j;
-  j["ok"] = s.ok;
-  // A failed run has no phi_net (null, never a number a reader could take for a result).
-  j["phi_net_deg"] = s.ok && std::isfinite(s.phi_net_deg) ? json(s.phi_net_deg) : json(nullptr);
-  j["t_stop_s"] = s.t_stop_s;
-  j["stick_slip_events"] = s.stick_slip_events;
-  j["wall_time_s"] = s.wall_time_s;
-  j["solver_steps"] = s.solver_steps;
-  if (!s.error.empty()) j["error"] = s.error;
-  // A finished run: was the body at rest at the end, and what makes the result doubtful.
-  j["at_rest"] = s.ok ? json(s.at_rest) : json(nullptr);
-  j["warnings"] = s.warnings;
-  for (const auto& [k, v] : s.extra) j["extra"][k] = std::isfinite(v) ? json(v) : json(nullptr);
-  return j;
-}
 
 std::string fmtSeconds(double s) {
   char b[32];
@@ -110,6 +94,23 @@ std::string caseDirName(const std::string& name) {
   if (!d.empty() && (d[0] == '.' || d[0] == '-')) d[0] = '_';
   if (d.empty()) d = "case";
   return d + "~" + sha256Hex(name).substr(0, 16);
+}
+
+json summaryJson(const RunSummary& s) {
+  json j;
+  j["ok"] = s.ok;
+  // A failed run has no phi_net (null, never a number a reader could take for a result).
+  j["phi_net_deg"] = s.ok && std::isfinite(s.phi_net_deg) ? json(s.phi_net_deg) : json(nullptr);
+  j["t_stop_s"] = s.t_stop_s;
+  j["stick_slip_events"] = s.stick_slip_events;
+  j["wall_time_s"] = s.wall_time_s;
+  j["solver_steps"] = s.solver_steps;
+  if (!s.error.empty()) j["error"] = s.error;
+  // A finished run: was the body at rest at the end, and what makes the result doubtful.
+  j["at_rest"] = s.ok ? json(s.at_rest) : json(nullptr);
+  j["warnings"] = s.warnings;
+  for (const auto& [k, v] : s.extra) j["extra"][k] = std::isfinite(v) ? json(v) : json(nullptr);
+  return j;
 }
 
 std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {

@@ -46,6 +46,9 @@ struct RunStats {
 // `ctx`: caches shared by the cases of a run (model_registry.h), or nullptr.
 std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx = nullptr);
 
+// A run's entry under "runs" in summary.json and result.json ({"ok", "phi_net_deg", ...}).
+nlohmann::json summaryJson(const RunSummary& s);
+
 // The folder name of a case under DIR/cases/.
 // Unique by construction: a name of [A-Za-z0-9.=,_-] (not starting with . or -, <= 100 chars) is
 // its own folder; any other gets a sanitized, shortened form + "~" + 16 hex digits of its SHA-256.

@@ -1,0 +1,245 @@
+// The Python module `tailsim` (issue 14, item 2; docs/python.md): the experiments layer seen from
+// Python. Every input goes through the YAML loader (experiments/experiment_loader.h): a file by its
+// path (run), or keyword arguments shaped like the sections of an experiment file, written as the
+// YAML text of one experiment (simulate). So keys, units, ranges, defaults and error messages are
+// the CLI's, declared once (settings/fields.h). No file is written except by run().
+//
+// The GIL is released while the loader and the models work, so Python threads run cases in parallel.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "experiments/experiment_loader.h"
+#include "experiments/experiment_runner.h"
+#include "experiments/model_registry.h"
+#include "experiments/settings_json.h"
+#include "results/columns.h"
+#include "tailsim_version.h"
+
+namespace py = pybind11;
+using json = nlohmann::json;
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// JSON -> Python objects through Python's own json module (floats round-trip exactly both ways).
+py::object toPython(const json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+// Writes a settings struct under its YAML keys and units (the value as an experiment file gives it).
+struct YamlKeyWriter {
+  json& j;
+  void number(const settings::Field& f, double x, const settings::Limits&) { j[f.key] = x / f.scale; }
+  void integer(const settings::Field& f, int x, const settings::Limits&, const settings::IntSet& = {}) { j[f.key] = x; }
+  void boolean(const settings::Field& f, bool x) { j[f.key] = x; }
+  template <class E>
+  void choice(const settings::Field& f, E x, const settings::EnumNames<E>& names) {
+    j[f.key] = settings::nameOf(names, x);
+  }
+  void text(const settings::Field& f, const std::string& x, const settings::TextRule&) { j[f.key] = x; }
+  template <std::size_t N>
+  void numbers(const settings::Field& f, const std::array<double, N>& x) {
+    j[f.key] = std::vector<double>(x.begin(), x.end());
+  }
+  template <class T>
+  void internal(const settings::Field&, const T&) {}  // not a YAML key
+};
+template <class S>
+json yamlKeys(const S& s) {
+  json j = json::object();
+  YamlKeyWriter w{j};
+  declareFields(w, s);
+  return j;
+}
+
+// A Python dict -> the YAML text of one experiment (JSON is YAML; one key a line, so a loader
+// error's line:col points into this text). numpy scalars and arrays become plain numbers and lists.
+std::string yamlText(const py::dict& doc) {
+  const py::cpp_function plain([](py::object o) -> py::object {
+    if (py::hasattr(o, "tolist")) return o.attr("tolist")();
+    throw py::type_error("tailsim: cannot use a value of type " + std::string(py::str(o.get_type().attr("__name__"))) +
+                         " in a setting (numbers, strings, booleans, lists and dicts only)");
+  });
+  return py::module_::import("json").attr("dumps")(doc, py::arg("indent") = 1, py::arg("default") = plain)
+      .cast<std::string>();
+}
+
+// What simulate() returns: the time series (columns in the CSV's order), the summary (summary.json's
+// entry for the run) and every resolved parameter (result.json's "resolved").
+struct Simulation {
+  py::dict series;     // column name -> 1-D float64 numpy array
+  py::list columns;    // the names, in the CSV's column order
+  py::dict summary;
+  py::dict resolved;
+  std::string model;
+};
+
+py::dict seriesToNumpy(const TimeSeries& ts, py::list& columns) {
+  py::dict out;
+  for (std::size_t c = 0; c < ts.numColumns(); ++c) {
+    const std::vector<double>& v = ts.values(static_cast<int>(c));
+    py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+    std::copy(v.begin(), v.end(), a.mutable_data());
+    out[py::str(ts.names()[c])] = a;
+    columns.append(py::str(ts.names()[c]));
+  }
+  return out;
+}
+
+constexpr const char* kSimulateLabel = "<tailsim.simulate>";
+
+Simulation simulate(const std::string& robot, py::object trajectory, const std::string& model, py::kwargs sections) {
+  for (const char* k : {"name", "robot", "models"})
+    if (sections.contains(k))
+      throw py::type_error(std::string("tailsim.simulate: '") + k + "' is not a keyword here" +
+                           (std::string(k) == "models" ? " (model='analytic' or 'mujoco': one model a call)" : ""));
+  py::dict doc;
+  doc["name"] = "simulate";
+  doc["robot"] = robot;
+  for (auto kv : sections) doc[kv.first] = kv.second;
+  if (!trajectory.is_none()) doc["trajectory"] = trajectory;
+  py::list models;
+  models.append(model);
+  doc["models"] = models;
+  const std::string text = yamlText(doc);
+
+  std::vector<RunResult> runs;
+  ExperimentCase c;
+  {
+    py::gil_scoped_release free;
+    Experiment e = loadExperimentText(text, kSimulateLabel);
+    if (e.cases.size() != 1)
+      throw ConfigError(std::string(kSimulateLabel) + ": the arguments sweep " + std::to_string(e.cases.size()) +
+                        " cases (" + e.swept_keys.front() + ", ...); simulate() runs one case: give single values, "
+                        "or loop in Python, or save the experiment and use tailsim.run()");
+    c = std::move(e.cases.front());
+    runs = runCase(c);
+  }
+  const RunResult& r = runs.front();
+  Simulation s;
+  const TimeSeries ordered =
+      c.kind == CaseKind::kSimulate ? col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series))) : r.series;
+  s.series = seriesToNumpy(ordered, s.columns);
+  s.summary = toPython(summaryJson(r.summary));
+  json resolved = resolvedJson(c);
+  resolved.erase("source_file");
+  s.resolved = toPython(resolved);
+  s.model = r.summary.model;
+  return s;
+}
+
+// tailsim run EXPERIMENT --out DIR [--models ...] [--threads N] [--case NAME] [--fresh] [--no-render]
+py::object run(const std::string& experiment, const std::string& out, std::vector<std::string> models, int threads,
+               const std::string& case_name, bool fresh, bool render, bool progress) {
+  std::vector<Experiment> suite;
+  {
+    py::gil_scoped_release free;
+    suite = loadExperimentSuite(experiment);  // all errors before any work
+    if (!models.empty())
+      for (Experiment& e : suite)
+        for (ExperimentCase& c : e.cases) {
+          std::vector<std::string> keep;
+          for (const std::string& m : c.models)
+            if (std::find(models.begin(), models.end(), m) != models.end()) keep.push_back(m);
+          c.models = keep;
+        }
+    if (!case_name.empty()) {
+      bool found = false;
+      for (const Experiment& e : suite)
+        for (const ExperimentCase& c : e.cases) found = found || c.name == case_name;
+      if (!found) throw std::runtime_error("no case named '" + case_name + "' in " + experiment);
+    }
+    RunOptions o;
+    o.out_dir = out;
+    o.threads = threads;
+    o.render = render;
+    o.resume = !fresh;
+    o.progress = progress;
+    o.only_case = case_name;
+    runSuite(suite, o);
+  }
+  // The summary as the folder holds it (a suite: one per member, by experiment name).
+  auto read = [](const fs::path& f) {
+    std::ifstream in(f);
+    if (!in) throw std::runtime_error(f.string() + ": cannot read the summary");
+    return toPython(json::parse(in));
+  };
+  if (suite.size() == 1) return read(fs::path(out) / "summary.json");
+  py::dict all;
+  for (const Experiment& e : suite) all[py::str(e.name)] = read(fs::path(out) / e.name / "summary.json");
+  return all;
+}
+
+py::dict robotDict(const std::string& name_or_path) {
+  const RobotFileData rf = loadRobotFile(name_or_path);
+  json j;
+  j["quadruped"] = yamlKeys(rf.base.quadruped);
+  j["friction"] = yamlKeys(rf.base.friction);
+  j["gravity_mps2"] = rf.base.gravity_mps2;
+  py::dict d = toPython(j);
+  py::dict tails;
+  for (const auto& [n, link] : rf.tails) tails[py::int_(n)] = toPython(yamlKeys(link));
+  d["tails"] = tails;
+  d["file"] = rf.file;
+  return d;
+}
+
+}  // namespace
+}  // namespace tailsim
+
+PYBIND11_MODULE(tailsim, m) {
+  using namespace tailsim;
+  m.doc() = "tailsim: a quadruped turned by a planar robotic tail (Rone & Ben-Tzvi 2016), analytic and MuJoCo "
+            "models. Settings use the YAML keys and units of experiment files (docs/experiment-format.md); "
+            "see docs/python.md.";
+  m.attr("__version__") = kVersion;
+  py::register_exception<ConfigError>(m, "ConfigError", PyExc_ValueError);
+  // pybind11 sets up numpy's C API in a function-local static on the first array made. Made first by
+  // two pool threads at once, one waits in the static's guard holding nothing while the other imports
+  // numpy and waits for the GIL: a deadlock. Do it here, once, while importing the module.
+  py::module_::import("numpy");
+  (void)py::array_t<double>(0);
+
+  py::class_<Simulation>(m, "Simulation", "The result of tailsim.simulate(): one model run of one case")
+      .def_readonly("series", &Simulation::series, "column name -> 1-D numpy array (the CSV's columns)")
+      .def_readonly("columns", &Simulation::columns, "column names in the CSV's order")
+      .def_readonly("summary", &Simulation::summary, "the run's summary, as summary.json's runs.<model>")
+      .def_readonly("resolved", &Simulation::resolved, "every parameter used, SI units (result.json's resolved)")
+      .def_readonly("model", &Simulation::model)
+      .def("__getitem__", [](const Simulation& s, const std::string& k) -> py::object {
+        if (!s.series.contains(k)) throw py::key_error(k);
+        return s.series[py::str(k)];
+      })
+      .def("__repr__", [](const Simulation& s) {
+        const py::object phi = s.summary["phi_net_deg"];
+        return "<tailsim.Simulation " + s.model + ": " + std::to_string(py::len(s.columns)) + " columns, " +
+               std::to_string(s.series.contains("t_s") ? py::len(s.series["t_s"]) : 0) + " rows, phi_net_deg=" +
+               std::string(py::repr(phi)) + ">";
+      });
+
+  m.def("simulate", &simulate, py::arg("robot") = "paper", py::arg("trajectory") = py::none(),
+        py::arg("model") = "analytic",
+        "simulate(robot='paper', trajectory={...}, model='analytic'|'mujoco'|'perfoot', **sections) -> Simulation\n\n"
+        "One case, no files written. The keywords are the top-level keys of an experiment file (tail, quadruped,\n"
+        "friction, gravity_mps2, kind, pose, analytic, perfoot, mujoco, effects, output) with dicts shaped as in\n"
+        "YAML, e.g. trajectory={'theta0_deg': 0, 'dtheta_deg': -90, 'dT_s': 0.25, 'w_ss': 0.25}.\n"
+        "Raises ConfigError with the loader's message ('<tailsim.simulate>:line:col: key: what is wrong').");
+  m.def("run", &run, py::arg("experiment"), py::arg("out"), py::arg("models") = std::vector<std::string>{},
+        py::arg("threads") = 0, py::arg("case") = "", py::arg("fresh") = false, py::arg("render") = true,
+        py::arg("progress") = false,
+        "run(experiment, out, models=[], threads=0, case='', fresh=False, render=True, progress=False) -> dict\n\n"
+        "`tailsim run EXPERIMENT --out OUT`: writes the result folder and returns its summary.json as a dict\n"
+        "(a suite: {experiment name: summary}). Raises ConfigError for a bad experiment file.");
+  m.def("robot", &robotDict, py::arg("name_or_path") = "paper",
+        "robot('paper' | 'path/to/robot.yaml') -> dict: the robot file as read and validated (YAML keys and units;\n"
+        "tails by link count), plus 'file', the path it was read from");
+  m.def("models", &modelNames, "the model names (analytic, perfoot, mujoco)");
+}

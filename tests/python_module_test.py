@@ -1,0 +1,154 @@
+"""CTest python_module (issue 14, item 2): the Python module against the CLI.
+
+usage: python_module_test.py SOURCE_DIR BUILD_DIR   (PYTHONPATH=BUILD_DIR/python)
+The CLI (BUILD_DIR/tailsim) is the independent reference: its summary.json and CSV.
+"""
+import concurrent.futures
+import csv
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+SRC, BUILD = (os.path.abspath(a) for a in sys.argv[1:3])
+del sys.argv[1:3]
+import tailsim  # noqa: E402  (PYTHONPATH set by CTest)
+
+FIG7 = os.path.join(SRC, "configs", "default.yaml")
+FIG7_ARGS = dict(robot="paper", tail={"links": 1}, quadruped={"d_Q2B_m": 0.125},
+                 trajectory={"theta0_deg": 0, "dtheta_deg": -90, "dT_s": 0.25, "w_ss": 0.25})
+
+
+class PythonModule(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory(prefix="tailsim-py-")
+        out = os.path.join(cls.tmp.name, "cli")
+        subprocess.run([os.path.join(BUILD, "tailsim"), "run", FIG7, "--out", out, "--quiet"], check=True,
+                       stdout=subprocess.DEVNULL)
+        with open(os.path.join(out, "summary.json")) as f:
+            cls.cli = json.load(f)
+        cls.cli_phi = cls.cli["cases"][0]["runs"]["analytic"]["phi_net_deg"]
+        with open(os.path.join(out, "cases", "base", "analytic.csv")) as f:
+            rows = list(csv.reader(f))
+        cls.csv_header, cls.csv_rows = rows[0], rows[1:]
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_import(self):
+        self.assertTrue(tailsim.__version__)
+        self.assertIn("analytic", tailsim.models())
+        self.assertTrue(issubclass(tailsim.ConfigError, ValueError))
+
+    def test_run_equals_cli(self):
+        s = tailsim.run(FIG7, out=os.path.join(self.tmp.name, "py"), models=["analytic"])
+        self.assertEqual(s["experiment"], "fig07_default")
+        self.assertEqual(s["cases"][0]["runs"]["analytic"]["phi_net_deg"], self.cli_phi)  # to the last digit
+        self.assertEqual(repr(s["cases"][0]["runs"]["analytic"]["phi_net_deg"]), repr(self.cli_phi))
+
+    def test_simulate_equals_cli(self):
+        r = tailsim.simulate(**FIG7_ARGS)
+        self.assertEqual(r.summary["phi_net_deg"], self.cli_phi)
+        self.assertTrue(r.summary["ok"])
+        # The same columns in the same order and one array element per CSV row.
+        self.assertEqual(list(r.columns), self.csv_header)
+        self.assertEqual(list(r.series.keys()), self.csv_header)
+        for name in self.csv_header:
+            self.assertEqual(r[name].shape, (len(self.csv_rows),), name)
+        # Values agree with the CSV text (written with fewer digits).
+        for j in (self.csv_header.index("t_s"), self.csv_header.index("phi_deg")):
+            for row in self.csv_rows[::50]:
+                want = float(row[j])
+                got = r.series[self.csv_header[j]][self.csv_rows.index(row)]
+                self.assertAlmostEqual(got, want, delta=1e-9 + 1e-6 * abs(want))
+        self.assertEqual(r.resolved["quadruped"]["d_Q2B_m"], 0.125)
+        self.assertEqual(r.resolved["models"], ["analytic"])
+
+    def test_robot(self):
+        r = tailsim.robot("paper")
+        self.assertEqual(r["quadruped"]["mass_kg"], 8.458)  # Table 1
+        self.assertEqual(r["tails"][1]["mass_kg"], 2.4)     # Table 2
+        self.assertTrue(r["file"].endswith("paper_quadruped.yaml"))
+        # Its sections go back into simulate() unchanged, with the same result.
+        args = dict(FIG7_ARGS, quadruped=dict(r["quadruped"], d_Q2B_m=0.125), friction=r["friction"])
+        self.assertEqual(tailsim.simulate(**args).summary["phi_net_deg"], self.cli_phi)
+        with self.assertRaisesRegex(tailsim.ConfigError, "unknown built-in robot 'nosuch'"):
+            tailsim.robot("nosuch")
+
+    def test_bad_key_in_file(self):
+        bad = os.path.join(self.tmp.name, "bad.yaml")
+        with open(FIG7) as f:
+            text = f.read().replace("w_ss: 0.25", "w_sss: 0.25").replace("robots/paper_quadruped.yaml", "paper")
+        with open(bad, "w") as f:
+            f.write(text)
+        with self.assertRaises(tailsim.ConfigError) as e:
+            tailsim.run(bad, out=os.path.join(self.tmp.name, "bad"))
+        self.assertRegex(str(e.exception), r"bad\.yaml:\d+:\d+: trajectory\.w_sss: unknown key")
+        # The CLI prints the same text.
+        p = subprocess.run([os.path.join(BUILD, "tailsim"), "run", bad, "--out", os.path.join(self.tmp.name, "bad")],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 1)
+        self.assertEqual(p.stderr.strip(), "error: " + str(e.exception))
+        self.assertFalse(os.path.exists(os.path.join(self.tmp.name, "bad")))
+
+    def test_bad_values_in_simulate(self):
+        with self.assertRaisesRegex(tailsim.ConfigError, r"<tailsim\.simulate>:\d+:\d+: trajectory\.theta0_dgx: unknown key"):
+            tailsim.simulate(trajectory={"theta0_dgx": 0})
+        with self.assertRaisesRegex(tailsim.ConfigError, r"quadruped\.mass_kg: must be > 0"):
+            tailsim.simulate(**dict(FIG7_ARGS, quadruped={"mass_kg": -1}))
+        with self.assertRaisesRegex(tailsim.ConfigError, "simulate\\(\\) runs one case"):
+            tailsim.simulate(**dict(FIG7_ARGS, trajectory=dict(FIG7_ARGS["trajectory"], dtheta_deg={"sweep": [-60, -90]})))
+
+    def test_mujoco(self):
+        r = tailsim.simulate(**FIG7_ARGS, model="mujoco")
+        self.assertTrue(r.summary["ok"], r.summary.get("error"))
+        self.assertEqual(r.model, "mujoco")
+        self.assertIn("foot1_Fn_N", r.columns)
+        # The contact model turns the body the same way, within the documented ~10 % gap.
+        self.assertAlmostEqual(r.summary["phi_net_deg"], self.cli_phi, delta=0.2 * abs(self.cli_phi))
+
+    def test_thread_pool_equals_serial(self):
+        dthetas = [-30 - 2 * k for k in range(30)]
+
+        def one(d):
+            return tailsim.simulate(**dict(FIG7_ARGS, trajectory=dict(FIG7_ARGS["trajectory"], dtheta_deg=d))
+                                    ).summary["phi_net_deg"]
+        serial = [one(d) for d in dthetas]
+        with concurrent.futures.ThreadPoolExecutor(2) as pool:
+            parallel = list(pool.map(one, dthetas))
+        self.assertEqual(parallel, serial)
+        self.assertEqual(len(set(serial)), len(serial))  # distinct cases, not one result repeated
+        self.assertEqual(one(-90), self.cli_phi)
+
+    def test_first_calls_concurrent(self):
+        # A fresh interpreter whose first simulate() calls come from two threads at once (pybind11's
+        # numpy set-up once deadlocked there): must finish, with the serial results.
+        code = ("import concurrent.futures as cf, tailsim\n"
+                "f = lambda d: tailsim.simulate(robot='paper', trajectory={'theta0_deg': 0, 'dtheta_deg': d, "
+                "'dT_s': 0.25, 'w_ss': 0.25}).summary['phi_net_deg']\n"
+                "with cf.ThreadPoolExecutor(2) as p: a = list(p.map(f, [-60, -90, -60, -90]))\n"
+                "assert a == [f(-60), f(-90)] * 2, a\n")
+        subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+    def test_example_without_matplotlib(self):
+        out = os.path.join(self.tmp.name, "example")
+        code = ("import sys; sys.modules['matplotlib'] = None\n"  # import matplotlib -> ImportError
+                f"sys.argv = ['sweep.py', '--out', {out!r}, '--cases', '5', '--threads', '2']\n"
+                f"exec(compile(open({os.path.join(SRC, 'examples', 'sweep.py')!r}).read(), 'sweep.py', 'exec'))\n")
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("matplotlib not installed", p.stdout)
+        self.assertFalse(os.path.exists(os.path.join(out, "sweep.png")))
+        with open(os.path.join(out, "sweep.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual([float(r["dtheta_deg"]) for r in rows], [-10, -50, -90, -130, -170])
+        row = rows[2]  # dtheta = -90: the Fig. 7 case
+        self.assertEqual(float(row["phi_net_deg"]), self.cli_phi)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
