@@ -280,7 +280,8 @@ int main(int argc, char** argv) {
                    first.c_str(), names.c_str());
     } else {
       // CLI11 checks required arguments before unknown ones ("--out is required" for
-      // `tailsim run --bogus`): name an unknown option first, it is the likelier mistake.
+      // `tailsim run --bogus`): name an unknown option first, it is the likelier mistake (and name it
+      // the same way when nothing else is wrong).
       std::string unknown, where = "tailsim";
       for (const std::string& a : app.remaining())
         if (unknown.empty() && a.size() > 1 && a[0] == '-') unknown = a;
@@ -290,7 +291,7 @@ int main(int argc, char** argv) {
             unknown = a;
             where = "tailsim " + sc->get_name();
           }
-      if (!unknown.empty() && dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr)
+      if (!unknown.empty())
         std::fprintf(stderr, "error: unknown option '%s' for '%s'\nRun '%s --help' for the options.\n", unknown.c_str(),
                      where.c_str(), where.c_str());
       else
