@@ -92,6 +92,28 @@ run 1 "$tailsim" mjcf --links 2 --out adir
 [ -d adir ] || fail "mjcf --out DIR replaced the folder"
 ok "mjcf --out: - (XML only), /dev/null, /dev/stdout >> file (appended), symlink (kept, target written), folder (error)"
 
+echo "== mjcf of an experiment: a custom tail as one file (= the result folder's model) and in Menagerie form"
+printf 'name: custom3\nrobot: %s\n' "$robot" >custom3.yaml
+printf 'tail: {custom: [{mass_kg: 1.1, izz_kgm2: 0.004, length_m: 0.14}, {mass_kg: 0.7, izz_kgm2: 0.002, length_m: 0.11}, {mass_kg: 0.45, izz_kgm2: 0.0007, length_m: 0.09}]}\n' >>custom3.yaml
+printf 'trajectory: {theta0_deg: 0, dtheta_deg: -30, dT_s: 0.3, w_ss: 0.3}\nmodels: [mujoco]\noutput: {duration_s: 0.2}\n' >>custom3.yaml
+run 0 "$tailsim" mjcf custom3.yaml --out custom3.xml
+run 0 "$tailsim" run custom3.yaml --out custom3_run --models mujoco --no-render --quiet
+ls custom3_run/mjcf/*.xml >/dev/null 2>&1 || fail "run custom3.yaml wrote no mjcf/<hash>.xml"
+cmp -s custom3.xml custom3_run/mjcf/*.xml || fail "mjcf custom3.yaml --out differs from the model the run simulated"
+run 0 "$tailsim" mjcf custom3.yaml --menagerie men
+[ -s men/tailsim_custom3.xml ] && [ -s men/scene_custom3.xml ] || fail "mjcf --menagerie men: $(ls men)"
+grep -q 'm_L,i = \[1.1, 0.7, 0.45\] kg' men/tailsim_custom3.xml || fail "the robot file's comment does not list the link masses"
+grep -q '<include file="tailsim_custom3.xml"/>' men/scene_custom3.xml || fail "the scene does not include the robot file"
+msg=$(mujoco-compile men/scene_custom3.xml model.txt 2>&1 </dev/null)
+grep -q Done <<<"$msg" || fail "MuJoCo cannot compile men/scene_custom3.xml: $msg"
+grep -Eq "^ *nu +3$" model.txt || fail "men/scene_custom3.xml does not have 3 tail actuators"
+run 2 "$tailsim" mjcf custom3.yaml
+grep -q -- "--out FILE or --menagerie DIR" err.txt || fail "mjcf without --out/--menagerie: $(cat err.txt)"
+run 1 "$tailsim" mjcf "$src/configs/paper/all.yaml" --out many.xml
+grep -q "distinct MuJoCo models" err.txt || fail "mjcf of a many-model suite with --out: $(cat err.txt)"
+run 1 "$tailsim" mjcf custom3.yaml --case nosuch --out x.xml
+ok "mjcf EXPERIMENT: --out = the run's mjcf/<hash>.xml; --menagerie: robot + scene, compiles (nu 3); usage and many-model errors"
+
 echo "== progress in a log (stderr not a TTY): plain lines, no carriage returns"
 printf 'name: wss_sweep\nrobot: %s\ntail: {links: 1}\n' "$robot" >sweep.yaml
 printf 'trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: {range: [0.1, 0.9, 0.03]}}\n' >>sweep.yaml

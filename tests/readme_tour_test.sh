@@ -99,6 +99,20 @@ check() {
     mjcf)
       local f; f=$(opt --out "$@")
       local links; links=$(opt --links "$@")
+      local men; men=$(opt --menagerie "$@")
+      if [ -n "$men" ]; then  # Menagerie form: every scene compiles (its robot file included)
+        local scenes; scenes=$(find "$men" -name 'scene_*.xml' | sort)
+        [ -n "$scenes" ] || fail "mjcf --menagerie $men: no scene_*.xml"
+        for sc in $scenes; do
+          local robotf; robotf="$men/tailsim_$(basename "$sc" | sed 's/^scene_//')"
+          [ -s "$robotf" ] || fail "mjcf --menagerie: $sc without its robot file $robotf"
+          rm -f "$work/model.txt"
+          local msg; msg=$(mujoco-compile "$sc" "$work/model.txt" 2>&1 </dev/null)
+          grep -q Done <<<"$msg" || fail "mjcf: MuJoCo cannot compile $sc: $msg"
+        done
+        ok "mjcf --menagerie: $(wc -w <<<"$scenes") scene(s) in $men compile with their robot files"
+        return
+      fi
       rm -f "$work/model.txt"
       local msg; msg=$(mujoco-compile "$f" "$work/model.txt" 2>&1 </dev/null)
       grep -q Done <<<"$msg" || fail "mjcf: MuJoCo cannot compile $f: $msg"

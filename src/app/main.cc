@@ -2,7 +2,8 @@
 //   tailsim run EXPERIMENT.yaml --out DIR      both models as the experiment lists, results in DIR
 //   tailsim plot DIR | tailsim report DIR      figures / Markdown report from saved results
 //   tailsim render EXPERIMENT.yaml --out DIR   headless MP4 + PNG of each case
-//   tailsim mjcf --links N --out FILE          the MuJoCo model of the paper robot
+//   tailsim mjcf [EXPERIMENT.yaml | --links N] (--out FILE | --menagerie DIR)
+//                                              the MuJoCo model: one file, or robot + scene (mjcf/README.md)
 //   tailsim accuracy EXPERIMENT.yaml --out DIR work-precision study of both models
 //   tailsim optimize EXPERIMENT.yaml --out DIR best tail stroke (kind: optimize, docs/design-a-tail-stroke.md)
 // Exit codes: see kExitCodes below (also printed by --help).
@@ -32,6 +33,7 @@
 #include "plotting/plots.h"
 #include "plotting/report.h"
 #include "results/atomic_file.h"
+#include "results/sha256.h"
 #include "tailsim_version.h"
 
 using namespace tailsim;
@@ -127,6 +129,70 @@ void printSeriesNotes(const std::string& dir) {
   }
 }
 
+// The distinct MuJoCo models of a suite (by their single-file MJCF, as result folders name them
+// mjcf/<hash>.xml), each with the first case that simulates it.
+struct SuiteModel {
+  const Experiment* experiment;
+  const ExperimentCase* c;
+  std::string xml;
+};
+std::vector<SuiteModel> distinctModels(const std::vector<Experiment>& suite, const std::string& only_case) {
+  std::vector<SuiteModel> out;
+  std::set<std::string> seen;
+  for (const Experiment& e : suite)
+    for (const ExperimentCase& c : e.cases) {
+      if (!only_case.empty() && c.name != only_case) continue;
+      std::string xml = generateMjcf(c.robot, c.mujoco, c.effects);
+      if (seen.insert(xml).second) out.push_back({&e, &c, std::move(xml)});
+    }
+  return out;
+}
+
+// A file-name stem of [A-Za-z0-9._=,~-] from any text (others become '_').
+std::string fileStem(const std::string& text) {
+  std::string s;
+  for (char ch : text) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+                    std::string("._=,~-").find(ch) != std::string::npos;
+    s += ok ? ch : '_';
+  }
+  if (s.empty() || s[0] == '.' || s[0] == '-') s = "x" + s;
+  return s.substr(0, 120);
+}
+
+// `tailsim mjcf EXPERIMENT.yaml ...`: the models of an experiment's cases. Returns the exit code.
+int writeExperimentMjcf(const std::string& exp_path, const std::string& only_case, const std::string& out,
+                        const std::string& menagerie_dir) {
+  const std::vector<Experiment> suite = loadExperimentSuite(exp_path);  // all errors before any work
+  requireCase(suite, exp_path, only_case);
+  const std::vector<SuiteModel> models = distinctModels(suite, only_case);
+  if (!out.empty()) {
+    if (models.size() != 1) {
+      std::string names;
+      for (size_t i = 0; i < models.size() && i < 5; ++i) names += (i ? ", " : "") + models[i].c->name;
+      throw std::runtime_error(exp_path + " has " + std::to_string(models.size()) +
+                               " distinct MuJoCo models (cases " + names + (models.size() > 5 ? ", ..." : "") +
+                               "); pick one with --case NAME, or write them all with --menagerie DIR");
+    }
+    const bool to_stream = writeUserFile(out, models[0].xml);
+    std::fprintf(to_stream ? stderr : stdout, "wrote %s (case %s)\n", out == "-" ? "the MJCF to stdout" : out.c_str(),
+                 models[0].c->name.c_str());
+    return kExitOk;
+  }
+  std::set<std::string> stems;
+  for (const SuiteModel& m : models) {
+    std::string stem = fileStem(models.size() == 1 && only_case.empty()
+                                    ? m.experiment->name
+                                    : m.experiment->name + "_" + caseDirName(m.c->name));
+    if (!stems.insert(stem).second) stem += "_" + sha256Hex(m.xml).substr(0, 8);
+    stems.insert(stem);
+    const std::vector<std::string> paths =
+        writeMenagerie(generateMenagerie(m.c->robot, m.c->mujoco, m.c->effects, stem), menagerie_dir);
+    std::printf("wrote %s + %s (case %s)\n", paths[0].c_str(), paths[1].c_str(), m.c->name.c_str());
+  }
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -161,10 +227,18 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(modelNames()));
 
   int links = 1;
-  std::string mjcf_out;
-  auto* mjcf = app.add_subcommand("mjcf", "write the MuJoCo model (MJCF) of the paper robot");
-  mjcf->add_option("--links", links, "tail links n (1..6)")->check(CLI::Range(1, 6));
-  mjcf->add_option("--out", mjcf_out, "output .xml")->required();
+  std::string mjcf_out, mjcf_exp, mjcf_case, mjcf_menagerie;
+  auto* mjcf = app.add_subcommand("mjcf", "write the MuJoCo model (MJCF) of the paper robot or of an experiment's cases");
+  auto* mjcf_exp_opt = mjcf->add_option("experiment", mjcf_exp, "experiment YAML: the models its cases simulate")
+                           ->check(CLI::ExistingFile);
+  mjcf->add_option("--links", links, "the paper robot with an n-link tail (1..6; default 1)")
+      ->check(CLI::Range(1, 6))
+      ->excludes(mjcf_exp_opt);
+  mjcf->add_option("--case", mjcf_case, "only this case's model")->needs(mjcf_exp_opt);
+  auto* mjcf_out_opt = mjcf->add_option("--out", mjcf_out, "one self-contained .xml, the model tailsim simulates (- = stdout)");
+  mjcf->add_option("--menagerie", mjcf_menagerie,
+                   "folder for the Menagerie form: tailsim_<name>.xml (robot) + scene_<name>.xml (mjcf/README.md)")
+      ->excludes(mjcf_out_opt);
 
   std::string render_out = "renders";
   auto* render = app.add_subcommand("render", "render each case of an experiment to MP4 + PNG (headless)");
@@ -216,7 +290,8 @@ int main(int argc, char** argv) {
                    first.c_str(), names.c_str());
     } else {
       // CLI11 checks required arguments before unknown ones ("--out is required" for
-      // `tailsim run --bogus`): name an unknown option first, it is the likelier mistake.
+      // `tailsim run --bogus`): name an unknown option first, it is the likelier mistake (and name it
+      // the same way when nothing else is wrong).
       std::string unknown, where = "tailsim";
       for (const std::string& a : app.remaining())
         if (unknown.empty() && a.size() > 1 && a[0] == '-') unknown = a;
@@ -226,7 +301,7 @@ int main(int argc, char** argv) {
             unknown = a;
             where = "tailsim " + sc->get_name();
           }
-      if (!unknown.empty() && dynamic_cast<const CLI::ExtrasError*>(&e) == nullptr)
+      if (!unknown.empty())
         std::fprintf(stderr, "error: unknown option '%s' for '%s'\nRun '%s --help' for the options.\n", unknown.c_str(),
                      where.c_str(), where.c_str());
       else
@@ -283,6 +358,16 @@ int main(int argc, char** argv) {
       return kExitOk;
     }
     if (*mjcf) {
+      if (mjcf_out.empty() && mjcf_menagerie.empty()) {
+        std::fprintf(stderr, "error: tailsim mjcf needs --out FILE or --menagerie DIR\nRun 'tailsim mjcf --help' for the options.\n");
+        return kExitUsage;
+      }
+      if (!mjcf_exp.empty()) return writeExperimentMjcf(mjcf_exp, mjcf_case, mjcf_out, mjcf_menagerie);
+      if (!mjcf_menagerie.empty()) {
+        const std::vector<std::string> paths = writeMenagerieFiles(links, mjcf_menagerie);
+        std::printf("wrote %s + %s\n", paths[0].c_str(), paths[1].c_str());
+        return kExitOk;
+      }
       const bool to_stream = writeMjcfFile(links, mjcf_out);
       // XML on stdout stays XML: the message goes to stderr when the model went to a stream.
       std::fprintf(to_stream ? stderr : stdout, "wrote %s\n", mjcf_out == "-" ? "the MJCF to stdout" : mjcf_out.c_str());

@@ -60,8 +60,44 @@ std::string generateMjcf(const RobotParams& p, const MujocoSettings& s, const Ef
 // The paper robot (Table 1 defaults of RobotParams, Table 2 n-link tail).
 RobotParams paperRobot(int links);
 
+// ---- Menagerie form (mjcf/README.md) ------------------------------------------------------------
+// The same robot split as MuJoCo Menagerie splits its models: a robot file (compiler, options,
+// default classes, bodies, joints, actuators, the `home` keyframe, comments naming the paper's
+// symbols) and a scene that <include>s it and adds a floor with MuJoCo's default friction (1), a light
+// and a skybox. The foot geoms carry `priority="1"`, so every contact of a foot takes the foot's
+// friction, condim, solref and solimp whatever the floor says (MuJoCo's mj_contactParam: the geom
+// of higher priority wins; equal priorities take the max friction and mix solref/solimp): the paper's
+// mu in any scene. generateMjcf above stays the single-file model that tailsim simulates.
+struct MenagerieFiles {
+  std::string robot_file;  // "tailsim_<stem>.xml"
+  std::string robot_xml;
+  std::string scene_file;  // "scene_<stem>.xml"
+  std::string scene_xml;
+};
+
+// The foot friction written into the robot file: footFrictionCoefficient, except the continuous
+// law (which the simulation varies every step from mu(0) = 0) gets its stiction value
+// (settings.mu, or max(mu_s, mu_d)): a static file cannot vary it, and mu = 0 would let the robot
+// slide off in any viewer.
+double menagerieFootFriction(const RobotParams& p, const MujocoSettings& s, const Effects& e);
+
+// Half-width of the tail servos' ctrlrange in the robot file [rad]: a half turn each way plus room
+// for the velocity feed-forward (kv/kp) theta_dot. (The single-file model has no ctrl limits.)
+inline constexpr double kMenagerieCtrlRange = 4.0;
+
+// stem: one file-name component of [A-Za-z0-9._=,~-], not starting with '.' or '-' (else
+// std::invalid_argument). Throws std::invalid_argument on bad parameters or settings, as generateMjcf.
+MenagerieFiles generateMenagerie(const RobotParams& p, const MujocoSettings& s, const Effects& e,
+                                 const std::string& stem);
+
+// Writes both files into dir (created if missing), each whole or not at all; returns their paths.
+std::vector<std::string> writeMenagerie(const MenagerieFiles& f, const std::string& dir);
+
 // `tailsim mjcf --links N --out FILE`: the paper robot with default settings and effects, written
 // as writeUserFile (FILE may be "-" for stdout, a symlink or a device). True when it went to a stream.
 bool writeMjcfFile(int links, const std::string& out);
+
+// `tailsim mjcf --links N --menagerie DIR`: DIR/tailsim_n<N>.xml and DIR/scene_n<N>.xml (the files in mjcf/).
+std::vector<std::string> writeMenagerieFiles(int links, const std::string& dir);
 
 }  // namespace tailsim
