@@ -13,4 +13,11 @@ double ExperimentCase::simDuration() const {
   return trajectory().endTime() + output.settle_s;
 }
 
+std::vector<std::string> sectionKeys() {
+  std::vector<std::string> keys;
+  ExperimentCase c;
+  forEachSection(c, [&](const SectionInfo& s, const auto&) { keys.push_back(s.key); });
+  return keys;
+}
+
 }  // namespace tailsim

@@ -60,4 +60,42 @@ struct ExperimentCase {
 
 };
 
+// An experiment file's settings sections: each is a struct that declares its own fields once
+// (settings/fields.h) and is listed once, in forEachSection below. The loader (its allowed keys and
+// reading), the resolved case (result.json and the resume key), the JSON Schema and the key tables
+// of docs/experiment-format.md iterate that list, so a new section is its struct + a member above
+// + one line below. (Sections with checks across keys keep a reader of their own in the loader.)
+struct SectionInfo {
+  const char* key;    // YAML key, result.json key, doc table title
+  const char* note;   // the doc table's note
+  const char* model;  // in the resolved case only when this model runs (nullptr: always), so the
+                      // other cases' resume keys stay as they were
+};
+
+// Calls f(SectionInfo, section member) for every section, in file order (the loader's order:
+// render is read after output, whose duration it checks against).
+template <class Case, class F>
+void forEachSection(Case& c, F&& f) {
+  f(SectionInfo{"analytic", "Solver and modelling settings of the analytic model.", nullptr}, c.analytic);
+  f(SectionInfo{"perfoot",
+                "Solver and modelling settings of the per-foot model (docs/per-foot-model.md); its friction "
+                "law is `effects.friction`.",
+                "perfoot"},
+    c.perfoot);
+  f(SectionInfo{"mujoco", "Settings of the MuJoCo contact model (docs/mujoco-model.md).", nullptr}, c.mujoco);
+  f(SectionInfo{"effects", "Which physical effects a scene simulates; the defaults reproduce the paper.", nullptr},
+    c.effects);
+  f(SectionInfo{"output",
+                "The output time grid both models sample on, and which rows are kept where "
+                "([Time-series output](#time-series-output)).",
+                nullptr},
+    c.output);
+  f(SectionInfo{"render", "The section's presence turns video on (`render: {}` = defaults); docs/rendering.md.",
+                nullptr},
+    c.render);
+}
+
+// The section keys, in forEachSection's order.
+std::vector<std::string> sectionKeys();
+
 }  // namespace tailsim

@@ -26,6 +26,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <limits>
+#include <type_traits>
 #include <map>
 #include <memory>
 #include <set>
@@ -1052,9 +1053,13 @@ void checkCaseWork(const Reader& r, const MapView& top, const ExperimentCase& c)
 // Pass 2: one case, with the sweeps resolved by `r`.
 ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
   const Item root = r.root(doc);
-  const MapView top = r.map(root, {"name", "description", "robot", "kind", "tail", "quadruped", "friction",
-                                   "gravity_mps2", "trajectory", "pose", "models", "analytic", "perfoot", "mujoco",
-                                   "effects", "output", "render"});
+  static const std::vector<std::string> kTopKeys = [] {
+    std::vector<std::string> k = {"name",         "description", "robot", "kind",  "tail",  "quadruped",
+                                  "friction",     "gravity_mps2", "trajectory", "pose", "models"};
+    for (const std::string& s : sectionKeys()) k.push_back(s);  // experiment_config.h forEachSection
+    return k;
+  }();
+  const MapView top = r.map(root, kTopKeys);
   ExperimentCase c;
   c.source_file = source;
   const Item& name = r.need(top, "name");
@@ -1139,20 +1144,26 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   } else {
     c.models = {"analytic"};
   }
-  if (const Item* x = top.get("analytic")) readDeclared(r, *x, c.analytic);
-  if (const Item* x = top.get("perfoot")) readDeclared(r, *x, c.perfoot);
-  if (const Item* x = top.get("mujoco")) c.mujoco = readMujoco(r, *x);
-  // The MuJoCo body stands at the robot's COM height unless mujoco.body_height_m says otherwise.
-  const Item* mj = top.get("mujoco");
-  if (!(mj && mj->node.IsMap() && mj->node["body_height_m"])) c.mujoco.body_height_m = c.robot.quadruped.com_height_m;
-  if (const Item* x = top.get("effects")) readDeclared(r, *x, c.effects);
-  if (const Item* x = top.get("output"))
-    c.output = readOutput(r, *x, c.kind == CaseKind::kSimulate ? c.trajectory().endTime() : -1.0);
-  if (const Item* x = top.get("render")) {
-    const double run_end =
-        c.kind != CaseKind::kSimulate ? -1.0 : c.output.duration_s > 0 ? c.output.duration_s : c.trajectory().endTime() + c.output.settle_s;
-    c.render = readRender(r, *x, run_end);
-  }
+  // The settings sections (experiment_config.h forEachSection): declared fields, read by
+  // readDeclared; the few with checks across keys or defaults from elsewhere have their own reader.
+  forEachSection(c, [&](const SectionInfo& sec, auto& v) {
+    using T = std::decay_t<decltype(v)>;
+    const Item* x = top.get(sec.key);
+    if constexpr (std::is_same_v<T, MujocoSettings>) {
+      if (x) v = readMujoco(r, *x);
+      // The MuJoCo body stands at the robot's COM height unless mujoco.body_height_m says otherwise.
+      if (!(x && x->node.IsMap() && x->node["body_height_m"])) v.body_height_m = c.robot.quadruped.com_height_m;
+    } else if constexpr (std::is_same_v<T, OutputSettings>) {
+      if (x) v = readOutput(r, *x, c.kind == CaseKind::kSimulate ? c.trajectory().endTime() : -1.0);
+    } else if constexpr (std::is_same_v<T, RenderSettings>) {
+      const double run_end = c.kind != CaseKind::kSimulate ? -1.0
+                             : c.output.duration_s > 0     ? c.output.duration_s
+                                                           : c.trajectory().endTime() + c.output.settle_s;
+      if (x) v = readRender(r, *x, run_end);
+    } else if (x) {
+      readDeclared(r, *x, v);
+    }
+  });
   checkCaseWork(r, top, c);
   return c;
 }

@@ -1,6 +1,7 @@
 #include "experiments/settings_json.h"
 
 #include <algorithm>
+#include <type_traits>
 #include <stdexcept>
 
 #include "tailsim_version.h"
@@ -112,13 +113,10 @@ json resolvedJson(const ExperimentCase& c) {
   j["pose"] = {{"theta_rad", c.pose.theta_rad},
                {"thetadot_radps", c.pose.thetadot_radps},
                {"thetaddot_radps2", c.pose.thetaddot_radps2}};
-  j["analytic"] = toJson(c.analytic);
-  // Only where the per-foot model runs: other cases' resolved case (and resume key) stay as they were.
-  if (std::find(c.models.begin(), c.models.end(), "perfoot") != c.models.end()) j["perfoot"] = toJson(c.perfoot);
-  j["mujoco"] = toJson(c.mujoco);
-  j["effects"] = toJson(c.effects);
-  j["output"] = toJson(c.output);
-  j["render"] = toJson(c.render);
+  // The settings sections (experiment_config.h); a model's own section only where that model runs.
+  forEachSection(c, [&](const SectionInfo& s, const auto& v) {
+    if (!s.model || std::find(c.models.begin(), c.models.end(), s.model) != c.models.end()) j[s.key] = toJson(v);
+  });
   return j;
 }
 
@@ -142,12 +140,11 @@ ExperimentCase caseFromResolved(const json& j) {
     c.pose.theta_rad = need(pose, "theta_rad").get<std::vector<double>>();
     c.pose.thetadot_radps = need(pose, "thetadot_radps").get<std::vector<double>>();
     c.pose.thetaddot_radps2 = need(pose, "thetaddot_radps2").get<std::vector<double>>();
-    c.analytic = fromJson<AnalyticSettings>(need(j, "analytic"), "analytic");
-    if (j.contains("perfoot")) c.perfoot = fromJson<PerFootSettings>(j.at("perfoot"), "perfoot");
-    c.mujoco = fromJson<MujocoSettings>(need(j, "mujoco"), "mujoco");
-    c.effects = fromJson<Effects>(need(j, "effects"), "effects");
-    c.output = fromJson<OutputSettings>(need(j, "output"), "output");
-    c.render = fromJson<RenderSettings>(need(j, "render"), "render");
+    forEachSection(c, [&](const SectionInfo& s, auto& v) {
+      using T = std::decay_t<decltype(v)>;
+      if (!s.model) v = fromJson<T>(need(j, s.key), s.key);
+      else if (j.contains(s.key)) v = fromJson<T>(j.at(s.key), s.key);
+    });
   } catch (const json::exception& e) {
     throw std::runtime_error(std::string("resolved case: ") + e.what());
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
+#include <type_traits>
 
 #include "experiments/experiment_config.h"
 #include "experiments/experiment_loader.h"
@@ -169,7 +170,6 @@ json experimentSchema() {
                  {"custom", {{"type", "array"}, {"minItems", 1}, {"items", link}}}}},
                {"minProperties", 1},
                {"maxProperties", 1}};
-  json render = section(describe<RenderSettings>().props);
   json exp = section(
       {{"name", {{"type", "string"}, {"minLength", 1}, {"maxLength", 100}, {"pattern", "^[^/\\\\-][^/\\\\]*$"}}},
        {"description", {{"type", "string"}}},
@@ -183,13 +183,16 @@ json experimentSchema() {
        {"pose", pose},
        {"models", {{"type", "array"}, {"minItems", 1}, {"uniqueItems", true},
                    {"items", orSweep({{"type", "string"}, {"enum", modelNames()}})}}},
-       {"analytic", section(describe<AnalyticSettings>().props)},
-       {"perfoot", section(describe<PerFootSettings>().props)},
-       {"mujoco", section(describe<MujocoSettings>().props)},
-       {"effects", section(describe<Effects>().props)},
-       {"output", section(describe<OutputSettings>().props)},
-       {"render", {{"anyOf", json::array({{{"type", "null"}}, render})}}}},
+       },
       {"name", "robot"});
+  // The settings sections (experiment_config.h forEachSection); `render:` may also be empty (null).
+  const ExperimentCase defaults;
+  forEachSection(defaults, [&](const SectionInfo& s, const auto& v) {
+    using T = std::decay_t<decltype(v)>;
+    json sec = section(describe<T>().props);
+    if constexpr (std::is_same_v<T, RenderSettings>) sec = {{"anyOf", json::array({{{"type", "null"}}, sec})}};
+    exp["properties"][s.key] = sec;
+  });
   json suite = section({{"experiments", {{"type", "array"}, {"minItems", 1}, {"items", {{"type", "string"}}}}},
                         {"description", {{"type", "string"}}}},
                        {"experiments"});
@@ -243,17 +246,10 @@ std::string settingsMarkdown() {
   table("tail links", "Each entry of `tail: {custom: [...]}` and of a robot file's `tails.n`; `mass_kg`, "
                       "`izz_kgm2`, `length_m` required.",
         describe<TailLink>().rows);
-  table("analytic", "Solver and modelling settings of the analytic model.", describe<AnalyticSettings>().rows);
-  table("perfoot", "Solver and modelling settings of the per-foot model (docs/per-foot-model.md); its friction "
-                   "law is `effects.friction`.",
-        describe<PerFootSettings>().rows);
-  table("mujoco", "Settings of the MuJoCo contact model (docs/mujoco-model.md).", describe<MujocoSettings>().rows);
-  table("effects", "Which physical effects a scene simulates; the defaults reproduce the paper.",
-        describe<Effects>().rows);
-  table("output", "The output time grid both models sample on, and which rows are kept where ([Time-series output](#time-series-output)).",
-        describe<OutputSettings>().rows);
-  table("render", "The section's presence turns video on (`render: {}` = defaults); docs/rendering.md.",
-        describe<RenderSettings>().rows);
+  const ExperimentCase defaults;
+  forEachSection(defaults, [&](const SectionInfo& s, const auto& v) {
+    table(s.key, s.note, describe<std::decay_t<decltype(v)>>().rows);
+  });
   std::string s = o.str();
   while (s.size() >= 2 && s[s.size() - 1] == '\n' && s[s.size() - 2] == '\n') s.pop_back();
   return s;
