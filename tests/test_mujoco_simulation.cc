@@ -2,7 +2,9 @@
 // angular momentum without friction, and Newton-Euler consistency of the logged loads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "mujoco_model/mjcf_generator.h"
@@ -303,4 +305,57 @@ TEST(MujocoSimulation, ImpulseAveragedContactLoadsIntegrateToTheMomentumChange) 
   ASSERT_GT(peak_p, 0.05);
   EXPECT_LT(err_m, 0.03 * peak_h) << "peak |dH_z| " << peak_h << " kg m^2/s";
   EXPECT_LT(err_f, 0.03 * peak_p) << "peak |dp_x| " << peak_p << " kg m/s";
+}
+
+// Contact fidelity figures (docs/mujoco-model.md "Contact fidelity"): airborne_fraction and
+// peak_normal_force_over_mg, checked against what the impulse-averaged foot columns imply, and the
+// warning above the limits of results/work_limits.h.
+TEST(MujocoSimulation, ContactFidelityFiguresAndTheirWarning) {
+  const RobotParams p = paperRobot(1);
+  SplitCycleParams sp = fig6(-90.0);
+  const TailTrajectory tr = sameForAllJoints(1, sp);
+  const double weight = p.systemMass() * p.gravity_mps2;
+  auto summedFn = [](const RunResult& r) {
+    std::vector<double> s(r.series.numRows(), 0.0);
+    for (int k = 1; k <= 4; ++k) {
+      const std::vector<double>& f = r.series.values("foot" + std::to_string(k) + "_Fn_N");
+      for (size_t i = 0; i < s.size(); ++i) s[i] += f[i];
+    }
+    return s;
+  };
+  // Default contact (solref 0.002): the feet chatter (~17 % of the steps airborne), below the limit.
+  const RunResult def = simulateMujoco(p, tr, MujocoSettings{}, Effects{}, {});
+  ASSERT_TRUE(def.summary.ok) << def.summary.error;
+  const double air = def.summary.extra.at("airborne_fraction"), peak = def.summary.extra.at("peak_normal_force_over_mg");
+  const std::vector<double> fn = summedFn(def);
+  double mean = 0.0, row_max = 0.0;
+  size_t all_zero_rows = 0;
+  for (double f : fn) mean += f / fn.size(), row_max = std::max(row_max, f), all_zero_rows += f == 0.0;
+  EXPECT_NEAR(mean / weight, 1.0, 0.05);  // on average the feet carry the weight
+  // A row is the mean over its steps: its peak cannot exceed the steps' peak, and a row with no
+  // load at all has every step airborne.
+  EXPECT_GE(peak, row_max / weight - 1e-9);
+  EXPECT_GE(air, static_cast<double>(all_zero_rows) / fn.size() - 1e-9);
+  EXPECT_GT(air, 0.05);   // the chatter is there (measured 0.17)
+  EXPECT_GT(peak, 3.0);   // impulsive (measured 12.6)
+  EXPECT_LT(air, limits::kMaxAirborneFraction);
+  EXPECT_LT(peak, limits::kMaxPeakNormalForceOverMg);
+  EXPECT_TRUE(def.summary.warnings.empty()) << def.summary.warnings.front();
+
+  // Without friction the feet never leave the ground and carry about the weight.
+  Effects frictionless;
+  frictionless.friction = FrictionLaw::kNone;
+  const RunResult fl = simulateMujoco(p, tr, MujocoSettings{}, frictionless, {});
+  ASSERT_TRUE(fl.summary.ok) << fl.summary.error;
+  EXPECT_EQ(fl.summary.extra.at("airborne_fraction"), 0.0);
+  EXPECT_LT(fl.summary.extra.at("peak_normal_force_over_mg"), 1.5);
+
+  // A stiffer contact (solref 0.001 s) chatters more: above the limit, and the run says so.
+  MujocoSettings stiff;
+  stiff.solref[0] = 0.001;
+  const RunResult st = simulateMujoco(p, tr, stiff, Effects{}, {});
+  ASSERT_TRUE(st.summary.ok) << st.summary.error;
+  EXPECT_GT(st.summary.extra.at("airborne_fraction"), limits::kMaxAirborneFraction);
+  ASSERT_EQ(st.summary.warnings.size(), 1u);
+  EXPECT_NE(st.summary.warnings[0].find("all four feet carry no load"), std::string::npos) << st.summary.warnings[0];
 }

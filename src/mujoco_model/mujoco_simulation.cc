@@ -304,6 +304,10 @@ class StandingMonitor {
     }
     off_steps_ = loaded ? 0 : off_steps_ + 1;
     longest_off_steps_ = std::max(longest_off_steps_, off_steps_);
+    if (t_s >= 0.0) {  // the run proper (the pre-roll has t < 0): airborne steps
+      ++run_steps_;
+      if (!loaded) ++airborne_steps_;
+    }
     if (!enforce_ || !why_.empty()) return why_.empty();
     std::ostringstream os;
     os.precision(4);
@@ -326,7 +330,13 @@ class StandingMonitor {
     extra["max_tilt_deg"] = tiltDeg(min_cos_);
     extra["max_height_change_m"] = max_dz_;
     extra["longest_all_feet_off_s"] = longest_off_steps_ * h_;
+    extra["airborne_fraction"] = airborneFraction();
   }
+  // Share of the run's steps (t >= 0, the pre-roll excluded) in which no foot carried load.
+  double airborneFraction() const {
+    return run_steps_ > 0 ? static_cast<double>(airborne_steps_) / static_cast<double>(run_steps_) : 0.0;
+  }
+  bool enforced() const { return enforce_; }
 
  private:
   static double tiltDeg(double c) { return std::acos(std::clamp(c, -1.0, 1.0)) * kRad2Deg; }
@@ -338,6 +348,7 @@ class StandingMonitor {
   double max_tilt_deg_, max_off_s_;
   double min_cos_ = 1.0, max_dz_ = 0.0;
   long off_steps_ = 0, longest_off_steps_ = 0;
+  long run_steps_ = 0, airborne_steps_ = 0;
   std::string why_;
 };
 
@@ -560,9 +571,17 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   };
 
   StandingMonitor standing(settings, effects, L.quad_body);
+  // Peak of the summed foot normal force over the run's steps (each step's force, not the 1 ms
+  // averages), in units of the robot's weight m g (m = every body, g = robot.gravity_mps2).
+  const double weight_N = mj_getTotalmass(m) * robot.gravity_mps2;
+  double peak_normal_N = 0.0;
+  auto reportContact = [&]() {
+    sum.extra["peak_normal_force_over_mg"] = weight_N > 0.0 ? peak_normal_N / weight_N : 0.0;
+  };
   auto failed = [&]() {  // the run's result when it fails
     sum.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
     standing.report(sum.extra);
+    reportContact();
     sum.extra["mujoco_warnings"] = warningCount(d);
     return result;
   };
@@ -676,7 +695,10 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
         ++k;
       }
     }
-    if (averaged) averager.addStep(t, loads);
+    if (averaged) {
+      averager.addStep(t, loads);
+      peak_normal_N = std::max(peak_normal_N, loads[kFn1] + loads[kFn1 + 1] + loads[kFn1 + 2] + loads[kFn1 + 3]);
+    }
   }
   averager.finish();
   sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -706,6 +728,25 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
   sum.extra["mujoco_warnings"] = warningCount(d);
   sum.extra["kp_j1"] = gains.kp[0];
   standing.report(sum.extra);
+  reportContact();
+  // Contact fidelity (docs/mujoco-model.md "Contact fidelity"): feet that leave the ground while the
+  // body slides, and impulsive normal forces, mean MuJoCo's soft contact, not Coulomb friction,
+  // shaped the result.
+  if (standing.enforced() && sum.ok) {
+    const double airborne = sum.extra["airborne_fraction"], peak = sum.extra["peak_normal_force_over_mg"];
+    std::ostringstream os;
+    os.precision(3);
+    if (airborne > limits::kMaxAirborneFraction)
+      os << "all four feet carry no load in " << 100.0 * airborne << " % of the steps (limit "
+         << 100.0 * limits::kMaxAirborneFraction << " %): MuJoCo's soft contact chatters while the body slides";
+    if (peak > limits::kMaxPeakNormalForceOverMg)
+      os << (os.str().empty() ? "" : "; ") << "the summed foot normal force peaks at " << peak
+         << " m g (limit " << limits::kMaxPeakNormalForceOverMg << " m g): impulsive contact";
+    if (!os.str().empty()) {
+      os << "; phi_net depends on the contact softness (mujoco.solref), see docs/mujoco-model.md \"Contact fidelity\"";
+      sum.warnings.push_back(os.str());
+    }
+  }
   // At rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
   {
     mjtNum v6[6];

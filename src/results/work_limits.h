@@ -27,5 +27,9 @@ constexpr double kAtRestPhidotDps = 0.1;        // |phi_dot| at the end below th
 constexpr double kAtRestSpeedMps = 1e-3;        // body speed at the end below this: at rest  [m/s]
 constexpr double kMaxPaperSpuriousTurnDeg = 10.0;  // paper coupling: turn its momentum error alone causes  [deg]
 constexpr double kMaxTrackingErrorDeg = 1.0;       // MuJoCo: max servo tracking error above this warns  [deg]
+// MuJoCo contact fidelity (docs/mujoco-model.md "Contact fidelity"): share of the run's steps with
+// no foot loaded, and the peak summed foot normal force in units of the weight m g; above these warns.
+constexpr double kMaxAirborneFraction = 0.2;        // [1]
+constexpr double kMaxPeakNormalForceOverMg = 30.0;  // [1]
 
 }  // namespace tailsim::limits
