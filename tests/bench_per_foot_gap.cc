@@ -2,7 +2,8 @@
 // and (with --gap) the first gap measurement: |phi_net difference| / |phi_net| against MuJoCo with
 // the same friction law, over every case of Figs. 6, 7, 9, 11-14 (configs/paper), for the
 // exact-coupling analytic model and the per-foot model (quasi-static loads / load transfer).
-//   build/tests/bench_per_foot_gap --gap [--csv FILE]      (about a minute on one core)
+//   build/tests/bench_per_foot_gap --gap [--csv FILE] [--suite SUITE.yaml]   (about a minute on one core;
+//   --suite: another copy of configs/paper/all.yaml, e.g. with other mujoco settings)
 //   build/tests/bench_per_foot_gap                          (benchmarks only)
 #include <benchmark/benchmark.h>
 
@@ -32,9 +33,9 @@ bool inGap(const std::string& name) {
   return false;
 }
 
-std::vector<ExperimentCase> gapCases() {
+std::vector<ExperimentCase> gapCases(const std::string& suite) {
   std::vector<ExperimentCase> out;
-  for (const Experiment& e : loadExperimentSuite(TAILSIM_SOURCE_DIR "/configs/paper/all.yaml"))
+  for (const Experiment& e : loadExperimentSuite(suite))
     if (inGap(e.name))
       for (const ExperimentCase& c : e.cases) out.push_back(c);
   return out;
@@ -58,8 +59,8 @@ const char* kModels[] = {"exact_stiction", "perfoot_stiction_qs", "perfoot_stict
                          "exact_adams", "perfoot_adams_qs", "perfoot_adams_lt", "mujoco_adams"};
 constexpr int kN = 8;
 
-int runGap(const char* csv_path) {
-  const std::vector<ExperimentCase> cases = gapCases();
+int runGap(const char* csv_path, const std::string& suite) {
+  const std::vector<ExperimentCase> cases = gapCases(suite);
   std::map<std::string, std::vector<std::array<double, kN>>> byFig;
   std::vector<std::pair<std::string, std::array<double, kN>>> rows;
   double wall[kN] = {0};
@@ -182,9 +183,12 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::strcmp(argv[i], "--gap") == 0) {
       const char* csv = nullptr;
-      for (int j = 1; j + 1 < argc; ++j)
+      std::string suite = TAILSIM_SOURCE_DIR "/configs/paper/all.yaml";
+      for (int j = 1; j + 1 < argc; ++j) {
         if (std::strcmp(argv[j], "--csv") == 0) csv = argv[j + 1];
-      return runGap(csv);
+        if (std::strcmp(argv[j], "--suite") == 0) suite = argv[j + 1];
+      }
+      return runGap(csv, suite);
     }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
