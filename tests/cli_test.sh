@@ -151,6 +151,42 @@ run 0 "$tailsim" run sweep.yaml --out int_run --threads 2 --quiet
 grep -q "^$total cases: $((total - saved)) run, $saved resumed, 0 failed" out.txt || fail "rerun: $(head -n 1 out.txt)"
 ok "Ctrl-C after the first case: exit 130, '$said', rerun resumed $saved"
 
+echo "== Ctrl-C twice with every series in one HDF5 file: the finished cases stay resumable"
+sed 's/^name: wss_sweep/name: wss_sweep_h5/' sweep.yaml >sweep_h5.yaml
+printf 'output: {time_series_file: hdf5}\n' >>sweep_h5.yaml
+set -m
+"$tailsim" run sweep_h5.yaml --out int_h5 --threads 1 >out.txt 2>err.txt &
+pid=$!
+for _ in $(seq 1 600); do  # until 2 cases are in the journal, at most 60 s
+  [ "$(wc -l <int_h5/cases.jsonl 2>/dev/null || echo 0)" -ge 2 ] && break
+  sleep 0.1
+done
+kill -INT "$pid"; sleep 0.2; kill -INT "$pid" 2>/dev/null || true
+rc=0
+wait "$pid" || rc=$?
+set +m
+[ $rc -eq 130 ] || fail "exit $rc after two Ctrl-C (want 130)\n$(cat err.txt)"
+grep -q "^interrupted again: abandoning the running cases; [0-9]* cases saved" err.txt || fail "no 'abandoning' message: $(cat err.txt)"
+saved=$(sed -n 's/^interrupted again: abandoning the running cases; \([0-9]*\) cases saved$/\1/p' err.txt)
+[ -f int_h5/time_series.h5 ] || fail "two Ctrl-C left no published time_series.h5: $(ls int_h5)"
+run 0 "$tailsim" run sweep_h5.yaml --out int_h5 --threads 2 --quiet
+resumed=$(sed -n 's/^[0-9]* cases: [0-9]* run, \([0-9]*\) resumed.*/\1/p' out.txt)
+[ "${resumed:-0}" -ge "$saved" ] && [ "$saved" -ge 1 ] || fail "$saved saved, but the rerun resumed ${resumed:-0}: $(head -n 1 out.txt)"
+ok "two Ctrl-C with HDF5 output: '$saved cases saved', the rerun resumed $resumed"
+
+echo "== --models, --shard, --threads: nothing silently empty, usage errors exit 2"
+run 1 "$tailsim" run "$src/configs/default.yaml" --out models_none --models perfoot
+grep -q "none of those its cases run (analytic): nothing would run" err.txt || fail "--models perfoot on an analytic experiment: $(cat err.txt)"
+[ ! -e models_none/results.csv ] || fail "--models selecting nothing still wrote results"
+run 2 "$tailsim" run "$src/configs/default.yaml" --out r --models mujocoo
+for sh in 5/4 0/4 abc; do
+  run 2 "$tailsim" run "$src/configs/default.yaml" --out r --shard "$sh"
+  grep -q -- "--shard $sh: want K/N" err.txt || fail "--shard $sh: $(cat err.txt)"
+done
+run 2 "$tailsim" run "$src/configs/default.yaml" --out r --threads -1
+run 2 "$tailsim" accuracy "$src/configs/accuracy/fig07.yaml" --out r --repeats 0
+ok "--models selecting nothing exits 1 and writes nothing; bad --shard/--threads/--repeats exit 2"
+
 # Issue 13: a run that renders nothing does not load OSMesa (LLVM, z3, ICU) at all.
 LD_DEBUG=libs "$tailsim" run "$src/configs/default.yaml" --out lazy_gl --quiet >out.txt 2>err.txt || fail "lazy-GL run: $(tail -3 err.txt)"
 grep -q "calling init: .*libyaml-cpp" err.txt || fail "LD_DEBUG=libs printed no library list: cannot check OSMesa"

@@ -103,6 +103,32 @@ class PythonModule(unittest.TestCase):
         with self.assertRaisesRegex(tailsim.ConfigError, "simulate\\(\\) runs one case"):
             tailsim.simulate(**dict(FIG7_ARGS, trajectory=dict(FIG7_ARGS["trajectory"], dtheta_deg={"sweep": [-60, -90]})))
 
+    def test_run_selection_errors_are_config_errors(self):
+        out = os.path.join(self.tmp.name, "sel")
+        with self.assertRaisesRegex(tailsim.ConfigError, r"unknown model 'mujocoo'"):
+            tailsim.run(FIG7, out=out, models=["mujocoo"])
+        with self.assertRaisesRegex(tailsim.ConfigError, r"none of those its cases run \(analytic\): nothing would run"):
+            tailsim.run(FIG7, out=out, models=["perfoot"])
+        with self.assertRaisesRegex(tailsim.ConfigError, r"no case named 'nope' in .*; cases: base"):
+            tailsim.run(FIG7, out=out, case="nope")
+        self.assertFalse(os.path.exists(os.path.join(out, "results.csv")))
+
+    def test_simulate_keeps_the_rows_output_time_series_asks_for(self):
+        thin = tailsim.simulate(**dict(FIG7_ARGS, output={"time_series": "thin"}))
+        full = tailsim.simulate(**FIG7_ARGS)
+        none = tailsim.simulate(**dict(FIG7_ARGS, output={"time_series": "none"}))
+        self.assertEqual(thin.summary["phi_net_deg"], full.summary["phi_net_deg"])
+        self.assertEqual(none.summary["phi_net_deg"], full.summary["phi_net_deg"])
+        n = len(thin["t_s"])
+        self.assertTrue(0 < n < len(full["t_s"]) // 4, n)  # docs/experiment-format.md: 87 of 751 for this case
+        # Kept rows are full rows, unchanged.
+        t_full = list(full["t_s"])
+        for k in range(n):
+            i = t_full.index(thin["t_s"][k])
+            self.assertEqual(thin["phi_deg"][k], full["phi_deg"][i])
+        self.assertEqual(list(none.columns), list(full.columns))
+        self.assertEqual(len(none["t_s"]), 0)
+
     def test_mujoco(self):
         r = tailsim.simulate(**FIG7_ARGS, model="mujoco")
         self.assertTrue(r.summary["ok"], r.summary.get("error"))

@@ -57,22 +57,6 @@ std::string versionString() {
 }
 
 // `--case NAME` must name a case of the suite: an error listing the available ones otherwise.
-void requireCase(const std::vector<Experiment>& suite, const std::string& file, const std::string& name) {
-  if (name.empty()) return;
-  std::vector<std::string> names;  // in file order, each once
-  std::set<std::string> listed;     // (a set: a 10^5-case sweep must not cost 10^10 comparisons)
-  for (const Experiment& e : suite)
-    for (const ExperimentCase& c : e.cases) {
-      if (c.name == name) return;
-      if (listed.insert(c.name).second) names.push_back(c.name);
-    }
-  std::string list;
-  const size_t show = std::min<size_t>(names.size(), 20);
-  for (size_t i = 0; i < show; ++i) list += (i ? ", " : "") + names[i];
-  if (names.size() > show) list += ", ... (" + std::to_string(names.size() - show) + " more)";
-  throw std::runtime_error("no case named '" + name + "' in " + file +
-                           "; cases: " + (list.empty() ? "(none)" : list));
-}
 
 void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite) {
   // A short table of phi_net per case and model, read back from the result folder's summary.json
@@ -207,7 +191,7 @@ int main(int argc, char** argv) {
   auto* run = app.add_subcommand("run", "run an experiment (or a suite such as configs/paper/all.yaml)");
   run->add_option("experiment", exp_path, "experiment YAML")->required()->check(CLI::ExistingFile);
   run->add_option("--out", out_dir, "result folder")->required();
-  run->add_option("--threads", threads, "worker threads (default: all cores)");
+  run->add_option("--threads", threads, "worker threads (default 0: all cores)")->check(CLI::NonNegativeNumber);
   run->add_option("--case", case_name, "run only this case");
   run->add_flag("--no-render", no_render, "skip the render section");
   run->add_flag("--fresh", fresh, "start from an empty result folder (deletes tailsim's results in --out, also another experiment's)");
@@ -221,9 +205,9 @@ int main(int argc, char** argv) {
   auto* merge = app.add_subcommand("merge", "join the result folders of `run --shard K/N` into one folder");
   merge->add_option("shards", merge_dirs, "the shards' result folders")->required()->check(CLI::ExistingDirectory);
   merge->add_option("--out", merge_out, "the merged result folder (new or empty)")->required();
-  merge->add_option("--threads", threads, "worker threads (default: all cores)");
+  merge->add_option("--threads", threads, "worker threads (default 0: all cores)")->check(CLI::NonNegativeNumber);
   std::vector<std::string> only_models;
-  run->add_option("--models", only_models, "run only these models (analytic, mujoco) of each case")
+  run->add_option("--models", only_models, "run only these models (analytic, perfoot, mujoco) of each case")
       ->check(CLI::IsMember(modelNames()));
 
   int links = 1;
@@ -261,7 +245,9 @@ int main(int argc, char** argv) {
   accuracy->add_option("experiment", exp_path, "experiment YAML (every simulate case is studied)")
       ->required()->check(CLI::ExistingFile);
   accuracy->add_option("--out", acc_out, "output folder")->required();
-  accuracy->add_option("--repeats", acc_repeats, "runs per setting; wall time is their median");
+  accuracy->add_option("--repeats", acc_repeats, "runs per setting; wall time is their median")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   accuracy->add_flag("--quick", acc_quick, "a reduced grid");
   accuracy->add_flag("--no-mujoco", acc_no_mujoco, "analytic model only");
 
@@ -312,15 +298,17 @@ int main(int argc, char** argv) {
 
   try {
     if (*run) {
+      ShardSpec shard{};
+      if (!shard_text.empty()) {
+        try {
+          shard = parseShard(shard_text);
+        } catch (const std::invalid_argument& e) {  // a usage error, like any other bad option
+          std::fprintf(stderr, "error: %s\n", e.what());
+          return kExitUsage;
+        }
+      }
       std::vector<Experiment> suite = loadExperimentSuite(exp_path);  // all errors before any work
-      if (!only_models.empty())
-        for (Experiment& e : suite)
-          for (ExperimentCase& c : e.cases) {
-            std::vector<std::string> keep;
-            for (const std::string& m : c.models)
-              if (std::find(only_models.begin(), only_models.end(), m) != only_models.end()) keep.push_back(m);
-            c.models = keep;
-          }
+      selectModels(suite, only_models, exp_path);
       RunOptions o;
       o.out_dir = out_dir;
       o.threads = threads;
@@ -330,9 +318,8 @@ int main(int argc, char** argv) {
       o.only_case = case_name;
       o.stop_on_sigint = true;
       if (!shard_text.empty()) {
-        const ShardSpec sh = parseShard(shard_text);
-        o.shard_index = sh.index;
-        o.shard_count = sh.count;
+        o.shard_index = shard.index;
+        o.shard_count = shard.count;
       }
       requireCase(suite, exp_path, case_name);
       const RunStats s = runSuite(suite, o);

@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <system_error>
@@ -111,6 +112,53 @@ json summaryJson(const RunSummary& s) {
   j["warnings"] = s.warnings;
   for (const auto& [k, v] : s.extra) j["extra"][k] = std::isfinite(v) ? json(v) : json(nullptr);
   return j;
+}
+
+void selectModels(std::vector<Experiment>& suite, const std::vector<std::string>& only, const std::string& file) {
+  if (only.empty()) return;
+  const std::vector<std::string> known = modelNames();
+  std::string known_list;
+  for (const std::string& k : known) known_list += (known_list.empty() ? "" : ", ") + k;
+  for (const std::string& m : only)
+    if (std::find(known.begin(), known.end(), m) == known.end())
+      throw ConfigError("unknown model '" + m + "' (models: " + known_list + ")");
+  bool any_simulate = false, any_left = false;
+  std::set<std::string> had;  // the models the file's simulated cases list, for the message
+  for (Experiment& e : suite)
+    for (ExperimentCase& c : e.cases) {
+      if (c.kind != CaseKind::kSimulate) continue;  // pose cases evaluate the analytic loads whatever is listed
+      any_simulate = true;
+      std::vector<std::string> keep;
+      for (const std::string& m : c.models) {
+        had.insert(m);
+        if (std::find(only.begin(), only.end(), m) != only.end()) keep.push_back(m);
+      }
+      any_left = any_left || !keep.empty();
+      c.models = keep;
+    }
+  if (any_simulate && !any_left) {
+    std::string sel, lst;
+    for (const std::string& m : only) sel += (sel.empty() ? "" : ", ") + m;
+    for (const std::string& m : had) lst += (lst.empty() ? "" : ", ") + m;
+    throw ConfigError(file + ": the models selected (" + sel + ") are none of those its cases run (" + lst +
+                      "): nothing would run");
+  }
+}
+
+void requireCase(const std::vector<Experiment>& suite, const std::string& file, const std::string& name) {
+  if (name.empty()) return;
+  std::vector<std::string> names;  // in file order, each once
+  std::set<std::string> listed;     // (a set: a 10^5-case sweep must not cost 10^10 comparisons)
+  for (const Experiment& e : suite)
+    for (const ExperimentCase& c : e.cases) {
+      if (c.name == name) return;
+      if (listed.insert(c.name).second) names.push_back(c.name);
+    }
+  std::string list;
+  const size_t show = std::min<size_t>(names.size(), 20);
+  for (size_t i = 0; i < show; ++i) list += (i ? ", " : "") + names[i];
+  if (names.size() > show) list += ", ... (" + std::to_string(names.size() - show) + " more)";
+  throw ConfigError("no case named '" + name + "' in " + file + "; cases: " + (list.empty() ? "(none)" : list));
 }
 
 std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {
@@ -753,6 +801,16 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
           std::fprintf(stderr, "interrupted: finishing %d running case%s (Ctrl-C again to abandon %s)\n", in_flight,
                        in_flight == 1 ? "" : "s", in_flight == 1 ? "it" : "them");
         } else {
+          // Finished cases stay resumable: their result.json / cases.jsonl line is on disk; their
+          // HDF5 groups are in the unpublished temporary file, so publish it now (a case still being
+          // written is incomplete there, and a resume runs it again: hasCase needs every model).
+          for (Job& job : jobs) {
+            if (!job.h5) continue;
+            try {
+              job.h5->publish();
+            } catch (const std::exception&) {  // nothing more to save; the signal still ends the run
+            }
+          }
           std::fprintf(stderr, "interrupted again: abandoning the running cases; %d cases saved\n",
                        done.load() + stats.resumed);
           std::signal(SIGINT, SIG_DFL);

@@ -42,6 +42,14 @@ struct RunStats {
   bool interrupted = false;  // stopped early by SIGINT; resumed + ran cases are saved
 };
 
+// Keeps only the models named in `only` in every case (none given: all). Throws ConfigError naming
+// `file` for an unknown model name, or when the names select no model of any simulated case (the run
+// would write empty results).
+void selectModels(std::vector<Experiment>& suite, const std::vector<std::string>& only, const std::string& file);
+// Throws ConfigError when no case of the suite is named `name` (empty: nothing to check), listing
+// the case names (at most 20).
+void requireCase(const std::vector<Experiment>& suite, const std::string& file, const std::string& name);
+
 // All models of one case (no files written). Pose cases evaluate the analytic model only.
 // `ctx`: caches shared by the cases of a run (model_registry.h), or nullptr.
 std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx = nullptr);

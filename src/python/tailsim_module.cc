@@ -21,6 +21,7 @@
 #include "experiments/model_registry.h"
 #include "experiments/settings_json.h"
 #include "results/columns.h"
+#include "results/thin_series.h"
 #include "tailsim_version.h"
 
 namespace py = pybind11;
@@ -125,8 +126,17 @@ Simulation simulate(const std::string& robot, py::object trajectory, const std::
   }
   const RunResult& r = runs.front();
   Simulation s;
-  const TimeSeries ordered =
+  TimeSeries ordered =
       c.kind == CaseKind::kSimulate ? col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series))) : r.series;
+  // output.time_series as in a result folder: thin keeps the rows a CSV would (results/thin_series.h),
+  // none keeps no rows (the columns stay, empty).
+  if (c.kind == CaseKind::kSimulate && c.output.time_series == TimeSeriesOutput::kThin)
+    ordered = thinRows(ordered, c.trajectory().breakpoints());
+  else if (c.kind == CaseKind::kSimulate && c.output.time_series == TimeSeriesOutput::kNone) {
+    TimeSeries empty;
+    for (const std::string& name : ordered.names()) empty.addColumn(name);
+    ordered = empty;
+  }
   s.series = seriesToNumpy(ordered, s.columns);
   s.summary = toPython(summaryJson(r.summary));
   json resolved = resolvedJson(c);
@@ -143,20 +153,8 @@ py::object run(const std::string& experiment, const std::string& out, std::vecto
   {
     py::gil_scoped_release free;
     suite = loadExperimentSuite(experiment);  // all errors before any work
-    if (!models.empty())
-      for (Experiment& e : suite)
-        for (ExperimentCase& c : e.cases) {
-          std::vector<std::string> keep;
-          for (const std::string& m : c.models)
-            if (std::find(models.begin(), models.end(), m) != models.end()) keep.push_back(m);
-          c.models = keep;
-        }
-    if (!case_name.empty()) {
-      bool found = false;
-      for (const Experiment& e : suite)
-        for (const ExperimentCase& c : e.cases) found = found || c.name == case_name;
-      if (!found) throw std::runtime_error("no case named '" + case_name + "' in " + experiment);
-    }
+    selectModels(suite, models, experiment);  // the CLI's checks and messages (ConfigError)
+    requireCase(suite, experiment, case_name);
     RunOptions o;
     o.out_dir = out;
     o.threads = threads;
