@@ -153,7 +153,8 @@ ok "Ctrl-C after the first case: exit 130, '$said', rerun resumed $saved"
 
 echo "== Ctrl-C twice with every series in one HDF5 file: the finished cases stay resumable"
 sed 's/^name: wss_sweep/name: wss_sweep_h5/' sweep.yaml >sweep_h5.yaml
-printf 'output: {time_series_file: hdf5}\n' >>sweep_h5.yaml
+# 4 s simulated per case: the case running at the first Ctrl-C is still running at the second.
+printf 'output: {time_series_file: hdf5, duration_s: 4}\n' >>sweep_h5.yaml
 set -m
 "$tailsim" run sweep_h5.yaml --out int_h5 --threads 1 >out.txt 2>err.txt &
 pid=$!
@@ -161,7 +162,12 @@ for _ in $(seq 1 600); do  # until 2 cases are in the journal, at most 60 s
   [ "$(wc -l <int_h5/cases.jsonl 2>/dev/null || echo 0)" -ge 2 ] && break
   sleep 0.1
 done
-kill -INT "$pid"; sleep 0.2; kill -INT "$pid" 2>/dev/null || true
+kill -INT "$pid"
+for _ in $(seq 1 100); do  # the first Ctrl-C answered ("finishing ..."), at most 10 s
+  grep -q "^interrupted: finishing" err.txt && break
+  sleep 0.1
+done
+kill -INT "$pid" 2>/dev/null || true
 rc=0
 wait "$pid" || rc=$?
 set +m

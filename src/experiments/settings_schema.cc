@@ -117,7 +117,9 @@ json section(const json& props, const std::vector<std::string>& required = {}) {
 template <class S>
 std::vector<std::string> allKeys() {
   std::vector<std::string> v;
-  for (const auto& [k, _] : describe<S>().props.items()) v.push_back(k);
+  const Describer d = describe<S>();  // named: a range-for over describe<S>().props.items() would
+                                      // iterate a destroyed temporary (ASan: stack-use-after-scope)
+  for (const auto& [k, _] : d.props.items()) v.push_back(k);
   return v;
 }
 
