@@ -24,5 +24,7 @@ echo "fuzz_experiment_loader, ${secs} s:"
 grep -E '^(Done [0-9]+ runs|stat::number_of_executed_units|stat::peak_rss_mb|stat::new_units_added)' "$log" || true
 echo "corpus: $(find build-fuzz/fuzz-corpus -type f | wc -l) inputs in build-fuzz/fuzz-corpus" \
      "(+ $(find configs -type f | wc -l) seeds in configs/)"
-echo "crashes/timeouts/leaks: $(find build-fuzz/fuzz-artifacts -type f | wc -l) in build-fuzz/fuzz-artifacts"
+echo "crashes/timeouts/leaks/ooms: $(find build-fuzz/fuzz-artifacts -type f \( -name 'crash-*' -o -name 'timeout-*' \
+  -o -name 'leak-*' -o -name 'oom-*' \) | wc -l) in build-fuzz/fuzz-artifacts" \
+  "(slow units, only reported: $(find build-fuzz/fuzz-artifacts -type f -name 'slow-unit-*' | wc -l))"
 exit $status
