@@ -1,7 +1,8 @@
 #include "experiments/time_series_h5.h"
 
+#include <dlfcn.h>
 #include <fcntl.h>
-#include <hdf5.h>
+#include <hdf5.h>  // types and constants only: libhdf5 is loaded at run time (see h5())
 #include <unistd.h>
 
 #include <cstdlib>
@@ -15,6 +16,106 @@ namespace fs = std::filesystem;
 static_assert(std::is_same<hid_t, int64_t>::value || sizeof(hid_t) <= sizeof(long long), "hid_t fits in long long");
 
 namespace {
+
+// libhdf5 (Debian's serial build) is loaded the first time a file is opened, not at process start:
+// linked, it brings curl, GnuTLS, Kerberos and LDAP (18 more shared libraries, ~5 ms of start-up
+// for every process; issue 13 item 2), and most runs write no HDF5 file. The functions are
+// resolved by name with dlsym; hdf5.h supplies their types only (its data-type macros name global
+// variables, read here through the same table). The handle is never closed.
+#define TAILSIM_HDF5_FUNCTIONS(X) \
+  X(H5Acreate2) \
+  X(H5Aexists) \
+  X(H5Aopen) \
+  X(H5Aread) \
+  X(H5Awrite) \
+  X(H5Dcreate2) \
+  X(H5Dget_space) \
+  X(H5Dopen2) \
+  X(H5Dread) \
+  X(H5Dwrite) \
+  X(H5Fclose) \
+  X(H5Fcreate) \
+  X(H5Fis_hdf5) \
+  X(H5Fopen) \
+  X(H5Gcreate2) \
+  X(H5Gget_info) \
+  X(H5Gopen2) \
+  X(H5Ldelete) \
+  X(H5Lexists) \
+  X(H5Lget_name_by_idx) \
+  X(H5Ocopy) \
+  X(H5Pcreate) \
+  X(H5Pset_link_creation_order) \
+  X(H5Screate) \
+  X(H5Screate_simple) \
+  X(H5Sget_simple_extent_dims) \
+  X(H5Sget_simple_extent_ndims) \
+  X(H5Tcopy) \
+  X(H5Tset_cset) \
+  X(H5Tset_size) \
+  X(H5free_memory) \
+  X(H5Tclose) \
+  X(H5Sclose) \
+  X(H5Aclose) \
+  X(H5Gclose) \
+  X(H5Dclose) \
+  X(H5Pclose) \
+  X(H5open)
+
+struct Hdf5Api {
+#define TAILSIM_HDF5_MEMBER(name) decltype(&::name) name = nullptr;
+  TAILSIM_HDF5_FUNCTIONS(TAILSIM_HDF5_MEMBER)
+#undef TAILSIM_HDF5_MEMBER
+  const hid_t* native_double_g = nullptr;
+  const hid_t* ieee_f64le_g = nullptr;
+  const hid_t* c_s1_g = nullptr;
+  const hid_t* group_create_g = nullptr;
+  // The library's predefined types and property classes (H5T_NATIVE_DOUBLE, ...): set by H5open().
+  hid_t native_double() const { return *native_double_g; }
+  hid_t ieee_f64le() const { return *ieee_f64le_g; }
+  hid_t c_s1() const { return *c_s1_g; }
+  hid_t group_create() const { return *group_create_g; }
+};
+
+Hdf5Api loadHdf5() {
+  void* lib = nullptr;
+  std::string why;
+  for (const char* name : {TAILSIM_HDF5_SONAME, "libhdf5_serial.so", "libhdf5.so"}) {
+    lib = ::dlopen(name, RTLD_NOW | RTLD_LOCAL);
+    if (lib) break;
+    if (const char* e = ::dlerror()) why = e;
+  }
+  if (!lib)
+    throw std::runtime_error("HDF5: cannot load " TAILSIM_HDF5_SONAME " (" + why +
+                             "); is libhdf5-103-1 installed (scripts/setup.sh)?");
+  Hdf5Api api;
+  std::string missing;
+  const auto symbol = [&](const char* name) {
+    void* p = ::dlsym(lib, name);
+    if (!p) missing += std::string(missing.empty() ? "" : ", ") + name;
+    return p;
+  };
+#define TAILSIM_HDF5_RESOLVE(name) api.name = reinterpret_cast<decltype(api.name)>(symbol(#name));
+  TAILSIM_HDF5_FUNCTIONS(TAILSIM_HDF5_RESOLVE)
+#undef TAILSIM_HDF5_RESOLVE
+  api.native_double_g = static_cast<const hid_t*>(symbol("H5T_NATIVE_DOUBLE_g"));
+  api.ieee_f64le_g = static_cast<const hid_t*>(symbol("H5T_IEEE_F64LE_g"));
+  api.c_s1_g = static_cast<const hid_t*>(symbol("H5T_C_S1_g"));
+  api.group_create_g = static_cast<const hid_t*>(symbol("H5P_CLS_GROUP_CREATE_ID_g"));
+  if (!missing.empty()) throw std::runtime_error("HDF5: " TAILSIM_HDF5_SONAME " lacks " + missing);
+  if (api.H5open() < 0) throw std::runtime_error("HDF5: H5open failed");
+  return api;
+}
+
+// H5F_ACC_* expand to H5check()/H5open() calls in hdf5.h: their values (H5Fpublic.h), used plainly.
+constexpr unsigned kAccRdonly = 0x0000u, kAccRdwr = 0x0001u, kAccTrunc = 0x0002u, kAccExcl = 0x0004u;
+
+// Loaded once per process (thread-safe static initialisation); a failed load is retried next time.
+const Hdf5Api& h5() {
+  static const Hdf5Api api = loadHdf5();
+  return api;
+}
+
 
 // One HDF5 identifier, closed by its own close function when it goes out of scope.
 class H5Handle {
@@ -55,42 +156,42 @@ H5Handle check(H5Handle h, const std::string& what) {
 
 // A variable-length UTF-8 string type (h5py reads it as str).
 H5Handle stringType() {
-  H5Handle t(H5Tcopy(H5T_C_S1), H5Tclose);
-  H5Tset_size(t.get(), H5T_VARIABLE);
-  H5Tset_cset(t.get(), H5T_CSET_UTF8);
+  H5Handle t(h5().H5Tcopy(h5().c_s1()), h5().H5Tclose);
+  h5().H5Tset_size(t.get(), H5T_VARIABLE);
+  h5().H5Tset_cset(t.get(), H5T_CSET_UTF8);
   return t;
 }
 
 void putString(hid_t obj, const std::string& name, const std::string& value) {
   const H5Handle t = stringType();
-  const H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-  const H5Handle a = check(H5Handle(H5Acreate2(obj, name.c_str(), t.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose),
+  const H5Handle space(h5().H5Screate(H5S_SCALAR), h5().H5Sclose);
+  const H5Handle a = check(H5Handle(h5().H5Acreate2(obj, name.c_str(), t.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), h5().H5Aclose),
                            "cannot create attribute " + name);
   const char* p = value.c_str();
-  if (H5Awrite(a.get(), t.get(), &p) < 0) fail("cannot write attribute " + name);
+  if (h5().H5Awrite(a.get(), t.get(), &p) < 0) fail("cannot write attribute " + name);
 }
 
 void putNumber(hid_t obj, const std::string& name, double value) {
-  const H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+  const H5Handle space(h5().H5Screate(H5S_SCALAR), h5().H5Sclose);
   const H5Handle a = check(
-      H5Handle(H5Acreate2(obj, name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose),
+      H5Handle(h5().H5Acreate2(obj, name.c_str(), h5().ieee_f64le(), space.get(), H5P_DEFAULT, H5P_DEFAULT), h5().H5Aclose),
       "cannot create attribute " + name);
-  if (H5Awrite(a.get(), H5T_NATIVE_DOUBLE, &value) < 0) fail("cannot write attribute " + name);
+  if (h5().H5Awrite(a.get(), h5().native_double(), &value) < 0) fail("cannot write attribute " + name);
 }
 
 std::string getString(hid_t obj, const std::string& name) {
-  if (H5Aexists(obj, name.c_str()) <= 0) return {};
-  const H5Handle a(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose);
+  if (h5().H5Aexists(obj, name.c_str()) <= 0) return {};
+  const H5Handle a(h5().H5Aopen(obj, name.c_str(), H5P_DEFAULT), h5().H5Aclose);
   if (!a.ok()) return {};
   const H5Handle t = stringType();
   char* p = nullptr;
-  if (H5Aread(a.get(), t.get(), &p) < 0 || !p) return {};
+  if (h5().H5Aread(a.get(), t.get(), &p) < 0 || !p) return {};
   std::string s(p);
-  H5free_memory(p);
+  h5().H5free_memory(p);
   return s;
 }
 
-bool linkExists(hid_t loc, const std::string& name) { return H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0; }
+bool linkExists(hid_t loc, const std::string& name) { return h5().H5Lexists(loc, name.c_str(), H5P_DEFAULT) > 0; }
 
 // A number as written ("0.25", "-90"): its value, or false when it is not one.
 bool asNumber(const std::string& s, double& out) {
@@ -104,13 +205,13 @@ bool asNumber(const std::string& s, double& out) {
 std::vector<std::string> linkNames(hid_t group, bool creation_order) {
   std::vector<std::string> out;
   H5G_info_t info{};
-  if (H5Gget_info(group, &info) < 0) return out;
+  if (h5().H5Gget_info(group, &info) < 0) return out;
   const H5_index_t idx = creation_order ? H5_INDEX_CRT_ORDER : H5_INDEX_NAME;
   for (hsize_t i = 0; i < info.nlinks; ++i) {
-    const ssize_t n = H5Lget_name_by_idx(group, ".", idx, H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
+    const ssize_t n = h5().H5Lget_name_by_idx(group, ".", idx, H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
     if (n < 0) continue;
     std::string name(static_cast<size_t>(n) + 1, '\0');
-    H5Lget_name_by_idx(group, ".", idx, H5_ITER_INC, i, name.data(), name.size(), H5P_DEFAULT);
+    h5().H5Lget_name_by_idx(group, ".", idx, H5_ITER_INC, i, name.data(), name.size(), H5P_DEFAULT);
     name.resize(static_cast<size_t>(n));
     out.push_back(name);
   }
@@ -119,12 +220,18 @@ std::vector<std::string> linkNames(hid_t group, bool creation_order) {
 
 // Group creation property list that tracks creation order (so columns read back in CSV order).
 H5Handle orderedGroupProps() {
-  H5Handle p(H5Pcreate(H5P_GROUP_CREATE), H5Pclose);
-  H5Pset_link_creation_order(p.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED);
+  H5Handle p(h5().H5Pcreate(h5().group_create()), h5().H5Pclose);
+  h5().H5Pset_link_creation_order(p.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED);
   return p;
 }
 
 }  // namespace
+
+bool hdf5Loaded() {
+  void* lib = ::dlopen(TAILSIM_HDF5_SONAME, RTLD_NOW | RTLD_NOLOAD);  // takes a reference when mapped
+  if (lib) ::dlclose(lib);
+  return lib != nullptr;
+}
 
 std::string columnUnits(const std::string& column) {
   const size_t u = column.rfind('_');
@@ -145,12 +252,12 @@ std::string columnUnits(const std::string& column) {
 
 TimeSeriesH5Reader::TimeSeriesH5Reader(const std::string& path) : path_(path) {
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec) || H5Fis_hdf5(path.c_str()) <= 0) return;
-  file_ = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (!fs::is_regular_file(path, ec) || h5().H5Fis_hdf5(path.c_str()) <= 0) return;
+  file_ = h5().H5Fopen(path.c_str(), kAccRdonly, H5P_DEFAULT);
 }
 
 TimeSeriesH5Reader::~TimeSeriesH5Reader() {
-  if (file_ >= 0) H5Fclose(file_);
+  if (file_ >= 0) h5().H5Fclose(file_);
 }
 
 bool TimeSeriesH5Reader::ok() const { return file_ >= 0; }
@@ -159,7 +266,7 @@ long long TimeSeriesH5Reader::handle() const { return file_; }
 bool TimeSeriesH5Reader::hasCase(const std::string& case_dir, const std::string& key,
                                  const std::vector<std::string>& models) const {
   if (file_ < 0 || !linkExists(file_, case_dir)) return false;
-  const H5Handle g(H5Gopen2(file_, case_dir.c_str(), H5P_DEFAULT), H5Gclose);
+  const H5Handle g(h5().H5Gopen2(file_, case_dir.c_str(), H5P_DEFAULT), h5().H5Gclose);
   if (!g.ok() || getString(g.get(), "key") != key) return false;
   for (const std::string& m : models)
     if (!linkExists(g.get(), m)) return false;
@@ -171,18 +278,18 @@ TimeSeries TimeSeriesH5Reader::read(const std::string& case_dir, const std::stri
   if (file_ < 0) throw std::runtime_error("cannot read " + path_ + " (absent or not an HDF5 file)");
   if (!linkExists(file_, case_dir) || !linkExists(file_, case_dir + "/" + model))
     throw std::runtime_error(where + " does not exist");
-  const H5Handle g(H5Gopen2(file_, (case_dir + "/" + model).c_str(), H5P_DEFAULT), H5Gclose);
+  const H5Handle g(h5().H5Gopen2(file_, (case_dir + "/" + model).c_str(), H5P_DEFAULT), h5().H5Gclose);
   if (!g.ok()) throw std::runtime_error("cannot open " + where);
   TimeSeries ts;
   std::vector<std::vector<double>> cols;
   for (const std::string& name : linkNames(g.get(), true)) {
-    const H5Handle d(H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
-    const H5Handle sp(d.ok() ? H5Dget_space(d.get()) : -1, H5Sclose);
+    const H5Handle d(h5().H5Dopen2(g.get(), name.c_str(), H5P_DEFAULT), h5().H5Dclose);
+    const H5Handle sp(d.ok() ? h5().H5Dget_space(d.get()) : -1, h5().H5Sclose);
     hsize_t n = 0;
-    if (!sp.ok() || H5Sget_simple_extent_ndims(sp.get()) != 1 || H5Sget_simple_extent_dims(sp.get(), &n, nullptr) < 0)
+    if (!sp.ok() || h5().H5Sget_simple_extent_ndims(sp.get()) != 1 || h5().H5Sget_simple_extent_dims(sp.get(), &n, nullptr) < 0)
       throw std::runtime_error(where + "/" + name + " is not a 1-D dataset");
     std::vector<double> v(n);
-    if (n && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+    if (n && h5().H5Dread(d.get(), h5().native_double(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
       throw std::runtime_error("cannot read " + where + "/" + name);
     if (!cols.empty() && v.size() != cols.front().size())
       throw std::runtime_error(where + ": columns of different lengths");
@@ -203,13 +310,13 @@ TimeSeries TimeSeriesH5Reader::read(const std::string& case_dir, const std::stri
 
 TimeSeriesH5Writer::TimeSeriesH5Writer(const std::string& final_path) : final_path_(final_path) {
   temp_path_ = final_path + ".tmp." + std::to_string(::getpid()) + ".h5";
-  file_ = H5Fcreate(temp_path_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  file_ = h5().H5Fcreate(temp_path_.c_str(), kAccTrunc, H5P_DEFAULT, H5P_DEFAULT);
   if (file_ < 0) throw std::runtime_error("HDF5: cannot create " + temp_path_);
 }
 
 TimeSeriesH5Writer::~TimeSeriesH5Writer() {
   if (published_) return;
-  if (file_ >= 0) H5Fclose(file_);
+  if (file_ >= 0) h5().H5Fclose(file_);
   std::error_code ec;
   fs::remove(temp_path_, ec);
 }
@@ -220,9 +327,9 @@ void TimeSeriesH5Writer::write(const std::string& case_dir, const std::string& c
   std::lock_guard<std::mutex> lock(mu_);
   H5Handle cg;
   if (linkExists(file_, case_dir)) {
-    cg = H5Handle(H5Gopen2(file_, case_dir.c_str(), H5P_DEFAULT), H5Gclose);
+    cg = H5Handle(h5().H5Gopen2(file_, case_dir.c_str(), H5P_DEFAULT), h5().H5Gclose);
   } else {
-    cg = check(H5Handle(H5Gcreate2(file_, case_dir.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose),
+    cg = check(H5Handle(h5().H5Gcreate2(file_, case_dir.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), h5().H5Gclose),
                "cannot create group /" + case_dir + " in " + temp_path_);
     putString(cg.get(), "case", case_name);
     putString(cg.get(), "key", key);
@@ -232,20 +339,20 @@ void TimeSeriesH5Writer::write(const std::string& case_dir, const std::string& c
       else putString(cg.get(), k, v);
     }
   }
-  if (linkExists(cg.get(), model)) H5Ldelete(cg.get(), model.c_str(), H5P_DEFAULT);  // a re-run case
+  if (linkExists(cg.get(), model)) h5().H5Ldelete(cg.get(), model.c_str(), H5P_DEFAULT);  // a re-run case
   const H5Handle gp = orderedGroupProps();
-  const H5Handle mg = check(H5Handle(H5Gcreate2(cg.get(), model.c_str(), H5P_DEFAULT, gp.get(), H5P_DEFAULT), H5Gclose),
+  const H5Handle mg = check(H5Handle(h5().H5Gcreate2(cg.get(), model.c_str(), H5P_DEFAULT, gp.get(), H5P_DEFAULT), h5().H5Gclose),
                             "cannot create group /" + case_dir + "/" + model);
   putString(mg.get(), "time_series", mode);
   const hsize_t n = ts.numRows();
-  const H5Handle space(H5Screate_simple(1, &n, nullptr), H5Sclose);
+  const H5Handle space(h5().H5Screate_simple(1, &n, nullptr), h5().H5Sclose);
   for (size_t c = 0; c < ts.numColumns(); ++c) {
     const std::string& name = ts.names()[c];
-    const H5Handle d = check(H5Handle(H5Dcreate2(mg.get(), name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT,
+    const H5Handle d = check(H5Handle(h5().H5Dcreate2(mg.get(), name.c_str(), h5().ieee_f64le(), space.get(), H5P_DEFAULT,
                                                  H5P_DEFAULT, H5P_DEFAULT),
-                                      H5Dclose),
+                                      h5().H5Dclose),
                              "cannot create dataset " + name);
-    if (n && H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, ts.values(static_cast<int>(c)).data()) < 0)
+    if (n && h5().H5Dwrite(d.get(), h5().native_double(), H5S_ALL, H5S_ALL, H5P_DEFAULT, ts.values(static_cast<int>(c)).data()) < 0)
       fail("cannot write dataset /" + case_dir + "/" + model + "/" + name);
     putString(d.get(), "units", columnUnits(name));
   }
@@ -253,15 +360,15 @@ void TimeSeriesH5Writer::write(const std::string& case_dir, const std::string& c
 
 void TimeSeriesH5Writer::copyCase(const TimeSeriesH5Reader& from, const std::string& case_dir) {
   std::lock_guard<std::mutex> lock(mu_);
-  if (linkExists(file_, case_dir)) H5Ldelete(file_, case_dir.c_str(), H5P_DEFAULT);
-  if (H5Ocopy(static_cast<hid_t>(from.handle()), case_dir.c_str(), file_, case_dir.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+  if (linkExists(file_, case_dir)) h5().H5Ldelete(file_, case_dir.c_str(), H5P_DEFAULT);
+  if (h5().H5Ocopy(static_cast<hid_t>(from.handle()), case_dir.c_str(), file_, case_dir.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
     fail("cannot copy /" + case_dir + " into " + temp_path_);
 }
 
 void TimeSeriesH5Writer::publish() {
   std::lock_guard<std::mutex> lock(mu_);
   if (published_) return;
-  const herr_t closed = H5Fclose(file_);
+  const herr_t closed = h5().H5Fclose(file_);
   file_ = -1;
   if (closed < 0) fail("cannot close " + temp_path_);
   // HDF5 wrote through its own descriptor; flush it to disk before the rename publishes it.
@@ -281,14 +388,14 @@ void mergeTimeSeriesH5(const std::string& src, const std::string& dst) {
   if (!in.ok()) throw std::runtime_error("merge: " + src + " is not an HDF5 file");
   std::error_code ec;
   const bool exists = fs::exists(dst, ec);
-  const H5Handle out(exists ? H5Fopen(dst.c_str(), H5F_ACC_RDWR, H5P_DEFAULT)
-                            : H5Fcreate(dst.c_str(), H5F_ACC_EXCL, H5P_DEFAULT, H5P_DEFAULT),
-                     H5Fclose);
+  const H5Handle out(exists ? h5().H5Fopen(dst.c_str(), kAccRdwr, H5P_DEFAULT)
+                            : h5().H5Fcreate(dst.c_str(), kAccExcl, H5P_DEFAULT, H5P_DEFAULT),
+                     h5().H5Fclose);
   if (!out.ok()) throw std::runtime_error("merge: cannot open " + dst);
-  const H5Handle root(H5Gopen2(static_cast<hid_t>(in.handle()), "/", H5P_DEFAULT), H5Gclose);
+  const H5Handle root(h5().H5Gopen2(static_cast<hid_t>(in.handle()), "/", H5P_DEFAULT), h5().H5Gclose);
   for (const std::string& name : linkNames(root.get(), false)) {
     if (linkExists(out.get(), name)) continue;  // an earlier shard's
-    if (H5Ocopy(static_cast<hid_t>(in.handle()), name.c_str(), out.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
+    if (h5().H5Ocopy(static_cast<hid_t>(in.handle()), name.c_str(), out.get(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0)
       throw std::runtime_error("merge: cannot copy /" + name + " from " + src);
   }
 }

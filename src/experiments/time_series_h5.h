@@ -23,6 +23,10 @@ namespace tailsim {
 // The unit of a column from its name's suffix (t_s -> "s", phidot_dps -> "deg/s", MzT_Nm -> "N m").
 std::string columnUnits(const std::string& column);
 
+// Whether libhdf5 is mapped into the process: it is loaded (dlopen) the first time a file is
+// opened, never at start-up (issue 13 item 2; tests/test_lazy_gl.cc).
+bool hdf5Loaded();
+
 // Reads a published file (never written through this class).
 class TimeSeriesH5Reader {
  public:
