@@ -84,6 +84,18 @@ TEST(TailDynamics, DecompositionAddsUpForAnyN) {
     for (auto& j : js) j = {u(rng), 10 * u(rng), 300 * u(rng)};
     const SystemLoads s = systemLoads(r, js);
     EXPECT_NEAR(s.MzT_acc + s.MzT_speed, s.MzT, 1e-12 * (1 + std::abs(s.MzT)));
+    // Each part by its own recursion: the total of the same pose with the other input zeroed
+    // (systemLoads takes the speed-driven part as total - acceleration-driven, relying on the
+    // loads being linear in the accelerations; this checks that).
+    std::vector<JointState> acc_only = js, speed_only = js;
+    for (auto& j : acc_only) j.theta_dot = 0.0;
+    for (auto& j : speed_only) j.theta_ddot = 0.0;
+    const SystemLoads a = systemLoads(r, acc_only, false), v = systemLoads(r, speed_only, false);
+    EXPECT_NEAR(s.MzT_acc, a.MzT, 1e-12 * (1 + std::abs(s.MzT))) << "n=" << n;
+    EXPECT_NEAR(s.MzT_speed, v.MzT, 1e-12 * (1 + std::abs(s.MzT))) << "n=" << n;
+    const double mQ_over_m = r.quadruped.mass_kg / s.mass_kg;
+    EXPECT_NEAR(s.MzT_tan, mQ_over_m * cross2(s.p_QB, a.F_T_Q), 1e-12 * (1 + std::abs(s.MzT))) << "n=" << n;
+    EXPECT_NEAR(s.MzT_cen, mQ_over_m * cross2(s.p_QB, v.F_T_Q), 1e-12 * (1 + std::abs(s.MzT))) << "n=" << n;
   }
 }
 

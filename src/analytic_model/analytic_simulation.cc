@@ -128,6 +128,7 @@ struct Run {
   double t_stop = 0.0;    // the rotation last stuck
   bool ever_rotated = false;
   long steps = 0;         // accepted solver steps
+  double dt_resume = 0.0;  // the step to restart with after a tail breakpoint (0: after a switch)
 };
 
 // The fixed-step solver checks once per step: a slide slower than one step's friction
@@ -214,8 +215,19 @@ void adaptiveSegment(Run& run, double seg_end) {
   const double max_dt = (tail_moving || run.modes.stuck[kRot] || run.modes.stuck[kTrans]) ? run.plan.h_max : (t_end - run.t);
   auto rhs = [&](const State& x, State& dx, double tt) { derivative(m, run.ws, tt, x, run.modes, dx); };
   auto stepper = odeint::make_dense_output(s.abs_tol, s.rel_tol, max_dt, odeint::runge_kutta_dopri5<State>());
-  stepper.initialize(run.y, run.t, std::min(max_dt, 1e-4));
+  // After a switch the dynamics change: start small. After a tail breakpoint they continue with
+  // a jump in the tail acceleration only: go on with the step size the solver had reached.
+  const double dt0 = std::min(max_dt, run.dt_resume > 0 ? run.dt_resume : 1e-4);
+  run.dt_resume = 0.0;
+  stepper.initialize(run.y, run.t, dt0);
+  Margins g_end{};
+  bool have_g_end = false;  // g_end holds the margins at the last step's end (modes unchanged since)
   for (;;) {
+    // A step that would cross the next breakpoint (where the tail acceleration jumps) ends on it
+    // instead: across it the error estimate fails and the step is rejected over and over.
+    const double t_now = stepper.current_time(), dt_now = stepper.current_time_step();
+    if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12 && seg_end < run.plan.t_end)
+      stepper.initialize(stepper.current_state(), t_now, seg_end - t_now);
     const auto [ta, tb_raw] = stepper.do_step(rhs);
     countStep(run);
     const double tb = std::min(tb_raw, seg_end);
@@ -227,7 +239,8 @@ void adaptiveSegment(Run& run, double seg_end) {
         stateAt(tt, yg);
         return eventMargins(m, run.ws, run.v_stop, tt, yg, run.modes);
       };
-      f = findSwitch(gAt, run.modes, ta, tb, run.plan.h_scan, s.event_tol_s);
+      f = findSwitch(gAt, run.modes, ta, tb, run.plan.h_scan, s.event_tol_s, have_g_end ? &g_end : nullptr, &g_end);
+      have_g_end = !f.hit && tb == tb_raw;
     }
     const double t_cut = f.hit ? f.t : tb;
     recordUpTo(run, t_cut, stateAt);
@@ -238,7 +251,10 @@ void adaptiveSegment(Run& run, double seg_end) {
       switchAt(run, f.which);
       return;
     }
-    if (tb_raw >= seg_end - 1e-15) return;  // a breakpoint of the tail profile: restart the step there
+    if (tb_raw >= seg_end - 1e-15) {  // a breakpoint of the tail profile: restart the step there
+      if (tb_raw <= seg_end + 1e-12) run.dt_resume = std::max(stepper.current_time_step(), tb_raw - ta);
+      return;
+    }
     if (run.t >= t_end - 1e-15 || settled(run, run.t)) return;
     // The solver's internal state may lie beyond t (when tb was clipped): continue from t.
     if (stepper.current_time() > run.t + 1e-15) return;

@@ -97,13 +97,16 @@ struct Found {
 // over: paper-notes point 4); in the first sample interval where any margin reaches zero, every
 // DOF that crosses there is located and the earliest wins, so no DOF's switch can hide behind
 // another's. A dip of a stuck DOF's margin between samples (all samples positive) is refined by
-// golden section.
+// golden section. g_ta: the margins at ta when the caller has them (the previous step's last
+// sample, same modes: saves one evaluation a step); g_tb: set to the margins at tb when nothing
+// switches.
 template <class GAt>
-Found findSwitch(const GAt& gAt, const Modes& m, double ta, double tb, double h_scan, double tol) {
+Found findSwitch(const GAt& gAt, const Modes& m, double ta, double tb, double h_scan, double tol,
+                 const Margins* g_ta = nullptr, Margins* g_tb = nullptr) {
   const int k = std::max(2, static_cast<int>(std::ceil((tb - ta) / h_scan)));
   // A stuck margin reaching 0 from above, or a sliding one turning negative (a stop).
   auto crosses = [&](int w, double g0, double g1) { return (g0 > 0 && g1 <= 0) || (!m.stuck[w] && g0 >= 0 && g1 < 0); };
-  Margins g_prev = gAt(ta), g_prev2 = g_prev;
+  Margins g_prev = g_ta ? *g_ta : gAt(ta), g_prev2 = g_prev;
   for (int w : {kRot, kTrans})  // already past the switch (settleModes normally resolves this)
     if ((m.stuck[w] && g_prev[w] <= 0) || (!m.stuck[w] && g_prev[w] < 0)) return {true, ta, w};
   double t_prev = ta, t_prev2 = ta;
@@ -131,6 +134,7 @@ Found findSwitch(const GAt& gAt, const Modes& m, double ta, double tb, double h_
     t_prev2 = t_prev; g_prev2 = g_prev;
     t_prev = t; g_prev = gt;
   }
+  if (g_tb) *g_tb = g_prev;
   return {};
 }
 

@@ -48,10 +48,11 @@ void systemLoads(const RobotParams& robot, const std::vector<JointState>& joints
     for (auto& j : part) j.theta_dot = 0.0;  // acceleration-driven
     tailKinematics(robot.tail, part, kin);
     netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, F_acc, s.MzT_acc);
-    part = joints;
-    for (auto& j : part) j.theta_ddot = 0.0;  // speed-driven
-    tailKinematics(robot.tail, part, kin);
-    netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, F_speed, s.MzT_speed);
+    // Speed-driven: the rest. The planar Newton-Euler loads are linear in the joint accelerations
+    // and carry no other term (no gravity in the plane), so total = acceleration- + speed-driven
+    // to round-off (test SystemLoads.DecompositionPartsSumToTheTotal): one recursion, not two.
+    F_speed = s.F_T_Q - F_acc;
+    s.MzT_speed = s.MzT - s.MzT_acc;
     const double mQ_over_m = robot.quadruped.mass_kg / s.mass_kg;
     // p_B - p_COM = (m_Q/m)(p_B - p_Q) + sum (m_i/m)(p_B - p_L,i): the first part carries d_Q2B.
     s.MzT_tan = mQ_over_m * cross2(s.p_QB, F_acc);
