@@ -226,7 +226,7 @@ void adaptiveSegment(Run& run, double seg_end) {
     // A step that would cross the next breakpoint (where the tail acceleration jumps) ends on it
     // instead: across it the error estimate fails and the step is rejected over and over.
     const double t_now = stepper.current_time(), dt_now = stepper.current_time_step();
-    if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12 && seg_end < run.plan.t_end)
+    if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12)
       stepper.initialize(stepper.current_state(), t_now, seg_end - t_now);
     const auto [ta, tb_raw] = stepper.do_step(rhs);
     countStep(run);

@@ -462,6 +462,7 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
       return t_end;
     };
     auto rhs = [&](const State& x, State& dx, double tt) { model.derivative(tt, x, dx); };
+    double dt_resume = 0.0;  // the step to go on with after a tail breakpoint (0: start small)
 
     while (t < t_end - 1e-15) {
       if (settled(t)) {
@@ -490,9 +491,16 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
       const double max_dt = t < tail_end ? h_max : t_end - t;
       auto stepper = odeint::make_dense_output(settings.abs_tol, settings.rel_tol, max_dt,
                                                odeint::runge_kutta_dopri5<State>());
-      stepper.initialize(y, t, std::min(max_dt, 1e-4));
+      // As in the analytic model (analytic_simulation.cc): after a switch start small, after a
+      // breakpoint go on with the reached step; a step never crosses a breakpoint (the tail
+      // acceleration jumps there and the error estimate fails), it ends on it.
+      stepper.initialize(y, t, std::min(max_dt, dt_resume > 0 ? dt_resume : 1e-4));
+      dt_resume = 0.0;
       bool restart = false;
       while (!restart) {
+        const double t_now = stepper.current_time(), dt_now = stepper.current_time_step();
+        if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12)
+          stepper.initialize(stepper.current_state(), t_now, seg_end - t_now);
         const auto [ta, tb_raw] = stepper.do_step(rhs);
         ++steps;
         if (steps > settings.max_steps)
@@ -511,6 +519,8 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
         if (ts <= tb) {
           settle();
           restart = true;
+        } else if (tb_raw >= seg_end - 1e-15 && tb_raw <= seg_end + 1e-12) {
+          dt_resume = std::max(stepper.current_time_step(), tb_raw - ta);
         }
         if (tb_raw >= seg_end - 1e-15 || t >= t_end - 1e-15 || stepper.current_time() > t + 1e-15) restart = true;
       }
