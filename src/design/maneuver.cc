@@ -499,6 +499,8 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     c.name = spec.name;
     c.render.enabled = true;
     c.render.slowmo = 1.0;
+    // Show the turn and 2 s after the closed loop is within tolerance (the run idles afterwards).
+    if (rep.runs[2].t_within_s >= 0) c.render.duration_s = rep.runs[2].t_within_s + 2.0;
     std::vector<RunResult> runs(2);
     runs[0].summary.model = "analytic";
     runs[0].series = rep.runs[0].series;
