@@ -31,6 +31,13 @@ TailController::TailController(const mjModel* m, TailTrajectory trajectory, std:
   resetStats();
 }
 
+void TailController::setTrajectory(TailTrajectory trajectory) {
+  if (trajectory.joints.size() != qposadr_.size())
+    throw std::invalid_argument("TailController: trajectory has " + std::to_string(trajectory.joints.size()) +
+                                " joints, model tail has " + std::to_string(qposadr_.size()));
+  traj_ = std::move(trajectory);
+}
+
 void TailController::apply(const mjModel* m, mjData* d, double t_ref, bool record) {
   traj_.evaluate(t_ref, ref_);
   const size_t n = ref_.size();

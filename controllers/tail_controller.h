@@ -48,6 +48,12 @@ class TailController {
   // state when `record` is set.
   void apply(const mjModel* m, mjData* d, double t_ref, bool record);
 
+  // Replaces the reference (same number of joints; throws std::invalid_argument otherwise). For a
+  // trajectory decided stroke by stroke (MujocoTrajectoryHook): the new one should continue the old
+  // one's reference at the switch time, or the servo sees a step.
+  void setTrajectory(TailTrajectory trajectory);
+  const TailTrajectory& trajectory() const { return traj_; }
+
   const std::vector<JointState>& reference() const { return ref_; }  // the last evaluated reference
   // theta - theta_ref of joint i (0-based) at the last apply()  [rad]
   double lastError(int i) const { return err_[i]; }

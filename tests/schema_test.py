@@ -28,8 +28,9 @@ skipped_optimize = 0
 for f in sorted(glob.glob(os.path.join(src, "configs", "**", "*.yaml"), recursive=True)):
     v = robot_v if os.sep + "robots" + os.sep in f else exp_v
     d = load(open(f).read())
-    if isinstance(d, dict) and d.get("kind") == "optimize":
-        # `tailsim optimize` files (configs/design/): their own format, read by src/design/optimize_config.cc
+    if isinstance(d, dict) and d.get("kind") in ("optimize", "maneuver"):
+        # `tailsim optimize` / `tailsim maneuver` files (configs/design/): their own format, read by
+        # src/design/optimize_config.cc and src/design/maneuver.cc
         # (file:line:col errors, tests/test_design.cc); not yet part of `tailsim schema`.
         skipped_optimize += 1
         continue

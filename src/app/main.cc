@@ -6,6 +6,7 @@
 //                                              the MuJoCo model: one file, or robot + scene (mjcf/README.md)
 //   tailsim accuracy EXPERIMENT.yaml --out DIR work-precision study of both models
 //   tailsim optimize EXPERIMENT.yaml --out DIR best tail stroke (kind: optimize, docs/design-a-tail-stroke.md)
+//   tailsim maneuver EXPERIMENT.yaml --out DIR turn to a heading, open- and closed-loop (kind: maneuver)
 // Exit codes: see kExitCodes below (also printed by --help).
 #include <CLI/CLI.hpp>
 #include <dlfcn.h>
@@ -47,7 +48,8 @@ constexpr const char* kExitCodes =
     "  0    ok\n"
     "  1    error: bad input (named file:line:col) or a failure that stopped the command\n"
     "  2    usage error: unknown subcommand or option, missing or bad argument\n"
-    "  3    run: some model runs failed (the rest is saved; see summary.json); optimize: a limit violated on the re-run\n"
+    "  3    run: some model runs failed (the rest is saved; see summary.json); optimize: a limit violated on the re-run;\n"
+    "       maneuver: a run failed or the closed loop missed the heading\n"
     "  130  run: interrupted by Ctrl-C (finished cases are saved; run again to resume)";
 
 std::string versionString() {
@@ -261,6 +263,13 @@ int main(int argc, char** argv) {
   optimize->add_option("experiment", exp_path, "optimize experiment YAML")->required()->check(CLI::ExistingFile);
   optimize->add_option("--out", opt_out, "result folder")->required();
   optimize->add_flag("--quiet", opt_quiet, "no progress lines");
+  std::string man_out;
+  bool man_quiet = false, man_video = false;
+  auto* maneuver = app.add_subcommand("maneuver", "turn to a heading with tail strokes, open- and closed-loop (kind: maneuver experiment)");
+  maneuver->add_option("experiment", exp_path, "maneuver experiment YAML")->required()->check(CLI::ExistingFile);
+  maneuver->add_option("--out", man_out, "result folder")->required();
+  maneuver->add_flag("--video", man_video, "also render the closed-loop turn (renders/<name>.mp4)");
+  maneuver->add_flag("--quiet", man_quiet, "no progress lines");
 
   try {
     app.parse(argc, argv);
@@ -399,9 +408,9 @@ int main(int argc, char** argv) {
       else std::printf("%s\n", (schema_robot ? robotSchema() : experimentSchema()).dump(2).c_str());
       return kExitOk;
     }
-    if (*optimize) {
-      // The optimiser lives in a module loaded only here (src/app/modules/optimize.cc): pagmo's
-      // start-up cost stays out of every other command.
+    if (*optimize || *maneuver) {
+      // The optimiser and the maneuvers live in a module loaded only here (src/app/modules/optimize.cc):
+      // pagmo's start-up cost stays out of every other command.
       const fs::path exe = fs::read_symlink("/proc/self/exe");
       std::string tried;
       void* lib = nullptr;
@@ -412,12 +421,21 @@ int main(int argc, char** argv) {
         const char* why = ::dlerror();
         tried += "\n  " + p.string() + ": " + (why ? why : "?");
       }
-      if (!lib) throw std::runtime_error("optimize: cannot load the optimiser module:" + tried);
-      using Entry = int (*)(const char*, const char*, int, char*, size_t);
-      const auto entry = reinterpret_cast<Entry>(::dlsym(lib, "tailsim_optimize_main"));
-      if (!entry) throw std::runtime_error("optimize: the optimiser module has no tailsim_optimize_main");
+      const char* what = *optimize ? "optimize" : "maneuver";
+      if (!lib) throw std::runtime_error(std::string(what) + ": cannot load the optimiser module:" + tried);
       char err[8192] = {0};
-      const int rc = entry(exp_path.c_str(), opt_out.c_str(), opt_quiet ? 1 : 0, err, sizeof err);
+      int rc = 0;
+      if (*optimize) {
+        using Entry = int (*)(const char*, const char*, int, char*, size_t);
+        const auto entry = reinterpret_cast<Entry>(::dlsym(lib, "tailsim_optimize_main"));
+        if (!entry) throw std::runtime_error("optimize: the optimiser module has no tailsim_optimize_main");
+        rc = entry(exp_path.c_str(), opt_out.c_str(), opt_quiet ? 1 : 0, err, sizeof err);
+      } else {
+        using Entry = int (*)(const char*, const char*, int, int, char*, size_t);
+        const auto entry = reinterpret_cast<Entry>(::dlsym(lib, "tailsim_maneuver_main"));
+        if (!entry) throw std::runtime_error("maneuver: the optimiser module has no tailsim_maneuver_main");
+        rc = entry(exp_path.c_str(), man_out.c_str(), man_quiet ? 1 : 0, man_video ? 1 : 0, err, sizeof err);
+      }
       if (rc == -1) throw ConfigError(err);
       if (rc < 0) throw std::runtime_error(err);
       return rc == 0 ? kExitOk : kExitRunsFailed;

@@ -1,5 +1,7 @@
 #include "experiments/settings_schema.h"
 
+#include "controllers/heading_controller.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -252,6 +254,9 @@ std::string settingsMarkdown() {
   forEachSection(defaults, [&](const SectionInfo& s, const auto& v) {
     table(s.key, s.note, describe<std::decay_t<decltype(v)>>().rows);
   });
+  table("maneuver", "The `maneuver:` section of a `kind: maneuver` file (`tailsim maneuver`, "
+                    "[design-a-tail-stroke.md](design-a-tail-stroke.md) \"Maneuvers\"), not of `tailsim run` experiments.",
+        describe<ManeuverSettings>().rows);
   std::string s = o.str();
   while (s.size() >= 2 && s[s.size() - 1] == '\n' && s[s.size() - 2] == '\n') s.pop_back();
   return s;

@@ -496,7 +496,7 @@ long MujocoSettleCache::settleSteps() const {
 
 RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
                          const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
-                         MujocoSettleCache* settle_cache) {
+                         MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
   const int n = robot.numLinks();
   if (static_cast<int>(trajectory.joints.size()) != n)
     throw std::invalid_argument("trajectory has " + std::to_string(trajectory.joints.size()) +
@@ -626,6 +626,12 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
     const bool averaged = t < duration - eps;  // the step lies inside the run: its impulse counts
     if (sample) {
       if (observer) observer(k * output.sample_dt_s, m, d);
+      if (hook) {
+        mj_kinematics(m, d);  // xmat of this state (the yaw so far is one step old)
+        const double phi_now = phi + wrapPi(yawOf(d, L.quad_body) - yaw_prev);
+        TailTrajectory next = ctrl.trajectory();
+        if (hook(k * output.sample_dt_s, phi_now - phi0, m, d, next)) ctrl.setTrajectory(std::move(next));
+      }
       std::copy(d->qpos, d->qpos + m->nq, qpos_t.begin());
       std::copy(d->qvel, d->qvel + m->nv, qvel_t.begin());
     }

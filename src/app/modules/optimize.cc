@@ -1,11 +1,13 @@
 // `tailsim optimize` as a module loaded at run time (dlopen by src/app/main.cc): pagmo2 (with TBB and
 // Boost.Serialization) costs ~4,000 page faults and ~75 ms of static initialisation per process, which
 // every `tailsim run` would pay if the program linked it (issue 13: start fast).
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
 #include <string>
 
+#include "design/maneuver.h"
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"
 
@@ -35,6 +37,39 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
     for (const std::string& f : r.files) std::printf("%s/%s\n", out_dir, f.c_str());
     std::fflush(stdout);
     return r.limits_analytic.ok ? 0 : 3;
+  } catch (const ConfigError& e) {
+    copyMessage(e.what(), err, err_len);
+    return -1;
+  } catch (const std::exception& e) {
+    copyMessage(e.what(), err, err_len);
+    return -2;
+  }
+}
+
+// `tailsim maneuver`: the same module (it needs the design layer, not pagmo, but one module keeps the
+// program's start-up free of both). Returns 0, or 3 when a run failed or missed the heading; -1 a
+// ConfigError, -2 another error (message in err).
+extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(const char* exp_path, const char* out_dir,
+                                                                           int quiet, int video, char* err, size_t err_len) {
+  using namespace tailsim;
+  try {
+    const ManeuverSpec spec = loadManeuverSpec(exp_path);  // all errors before any work
+    const ManeuverReport r = runManeuver(spec, out_dir, video != 0, quiet == 0);
+    bool all_ok = true;
+    std::printf("%s: target %.4g deg, tolerance %.4g deg; analytic cycle %+.4f deg (stroke %+.4f, return %+.4f)\n",
+                spec.name.c_str(), spec.settings.heading_deg, spec.settings.tolerance_deg, r.full_cycle.total() * 180 / M_PI,
+                r.full_cycle.fast_rad * 180 / M_PI, r.full_cycle.back_rad * 180 / M_PI);
+    for (const ManeuverRun& m : r.runs) {
+      const bool reached = m.ok && std::abs(m.final_error_rad) <= spec.settings.tolerance();
+      all_ok = all_ok && m.ok && (reached || m.label == "mujoco_open_loop");
+      std::printf("  %-20s %s strokes %zu, final error %+.4f deg, overshoot %.4f deg, within tolerance from %s\n",
+                  m.label.c_str(), m.ok ? "ok    " : "FAILED", m.strokes.size(), m.final_error_rad * 180 / M_PI,
+                  m.overshoot_rad * 180 / M_PI, m.t_within_s >= 0 ? (std::to_string(m.t_within_s) + " s").c_str() : "never");
+      if (!m.ok) std::printf("    error: %s\n", m.error.c_str());
+    }
+    for (const std::string& f : r.files) std::printf("%s/%s\n", out_dir, f.c_str());
+    std::fflush(stdout);
+    return all_ok ? 0 : 3;
   } catch (const ConfigError& e) {
     copyMessage(e.what(), err, err_len);
     return -1;

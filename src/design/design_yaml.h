@@ -1,0 +1,150 @@
+// The YAML reading of the design layer's experiment files (kind: optimize, kind: maneuver) with the
+// loader's conventions: ConfigError "<file>:<line>:<col>: <key>: <what>", unknown and duplicate keys
+// refused. Internal to src/design/.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "experiments/experiment_loader.h"
+
+namespace tailsim {
+namespace design_yaml {
+
+namespace fs = std::filesystem;
+constexpr std::uintmax_t kMaxFileBytes = 1u << 20;
+
+inline std::string fmtG(double v) {
+  std::ostringstream s;
+  s.precision(10);
+  s << v;
+  return s.str();
+}
+
+// One value with where it came from.
+struct Val {
+  YAML::Node node;
+  std::string key;
+  YAML::Mark mark;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+  [[noreturn]] void fail(const YAML::Mark& m, const std::string& key, const std::string& what) const {
+    std::string s = file_;
+    if (!m.is_null()) s += ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);
+    s += ": ";
+    if (!key.empty()) s += key + ": ";
+    throw ConfigError(s + what);
+  }
+  [[noreturn]] void fail(const Val& v, const std::string& what) const { fail(v.mark, v.key, what); }
+
+  // The map's entries; a key not in `allowed` (or twice) is an error at the key.
+  std::vector<std::pair<std::string, Val>> map(const Val& v, std::initializer_list<const char*> allowed) const {
+    if (!v.node.IsMap()) fail(v, "expected a map of key: value");
+    std::vector<std::pair<std::string, Val>> out;
+    std::string names;
+    for (const char* a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
+    for (const auto& kv : v.node) {
+      const std::string key = v.key.empty() ? kv.first.Scalar() : v.key + "." + kv.first.Scalar();
+      if (!kv.first.IsScalar()) fail(kv.first.Mark(), v.key, "keys must be plain names");
+      const std::string k = kv.first.Scalar();
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }))
+        fail(kv.first.Mark(), key, "unknown key (allowed here: " + names + ")");
+      for (const auto& e : out)
+        if (e.first == k) fail(kv.first.Mark(), key, "duplicate key");
+      const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
+      out.emplace_back(k, Val{kv.second, key, empty ? kv.first.Mark() : kv.second.Mark()});
+    }
+    return out;
+  }
+  static const Val* get(const std::vector<std::pair<std::string, Val>>& m, const std::string& k) {
+    for (const auto& e : m)
+      if (e.first == k) return &e.second;
+    return nullptr;
+  }
+  double number(const Val& v) const {
+    if (!v.node.IsScalar()) fail(v, "expected a number");
+    double x = 0;
+    try {
+      x = v.node.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(v, "expected a number, got '" + v.node.Scalar() + "'");
+    }
+    if (!std::isfinite(x)) fail(v, "must be finite");
+    return x;
+  }
+  double inRange(const Val& v, double lo, double hi) const {
+    const double x = number(v);
+    if (!(x >= lo && x <= hi)) fail(v, "must lie in [" + fmtG(lo) + ", " + fmtG(hi) + "], got " + fmtG(x));
+    return x;
+  }
+  int integer(const Val& v, int lo, int hi) const {
+    const double x = number(v);
+    if (x != std::floor(x)) fail(v, "must be a whole number, got " + fmtG(x));
+    if (!(x >= lo && x <= hi)) fail(v, "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + fmtG(x));
+    return static_cast<int>(x);
+  }
+  std::string choice(const Val& v, std::initializer_list<const char*> options) const {
+    std::string names;
+    for (const char* o : options) names += (names.empty() ? "" : ", ") + std::string(o);
+    if (!v.node.IsScalar()) fail(v, "expected one of: " + names);
+    const std::string s = v.node.Scalar();
+    if (std::none_of(options.begin(), options.end(), [&](const char* o) { return s == o; }))
+      fail(v, "'" + s + "' is not one of: " + names);
+    return s;
+  }
+  bool boolean(const Val& v) const {
+    const std::string s = choice(v, {"true", "false"});
+    return s == "true";
+  }
+  std::string text(const Val& v) const {
+    if (!v.node.IsScalar()) fail(v, "expected a string");
+    return v.node.Scalar();
+  }
+  std::vector<Val> list(const Val& v, std::size_t min, std::size_t max) const {
+    if (!v.node.IsSequence()) fail(v, "expected a list [a, b, ...]");
+    if (v.node.size() < min || v.node.size() > max)
+      fail(v, "expected " + (min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max)) +
+                  " values, got " + std::to_string(v.node.size()));
+    std::vector<Val> out;
+    for (std::size_t i = 0; i < v.node.size(); ++i)
+      out.push_back(Val{v.node[i], v.key + "[" + std::to_string(i) + "]", v.node[i].Mark().is_null() ? v.mark : v.node[i].Mark()});
+    return out;
+  }
+  // [lo, hi] with lo <= hi, both in [min, max].
+  std::pair<double, double> interval(const Val& v, double min, double max) const {
+    const std::vector<Val> l = list(v, 2, 2);
+    const double a = inRange(l[0], min, max), b = inRange(l[1], min, max);
+    if (a > b) fail(v, "expected [low, high] with low <= high, got [" + fmtG(a) + ", " + fmtG(b) + "]");
+    return {a, b};
+  }
+
+ private:
+  std::string file_;
+};
+
+inline YAML::Node loadYaml(const std::string& abs) {
+  std::error_code ec;
+  const auto size = fs::file_size(abs, ec);
+  if (ec) throw ConfigError(abs + ": cannot read: " + ec.message());
+  if (size > kMaxFileBytes) throw ConfigError(abs + ": file is larger than 1 MiB");
+  try {
+    return YAML::LoadFile(abs);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(abs + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+}
+
+}  // namespace design_yaml
+}  // namespace tailsim

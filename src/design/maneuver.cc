@@ -1,0 +1,551 @@
+#include "design/maneuver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "analytic_model/analytic_simulation.h"
+#include "design/design_yaml.h"
+#include "experiments/render_case.h"
+#include "mujoco_model/mujoco_simulation.h"
+#include "plotting/gnuplot.h"
+#include "results/atomic_file.h"
+
+namespace tailsim {
+namespace {
+
+using namespace design_yaml;
+constexpr double kDegPerRad = 180.0 / M_PI;
+
+std::string g17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+// The keys a struct declares (settings/fields.h).
+struct KeyList {
+  std::vector<std::string> keys;
+  template <class... T>
+  void number(const settings::Field& f, T&&...) { keys.push_back(f.key); }
+  template <class... T>
+  void integer(const settings::Field& f, T&&...) { keys.push_back(f.key); }
+  template <class... T>
+  void boolean(const settings::Field& f, T&&...) { keys.push_back(f.key); }
+};
+
+// Reads the declared fields from a YAML map through design_yaml::Reader (file:line:col errors).
+struct YamlFieldReader {
+  const Reader& r;
+  const std::vector<std::pair<std::string, Val>>& m;
+  void number(const settings::Field& f, double& x, const settings::Limits& l) {
+    const Val* v = Reader::get(m, f.key);
+    if (!v) return;
+    const double y = r.number(*v);
+    if (!l.ok(y)) r.fail(*v, "must " + l.text() + ", got " + fmtG(y));
+    x = y;
+  }
+  void integer(const settings::Field& f, int& x, const settings::Limits& l) {
+    if (const Val* v = Reader::get(m, f.key)) x = r.integer(*v, static_cast<int>(l.lo), static_cast<int>(l.hi));
+  }
+  void boolean(const settings::Field& f, bool& x) {
+    if (const Val* v = Reader::get(m, f.key)) x = r.boolean(*v);
+  }
+};
+
+OutputSettings segmentOutput(const ExperimentCase& base, double duration_s) {
+  OutputSettings o = base.output;
+  o.duration_s = duration_s;
+  o.time_series = TimeSeriesOutput::kFull;
+  return o;
+}
+
+// The trajectory of one stroke shifted to start at t = 0.
+TailTrajectory atZero(const TailTrajectory& t) {
+  TailTrajectory out;
+  for (const auto& j : t.joints) {
+    SplitCycleParams p = j.params();
+    p.t0_s = 0.0;
+    out.joints.emplace_back(p);
+  }
+  return out;
+}
+
+// Columns kept in a maneuver's series (what plots and the video need).
+std::vector<std::string> keptColumns(int n) {
+  std::vector<std::string> c{"t_s", "x_m", "y_m", "phi_deg", "phidot_dps"};
+  for (int i = 1; i <= n; ++i) c.push_back("theta" + std::to_string(i) + "_deg");
+  return c;
+}
+
+TimeSeries emptySeries(int n) {
+  TimeSeries ts;
+  for (const std::string& c : keptColumns(n)) ts.addColumn(c);
+  return ts;
+}
+
+// Appends an analytic segment (starting at rest at t = 0, pose 0) placed at time t_off and at the
+// pose (x0, y0, phi0) where the previous one ended; the segment's last row is dropped (the next
+// segment's first row is the same instant) unless `last`.
+void appendSegment(TimeSeries& out, const TimeSeries& seg, int n, double t_off, double x0, double y0, double phi0, bool last) {
+  const auto names = keptColumns(n);
+  std::vector<int> idx;
+  for (const auto& c : names) idx.push_back(seg.column(c));
+  const double c0 = std::cos(phi0), s0 = std::sin(phi0);
+  const double xs = seg.at(0, idx[1]), ys = seg.at(0, idx[2]), ps = seg.at(0, idx[3]);
+  const std::size_t rows = seg.numRows() - (last ? 0 : 1);
+  std::vector<double> row(names.size());
+  for (std::size_t r = 0; r < rows; ++r) {
+    const double x = seg.at(r, idx[1]) - xs, y = seg.at(r, idx[2]) - ys;
+    row[0] = t_off + seg.at(r, idx[0]);
+    row[1] = x0 + c0 * x - s0 * y;
+    row[2] = y0 + s0 * x + c0 * y;
+    row[3] = phi0 * kDegPerRad + seg.at(r, idx[3]) - ps;
+    for (std::size_t k = 4; k < names.size(); ++k) row[k] = idx[k] >= 0 ? seg.at(r, idx[k]) : 0.0;
+    out.appendRow(row);
+  }
+}
+
+// Heading figures of a finished run (series phi_deg relative to its first row).
+void finishFigures(ManeuverRun& run, const ManeuverSettings& s) {
+  const std::vector<double>& t = run.series.values("t_s");
+  const std::vector<double>& p = run.series.values("phi_deg");
+  if (t.empty()) return;
+  const double target = s.heading(), sign = target >= 0 ? 1.0 : -1.0;
+  double over = 0;
+  long last_out = -1;
+  for (std::size_t r = 0; r < t.size(); ++r) {
+    const double h = (p[r] - p[0]) / kDegPerRad;
+    over = std::max(over, sign * (h - target));
+    if (std::abs(target - h) > s.tolerance()) last_out = static_cast<long>(r);
+  }
+  run.overshoot_rad = over;
+  run.final_error_rad = target - (p.back() - p[0]) / kDegPerRad;
+  if (last_out + 1 < static_cast<long>(t.size())) {
+    run.t_within_s = t[static_cast<std::size_t>(last_out + 1)];
+    run.strokes_to_within = 0;
+    for (const StrokeRecord& k : run.strokes)
+      if (k.t_start_s < run.t_within_s) ++run.strokes_to_within;
+  }
+}
+
+// The MuJoCo series reduced to the kept columns, phi relative to the start.
+TimeSeries keepColumns(const TimeSeries& ts, int n) {
+  TimeSeries out = emptySeries(n);
+  const auto names = keptColumns(n);
+  std::vector<int> idx;
+  for (const auto& c : names) idx.push_back(ts.column(c));
+  std::vector<double> row(names.size());
+  for (std::size_t r = 0; r < ts.numRows(); ++r) {
+    for (std::size_t k = 0; k < names.size(); ++k) row[k] = idx[k] >= 0 ? ts.at(r, idx[k]) : 0.0;
+    out.appendRow(row);
+  }
+  return out;
+}
+
+double headingAt(const TimeSeries& ts, double t) {  // relative to the first row  [rad]
+  const std::vector<double>& tt = ts.values("t_s");
+  const std::vector<double>& p = ts.values("phi_deg");
+  if (tt.empty()) return 0.0;
+  const auto it = std::lower_bound(tt.begin(), tt.end(), t - 1e-9);
+  const std::size_t r = it == tt.end() ? tt.size() - 1 : static_cast<std::size_t>(it - tt.begin());
+  return (p[r] - p[0]) / kDegPerRad;
+}
+
+ManeuverRun fromMujoco(const RunResult& rm, const std::string& label, int n) {
+  ManeuverRun run;
+  run.label = label;
+  run.ok = rm.summary.ok;
+  run.error = rm.summary.error;
+  run.warnings = rm.summary.warnings;
+  run.series = keepColumns(rm.series, n);
+  return run;
+}
+
+}  // namespace
+
+ManeuverSpec loadManeuverSpec(const std::string& path) {
+  ManeuverSpec s;
+  s.source_file = fs::absolute(path).lexically_normal().string();
+  const Reader r(s.source_file);
+  const Val root{loadYaml(s.source_file), "", YAML::Mark()};
+  if (!root.node.IsMap()) r.fail(root, "the file must be a map of key: value");
+  const auto top = r.map(root, {"name", "description", "kind", "base", "maneuver"});
+  auto need = [&](const std::vector<std::pair<std::string, Val>>& m, const Val& parent, const char* k) -> const Val& {
+    const Val* v = Reader::get(m, k);
+    if (!v) r.fail(parent.mark, parent.key.empty() ? k : parent.key + "." + k, "required key is missing");
+    return *v;
+  };
+  s.name = r.text(need(top, root, "name"));
+  if (s.name.empty() || s.name.size() > 100 || s.name.find_first_of("/\\") != std::string::npos || s.name == "." ||
+      s.name == ".." || s.name[0] == '-')
+    r.fail(need(top, root, "name"), "must be one safe path component (no / or \\, not . or .., no leading -, 1..100 characters)");
+  if (const Val* d = Reader::get(top, "description")) s.description = r.text(*d);
+  r.choice(need(top, root, "kind"), {"maneuver"});
+  const Val& base = need(top, root, "base");
+  s.base_file = (fs::path(s.source_file).parent_path() / r.text(base)).lexically_normal().string();
+  if (!fs::is_regular_file(s.base_file)) r.fail(base, "no such experiment file: " + s.base_file);
+  const Val& mv = need(top, root, "maneuver");
+  KeyList kl;
+  declareFields(kl, static_cast<const ManeuverSettings&>(s.settings));
+  if (!mv.node.IsMap()) r.fail(mv, "expected a map of key: value");
+  std::vector<std::pair<std::string, Val>> m;
+  {
+    // Reader::map takes the allowed keys as an initializer list: check them here from the declaration.
+    std::string names;
+    for (const auto& k : kl.keys) names += (names.empty() ? "" : ", ") + k;
+    for (const auto& kv : mv.node) {
+      const std::string key = "maneuver." + kv.first.Scalar();
+      if (!kv.first.IsScalar()) r.fail(kv.first.Mark(), "maneuver", "keys must be plain names");
+      if (std::find(kl.keys.begin(), kl.keys.end(), kv.first.Scalar()) == kl.keys.end())
+        r.fail(kv.first.Mark(), key, "unknown key (allowed here: " + names + ")");
+      for (const auto& e : m)
+        if (e.first == kv.first.Scalar()) r.fail(kv.first.Mark(), key, "duplicate key");
+      const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
+      m.emplace_back(kv.first.Scalar(), Val{kv.second, key, empty ? kv.first.Mark() : kv.second.Mark()});
+    }
+  }
+  YamlFieldReader fr{r, m};
+  declareFields(fr, s.settings);
+  if (s.settings.min_scale > 1.0) r.fail(*Reader::get(m, "min_scale"), "must be <= 1");
+
+  const Experiment e = loadExperiment(s.base_file);
+  if (e.cases.size() != 1)
+    r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
+  s.base = e.cases.front();
+  if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
+  return s;
+}
+
+CycleYaw analyticCycleYaw(const ExperimentCase& base, const ManeuverSettings& s, double scale) {
+  const int n = base.robot.numLinks();
+  const CycleStrokes c = cycleStrokes(s, n, {scale, 1}, 0.0);
+  CycleYaw y;
+  const RunResult a = simulateAnalytic(base.robot, atZero(c.fast), base.analytic, base.effects,
+                                       segmentOutput(base, c.fast.endTime() + s.rest_s));
+  const RunResult b = simulateAnalytic(base.robot, atZero(c.back), base.analytic, base.effects,
+                                       segmentOutput(base, s.return_dT_s + s.rest_s));
+  if (!a.summary.ok || !b.summary.ok) throw std::runtime_error("analytic cycle failed: " + a.summary.error + b.summary.error);
+  y.fast_rad = a.summary.phi_net_deg / kDegPerRad;
+  y.back_rad = b.summary.phi_net_deg / kDegPerRad;
+  y.at_rest = a.summary.at_rest && b.summary.at_rest;
+  return y;
+}
+
+YawMap analyticYawMap(const ExperimentCase& base, const ManeuverSettings& s) {
+  YawMap m;
+  const int N = s.map_points;
+  const double full = analyticCycleYaw(base, s, 1.0).total();
+  const double sign = full >= 0 ? 1.0 : -1.0;
+  double best = 0.0;
+  for (int k = 0; k < N; ++k) {
+    const double sc = k + 1 == N ? 1.0 : s.min_scale + (1.0 - s.min_scale) * k / (N - 1);
+    const double y = k + 1 == N ? full : analyticCycleYaw(base, s, sc).total();
+    best = std::max(best, sign * y);  // monotone |yaw| (a running maximum)
+    m.scale.push_back(sc);
+    m.yaw_rad.push_back(sign * best);
+  }
+  return m;
+}
+
+std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map) {
+  std::vector<StrokeCommand> plan;
+  const double target = s.heading(), full = map.full();
+  if (std::abs(target) <= s.tolerance()) return plan;
+  const int dir = (target > 0) == (full > 0) ? 1 : -1;
+  const int n_full = static_cast<int>(std::floor(std::abs(target) / std::abs(full)));
+  for (int k = 0; k < n_full; ++k) plan.push_back({1.0, dir});
+  const double rest = std::abs(target) - n_full * std::abs(full);
+  if (rest > s.tolerance() * 1e-3) {
+    // Bisection on the analytic cycle yaw for the last cycle's scale.
+    double lo = s.min_scale, hi = 1.0;
+    if (std::abs(analyticCycleYaw(base, s, lo).total()) >= rest) {
+      hi = lo;
+    } else {
+      for (int it = 0; it < 40 && hi - lo > 1e-7; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (std::abs(analyticCycleYaw(base, s, mid).total()) < rest ? lo : hi) = mid;
+      }
+    }
+    plan.push_back({hi, dir});
+  }
+  if (static_cast<int>(plan.size()) > s.max_strokes)
+    throw std::runtime_error("the plan needs " + std::to_string(plan.size()) + " cycles, more than maneuver.max_strokes = " +
+                             std::to_string(s.max_strokes));
+  return plan;
+}
+
+ManeuverRun runAnalyticOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const std::vector<StrokeCommand>& plan) {
+  const int n = base.robot.numLinks();
+  ManeuverRun run;
+  run.label = "analytic_open_loop";
+  run.series = emptySeries(n);
+  double t = 0, x = 0, y = 0, phi = 0;
+  for (std::size_t k = 0; k < plan.size(); ++k) {
+    const CycleStrokes c = cycleStrokes(s, n, plan[k], 0.0);
+    StrokeRecord rec{t, plan[k], phi, phi};
+    int part = 0;
+    for (const TailTrajectory* tr : {&c.fast, &c.back}) {
+      const double dur = (part == 0 ? c.fast.endTime() : s.return_dT_s) + s.rest_s;
+      const RunResult a = simulateAnalytic(base.robot, atZero(*tr), base.analytic, base.effects, segmentOutput(base, dur));
+      if (!a.summary.ok) {
+        run.ok = false;
+        run.error = a.summary.error;
+        break;
+      }
+      if (!a.summary.at_rest)
+        run.warnings.push_back("cycle " + std::to_string(k + 1) + (part ? " return" : " stroke") +
+                               ": the body is still moving when the next stroke starts (raise maneuver.rest_s)");
+      appendSegment(run.series, a.series, n, t, x, y, phi, k + 1 == plan.size() && part == 1);
+      const std::size_t last = a.series.numRows() - 1;
+      const double dx = a.series.at(last, a.series.column("x_m")) - a.series.at(0, a.series.column("x_m"));
+      const double dy = a.series.at(last, a.series.column("y_m")) - a.series.at(0, a.series.column("y_m"));
+      x += std::cos(phi) * dx - std::sin(phi) * dy;
+      y += std::sin(phi) * dx + std::cos(phi) * dy;
+      phi += a.summary.phi_net_deg / kDegPerRad;
+      t += dur;
+      ++part;
+    }
+    if (!run.ok) break;
+    rec.heading_after_rad = phi;
+    run.strokes.push_back(rec);
+  }
+  if (plan.empty()) run.series.appendRow(std::vector<double>(run.series.numColumns(), 0.0));
+  finishFigures(run, s);
+  return run;
+}
+
+ManeuverRun runMujocoOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const std::vector<StrokeCommand>& plan) {
+  const int n = base.robot.numLinks();
+  // The schedule: at each switch time the reference becomes the next stroke (the previous one has
+  // ended and holds the angle the next one starts from).
+  std::vector<std::pair<double, TailTrajectory>> schedule;
+  std::vector<StrokeRecord> strokes;
+  double t = 0;
+  for (const StrokeCommand& c : plan) {
+    const CycleStrokes cs = cycleStrokes(s, n, c, t);
+    strokes.push_back({t, c, 0, 0});
+    schedule.emplace_back(t, cs.fast);
+    schedule.emplace_back(cs.fast.endTime(), cs.back);
+    t += cycleDuration(s, c.scale);
+  }
+  if (schedule.empty()) schedule.emplace_back(0.0, cycleStrokes(s, n, {1.0, 1}, 1e9).fast);  // held at 0
+  std::size_t next = 1;
+  const double eps = 1e-9;
+  const MujocoTrajectoryHook hook = [&](double ts, double, const mjModel*, const mjData*, TailTrajectory& ref) {
+    if (next < schedule.size() && ts >= schedule[next].first - eps) {
+      ref = schedule[next++].second;
+      return true;
+    }
+    return false;
+  };
+  const RunResult rm = simulateMujoco(base.robot, schedule.front().second, base.mujoco, base.effects,
+                                      segmentOutput(base, std::max(t, base.output.sample_dt_s)), nullptr, nullptr, hook);
+  ManeuverRun run = fromMujoco(rm, "mujoco_open_loop", n);
+  for (std::size_t k = 0; k < strokes.size(); ++k) {
+    strokes[k].heading_before_rad = headingAt(run.series, strokes[k].t_start_s);
+    strokes[k].heading_after_rad =
+        headingAt(run.series, k + 1 < strokes.size() ? strokes[k + 1].t_start_s : run.series.values("t_s").back());
+  }
+  run.strokes = strokes;
+  finishFigures(run, s);
+  return run;
+}
+
+ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map, double duration_s) {
+  const int n = base.robot.numLinks();
+  const HeadingController ctl(s, map);
+  std::vector<StrokeRecord> strokes;
+  enum class Phase { kIdle, kFast, kBack } phase = Phase::kIdle;
+  CycleStrokes cur;
+  double t_free = 0.0;  // the cycle's strokes and rests are over from this time
+  double phi_prev = 0.0;
+  bool done = false;
+  const double dt = base.output.sample_dt_s;
+  const double kRestRate = 0.5 / kDegPerRad;  // |phi_dot| below this: the body is at rest [rad/s]
+  const MujocoTrajectoryHook hook = [&](double ts, double phi, const mjModel*, const mjData*, TailTrajectory& ref) {
+    const double rate = std::abs(phi - phi_prev) / dt;
+    phi_prev = phi;
+    if (phase == Phase::kFast && ts >= cur.fast.endTime() - 1e-9) {
+      phase = Phase::kBack;
+      ref = cur.back;
+      return true;
+    }
+    if (done || strokes.size() >= static_cast<std::size_t>(s.max_strokes)) return false;
+    if (phase == Phase::kBack && ts >= t_free - 1e-9) phase = Phase::kIdle;
+    // Next cycle: the last one is over and the body is at rest (measured), or waited 1 s more.
+    if (phase != Phase::kIdle || (rate > kRestRate && ts < t_free + 1.0)) return false;
+    if (!strokes.empty()) strokes.back().heading_after_rad = phi;
+    const std::optional<StrokeCommand> c = ctl.next(phi);
+    if (!c) {
+      done = true;
+      return false;
+    }
+    cur = cycleStrokes(s, n, *c, ts);
+    t_free = cur.back.endTime() + s.rest_s;
+    strokes.push_back({ts, *c, phi, phi});
+    phase = Phase::kFast;
+    ref = cur.fast;
+    return true;
+  };
+  // The reference starts held at 0 (a stroke that never starts within the run).
+  const TailTrajectory hold = cycleStrokes(s, n, {1.0, 1}, 1e6).fast;
+  const RunResult rm = simulateMujoco(base.robot, hold, base.mujoco, base.effects, segmentOutput(base, duration_s), nullptr,
+                                      nullptr, hook);
+  ManeuverRun run = fromMujoco(rm, "mujoco_closed_loop", n);
+  if (!strokes.empty()) strokes.back().heading_after_rad = headingAt(run.series, run.series.values("t_s").back());
+  run.strokes = strokes;
+  if (!done) run.warnings.push_back("the controller was still turning when the run ended (raise maneuver.max_strokes?)");
+  finishFigures(run, s);
+  return run;
+}
+
+ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress) {
+  const auto w0 = std::chrono::steady_clock::now();
+  const ManeuverSettings& s = spec.settings;
+  const ExperimentCase& base = spec.base;
+  ManeuverReport rep;
+  fs::create_directories(fs::path(out_dir) / "plots");
+  rep.full_cycle = analyticCycleYaw(base, s, 1.0);
+  rep.map = analyticYawMap(base, s);
+  rep.plan = planOpenLoop(base, s, rep.map);
+  if (progress)
+    std::fprintf(stderr, "analytic cycle: stroke %+.4f deg, return %+.4f deg; plan: %zu cycles (last scale %.4f)\n",
+                 rep.full_cycle.fast_rad * kDegPerRad, rep.full_cycle.back_rad * kDegPerRad, rep.plan.size(),
+                 rep.plan.empty() ? 0.0 : rep.plan.back().scale);
+  rep.runs.push_back(runAnalyticOpenLoop(base, s, rep.plan));
+  double plan_time = 0;
+  for (const StrokeCommand& c : rep.plan) plan_time += cycleDuration(s, c.scale);
+  if (s.mujoco) {
+    rep.runs.push_back(runMujocoOpenLoop(base, s, rep.plan));
+    if (progress) std::fprintf(stderr, "MuJoCo open loop done\n");
+    // Closed loop: time for twice the plan's cycles plus two (MuJoCo turns less per cycle), at most max_strokes.
+    const int cycles = std::min(s.max_strokes, 2 * static_cast<int>(rep.plan.size()) + 2);
+    const double dur = cycles * (cycleDuration(s, 1.0) + 0.2) + 0.5;
+    rep.runs.push_back(runMujocoClosedLoop(base, s, rep.map, dur));
+    if (progress) std::fprintf(stderr, "MuJoCo closed loop done\n");
+  }
+  const int n = base.robot.numLinks();
+
+  // maneuver.csv: heading of each run on the output grid (empty where a run has no row).
+  {
+    std::ostringstream csv;
+    csv << "t_s";
+    std::size_t rows = 0;
+    for (const ManeuverRun& r : rep.runs) {
+      csv << "," << r.label << "_heading_deg";
+      rows = std::max(rows, r.series.numRows());
+    }
+    csv << "\n";
+    const double dt = base.output.sample_dt_s;
+    for (std::size_t k = 0; k < rows; ++k) {
+      csv << g17(k * dt);
+      for (const ManeuverRun& r : rep.runs) {
+        csv << ",";
+        if (k < r.series.numRows()) csv << g17(r.series.values("phi_deg")[k] - r.series.values("phi_deg")[0]);
+      }
+      csv << "\n";
+    }
+    writeFileAtomic((fs::path(out_dir) / "maneuver.csv").string(), csv.str());
+    rep.files.push_back("maneuver.csv");
+  }
+  {
+    std::ostringstream csv;
+    csv << "run,cycle,t_start_s,scale,direction,dtheta_deg,dT_s,return_dT_s,heading_before_deg,heading_after_deg,yaw_deg\n";
+    for (const ManeuverRun& r : rep.runs)
+      for (std::size_t k = 0; k < r.strokes.size(); ++k) {
+        const StrokeRecord& x = r.strokes[k];
+        csv << r.label << "," << k + 1 << "," << g17(x.t_start_s) << "," << g17(x.command.scale) << "," << x.command.direction
+            << "," << g17(x.command.direction * x.command.scale * s.stroke_deg) << "," << g17(x.command.scale * s.stroke_dT_s)
+            << "," << g17(s.return_dT_s) << "," << g17(x.heading_before_rad * kDegPerRad) << ","
+            << g17(x.heading_after_rad * kDegPerRad) << "," << g17((x.heading_after_rad - x.heading_before_rad) * kDegPerRad)
+            << "\n";
+      }
+    writeFileAtomic((fs::path(out_dir) / "strokes.csv").string(), csv.str());
+    rep.files.push_back("strokes.csv");
+  }
+  {
+    std::ostringstream csv;
+    csv << "scale,cycle_yaw_deg\n";
+    for (std::size_t k = 0; k < rep.map.scale.size(); ++k)
+      csv << g17(rep.map.scale[k]) << "," << g17(rep.map.yaw_rad[k] * kDegPerRad) << "\n";
+    writeFileAtomic((fs::path(out_dir) / "yaw_map.csv").string(), csv.str());
+    rep.files.push_back("yaw_map.csv");
+  }
+  {
+    GnuplotFigure fig;
+    fig.stem = "heading";
+    std::ostringstream b;
+    b << "set datafile separator ','\nset key bottom right\nset grid\n"
+      << "set title 'Maneuver " << spec.name << ": heading to " << s.heading_deg << " deg' noenhanced\n"
+      << "set xlabel 't [s]'\nset ylabel 'heading change [deg]'\n"
+      << "plot " << s.heading_deg << " with lines dt 2 lc rgb '#000000' title 'target'";
+    const char* colours[] = {"#0072B2", "#E69F00", "#009E73"};
+    for (std::size_t i = 0; i < rep.runs.size(); ++i)
+      b << ", '../maneuver.csv' every ::1 using 1:" << i + 2 << " with lines lw 2 lc rgb '" << colours[i % 3] << "' title '"
+        << rep.runs[i].label << "' noenhanced";
+    b << "\n";
+    fig.body = b.str();
+    renderFigure((fs::path(out_dir) / "plots").string(), fig);
+    rep.files.push_back("plots/heading.png");
+  }
+  if (video && s.mujoco) {
+    ExperimentCase c = base;
+    c.name = spec.name;
+    c.render.enabled = true;
+    c.render.slowmo = 1.0;
+    // Show the turn and 2 s after the closed loop is within tolerance (the run idles afterwards).
+    if (rep.runs[2].t_within_s >= 0) c.render.duration_s = rep.runs[2].t_within_s + 2.0;
+    std::vector<RunResult> runs(2);
+    runs[0].summary.model = "analytic";
+    runs[0].series = rep.runs[0].series;
+    runs[1].summary.model = "mujoco";
+    runs[1].series = rep.runs[2].series;
+    // The video's phase text follows the case trajectory: the first planned stroke.
+    c.joints.clear();
+    if (!rep.plan.empty())
+      for (const auto& jp : cycleStrokes(s, n, rep.plan.front(), 0.0).fast.joints) c.joints.push_back(jp.params());
+    renderCase(c, runs, (fs::path(out_dir) / "renders").string());
+    rep.files.push_back("renders/" + spec.name + ".mp4");
+  }
+  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+
+  nlohmann::json j;
+  j["experiment"] = spec.name;
+  j["source"] = spec.source_file;
+  j["base"] = spec.base_file;
+  j["target_deg"] = s.heading_deg;
+  j["tolerance_deg"] = s.tolerance_deg;
+  j["analytic_cycle"] = {{"stroke_yaw_deg", rep.full_cycle.fast_rad * kDegPerRad},
+                         {"return_yaw_deg", rep.full_cycle.back_rad * kDegPerRad},
+                         {"cycle_yaw_deg", rep.full_cycle.total() * kDegPerRad},
+                         {"at_rest_between_strokes", rep.full_cycle.at_rest}};
+  nlohmann::json plan = nlohmann::json::array();
+  for (const StrokeCommand& c : rep.plan) plan.push_back({{"scale", c.scale}, {"direction", c.direction}});
+  j["plan"] = plan;
+  for (const ManeuverRun& r : rep.runs) {
+    auto num = [](double v, bool ok) { return ok ? nlohmann::json(v) : nlohmann::json(); };
+    j["runs"][r.label] = {{"ok", r.ok},
+                          {"error", r.error},
+                          {"strokes", r.strokes.size()},
+                          {"strokes_to_within_tolerance", num(r.strokes_to_within, r.t_within_s >= 0)},
+                          {"time_to_within_tolerance_s", num(r.t_within_s, r.t_within_s >= 0)},
+                          {"final_heading_deg", (s.heading() - r.final_error_rad) * kDegPerRad},
+                          {"final_error_deg", r.final_error_rad * kDegPerRad},
+                          {"overshoot_deg", r.overshoot_rad * kDegPerRad},
+                          {"end_time_s", r.series.numRows() ? r.series.values("t_s").back() : 0.0},
+                          {"warnings", r.warnings}};
+  }
+  j["wall_s"] = rep.wall_s;
+  j["files"] = rep.files;
+  writeFileAtomic((fs::path(out_dir) / "summary.json").string(), j.dump(2) + "\n");
+  rep.files.push_back("summary.json");
+  return rep;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,87 @@
+// Issue 12 item 3: `kind: maneuver` experiment files and `tailsim maneuver EXP.yaml --out DIR`
+// (docs/design-a-tail-stroke.md "Maneuvers"): turn the robot to a commanded heading with cycles of
+// a fast stroke and a slow return (controllers/heading_controller.h),
+//   (a) planned open-loop on the analytic model and run as planned in both models,
+//   (b) closed-loop in MuJoCo: HeadingController picks each next cycle from the measured heading.
+// The file names a one-case base experiment (robot, tail, friction, solver settings), like an
+// optimize file, and holds a `maneuver:` section (ManeuverSettings, declared once).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "controllers/heading_controller.h"
+#include "experiments/experiment_config.h"
+#include "results/time_series.h"
+
+namespace tailsim {
+
+struct ManeuverSpec {
+  std::string name, description;
+  std::string source_file;  // absolute path of the maneuver file
+  std::string base_file;    // absolute path of the base experiment
+  ExperimentCase base;      // its one case (its trajectory is not used)
+  ManeuverSettings settings;
+};
+
+// Throws ConfigError "<file>:<line>:<col>: maneuver.<key>: ..." before any work.
+ManeuverSpec loadManeuverSpec(const std::string& path);
+
+// The analytic model's yaw of one cycle (fast stroke + return) at `scale`, direction +1, and of
+// its two strokes apart; at_rest: the body was at rest after each stroke.
+struct CycleYaw {
+  double fast_rad = 0, back_rad = 0;
+  bool at_rest = true;
+  double total() const { return fast_rad + back_rad; }
+};
+CycleYaw analyticCycleYaw(const ExperimentCase& base, const ManeuverSettings& s, double scale);
+
+// The yaw-vs-scale map on the analytic model (map_points scales in [min_scale, 1]; |yaw| made
+// monotone by a running maximum).
+YawMap analyticYawMap(const ExperimentCase& base, const ManeuverSettings& s);
+
+// One executed cycle.
+struct StrokeRecord {
+  double t_start_s = 0;
+  StrokeCommand command;
+  double heading_before_rad = 0, heading_after_rad = 0;
+};
+
+// One way of turning: the heading change over time (relative to the start) and the cycles.
+struct ManeuverRun {
+  std::string label;  // analytic_open_loop | mujoco_open_loop | mujoco_closed_loop
+  bool ok = true;
+  std::string error;
+  TimeSeries series;  // t_s, x_m, y_m, phi_deg, theta<i>_deg (+ thetadot<i>_dps): for plots and video
+  std::vector<StrokeRecord> strokes;
+  // Figures (heading error e = target - heading):
+  double final_error_rad = 0;
+  double overshoot_rad = 0;        // largest turn past the target (>= 0)
+  double t_within_s = -1;          // first time after which |e| <= tolerance to the end; -1: never
+  int strokes_to_within = -1;      // cycles started before t_within_s
+  std::vector<std::string> warnings;
+};
+
+// The open-loop plan: N full cycles and a last one scaled (bisection on the analytic model) so the
+// analytic heading lands on the target.
+std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map);
+
+ManeuverRun runAnalyticOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const std::vector<StrokeCommand>& plan);
+ManeuverRun runMujocoOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const std::vector<StrokeCommand>& plan);
+// duration_s: simulated time (the controller idles once within tolerance).
+ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map, double duration_s);
+
+struct ManeuverReport {
+  YawMap map;
+  CycleYaw full_cycle;
+  std::vector<StrokeCommand> plan;
+  std::vector<ManeuverRun> runs;
+  std::vector<std::string> files;  // relative to DIR
+  double wall_s = 0;
+};
+
+// Runs everything and writes DIR/maneuver.csv, strokes.csv, yaw_map.csv, summary.json,
+// plots/heading.{gp,png,svg} and, with `video`, renders/<name>.mp4 (closed loop, analytic ghost).
+ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress);
+
+}  // namespace tailsim
