@@ -3,20 +3,23 @@
 // gap |phi_net,perfoot - phi_net,MuJoCo| / |phi_net,MuJoCo| (median / max over the cases with
 // |phi_net,MuJoCo| >= 1 deg). docs/per-foot-model.md "What holds the per-foot model and MuJoCo apart".
 //   build/tests/bench_gap_attribution [--law stiction|adams] [--only REGEX] [--variants a,b,..]
-//                                     [--csv FILE] [--suite SUITE.yaml]
+//                                     [--csv FILE] [--suite SUITE.yaml] [--dump DIR]
 // Variants (each a pair: per-foot run vs MuJoCo run, same friction law):
 //   base       perfoot load transfer (h = com_height_m)    vs MuJoCo default
 //   qs         perfoot quasi-static loads                  vs MuJoCo default
 //   measured   perfoot driven by MuJoCo's own foot<k>_Fn_N (impulse averages, 1 ms) vs MuJoCo default
-//   h2, h4     perfoot lt vs MuJoCo timestep / 2, / 4 (servo w_n kept)
-//   stiff2     perfoot lt vs MuJoCo solref 0.001 at timestep / 2;  stiff4: solref 0.0005 at / 4
+//   h<N>       perfoot lt vs MuJoCo timestep / N (servo w_n kept), e.g. h2, h4, h8
+//   stiff<N>   perfoot lt vs MuJoCo solref[0] / N at timestep / N (stiff2: solref 0.001 at 1e-4 s)
 //   impratio   perfoot lt vs MuJoCo impratio 100
+//   torsion<T> perfoot lt vs MuJoCo condim 4 with torsional friction T mm (moment / normal force), e.g. torsion1
+//   condim6    perfoot lt vs MuJoCo condim 6 (torsional and rolling friction 0: must equal base)
 //   softimp    perfoot lt vs MuJoCo impratio 100, noslip 3, solimp 0.015 0.9999 0.031
 //   low        perfoot lt and MuJoCo with the body (COM) 0.05 m high instead of 0.15 m
 //   servo      perfoot lt vs MuJoCo with a 2x stiffer tail servo (servo_wn_dt 0.4)
 //   noff       perfoot lt vs MuJoCo without the inverse-dynamics feed-forward
 //   nofric     both without friction (the multibody and the integrator alone)
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -31,6 +34,7 @@
 #include "analytic_model/per_foot_model.h"
 #include "experiments/experiment_loader.h"
 #include "mujoco_model/mujoco_simulation.h"
+#include "results/atomic_file.h"
 #include "results/columns.h"
 
 using namespace tailsim;
@@ -73,12 +77,14 @@ int main(int argc, char** argv) {
   std::string suite = TAILSIM_SOURCE_DIR "/configs/paper/all.yaml", only = ".*", law_name = "stiction";
   std::string variants = "base,qs,measured,h2,stiff2,impratio,low,servo,noff,nofric";
   const char* csv = nullptr;
+  std::string dump;  // --dump DIR: the default MuJoCo run and the measured-load per-foot run of each case as CSV
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--suite")) suite = argv[i + 1];
     else if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
     else if (!std::strcmp(argv[i], "--variants")) variants = argv[i + 1];
     else if (!std::strcmp(argv[i], "--law")) law_name = argv[i + 1];
     else if (!std::strcmp(argv[i], "--csv")) csv = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--dump")) dump = argv[i + 1];
     else {
       std::fprintf(stderr, "unknown option %s\n", argv[i]);
       return 2;
@@ -133,13 +139,28 @@ int main(int argc, char** argv) {
           ps.normal_loads = NormalLoadModel::kQuasiStatic;
           own_perfoot = true;
         }
-        if (v == "measured" && mj0.summary.ok)
-          p.perfoot = phiOf(simulatePerFoot(robot, tr, ps, ev, out, loadsOf(mj0.series)), "perfoot", v);
-      } else if (v == "h2" || v == "h4" || v == "stiff2" || v == "stiff4") {
-        const double f = (v == "h2" || v == "stiff2") ? 2.0 : 4.0;
+        if (v == "measured" && mj0.summary.ok) {
+          const RunResult r = simulatePerFoot(robot, tr, ps, ev, out, loadsOf(mj0.series));
+          p.perfoot = phiOf(r, "perfoot", v);
+          if (!dump.empty()) {
+            std::string tag = case_names.back();
+            for (char& ch : tag)
+              if (ch == '/' || ch == ',' || ch == '=') ch = '_';
+            writeCsvAtomic(dump + "/" + tag + "_mujoco.csv", mj0.series);
+            writeCsvAtomic(dump + "/" + tag + "_perfoot_measured.csv", r.series);
+          }
+        }
+      } else if ((v.rfind("h", 0) == 0 && v.size() > 1 && std::isdigit(v[1])) || v.rfind("stiff", 0) == 0) {
+        const bool stiff = v[0] == 's';
+        const double f = std::stod(v.substr(stiff ? 5 : 1));
         ms.timestep_s /= f;
         ms.servo_wn_dt /= f;
-        if (v == "stiff2" || v == "stiff4") ms.solref[0] /= f;
+        if (stiff) ms.solref[0] /= f;
+      } else if (v.rfind("torsion", 0) == 0) {
+        ms.condim = 4;
+        ms.torsional_friction_m = 1e-3 * std::stod(v.substr(7));
+      } else if (v == "condim6") {
+        ms.condim = 6;
       } else if (v == "impratio") {
         ms.impratio = 100;
       } else if (v == "softimp") {
