@@ -138,6 +138,8 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
   s.noslip_iterations = 3;
   s.impratio = 2.5;
   s.mu = 0.42;
+  s.torsional_friction_m = 0.003;
+  s.condim = 4;
   s.solref = {0.004, 0.9};
   Effects e;
   ModelPtr m = loadModelFromXml(generateMjcf(p, s, e));
@@ -150,6 +152,9 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
   EXPECT_DOUBLE_EQ(m->opt.impratio, 2.5);
   const int g = geomId(m.get(), mjcf::footGeomName(3));
   EXPECT_DOUBLE_EQ(m->geom_friction[3 * g], 0.42);
+  EXPECT_DOUBLE_EQ(m->geom_friction[3 * g + 1], 0.003);
+  EXPECT_DOUBLE_EQ(m->geom_friction[3 * g + 2], 0.0);
+  EXPECT_EQ(m->geom_condim[g], 4);
   EXPECT_DOUBLE_EQ(m->geom_solref[mjNREF * g], 0.004);
   EXPECT_DOUBLE_EQ(m->geom_solref[mjNREF * g + 1], 0.9);
 

@@ -192,6 +192,35 @@ TEST(PerFootModel, SlidingBodyDeceleratesAtMuG) {
   EXPECT_NEAR(F1[50], -r.friction.mu_d * N1[50], 1e-9);
 }
 
+// Prescribed normal loads (the diagnostic input of bench_gap_attribution): equal loads summing to
+// twice the weight until t = 0.05 s, then to the weight, ramped linearly over 0.05-0.06 s. The
+// slide then decelerates at 2 mu_d g, then mu_d g (the trapezoid between the two given samples),
+// and each foot carries its prescribed load.
+TEST(PerFootModel, PrescribedNormalLoadsDriveTheSlide) {
+  const RobotParams r = paperRobot(1);
+  const double W = r.systemMass() * r.gravity_mps2, mu = r.friction.mu_d, v0 = 0.5;
+  PrescribedNormalLoads L;
+  L.t_s = {0.0, 0.05, 0.06};
+  L.N = {{W / 2, W / 2, W / 2, W / 2}, {W / 2, W / 2, W / 2, W / 2}, {W / 4, W / 4, W / 4, W / 4}};
+  const RunResult p = simulatePerFoot(r, sameMove(1, 0, 0, 0.25, 0.25), slideSettings(v0), {}, {}, L);
+  ASSERT_TRUE(p.summary.ok) << p.summary.error;
+  const double a2 = 2 * mu * kG, a1 = mu * kG;
+  const double v_ramp_end = v0 - a2 * 0.05 - 0.5 * (a2 + a1) * 0.01;  // speed at t = 0.06 s
+  const auto& t = p.series.values("t_s");
+  const auto& x = p.series.values("x_m");
+  const auto& N3 = p.series.values("N3_N");
+  for (size_t k = 0; k < t.size() && t[k] <= 0.05 + 1e-12; ++k) {
+    ASSERT_NEAR(x[k], v0 * t[k] - 0.5 * a2 * t[k] * t[k], 1e-7) << t[k];
+    ASSERT_NEAR(N3[k], W / 2, 1e-9) << t[k];
+  }
+  EXPECT_NEAR(N3[100], W / 4, 1e-9);  // t = 0.1 s: held at the last sample
+  EXPECT_NEAR(p.summary.t_stop_s, 0.06 + v_ramp_end / a1, 1e-4);
+  EXPECT_NEAR(p.summary.phi_net_deg, 0.0, 1e-9);
+  // The input is checked: times must ascend.
+  L.t_s = {0.0, 0.05, 0.05};
+  EXPECT_THROW(simulatePerFoot(r, sameMove(1, 0, 0, 0.25, 0.25), slideSettings(v0), {}, {}, L), std::invalid_argument);
+}
+
 // The ADAMS law per foot: above v_d the coefficient is mu_d, so a fast slide decelerates at
 // mu_d g until v_d; mu(0) = 0, so it never sticks.
 TEST(PerFootModel, AdamsLawSlideDeceleratesAtMuDAboveVd) {

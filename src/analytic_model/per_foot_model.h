@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include "analytic_model/foot_loads.h"
 #include "results/output_settings.h"
@@ -68,6 +69,20 @@ settings::For<S, PerFootSettings> declareFields(V& v, S& s) {
 // throws std::invalid_argument for settings it cannot run with.
 RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
                           const Effects& effects, const OutputSettings& output);
+
+// Diagnostic input, not a setting: the four feet's normal loads prescribed over time instead of
+// computed (`normal_loads` and `effects.foot_loads` are then unused), e.g. MuJoCo's recorded
+// foot<k>_Fn_N, to isolate the load distribution in the gap between the two models
+// (tests/bench_gap_attribution.cc, docs/per-foot-model.md "What holds the per-foot model and MuJoCo
+// apart"). t_s strictly ascending, N[j][k] foot k+1's load at t_s[j] [N]; linear in between, held
+// beyond the ends.
+struct PrescribedNormalLoads {
+  std::vector<double> t_s;
+  std::vector<std::array<double, 4>> N;
+  std::array<double, 4> at(double t) const;
+};
+RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                          const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads& loads);
 
 // ---------------------------------------------------------------------------------------------
 // The planar limit surface of four friction discs (Goyal, Ruina & Papadopoulos 1991).

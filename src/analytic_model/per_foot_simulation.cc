@@ -40,8 +40,9 @@ struct Eval {
 
 class Model {
  public:
-  Model(const RobotParams& r, const TailTrajectory& tr, const PerFootSettings& s, const Effects& e)
-      : robot_(r), traj_(tr), s_(s), e_(e) {
+  Model(const RobotParams& r, const TailTrajectory& tr, const PerFootSettings& s, const Effects& e,
+        const PrescribedNormalLoads* loads)
+      : robot_(r), traj_(tr), s_(s), e_(e), prescribed_(loads) {
     weight_ = r.systemMass() * (e.gravity ? r.gravity_mps2 : 0.0);
     mu_break_ = breakawayCoefficient(r.friction);
     const QuadrupedParams& q = r.quadruped;
@@ -88,7 +89,7 @@ class Model {
       if (!translation()) {
         // x, y locked: a pin at the quadruped COM takes any force; the feet must supply the moment
         // about it, -r0_z, at most sum c_i |rho_i| (every foot tangential).
-        normalLoads(ev, phi, Vec2::Zero());
+        normalLoads(ev, t, phi, Vec2::Zero());
         double D = 0.0;
         for (int i = 0; i < 4; ++i) {
           ev.discs.c[i] = mu_break_ * ev.N[i];
@@ -108,7 +109,7 @@ class Model {
       // probe of a fast slide's holding wrench neither tips nor jumps.
       const double F_cap = mu_break_ * weight_;
       const double Fn = req.F.norm();
-      normalLoads(ev, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
+      normalLoads(ev, t, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
       for (int i = 0; i < 4; ++i) ev.discs.c[i] = mu_break_ * ev.N[i];
       ev.load_factor = loadFactor(ev.discs, req).s;
       ev.Ff = heldFootForces(ev.discs, req);
@@ -134,13 +135,13 @@ class Model {
     // Load transfer: N depends on the summed friction, which depends on N: fixed point (a
     // contraction of factor ~ mu h / l_F).
     Vec2 F = Vec2::Zero();
-    normalLoads(ev, phi, F);
-    if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction()) {
+    normalLoads(ev, t, phi, F);
+    if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction() && !prescribed_) {
       for (int it = 0;; ++it) {
         F.setZero();
         for (int i = 0; i < 4; ++i) F += ev.N[i] * dir[i];
         const std::array<double, 4> N_old = ev.N;
-        normalLoads(ev, phi, F);
+        normalLoads(ev, t, phi, F);
         double change = 0.0;
         for (int i = 0; i < 4; ++i) change = std::max(change, std::abs(ev.N[i] - N_old[i]));
         if (change <= 1e-13 * weight_) break;
@@ -192,9 +193,13 @@ class Model {
  private:
   // Normal loads from the Appendix distribution at the system COM, or (load transfer) at the
   // centre of pressure shifted by -h F / W. Throws TippingError outside the support rectangle.
-  void normalLoads(Eval& ev, double phi, const Vec2& F_W) const {
+  void normalLoads(Eval& ev, double t, double phi, const Vec2& F_W) const {
     if (!hasFriction()) {
       ev.N.fill(0.0);
+      return;
+    }
+    if (prescribed_) {
+      ev.N = prescribed_->at(t);
       return;
     }
     std::array<double, 4> f;
@@ -238,6 +243,7 @@ class Model {
   const TailTrajectory& traj_;
   PerFootSettings s_;
   Effects e_;
+  const PrescribedNormalLoads* prescribed_ = nullptr;  // diagnostic: loads given over time
   double weight_ = 0, mu_break_ = 0;
   std::array<Vec2, 4> foot_Q_ = zeros4();
   std::array<double, 4> fC_const_{};
@@ -386,8 +392,19 @@ std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) 
 
 }  // namespace
 
-RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
-                          const Effects& effects, const OutputSettings& output) {
+std::array<double, 4> PrescribedNormalLoads::at(double t) const {
+  if (t <= t_s.front()) return N.front();
+  if (t >= t_s.back()) return N.back();
+  const size_t j = static_cast<size_t>(std::upper_bound(t_s.begin(), t_s.end(), t) - t_s.begin());  // t_s[j-1] <= t < t_s[j]
+  const double a = (t - t_s[j - 1]) / (t_s[j] - t_s[j - 1]);
+  std::array<double, 4> out;
+  for (int k = 0; k < 4; ++k) out[k] = (1 - a) * N[j - 1][k] + a * N[j][k];
+  return out;
+}
+
+namespace {
+RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                              const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads* loads) {
   if (!(settings.rel_tol > 0) || !(settings.abs_tol > 0)) throw std::invalid_argument("perfoot tolerances must be > 0");
   if (!(settings.event_tol_s > 0)) throw std::invalid_argument("perfoot event_tol_s must be > 0");
   if (!(settings.v_stop_mps > 0)) throw std::invalid_argument("perfoot v_stop_mps must be > 0");
@@ -413,7 +430,7 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
   const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
 
   try {
-    const Model model(robot, trajectory, settings, effects);
+    const Model model(robot, trajectory, settings, effects, loads);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
     const double v_stop = settings.v_stop_mps;
     State y{};
@@ -550,6 +567,26 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
   }
   sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
+}
+
+}  // namespace
+
+RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                          const Effects& effects, const OutputSettings& output) {
+  return simulatePerFootImpl(robot, trajectory, settings, effects, output, nullptr);
+}
+
+RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                          const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads& loads) {
+  if (loads.t_s.empty() || loads.t_s.size() != loads.N.size())
+    throw std::invalid_argument("prescribed normal loads: need as many times as load rows, at least one");
+  for (size_t j = 0; j < loads.t_s.size(); ++j) {
+    if (!std::isfinite(loads.t_s[j]) || (j > 0 && !(loads.t_s[j] > loads.t_s[j - 1])))
+      throw std::invalid_argument("prescribed normal loads: times must be finite and strictly ascending");
+    for (double n : loads.N[j])
+      if (!std::isfinite(n) || n < 0) throw std::invalid_argument("prescribed normal loads must be finite and >= 0");
+  }
+  return simulatePerFootImpl(robot, trajectory, settings, effects, output, &loads);
 }
 
 }  // namespace tailsim

@@ -199,7 +199,7 @@ void addFootDefault(XMLElement* dmain, const MujocoSettings& s, double mu, int c
   g->SetAttribute("conaffinity", 1);
   g->SetAttribute("condim", condim);
   if (priority) g->SetAttribute("priority", 1);
-  g->SetAttribute("friction", nums({mu, 0.0, 0.0}).c_str());
+  g->SetAttribute("friction", nums({mu, s.torsional_friction_m, 0.0}).c_str());
   g->SetAttribute("solref", solrefText(s).c_str());
   g->SetAttribute("solimp", solimpText(s).c_str());
   g->SetAttribute("group", 3);

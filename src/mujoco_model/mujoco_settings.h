@@ -46,6 +46,10 @@ struct MujocoSettings {
   std::array<double, 2> solref = {0.002, 1.0};                  // contact time constant [s], damping ratio
   std::array<double, 5> solimp = {0.95, 0.99, 0.001, 0.5, 2.0};  // contact impedance
   double mu = -1.0;                     // contact friction; < 0: max(mu_s, mu_d)
+  // Torsional friction of each foot (MuJoCo friction[1], a length: the largest torsional moment
+  // is this times the normal force); acts with condim 4 or 6 only. 0: point feet, as the per-foot
+  // model (docs/per-foot-model.md "What holds the per-foot model and MuJoCo apart")  [m]
+  double torsional_friction_m = 0.0;
   double kp = 0.0;                      // tail position gain [N m/rad]; 0 = chosen from the link inertia
   double kv = 0.0;                      // tail velocity gain [N m s/rad]; 0 = critically damped
   bool velocity_feedforward = true;     // add kv * theta_dot_ref
@@ -87,6 +91,8 @@ settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
             s.solimp);
   v.number(Field{"mu", "contact friction; absent (-1 in the resolved case) = max(mu_s, mu_d)"}, s.mu,
            Limits::nonNegative());
+  v.number(Field{"torsional_friction_m", "feet's torsional friction (moment / normal force; condim 4 or 6 only) [m]"},
+           s.torsional_friction_m, Limits::nonNegative());
   v.number(Field{"kp", "tail position gain [N m/rad]; 0 = from servo_wn_dt and the link inertia"}, s.kp,
            Limits::nonNegative());
   v.number(Field{"kv", "tail velocity gain [N m s/rad]; 0 = critically damped"}, s.kv, Limits::nonNegative());
