@@ -68,7 +68,7 @@ class JointProfile {
   bool isSpline() const { return !knots_.empty(); }
   JointState at(double t) const;
   // Split-cycle: its parameters. Spline: the envelope (theta0 = first knot, dtheta = last - first,
-  // dT, t0, and w_ss = knot spacing / dT, so w_ss dT is the shortest smooth piece).
+  // dT, t0, and w_ss = knot spacing / dT, so w_ss dT is the shortest smooth piece; 0.5 for 2 knots).
   const SplitCycleParams& params() const { return p_; }
   const SplineParams& spline() const { return s_; }  // spline profiles only (empty knots otherwise)
   double accelAmplitude() const { return A_; }  // A of Eq. (23)  [rad/s^2] (0 for a spline)
