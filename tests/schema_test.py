@@ -57,7 +57,12 @@ for doc in ("README.md", os.path.join("docs", "experiment-format.md")):
 base = {"name": "x", "robot": "paper", "trajectory": {"dtheta_deg": -90, "dT_s": 0.25}}
 assert not list(exp_v.iter_errors(base)), "the minimal experiment must pass"
 assert not list(exp_v.iter_errors({**base, "trajectory": {"theta0_deg": {"range": [0, 90, 15]}, "dtheta_deg": -90, "dT_s": 0.25}}))
+assert not list(exp_v.iter_errors({**base, "trajectory": {"family": "spline", "knots_deg": [[30, 10, -40], [0, 20]], "dT_s": 0.3}}))
+assert not list(exp_v.iter_errors({**base, "trajectory": {"family": "spline", "knots_deg": [30, {"sweep": [0, 10]}], "dT_s": 0.3}}))
 negatives = {
+    "spline knot out of range": {**base, "trajectory": {"family": "spline", "knots_deg": [30, 500], "dT_s": 0.3}},
+    "one spline knot": {**base, "trajectory": {"family": "spline", "knots_deg": [30], "dT_s": 0.3}},
+    "unknown family": {**base, "trajectory": {"family": "bezier", "knots_deg": [30, 0], "dT_s": 0.3}},
     "unknown top-level key": {**base, "colour": "red"},
     "unknown analytic key": {**base, "analytic": {"solvr": "fixed"}},
     "render fps out of range": {**base, "render": {"fps": 1000}},

@@ -152,6 +152,37 @@ TEST(StrokeDesign, SameSeedSameResult) {
   EXPECT_EQ(a.evaluations, b.evaluations);
 }
 
+// Restarts (IPOP): the first restart is the single-start search itself (same sub-seeds), the later
+// ones run fresh archipelagos with populations growing by restart_growth; the result is the best
+// over all of them, so it is never worse than the single start's global best.
+TEST(StrokeDesign, RestartsRunGrowingPopulationsAndKeepTheBest) {
+  StrokeProblem p;
+  p.base = baseCase(1);
+  p.space.n_links = 1;
+  p.space.limits.torque_max_Nm = 8.0;
+  OptimizerSettings one = smallBudget(5);
+  one.generations = 6;
+  one.polish = "none";
+  OptimizerSettings three = one;
+  three.restarts = 3;
+  three.restart_growth = 2;
+  const OptimizeResult a = optimizeStroke(p, one), b = optimizeStroke(p, three);
+  // Generation rows: 0, then one per generation of every restart.
+  ASSERT_EQ(a.history.size(), 1u + 6u);
+  ASSERT_EQ(b.history.size(), 1u + 3u * 6u);
+  // Restart 0 repeats the single start exactly.
+  for (std::size_t g = 0; g < a.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].evaluations, a.history[g].evaluations) << g;
+    EXPECT_EQ(b.history[g].best_objective, a.history[g].best_objective) << g;
+  }
+  // Each restart r evaluates islands x population x 2^r per generation (and once more to fill its
+  // population): the extra evaluations are those of populations 16 and 32 on 2 islands.
+  const long per_pop = 2L * (6 + 1);  // islands x (initial population + generations)
+  EXPECT_EQ(b.evaluations - a.evaluations, per_pop * (16 + 32));
+  EXPECT_GE(b.best.objective, a.best.objective);
+  EXPECT_TRUE(b.best.feasible());
+}
+
 class OptimizeFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -179,6 +210,8 @@ class OptimizeFileTest : public ::testing::Test {
     }
     return "(no error)";
   }
+  // `tailsim optimize` on a tiny budget, then `tailsim run DIR/best.yaml`: same phi_net in every model.
+  void checkBestRuns(const std::string& family);
   fs::path dir_;
 };
 
@@ -225,6 +258,9 @@ TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
       {"  family: bspline\n" + std::string(kLimits), "5:11: optimize.family: ", "not one of: split_cycle, spline"},
       {"  family: spline\n" + std::string(kLimits) + "  seeds: [1, 1]\n", "7:14: optimize.seeds[1]: ", "duplicate seed"},
       {"  family: spline\n" + std::string(kLimits) + "  pareto_points: 1\n", "7:18: optimize.pareto_points: ", "at least 2"},
+      {"  family: spline\n" + std::string(kLimits) + "  restarts: 0\n", "7:13: optimize.restarts: ", "must lie in [1, 50]"},
+      {"  family: spline\n" + std::string(kLimits) + "  population: 300\n  restarts: 3\n  restart_growth: 2\n",
+       "9:19: optimize.restart_growth: ", "population of 1200, over 1000"},
   };
   for (const Bad& b : cases) {
     const std::string msg = error(write(b.section));
@@ -265,8 +301,8 @@ int runCommand(const std::string& cmd, std::string& out) {
 
 // `tailsim optimize` writes the best stroke as an experiment that `tailsim run` runs as it is,
 // with the same phi_net; the history CSV and plot exist.
-TEST_F(OptimizeFileTest, BestStrokeIsAReadyToRunExperiment) {
-  const std::string f = write(std::string("  family: split_cycle\n") + kLimits +
+void OptimizeFileTest::checkBestRuns(const std::string& family) {
+  const std::string f = write("  family: " + family + "\n" + kLimits +
                               "  islands: 2\n  population: 8\n  generations: 6\n  polish_evaluations: 30\n  seeds: [3]\n");
   const std::string bin = std::string(TAILSIM_BINARY_DIR) + "/tailsim";
   std::string out;
@@ -292,10 +328,32 @@ TEST_F(OptimizeFileTest, BestStrokeIsAReadyToRunExperiment) {
               opt["resimulated"]["perfoot"]["phi_net_deg"].get<double>(), 1e-9);
   EXPECT_NEAR(opt["resimulated"]["perfoot"]["difference_deg"].get<double>(),
               opt["resimulated"]["perfoot"]["phi_net_deg"].get<double>() - phi_run, 1e-9);
-  if (opt["resimulated"].contains("mujoco")) {
+  ASSERT_TRUE(opt["resimulated"].contains("mujoco"));
+  {
     EXPECT_NEAR(run["cases"][0]["runs"]["mujoco"]["phi_net_deg"].get<double>(),
                 opt["resimulated"]["mujoco"]["phi_net_deg"].get<double>(), 1e-9);
   }
+}
+
+
+TEST_F(OptimizeFileTest, BestStrokeIsAReadyToRunExperiment) { checkBestRuns("split_cycle"); }
+
+// A spline optimum too: best.yaml holds `trajectory: {family: spline, knots_deg: ...}` (summary.json's
+// knots), and `tailsim run` gives every model the phi_net summary.json reports.
+TEST_F(OptimizeFileTest, BestSplineStrokeIsAReadyToRunExperiment) {
+  checkBestRuns("spline\n  knots: 2");
+  const Experiment best = loadExperiment((dir_ / "res/best.yaml").string());
+  ASSERT_EQ(best.cases.size(), 1u);
+  ASSERT_EQ(best.cases[0].splines.size(), 1u);
+  EXPECT_TRUE(best.cases[0].joints.empty());
+  nlohmann::json opt;
+  std::ifstream(dir_ / "res/summary.json") >> opt;
+  std::vector<double> knots;
+  for (double k : best.cases[0].splines[0].knots_rad) knots.push_back(k * 180.0 / M_PI);
+  const auto want = opt["best"]["joints"][0]["knots_deg"].get<std::vector<double>>();
+  ASSERT_EQ(knots.size(), 4u);  // start, 2 interior knots, end
+  ASSERT_EQ(want.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_NEAR(knots[k], want[k], 1e-9) << k;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "experiments/experiment_loader.h"
+#include "experiments/settings_json.h"
 
 namespace tailsim {
 namespace {
@@ -521,6 +522,65 @@ TEST_F(LoaderTest, BadRobotValues) {
   expectError("name: t\nrobot: robots/paper_quadruped.yaml\n"
               "tail: {custom: [{izz_kgm2: 0.01, length_m: 0.1}]}\n" + std::string(kTraj),
               3, "tail.custom[0].mass_kg", "required");
+}
+
+// trajectory: {family: spline, ...}: per joint a clamped cubic spline through its knots; the case
+// keeps the knots (radians) and its resume key and resolved JSON include them.
+TEST_F(LoaderTest, SplineTrajectory) {
+  const std::string text =
+      "name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 2}\n"
+      "trajectory: {family: spline, knots_deg: [[30, 10, -40], [0, 20, 5, -15]], dT_s: [0.3, 0.4], t0_s: 0.05}\n";
+  const Experiment e = loadExperiment(write("exp.yaml", text));
+  ASSERT_EQ(e.cases.size(), 1u);
+  const ExperimentCase& c = e.cases[0];
+  EXPECT_TRUE(c.joints.empty());
+  ASSERT_EQ(c.splines.size(), 2u);
+  ASSERT_EQ(c.splines[0].knots_rad.size(), 3u);
+  ASSERT_EQ(c.splines[1].knots_rad.size(), 4u);
+  EXPECT_DOUBLE_EQ(c.splines[0].knots_rad[2], -40 * kDeg);
+  EXPECT_DOUBLE_EQ(c.splines[1].knots_rad[1], 20 * kDeg);
+  EXPECT_EQ(c.splines[1].dT_s, 0.4);
+  EXPECT_EQ(c.splines[0].t0_s, 0.05);
+  const TailTrajectory t = c.trajectory();
+  ASSERT_EQ(t.joints.size(), 2u);
+  EXPECT_TRUE(t.joints[1].isSpline());
+  EXPECT_NEAR(t.joints[1].at(0.05 + 0.4 / 3).theta, 20 * kDeg, 1e-12);  // through its knot
+  EXPECT_NEAR(t.endTime(), 0.45, 1e-12);
+  // One list of knots for every joint.
+  const Experiment same = loadExperiment(
+      write("exp.yaml", "name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 2}\n"
+                        "trajectory: {family: spline, knots_deg: [30, -30], dT_s: 0.3}\n"));
+  ASSERT_EQ(same.cases[0].splines.size(), 2u);
+  EXPECT_EQ(same.cases[0].splines[1].knots_rad, same.cases[0].splines[0].knots_rad);
+  // The resolved case round-trips, and a different knot is a different resume key.
+  const ExperimentCase back = caseFromResolved(resolvedJson(c));
+  ASSERT_EQ(back.splines.size(), 2u);
+  EXPECT_EQ(back.splines[1].knots_rad, c.splines[1].knots_rad);
+  EXPECT_EQ(caseKeyText(back, false), caseKeyText(c, false));
+  ExperimentCase other = c;
+  other.splines[1].knots_rad[1] += 1e-9;
+  EXPECT_NE(caseKeyText(other, false), caseKeyText(c, false));
+  // A split-cycle case's resolved JSON has no "splines" (its resume key is unchanged).
+  const Experiment sc = loadExperiment(write("exp.yaml", exp(kTraj)));
+  EXPECT_FALSE(resolvedJson(sc.cases[0]).contains("splines"));
+}
+
+TEST_F(LoaderTest, BadSplineTrajectory) {
+  const std::string head = "name: t\nrobot: robots/paper_quadruped.yaml\ntail: {links: 2}\n";
+  expectError(head + "trajectory: {family: spline, knots_deg: [[30, 10], [0, 500]], dT_s: 0.3}\n", 4,
+              "trajectory.knots_deg[1][1]", "must lie in [-360, 360] deg", "exp.yaml", 56);
+  expectError(head + "trajectory: {family: spline, knots_deg: [[30, 10]], dT_s: 0.3}\n", 4, "trajectory.knots_deg",
+              "has 1 knot lists but the tail has 2 joints");
+  expectError(head + "trajectory: {family: spline, knots_deg: [30], dT_s: 0.3}\n", 4, "trajectory.knots_deg",
+              "needs 2..64 knots");
+  expectError(head + "trajectory: {family: spline, knots_deg: [30, 0], dT_s: 0.0001}\n", 4, "trajectory.dT_s",
+              "must be >= 0.001 s");
+  expectError(head + "trajectory: {family: spline, knots_deg: [30, 0]}\n", 4, "trajectory.dT_s", "required key is missing");
+  expectError(head + "trajectory: {family: spline, knots_deg: [30, 0], dT_s: 0.3, w_ss: 0.2}\n", 4, "trajectory.w_ss",
+              "not used with family: spline");
+  expectError(head + "trajectory: {dtheta_deg: -90, dT_s: 0.25, knots_deg: [1, 2]}\n", 4, "trajectory.knots_deg",
+              "only used with family: spline");
+  expectError(head + "trajectory: {family: bezier, knots_deg: [1, 2], dT_s: 0.3}\n", 4, "trajectory.family");
 }
 
 TEST_F(LoaderTest, BadSettings) {

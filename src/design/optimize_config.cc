@@ -51,7 +51,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   if (!fs::is_regular_file(s.base_file)) r.fail(base, "no such experiment file: " + s.base_file);
   const Val& opt = need(top, root, "optimize");
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
+                             "generations", "restarts", "restart_growth", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -108,6 +108,15 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   if (const Val* v = Reader::get(o, "islands")) os.islands = r.integer(*v, 1, kMaxIslands);
   if (const Val* v = Reader::get(o, "population")) os.population = r.integer(*v, 5, kMaxPopulation);
   if (const Val* v = Reader::get(o, "generations")) os.generations = r.integer(*v, 1, kMaxGenerations);
+  if (const Val* v = Reader::get(o, "restarts")) os.restarts = r.integer(*v, 1, kMaxRestarts);
+  if (const Val* v = Reader::get(o, "restart_growth")) {
+    os.restart_growth = r.integer(*v, 1, 4);
+    double last = os.population;  // the last restart's population must stay within the limit
+    for (int i = 1; i < os.restarts; ++i) last *= os.restart_growth;
+    if (last > kMaxPopulation)
+      r.fail(*v, "gives the last restart a population of " + fmtG(last) + ", over " + std::to_string(kMaxPopulation) +
+                     " (population x restart_growth^(restarts - 1))");
+  }
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
   if (const Val* v = Reader::get(o, "seeds")) {
@@ -131,6 +140,8 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
   s.base = e.cases.front();
   if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
+  if (!s.base.splines.empty())
+    r.fail(base, "the base experiment's trajectory is the search's start and must be split-cycle (not family: spline)");
   sp.n_links = s.base.robot.numLinks();
   if (torque && L.torque_max_Nm == 0.0) {  // torque_max_Nm: base -- the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;

@@ -32,6 +32,7 @@ constexpr int kMaxKnots = 12;
 constexpr int kMaxIslands = 64;
 constexpr int kMaxPopulation = 1000;
 constexpr int kMaxGenerations = 10000;
+constexpr int kMaxRestarts = 50;
 constexpr int kMaxPolishEvaluations = 100000;
 constexpr int kMaxSeeds = 20;
 constexpr int kMaxParetoPoints = 20;

@@ -114,19 +114,40 @@ std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& t
   doc["description"] = "Best stroke of " + spec.name + " (tailsim optimize, " + std::string(familyName(spec.problem.space.family)) + ")";
   doc["robot"] = spec.base.robot_file;  // absolute: the file runs from any folder
   YAML::Node t(YAML::NodeType::Map);
-  const char* keys[] = {"theta0_deg", "dtheta_deg", "dT_s", "w_ss", "t0_s"};
-  for (const char* k : keys) {
+  auto flowList = [] {
     YAML::Node l(YAML::NodeType::Sequence);
     l.SetStyle(YAML::EmitterStyle::Flow);
+    return l;
+  };
+  if (spec.problem.space.family == StrokeFamily::kSpline) {
+    // trajectory: {family: spline, knots_deg: [[...] per joint], dT_s: [...], t0_s: [...]}
+    t["family"] = "spline";
+    YAML::Node knots(YAML::NodeType::Sequence);
+    YAML::Node dT = flowList(), t0 = flowList();
     for (const auto& j : traj.joints) {
-      const SplitCycleParams& p = j.params();
-      const std::string key = k;
-      const double v = key == "theta0_deg" ? p.theta0_rad * kDegPerRad
-                       : key == "dtheta_deg" ? p.dtheta_rad * kDegPerRad
-                       : key == "dT_s" ? p.dT_s : key == "w_ss" ? p.w_ss : p.t0_s;
-      l.push_back(YAML::Load(g17(v)));
+      YAML::Node k = flowList();
+      for (double v : j.spline().knots_rad) k.push_back(YAML::Load(g17(v * kDegPerRad)));
+      knots.push_back(k);
+      dT.push_back(YAML::Load(g17(j.spline().dT_s)));
+      t0.push_back(YAML::Load(g17(j.spline().t0_s)));
     }
-    t[k] = l;
+    t["knots_deg"] = knots;
+    t["dT_s"] = dT;
+    t["t0_s"] = t0;
+  } else {
+    const char* keys[] = {"theta0_deg", "dtheta_deg", "dT_s", "w_ss", "t0_s"};
+    for (const char* k : keys) {
+      YAML::Node l = flowList();
+      for (const auto& j : traj.joints) {
+        const SplitCycleParams& p = j.params();
+        const std::string key = k;
+        const double v = key == "theta0_deg" ? p.theta0_rad * kDegPerRad
+                         : key == "dtheta_deg" ? p.dtheta_rad * kDegPerRad
+                         : key == "dT_s" ? p.dT_s : key == "w_ss" ? p.w_ss : p.t0_s;
+        l.push_back(YAML::Load(g17(v)));
+      }
+      t[k] = l;
+    }
   }
   doc["trajectory"] = t;
   YAML::Node models(YAML::NodeType::Sequence);
@@ -197,10 +218,8 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   writeCsvAtomic((fs::path(out_dir) / "best_trajectory.csv").string(),
                  trajectorySeries(spec.base.robot.tail, traj, 1e-3, traj.endTime()));
   rep.files.push_back("best_trajectory.csv");
-  if (prob.space.family == StrokeFamily::kSplitCycle) {
-    writeFileAtomic((fs::path(out_dir) / "best.yaml").string(), bestExperimentYaml(spec, traj));
-    rep.files.push_back("best.yaml");
-  }
+  writeFileAtomic((fs::path(out_dir) / "best.yaml").string(), bestExperimentYaml(spec, traj));
+  rep.files.push_back("best.yaml");
 
   // Convergence history.
   {
@@ -275,6 +294,8 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["dimensions"] = prob.space.dim();
   j["algorithm"] = spec.optimizer.algorithm;
   j["islands"] = spec.optimizer.islands;
+  j["restarts"] = spec.optimizer.restarts;
+  j["restart_growth"] = spec.optimizer.restart_growth;
   j["polish"] = spec.optimizer.polish;
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};

@@ -100,7 +100,8 @@ pagmo::algorithm makeAlgorithm(const OptimizerSettings& s, unsigned seed) {
 }  // namespace
 
 OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s) {
-  if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0)
+  if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
+      s.restart_growth < 1)
     throw std::invalid_argument("optimizer settings out of range");
   const auto t_start = Clock::now();
   auto shared = std::make_shared<const StrokeProblem>(prob);
@@ -113,23 +114,32 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   tracker->record(x0, evaluateStroke(prob, x0));
 
   pagmo::problem pp{PagmoStroke{shared, tracker}};
-  pagmo::archipelago archi;
-  for (int i = 0; i < s.islands; ++i) {
-    const unsigned seed = static_cast<unsigned>(s.seed * 1000003u + static_cast<unsigned>(i) * 7919u);
-    pagmo::population pop(pp, static_cast<pagmo::population::size_type>(s.population), seed);
-    pop.set_x(0, x0);
-    archi.push_back(pagmo::thread_island{}, makeAlgorithm(s, seed + 1u), std::move(pop));
-  }
   auto snapshot = [&](int gen, const char* stage) {
     std::lock_guard<std::mutex> lock(tracker->mu);
     res.history.push_back({gen, tracker->evaluations, std::chrono::duration<double>(Clock::now() - t_start).count(),
                            tracker->have_best ? tracker->best_objective : 0.0, stage});
   };
   snapshot(0, "global");
-  for (int g = 1; g <= s.generations; ++g) {
-    archi.evolve(1);
-    archi.wait_check();
-    snapshot(g, "global");
+  // Restarts (issue 12: a multimodal problem): each is a fresh archipelago with its own sub-seeds
+  // and random populations; only the first holds the start point (CMA-ES centres on a population's
+  // best, so the start in every restart would pull each back to the same basin). IPOP: the
+  // population grows by restart_growth per restart. The tracker keeps the best over all restarts.
+  int gen_count = 0;
+  long pop_size = s.population;
+  for (int r = 0; r < s.restarts; ++r, pop_size *= s.restart_growth) {
+    pagmo::archipelago archi;
+    for (int i = 0; i < s.islands; ++i) {
+      const unsigned seed = static_cast<unsigned>(s.seed * 1000003u + static_cast<unsigned>(i) * 7919u +
+                                                  static_cast<unsigned>(r) * 104729u);
+      pagmo::population pop(pp, static_cast<pagmo::population::size_type>(pop_size), seed);
+      if (r == 0) pop.set_x(0, x0);
+      archi.push_back(pagmo::thread_island{}, makeAlgorithm(s, seed + 1u), std::move(pop));
+    }
+    for (int g = 1; g <= s.generations; ++g) {
+      archi.evolve(1);
+      archi.wait_check();
+      snapshot(++gen_count, "global");
+    }
   }
 
   // Polish from the best feasible point (NLopt works on the same unit box).
@@ -182,7 +192,7 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
     } catch (const std::exception&) {
       // NLopt's roundoff/forced stops: the tracker holds the best feasible point seen.
     }
-    snapshot(s.generations + 1, "polish");
+    snapshot(gen_count + 1, "polish");
   }
 
   res.evaluations = tracker->evaluations;

@@ -17,7 +17,9 @@ struct OptimizerSettings {
   std::string algorithm = "cmaes";  // "cmaes" | "de" (pagmo2)
   int islands = 2;                  // thread islands, evolved in parallel, no migration
   int population = 16;              // per island
-  int generations = 60;             // per island
+  int generations = 60;             // per island and restart
+  int restarts = 1;                 // independent global searches per seed (distinct sub-seeds); the best is polished
+  int restart_growth = 1;           // population factor from one restart to the next (2: IPOP-CMA-ES)
   std::string polish = "cobyla";    // "cobyla" | "bobyqa" | "none" (NLopt)
   int polish_evaluations = 200;
   std::uint64_t seed = 1;

@@ -169,9 +169,15 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
       auto perturbed = [&](int k) {
         TailTrajectory t;
         for (const SplitCycleProfile& j : traj.joints) {
-          SplitCycleParams p = j.params();
-          p.dT_s += 1e-6 * k;
-          t.joints.emplace_back(p);
+          if (j.isSpline()) {
+            SplineParams p = j.spline();
+            p.dT_s += 1e-6 * k;
+            t.joints.emplace_back(p);
+          } else {
+            SplitCycleParams p = j.params();
+            p.dT_s += 1e-6 * k;
+            t.joints.emplace_back(p);
+          }
         }
         return t;
       };

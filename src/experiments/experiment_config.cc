@@ -5,6 +5,7 @@ namespace tailsim {
 TailTrajectory ExperimentCase::trajectory() const {
   TailTrajectory t;
   for (const SplitCycleParams& p : joints) t.joints.emplace_back(p);
+  for (const SplineParams& p : splines) t.joints.emplace_back(p);
   return t;
 }
 

@@ -46,7 +46,8 @@ struct ExperimentCase {
   PoseSpec pose;  // kind == kPose
 
   RobotParams robot;
-  std::vector<SplitCycleParams> joints;  // one per tail link
+  std::vector<SplitCycleParams> joints;  // one per tail link (split-cycle trajectory)
+  std::vector<SplineParams> splines;     // or one per tail link (trajectory family: spline; joints empty)
   std::vector<std::string> models;       // "analytic", "perfoot", "mujoco" (experiments/model_registry.h)
   AnalyticSettings analytic;
   PerFootSettings perfoot;
@@ -55,7 +56,7 @@ struct ExperimentCase {
   OutputSettings output;
   RenderSettings render;
 
-  TailTrajectory trajectory() const;  // one SplitCycleProfile per joint
+  TailTrajectory trajectory() const;  // one JointProfile per joint (split-cycle or spline)
   double simDuration() const;         // output.duration_s, or tail end + settle_s
 
 };

@@ -861,9 +861,64 @@ struct JointLocs {
   Loc dT, w_ss;
 };
 
+// The trajectory section's keys: split-cycle (the default family) and spline (family: spline).
+const std::vector<std::string> kSplitCycleKeys = {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps", "w_ss",
+                                                  "t0_s", "rule", "thetadot_max_dps", "thetadot_max_radps"};
+const std::vector<std::string> kSplineKeys = {"knots_deg", "dT_s", "t0_s"};
+
+// family: spline -- per joint a clamped cubic spline through equally spaced knots (JointProfile).
+std::vector<SplineParams> readSplineTrajectory(const Reader& r, const Item& item, const MapView& t, int n) {
+  for (const auto& [k, it] : t.fields)
+    if (k != "family" && std::find(kSplineKeys.begin(), kSplineKeys.end(), k) == kSplineKeys.end())
+      r.fail(it, "not used with family: spline (spline keys: knots_deg, dT_s, t0_s)");
+  std::vector<SplineParams> joints(static_cast<std::size_t>(n));
+  // knots_deg: one list of knots for every joint, or a list of n lists (one per joint).
+  const Item& kn = r.need(t, "knots_deg");
+  const std::vector<Item> outer = r.list(kn);
+  const bool per_joint = !outer.empty() && outer.front().node.IsSequence();
+  std::vector<Item> lists;
+  if (per_joint) {
+    if (static_cast<int>(outer.size()) != n)
+      r.fail(kn, "has " + std::to_string(outer.size()) + " knot lists but the tail has " + std::to_string(n) +
+                     " joints: give one list of knots for all joints or one list per joint");
+    lists = outer;
+  } else {
+    lists.assign(static_cast<std::size_t>(n), kn);
+  }
+  for (int i = 0; i < n; ++i) {
+    const std::vector<Item> v = r.list(lists[i]);
+    if (v.size() < 2 || v.size() > static_cast<std::size_t>(limits::kMaxSplineKnots))
+      r.fail(lists[i], "needs 2.." + std::to_string(limits::kMaxSplineKnots) + " knots (start, interior knots, end), got " +
+                           std::to_string(v.size()));
+    for (const Item& x : v) joints[i].knots_rad.push_back(boundedDeg(r, x, limits::kMaxAbsTheta0Deg) * kRadPerDeg);
+  }
+  const std::vector<Item> dT = r.perJoint(r.need(t, "dT_s"), n);
+  for (int i = 0; i < n; ++i) {
+    joints[i].dT_s = r.positive(dT[i]);
+    if (joints[i].dT_s < limits::kMinDT_s)
+      r.fail(dT[i], "must be >= " + fmtG(limits::kMinDT_s) + " s, got " + fmtG(joints[i].dT_s) +
+                        " (docs/experiment-format.md \"Limits\")");
+  }
+  if (const Item* t0 = t.get("t0_s")) {
+    const std::vector<Item> v = r.perJoint(*t0, n);
+    for (int i = 0; i < n; ++i) joints[i].t0_s = r.nonNegative(v[i]);
+  }
+  for (int i = 0; i < n; ++i) {  // JointProfile's own checks
+    try {
+      JointProfile check(joints[i]);
+    } catch (const std::invalid_argument& e) {
+      r.fail(per_joint ? lists[i] : kn, e.what());
+    }
+  }
+  (void)item;
+  return joints;
+}
+
 std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, int n) {
-  const MapView t = r.map(item, {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps", "w_ss", "t0_s", "rule",
-                                 "thetadot_max_dps", "thetadot_max_radps"});
+  std::vector<std::string> allowed = kSplitCycleKeys;
+  allowed.push_back("family");
+  const MapView t = r.map(item, allowed);
+  if (const Item* f = t.get("family")) r.choice(*f, {"split_cycle"});  // spline: readSplineTrajectory
   std::vector<SplitCycleParams> joints(static_cast<std::size_t>(n));
   std::vector<JointLocs> locs(static_cast<std::size_t>(n), JointLocs{r.loc(item), r.loc(item)});
 
@@ -1127,7 +1182,19 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   if (c.kind == CaseKind::kSimulate) {
     if (pose) r.fail(*pose, "only used with kind: pose");
     if (!traj) tailsim::fail(r.locAt(root, "trajectory"), "required for kind: simulate");
-    c.joints = readTrajectory(r, *traj, n);
+    // family: split_cycle (default: Eqs. 20-23) or spline (a clamped cubic spline per joint).
+    const MapView tm = r.map(*traj, [] {
+      std::vector<std::string> k = kSplitCycleKeys;
+      k.insert(k.end(), {"family", "knots_deg"});
+      return k;
+    }());
+    const Item* fam = tm.get("family");
+    if (fam && r.choice(*fam, {"split_cycle", "spline"}) == "spline") {
+      c.splines = readSplineTrajectory(r, *traj, tm, n);
+    } else {
+      if (const Item* k = tm.get("knots_deg")) r.fail(*k, "only used with family: spline");
+      c.joints = readTrajectory(r, *traj, n);
+    }
   } else {
     if (traj) r.fail(*traj, "only used with kind: simulate");
     c.pose = pose ? readPose(r, *pose, n) : readPose(r, Item{YAML::Node(YAML::NodeType::Map), "pose", root.mark}, n);

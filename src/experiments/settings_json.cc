@@ -110,6 +110,10 @@ json resolvedJson(const ExperimentCase& c) {
   for (const TailLink& l : c.robot.tail) j["tail"].push_back(toJson(l));
   j["joints"] = json::array();
   for (const SplitCycleParams& p : c.joints) j["joints"].push_back(toJson(p));
+  if (!c.splines.empty()) {  // only then: split-cycle cases keep their resume keys
+    j["splines"] = json::array();
+    for (const SplineParams& p : c.splines) j["splines"].push_back(toJson(p));
+  }
   j["pose"] = {{"theta_rad", c.pose.theta_rad},
                {"thetadot_radps", c.pose.thetadot_radps},
                {"thetaddot_radps2", c.pose.thetaddot_radps2}};
@@ -136,6 +140,8 @@ ExperimentCase caseFromResolved(const json& j) {
     c.robot.gravity_mps2 = need(j, "gravity_mps2").get<double>();
     for (const json& l : need(j, "tail")) c.robot.tail.push_back(fromJson<TailLink>(l, "tail[]"));
     for (const json& p : need(j, "joints")) c.joints.push_back(fromJson<SplitCycleParams>(p, "joints[]"));
+    if (j.contains("splines"))
+      for (const json& p : j.at("splines")) c.splines.push_back(fromJson<SplineParams>(p, "splines[]"));
     const json& pose = need(j, "pose");
     c.pose.theta_rad = need(pose, "theta_rad").get<std::vector<double>>();
     c.pose.thetadot_radps = need(pose, "thetadot_radps").get<std::vector<double>>();

@@ -150,6 +150,8 @@ json perJoint(json value, const std::string& doc) {
 json experimentSchema() {
   const json num = {{"type", "number"}};
   json link = section(describe<TailLink>().props, {"mass_kg", "izz_kgm2", "length_m"});
+  const json knot = orSweep({{"type", "number"}, {"minimum", -limits::kMaxAbsTheta0Deg}, {"maximum", limits::kMaxAbsTheta0Deg}});
+  const json knots = {{"type", "array"}, {"minItems", 2}, {"maxItems", limits::kMaxSplineKnots}, {"items", knot}};
   json traj = section({
       {"theta0_deg", perJoint({{"type", "number"}, {"minimum", -limits::kMaxAbsTheta0Deg}, {"maximum", limits::kMaxAbsTheta0Deg}},
                               "start angle theta_0 [deg]")},
@@ -161,6 +163,10 @@ json experimentSchema() {
                         "split-cycle parameter")},
       {"t0_s", perJoint({{"type", "number"}, {"minimum", 0}}, "start time [s]")},
       {"rule", orSweep({{"type", "string"}, {"enum", {"eq25"}}})},
+      {"family", orSweep({{"type", "string"}, {"enum", {"split_cycle", "spline"}}})},
+      {"knots_deg",
+       {{"description", "family: spline: knot angles [deg], one list for all joints or one list per joint"},
+        {"anyOf", json::array({knots, {{"type", "array"}, {"minItems", 1}, {"items", knots}}})}}},
       {"thetadot_max_dps", orSweep({{"type", "number"}, {"exclusiveMinimum", 0}})},
       {"thetadot_max_radps", orSweep({{"type", "number"}, {"exclusiveMinimum", 0}})},
   });

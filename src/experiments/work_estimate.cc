@@ -26,7 +26,7 @@ double mujocoColumns(int n) { return 1 + 3 * n + 14 + 8 + n; }
 std::vector<std::string> timeKeys(const ExperimentCase& c) {
   if (c.output.duration_s > 0) return {"output.duration_s"};
   double t0 = 0;
-  for (const SplitCycleParams& p : c.joints) t0 = std::max(t0, p.t0_s);
+  for (const JointProfile& j : c.trajectory().joints) t0 = std::max(t0, j.params().t0_s);
   if (t0 > c.output.settle_s) return {"trajectory.t0_s", "output.settle_s", "trajectory.dT_s"};
   return {"output.settle_s", "trajectory.t0_s", "trajectory.dT_s"};
 }
@@ -49,7 +49,10 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
     // While the tail moves (t0 delay included) the adaptive step is at most max_step_s, by default
     // 1/8 of the shortest acceleration or deceleration phase; the fixed step is fixed_dt_s.
     double shortest = std::numeric_limits<double>::infinity();
-    for (const SplitCycleParams& p : c.joints) shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
+    for (const JointProfile& j : traj.joints) {  // a spline's envelope: w_ss dT = its knot spacing
+      const SplitCycleParams& p = j.params();
+      shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
+    }
     const double h = c.analytic.solver == AnalyticSolver::kFixed ? c.analytic.fixed_dt_s
                      : c.analytic.max_step_s > 0 ? c.analytic.max_step_s
                                                  : shortest / 8.0;

@@ -18,7 +18,8 @@ constexpr double kMaxRenderFrames = 1e5;    // video frames per case (~55 min at
 constexpr double kMinDT_s = 1e-3;              // tail motion duration dT  [s]
 constexpr double kMinWss = 0.01, kMaxWss = 0.99;  // acceleration share w_ss of dT
 constexpr double kMaxAbsDthetaDeg = 3600.0;    // |dtheta| (ten turns)  [deg]
-constexpr double kMaxAbsTheta0Deg = 360.0;     // |theta0|  [deg]
+constexpr double kMaxAbsTheta0Deg = 360.0;     // |theta0|, and every spline knot  [deg]
+constexpr int kMaxSplineKnots = 64;            // knots per joint of a spline trajectory (start and end included)
 constexpr double kMinMassKg = 1e-3;            // quadruped and tail link masses  [kg]
 constexpr double kMaxMassKg = 1e4;
 

@@ -50,7 +50,9 @@ JointProfile::JointProfile(const SplineParams& s) : s_(s) {
   p_.theta0_rad = knots_.front();
   p_.dtheta_rad = knots_.back() - knots_.front();
   p_.dT_s = s.dT_s;
-  p_.w_ss = 1.0 / static_cast<double>(N - 1);
+  // The knot spacing; a single piece (2 knots) counts as two halves, so that min(w_ss, 1 - w_ss) dT
+  // (the analytic model's step bound and the loader's work estimate) is never 0.
+  p_.w_ss = N > 2 ? 1.0 / static_cast<double>(N - 1) : 0.5;
   p_.t0_s = s.t0_s;
   // Peak |speed|: the speed is quadratic on each piece, so its extremes are at knots or at the
   // piece's vertex (where the acceleration, linear on the piece, is zero).

@@ -46,6 +46,17 @@ struct SplineParams {
   double t0_s = 0.0;              // start time  [s]
 };
 
+// A spline joint as the resolved case keeps it (SI units; the YAML `family: spline` trajectory, with
+// its knots in degrees and per-joint lists, is read by the loader).
+template <class V, class S>
+settings::For<S, SplineParams> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.internal(Field{"knots_rad", "theta at t0 + k dT / (K + 1), k = 0..K+1 [rad]"}, s.knots_rad);
+  v.number(Field{"dT_s", "stroke duration [s]"}, s.dT_s, Limits::positive());
+  v.number(Field{"t0_s", "start time [s]"}, s.t0_s, Limits::nonNegative());
+}
+
 // Eq. (20): half-sine acceleration A sin(pi (t-t0)/Delta_a) on [t0, t1], then
 // -B sin(pi (t-t1)/Delta_d) on (t1, t2]; at rest before t0 and after t2.
 // Or (a spline profile) the clamped cubic spline of SplineParams.
@@ -57,7 +68,7 @@ class JointProfile {
   bool isSpline() const { return !knots_.empty(); }
   JointState at(double t) const;
   // Split-cycle: its parameters. Spline: the envelope (theta0 = first knot, dtheta = last - first,
-  // dT, t0, and w_ss = knot spacing / dT, so w_ss dT is the shortest smooth piece).
+  // dT, t0, and w_ss = knot spacing / dT, so w_ss dT is the shortest smooth piece; 0.5 for 2 knots).
   const SplitCycleParams& params() const { return p_; }
   const SplineParams& spline() const { return s_; }  // spline profiles only (empty knots otherwise)
   double accelAmplitude() const { return A_; }  // A of Eq. (23)  [rad/s^2] (0 for a spline)
