@@ -9,11 +9,13 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 namespace tailsim {
 
@@ -110,17 +112,32 @@ std::string toCsv(const TimeSeries& ts) {
     out += ts.names()[c];
   }
   out += '\n';
+  // Formatting is most of the cost of a run's output (to_chars with a precision takes ~400
+  // instructions a number), and a column often repeats its last value (a body at rest, a state
+  // flag, rows copied to the end): each column keeps its last value's text and reuses it when the
+  // bits are the same (so -0 and 0 stay apart).
+  const size_t n_cols = ts.numColumns();
+  std::vector<uint64_t> last_bits(n_cols);
+  std::vector<std::string> last_text(n_cols);
+  std::vector<bool> have(n_cols, false);
   char buf[40];
   for (size_t r = 0; r < ts.numRows(); ++r) {
-    for (size_t c = 0; c < ts.numColumns(); ++c) {
+    for (size_t c = 0; c < n_cols; ++c) {
       if (c) out += ',';
       const double v = ts.at(r, static_cast<int>(c));
       if (std::isnan(v)) {
         out += "nan";
         continue;
       }
-      const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
-      out.append(buf, res.ptr);
+      uint64_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      if (!have[c] || bits != last_bits[c]) {
+        const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
+        last_text[c].assign(buf, res.ptr);
+        last_bits[c] = bits;
+        have[c] = true;
+      }
+      out += last_text[c];
     }
     out += '\n';
   }
