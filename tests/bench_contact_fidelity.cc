@@ -1,7 +1,8 @@
 // MuJoCo contact fidelity (issue 11 item 3; docs/mujoco-model.md "Contact fidelity"): for each
 // candidate contact setting, how far MuJoCo's soft convex contact is from rigid Coulomb friction
 // at four point feet. Prints one Markdown table row per candidate:
-//   build/tests/bench_contact_fidelity            (about 30 s on one core)
+//   build/tests/bench_contact_fidelity [NAME..]   (about 30 s a candidate on one core)
+// NAME..: only the default and the candidates whose name contains one of them, e.g. "feet".
 // Columns:
 //  * airborne, peak Fn/mg: summary extras `airborne_fraction`, `peak_normal_force_over_mg` of the
 //    Fig. 7 case (configs/default.yaml: 1 link, d_Q2B 0.125 m, -90 deg in 0.25 s) and of Fig. 6a
@@ -18,6 +19,7 @@
 // Not a benchmark of speed; a plain main() (linked like the other bench_* files).
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <string>
 #include <vector>
@@ -134,7 +136,7 @@ double extra(const RunResult& r, const char* key) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   const ExperimentCase fig7 = firstCase(TAILSIM_SOURCE_DIR "/configs/default.yaml");
   const ExperimentCase fig6 = firstCase(TAILSIM_SOURCE_DIR "/configs/paper/fig06a_model_comparison_1dof.yaml");
   const double perfoot7 =
@@ -160,12 +162,18 @@ int main() {
       {"impratio 100, noslip 3, solimp 0.015 0.9999 0.031",
        [](MujocoSettings& s) { s.impratio = 100.0, s.noslip_iterations = 3, s.solimp = {0.015, 0.9999, 0.031, 0.5, 2.0}; }},
       {"solref 0.001", [](MujocoSettings& s) { s.solref[0] = 0.001; }},
+      {"capsule feet (r 0.01, half-length 0.01 along x)", [](MujocoSettings& s) { s.foot_shape = MujocoFootShape::kCapsule; }},
+      {"box feet (cube, half-size 0.01)", [](MujocoSettings& s) { s.foot_shape = MujocoFootShape::kBox; }},
   };
   std::printf(
       "| candidate | Fig. 7 airborne | Fig. 7 peak Fn/mg | Fig. 6a airborne | Fig. 6a peak Fn/mg | creep at 0.9 M_break "
       "[um/s] | M_break / per-foot | F_break / per-foot | Fig. 7 phi_net [deg] | change at h/2 | Fig. 6a phi_net [deg] | "
       "gap to per-foot (Fig. 7) | Fig. 7 max height change [mm] |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Candidate& cand : candidates) {
+    // Arguments: run only the default and the candidates whose name contains one of them.
+    bool wanted = argc < 2 || &cand == &candidates.front();
+    for (int i = 1; i < argc; ++i) wanted = wanted || std::strstr(cand.name, argv[i]) != nullptr;
+    if (!wanted) continue;
     MujocoSettings s = fig7.mujoco;
     cand.apply(s);
     const RunResult r7 = simulateMujoco(fig7.robot, fig7.trajectory(), s, fig7.effects, fig7.output);

@@ -13,6 +13,8 @@
 //   impratio   perfoot lt vs MuJoCo impratio 100
 //   torsion<T> perfoot lt vs MuJoCo condim 4 with torsional friction T mm (moment / normal force), e.g. torsion1
 //   condim6    perfoot lt vs MuJoCo condim 6 (torsional and rolling friction 0: must equal base)
+//   capsule    perfoot lt vs MuJoCo capsule feet (mujoco.foot_shape, default foot_radius_m / foot_half_length_m)
+//   box        perfoot lt vs MuJoCo box feet (cubes of half-size foot_radius_m, 4 corner contacts)
 //   softimp    perfoot lt vs MuJoCo impratio 100, noslip 3, solimp 0.015 0.9999 0.031
 //   low        perfoot lt and MuJoCo with the body (COM) 0.05 m high instead of 0.15 m
 //   servo      perfoot lt vs MuJoCo with a 2x stiffer tail servo (servo_wn_dt 0.4)
@@ -161,6 +163,10 @@ int main(int argc, char** argv) {
         ms.torsional_friction_m = 1e-3 * std::stod(v.substr(7));
       } else if (v == "condim6") {
         ms.condim = 6;
+      } else if (v == "capsule") {
+        ms.foot_shape = MujocoFootShape::kCapsule;
+      } else if (v == "box") {
+        ms.foot_shape = MujocoFootShape::kBox;
       } else if (v == "impratio") {
         ms.impratio = 100;
       } else if (v == "softimp") {

@@ -2,6 +2,7 @@
 // geometry equal the robot parameters (read back from mjModel / mjData, not from the XML).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -140,6 +141,8 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
   s.mu = 0.42;
   s.torsional_friction_m = 0.003;
   s.condim = 4;
+  s.foot_shape = MujocoFootShape::kCapsule;
+  s.foot_half_length_m = 0.013;
   s.solref = {0.004, 0.9};
   Effects e;
   ModelPtr m = loadModelFromXml(generateMjcf(p, s, e));
@@ -155,6 +158,9 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
   EXPECT_DOUBLE_EQ(m->geom_friction[3 * g + 1], 0.003);
   EXPECT_DOUBLE_EQ(m->geom_friction[3 * g + 2], 0.0);
   EXPECT_EQ(m->geom_condim[g], 4);
+  EXPECT_EQ(m->geom_type[g], mjGEOM_CAPSULE);
+  EXPECT_DOUBLE_EQ(m->geom_size[3 * g], s.foot_radius_m);
+  EXPECT_DOUBLE_EQ(m->geom_size[3 * g + 1], 0.013);
   EXPECT_DOUBLE_EQ(m->geom_solref[mjNREF * g], 0.004);
   EXPECT_DOUBLE_EQ(m->geom_solref[mjNREF * g + 1], 0.9);
 
@@ -179,6 +185,70 @@ TEST(MujocoModel, EffectsAndSettingsReachTheModel) {
   e.friction = FrictionLaw::kContinuous;  // mu(0) = 0 until the first step updates it
   m = loadModelFromXml(generateMjcf(p, MujocoSettings{}, e));
   EXPECT_EQ(m->geom_friction[3 * geomId(m.get(), mjcf::footGeomName(1))], 0.0);
+}
+
+// mujoco.foot_shape reaches mjModel (geom type, size, capsule axis along body x), and the robot
+// stands on each shape: after 0.3 s with the tail held, the feet's contact normal forces carry
+// m g, the body sits at body_height_m (the lowest point / bottom face of every shape at z = 0,
+// less the soft contact's penetration) and each foot touches at 1 (sphere), 2 (capsule: the end
+// caps) or 4 (box: the bottom corners) points.
+TEST(MujocoModel, FootShapeReachesTheModelAndTheRobotStandsOnIt) {
+  const RobotParams p = paperRobot(1);
+  const double mg = p.systemMass() * p.gravity_mps2;
+  struct Shape {
+    MujocoFootShape shape;
+    int type, contacts_per_foot;
+  };
+  double z_sphere = NAN;
+  for (const Shape& sh : {Shape{MujocoFootShape::kSphere, mjGEOM_SPHERE, 1}, Shape{MujocoFootShape::kCapsule, mjGEOM_CAPSULE, 2},
+                          Shape{MujocoFootShape::kBox, mjGEOM_BOX, 4}}) {
+    SCOPED_TRACE(name(sh.shape));
+    MujocoSettings s;
+    s.foot_shape = sh.shape;
+    s.foot_radius_m = 0.012;
+    s.foot_half_length_m = 0.017;
+    ModelPtr model = loadModelFromXml(generateMjcf(p, s, Effects{}));
+    mjModel* m = model.get();
+    for (int k = 1; k <= 4; ++k) {
+      const int g = geomId(m, mjcf::footGeomName(k));
+      EXPECT_EQ(m->geom_type[g], sh.type);
+      EXPECT_DOUBLE_EQ(m->geom_size[3 * g], 0.012);
+      if (sh.shape == MujocoFootShape::kCapsule) {
+        EXPECT_DOUBLE_EQ(m->geom_size[3 * g + 1], 0.017);
+        // geom z axis (the capsule's) along body x: R(q) e_z = e_x.
+        const mjtNum* q = m->geom_quat + 4 * g;
+        const double zx = 2 * (q[1] * q[3] + q[0] * q[2]), zy = 2 * (q[2] * q[3] - q[0] * q[1]);
+        EXPECT_NEAR(zx, 1.0, 1e-9);
+        EXPECT_NEAR(zy, 0.0, 1e-9);
+      }
+      if (sh.shape == MujocoFootShape::kBox) {
+        EXPECT_DOUBLE_EQ(m->geom_size[3 * g + 1], 0.012);
+        EXPECT_DOUBLE_EQ(m->geom_size[3 * g + 2], 0.012);
+      }
+      // Centre foot_radius_m above the floor with the body at body_height_m.
+      EXPECT_NEAR(m->geom_pos[3 * g + 2], -(s.body_height_m - 0.012), 1e-12);
+    }
+    DataPtr data = makeData(m);
+    mjData* d = data.get();
+    for (int i = 0; i < static_cast<int>(0.3 / s.timestep_s); ++i) mj_step(m, d);
+    double fn = 0.0;
+    std::array<int, 4> touches{};
+    for (int i = 0; i < d->ncon; ++i) {
+      mjtNum f6[6];
+      mj_contactForce(m, d, i, f6);
+      fn += f6[0];
+      for (int k = 1; k <= 4; ++k)
+        if (d->contact[i].geom1 == geomId(m, mjcf::footGeomName(k)) || d->contact[i].geom2 == geomId(m, mjcf::footGeomName(k)))
+          ++touches[k - 1];
+    }
+    EXPECT_NEAR(fn, mg, 0.02 * mg);
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(touches[k], sh.contacts_per_foot) << "foot " << k + 1;
+    const double z = d->xpos[3 * mj_name2id(m, mjOBJ_BODY, mjcf::kQuadrupedBody) + 2];
+    EXPECT_LT(z, s.body_height_m);
+    EXPECT_GT(z, s.body_height_m - 2e-3);
+    if (sh.shape == MujocoFootShape::kSphere) z_sphere = z;
+    else EXPECT_NEAR(z, z_sphere, 1e-3);
+  }
 }
 
 TEST(MujocoModel, BadSettingsAreRejectedByName) {

@@ -64,6 +64,9 @@ void validateSettings(const MujocoSettings& s) {
   requireOneOf(name(s.integrator), {"Euler", "RK4", "implicit"}, "integrator");
   requireOneOf(name(s.solver), {"PGS", "CG", "Newton"}, "solver");
   requireOneOf(name(s.cone), {"pyramidal", "elliptic"}, "cone");
+  requireOneOf(name(s.foot_shape), {"sphere", "capsule", "box"}, "foot_shape");
+  if (s.foot_shape == MujocoFootShape::kCapsule && !(s.foot_half_length_m > 0.0))
+    throw std::invalid_argument("mujoco.foot_half_length_m must be > 0 for capsule feet");
   if (s.condim != 1 && s.condim != 3 && s.condim != 4 && s.condim != 6)
     throw std::invalid_argument("mujoco.condim must be 1, 3, 4 or 6, got " + std::to_string(s.condim));
   if (s.iterations < 1) throw std::invalid_argument("mujoco.iterations must be >= 1");
@@ -187,14 +190,26 @@ void addVisualDefault(XMLElement* dmain) {
   g->SetAttribute("density", 0);
 }
 
-// Default class "foot": the contact spheres with the friction law's mu and condim.
+// The foot geom's MJCF type and size (mujoco_settings.h MujocoFootShape); its centre is
+// foot_radius_m above its lowest point for every shape.
+std::string footGeomSize(const MujocoSettings& s) {
+  switch (s.foot_shape) {
+    case MujocoFootShape::kCapsule: return nums({s.foot_radius_m, s.foot_half_length_m});
+    case MujocoFootShape::kBox: return nums({s.foot_radius_m, s.foot_radius_m, s.foot_radius_m});
+    case MujocoFootShape::kSphere: break;
+  }
+  return num(s.foot_radius_m);
+}
+
+// Default class "foot": the contact geoms (spheres unless foot_shape says otherwise) with the
+// friction law's mu and condim.
 // priority (Menagerie robot file): the feet's contact parameters win over any floor's.
 void addFootDefault(XMLElement* dmain, const MujocoSettings& s, double mu, int condim, bool priority = false) {
   XMLElement* foot = child(dmain, "default");
   foot->SetAttribute("class", "foot");
   XMLElement* g = child(foot, "geom");
-  g->SetAttribute("type", "sphere");
-  g->SetAttribute("size", num(s.foot_radius_m).c_str());
+  g->SetAttribute("type", name(s.foot_shape));
+  g->SetAttribute("size", footGeomSize(s).c_str());
   g->SetAttribute("contype", 1);
   g->SetAttribute("conaffinity", 1);
   g->SetAttribute("condim", condim);
@@ -309,7 +324,7 @@ void addRootJoints(XMLElement* body, const Effects& e) {
 }
 
 // Torso box, four visual legs and the four contact feet (Eq. 17 positions).
-void addQuadrupedGeoms(XMLElement* body, const QuadrupedParams& q, double h, double rf) {
+void addQuadrupedGeoms(XMLElement* body, const QuadrupedParams& q, double h, double rf, MujocoFootShape shape) {
   XMLElement* torso = child(body, "geom");
   torso->SetAttribute("name", "torso");
   torso->SetAttribute("class", "visual");
@@ -332,7 +347,8 @@ void addQuadrupedGeoms(XMLElement* body, const QuadrupedParams& q, double h, dou
     XMLElement* foot = child(body, "geom");
     foot->SetAttribute("name", mjcf::footGeomName(k).c_str());
     foot->SetAttribute("class", "foot");
-    foot->SetAttribute("pos", nums({xy[0], xy[1], -(h - rf)}).c_str());  // sphere bottom at z = 0
+    foot->SetAttribute("pos", nums({xy[0], xy[1], -(h - rf)}).c_str());  // lowest point / bottom face at z = 0
+    if (shape == MujocoFootShape::kCapsule) foot->SetAttribute("zaxis", "1 0 0");  // capsule axis along body x
     foot->SetAttribute("rgba", "0.2 0.2 0.2 1");
   }
 }
@@ -350,7 +366,7 @@ XMLElement* addQuadruped(XMLElement* world, const QuadrupedParams& q, const Mujo
   in->SetAttribute("pos", "0 0 0");
   in->SetAttribute("mass", num(q.mass_kg).c_str());
   in->SetAttribute("diaginertia", nums({I[0], I[1], I[2]}).c_str());
-  addQuadrupedGeoms(body, q, h, s.foot_radius_m);
+  addQuadrupedGeoms(body, q, h, s.foot_radius_m, s.foot_shape);
   return body;
 }
 
@@ -454,6 +470,18 @@ std::string g6s(const std::vector<double>& vs) {
   std::string s = "[";
   for (size_t i = 0; i < vs.size(); ++i) s += (i ? ", " : "") + g6(vs[i]);
   return s + "]";
+}
+
+// The feet's shape in words, for the Menagerie file's comment (the sphere text as before the setting).
+std::string footNote(const MujocoSettings& s) {
+  switch (s.foot_shape) {
+    case MujocoFootShape::kCapsule:
+      return "capsules of radius " + g6(s.foot_radius_m) + " m, half-length " + g6(s.foot_half_length_m) +
+             " m along x,";
+    case MujocoFootShape::kBox: return "cubes of half-size " + g6(s.foot_radius_m) + " m, bottom face";
+    case MujocoFootShape::kSphere: break;
+  }
+  return "spheres of radius " + g6(s.foot_radius_m) + " m";
 }
 
 // A comment node in front of element e (XML comments hold no "--": the texts below have none).
@@ -566,8 +594,7 @@ MenagerieFiles generateMenagerie(const RobotParams& p, const MujocoSettings& s, 
                    g6(Iq[1]) + " kg m^2 from a 0.1 m high box of the same I_zz (only I_zz enters the planar model)");
     noteBefore(childNamed(body, "geom", mjcf::footGeomName(1)),
                "feet k = 1..4 (FL, FR, RR, RL) at (d_Q2C +- l_F/2, +-w_F/2), Eq. 17: d_Q2C = " + g6(q.d_Q2C_m) +
-                   " m, l_F = " + g6(q.l_F_m) + " m, w_F = " + g6(q.w_F_m) + " m; spheres of radius " +
-                   g6(s.foot_radius_m) + " m touching z = 0. Only the feet collide.");
+                   " m, l_F = " + g6(q.l_F_m) + " m, w_F = " + g6(q.w_F_m) + " m; " + footNote(s) + " touching z = 0. Only the feet collide.");
     XMLElement* link = childNamed(body, "body", mjcf::tailBodyName(1));
     noteBefore(link, "tail base B at -d_Q2B along x, d_Q2B = " + g6(q.d_Q2B_m) +
                          " m (Eq. 2); R_B = R_Q R_Z(180 deg) (Eq. 1): theta_i = 0 is the tail straight back");

@@ -12,6 +12,14 @@ namespace tailsim {
 enum class MujocoIntegrator { kEuler, kRK4, kImplicit };
 enum class MujocoSolver { kNewton, kCG, kPGS };
 enum class MujocoCone { kPyramidal, kElliptic };
+// Contact geometry of each foot (docs/mujoco-model.md "Contact fidelity"). Every shape's lowest
+// point or face is at z = 0 with the body at body_height_m, its centre foot_radius_m above the floor:
+//   sphere:  radius foot_radius_m (one contact point);
+//   capsule: radius foot_radius_m, half-length foot_half_length_m of its cylinder, axis along the
+//            body x (up to two contact points, one per end cap, 2 foot_half_length_m apart);
+//   box:     a cube of half-size foot_radius_m, bottom face flat on the floor (up to four contact
+//            points, the bottom corners).
+enum class MujocoFootShape { kSphere, kCapsule, kBox };
 
 // Their names, as in YAML and in MJCF's <option> attributes.
 inline const settings::EnumNames<MujocoIntegrator>& integratorNames() {
@@ -29,9 +37,15 @@ inline const settings::EnumNames<MujocoCone>& coneNames() {
                                                      {MujocoCone::kElliptic, "elliptic"}};
   return k;
 }
+inline const settings::EnumNames<MujocoFootShape>& footShapeNames() {
+  static const settings::EnumNames<MujocoFootShape> k = {
+      {MujocoFootShape::kSphere, "sphere"}, {MujocoFootShape::kCapsule, "capsule"}, {MujocoFootShape::kBox, "box"}};
+  return k;
+}
 inline const char* name(MujocoIntegrator v) { return settings::nameOf(integratorNames(), v); }
 inline const char* name(MujocoSolver v) { return settings::nameOf(solverNames(), v); }
 inline const char* name(MujocoCone v) { return settings::nameOf(coneNames(), v); }
+inline const char* name(MujocoFootShape v) { return settings::nameOf(footShapeNames(), v); }
 
 struct MujocoSettings {
   double timestep_s = 2e-4;             // physics step  [s]
@@ -57,7 +71,9 @@ struct MujocoSettings {
   // Added by the MuJoCo model (docs/mujoco-model.md):
   double servo_wn_dt = 0.2;             // kp = 0: servo natural frequency * timestep (w_n = servo_wn_dt / timestep_s)
   double body_height_m = 0.15;          // quadruped COM (= tail plane) height above the ground  [m]
-  double foot_radius_m = 0.01;          // foot spheres  [m]
+  double foot_radius_m = 0.01;          // foot sphere / capsule radius, box half-size  [m]
+  MujocoFootShape foot_shape = MujocoFootShape::kSphere;  // contact geometry of the feet (see the enum)
+  double foot_half_length_m = 0.01;     // capsule feet: half-length of the cylinder along body x  [m]
   double settle_s = 0.1;                // pre-roll with the tail held at theta(0) so the feet settle; then t = 0  [s]
   double stop_phidot_radps = 1e-3;      // t_stop: |phi_dot| below this from then on  [rad/s]
   // Tipping over (docs/mujoco-model.md "Tipping over"): with gravity and ground contact on, the run
@@ -102,7 +118,12 @@ settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
   v.number(Field{"servo_wn_dt", "kp = 0: servo natural frequency * timestep"}, s.servo_wn_dt, Limits::positive());
   v.number(Field{"body_height_m", "quadruped COM (= tail plane) height above the ground [m]"}, s.body_height_m,
            Limits::positive());
-  v.number(Field{"foot_radius_m", "foot spheres [m]"}, s.foot_radius_m, Limits::positive());
+  v.number(Field{"foot_radius_m", "foot sphere / capsule radius, box half-size [m]"}, s.foot_radius_m,
+           Limits::positive());
+  v.choice(Field{"foot_shape", "feet's contact geometry: sphere, capsule (axis along body x) or box (cube, flat bottom)"},
+           s.foot_shape, footShapeNames());
+  v.number(Field{"foot_half_length_m", "capsule feet: half-length of the cylinder along body x [m]"},
+           s.foot_half_length_m, Limits::positive());
   v.number(Field{"settle_s", "pre-roll with the tail held at theta(0) so the feet settle [s]"}, s.settle_s,
            Limits::nonNegative());
   v.number(Field{"stop_phidot_radps", "t_stop: |phi_dot| below this from then on [rad/s]"}, s.stop_phidot_radps,
