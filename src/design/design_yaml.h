@@ -146,5 +146,36 @@ inline YAML::Node loadYaml(const std::string& abs) {
   }
 }
 
+
+using Map = std::vector<std::pair<std::string, Val>>;
+
+// A required key of map m (as Reader::map returns it) whose node is parent.
+inline const Val& need(const Reader& r, const Map& m, const Val& parent, const char* k) {
+  const Val* v = Reader::get(m, k);
+  if (!v) r.fail(parent.mark, parent.key.empty() ? k : parent.key + "." + k, "required key is missing");
+  return *v;
+}
+
+// The keys every design file (kind optimize, kind maneuver) starts with: name (one safe path
+// component), description, kind (must be `kind`) and base (an experiment file, relative to this one).
+struct DesignHead {
+  std::string name, description, base_file;
+};
+inline DesignHead readDesignHead(const Reader& r, const Val& root, const Map& top, const std::string& source_file,
+                                 const char* kind) {
+  DesignHead h;
+  h.name = r.text(need(r, top, root, "name"));
+  if (h.name.empty() || h.name.size() > 100 || h.name.find_first_of("/\\") != std::string::npos || h.name == "." ||
+      h.name == ".." || h.name[0] == '-')
+    r.fail(need(r, top, root, "name"),
+           "must be one safe path component (no / or \\, not . or .., no leading -, 1..100 characters)");
+  if (const Val* d = Reader::get(top, "description")) h.description = r.text(*d);
+  r.choice(need(r, top, root, "kind"), {kind});
+  const Val& base = need(r, top, root, "base");
+  h.base_file = (fs::path(source_file).parent_path() / r.text(base)).lexically_normal().string();
+  if (!fs::is_regular_file(h.base_file)) r.fail(base, "no such experiment file: " + h.base_file);
+  return h;
+}
+
 }  // namespace design_yaml
 }  // namespace tailsim

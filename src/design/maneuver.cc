@@ -176,20 +176,14 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   const Val root{loadYaml(s.source_file), "", YAML::Mark()};
   if (!root.node.IsMap()) r.fail(root, "the file must be a map of key: value");
   const auto top = r.map(root, {"name", "description", "kind", "base", "maneuver"});
-  auto need = [&](const std::vector<std::pair<std::string, Val>>& m, const Val& parent, const char* k) -> const Val& {
-    const Val* v = Reader::get(m, k);
-    if (!v) r.fail(parent.mark, parent.key.empty() ? k : parent.key + "." + k, "required key is missing");
-    return *v;
+  auto need = [&](const design_yaml::Map& m, const Val& parent, const char* k) -> const Val& {
+    return design_yaml::need(r, m, parent, k);
   };
-  s.name = r.text(need(top, root, "name"));
-  if (s.name.empty() || s.name.size() > 100 || s.name.find_first_of("/\\") != std::string::npos || s.name == "." ||
-      s.name == ".." || s.name[0] == '-')
-    r.fail(need(top, root, "name"), "must be one safe path component (no / or \\, not . or .., no leading -, 1..100 characters)");
-  if (const Val* d = Reader::get(top, "description")) s.description = r.text(*d);
-  r.choice(need(top, root, "kind"), {"maneuver"});
-  const Val& base = need(top, root, "base");
-  s.base_file = (fs::path(s.source_file).parent_path() / r.text(base)).lexically_normal().string();
-  if (!fs::is_regular_file(s.base_file)) r.fail(base, "no such experiment file: " + s.base_file);
+  design_yaml::DesignHead head = design_yaml::readDesignHead(r, root, top, s.source_file, "maneuver");
+  s.name = std::move(head.name);
+  s.description = std::move(head.description);
+  s.base_file = std::move(head.base_file);
+  const Val& base = need(top, root, "base");  // the base experiment's own checks below point here
   const Val& mv = need(top, root, "maneuver");
   KeyList kl;
   declareFields(kl, static_cast<const ManeuverSettings&>(s.settings));
