@@ -17,6 +17,20 @@ void copyMessage(const char* what, char* err, size_t err_len) {
   std::strncpy(err, what, err_len - 1);
   err[err_len - 1] = '\0';
 }
+
+// Runs an entry point's body; an exception becomes -1 (ConfigError) or -2 with its message in err.
+template <class Body>
+int guarded(char* err, size_t err_len, const Body& body) {
+  try {
+    return body();
+  } catch (const tailsim::ConfigError& e) {
+    copyMessage(e.what(), err, err_len);
+    return -1;
+  } catch (const std::exception& e) {
+    copyMessage(e.what(), err, err_len);
+    return -2;
+  }
+}
 }  // namespace
 
 // Returns the process exit code: 0 limits kept, 3 a limit violated on the re-run; -1 a ConfigError,
@@ -24,7 +38,7 @@ void copyMessage(const char* what, char* err, size_t err_len) {
 extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(const char* exp_path, const char* out_dir,
                                                                            int quiet, char* err, size_t err_len) {
   using namespace tailsim;
-  try {
+  return guarded(err, err_len, [&] {
     const OptimizeSpec spec = loadOptimizeSpec(exp_path);  // all errors before any work
     const OptimizeReport r = runOptimize(spec, out_dir, quiet == 0);
     const std::string mujoco =
@@ -37,13 +51,7 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
     for (const std::string& f : r.files) std::printf("%s/%s\n", out_dir, f.c_str());
     std::fflush(stdout);
     return r.limits_analytic.ok ? 0 : 3;
-  } catch (const ConfigError& e) {
-    copyMessage(e.what(), err, err_len);
-    return -1;
-  } catch (const std::exception& e) {
-    copyMessage(e.what(), err, err_len);
-    return -2;
-  }
+  });
 }
 
 // `tailsim maneuver`: the same module (it needs the design layer, not pagmo, but one module keeps the
@@ -52,7 +60,7 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
 extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(const char* exp_path, const char* out_dir,
                                                                            int quiet, int video, char* err, size_t err_len) {
   using namespace tailsim;
-  try {
+  return guarded(err, err_len, [&] {
     const ManeuverSpec spec = loadManeuverSpec(exp_path);  // all errors before any work
     const ManeuverReport r = runManeuver(spec, out_dir, video != 0, quiet == 0);
     bool all_ok = true;
@@ -70,11 +78,5 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
     for (const std::string& f : r.files) std::printf("%s/%s\n", out_dir, f.c_str());
     std::fflush(stdout);
     return all_ok ? 0 : 3;
-  } catch (const ConfigError& e) {
-    copyMessage(e.what(), err, err_len);
-    return -1;
-  } catch (const std::exception& e) {
-    copyMessage(e.what(), err, err_len);
-    return -2;
-  }
+  });
 }
