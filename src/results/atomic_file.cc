@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <charconv>
@@ -16,6 +17,8 @@
 #include <stdexcept>
 #include <system_error>
 #include <vector>
+
+#include "results/number_text.h"
 
 namespace tailsim {
 
@@ -105,42 +108,55 @@ bool writeUserFile(const std::string& path, const std::string& contents) {
 }
 
 std::string toCsv(const TimeSeries& ts) {
-  std::string out;
-  out.reserve(ts.numRows() * ts.numColumns() * 12 + 256);
+  std::string head;
   for (size_t c = 0; c < ts.numColumns(); ++c) {
-    if (c) out += ',';
-    out += ts.names()[c];
+    if (c) head += ',';
+    head += ts.names()[c];
   }
-  out += '\n';
-  // Formatting is most of the cost of a run's output (to_chars with a precision takes ~400
-  // instructions a number), and a column often repeats its last value (a body at rest, a state
-  // flag, rows copied to the end): each column keeps its last value's text and reuses it when the
-  // bits are the same (so -0 and 0 stay apart).
-  const size_t n_cols = ts.numColumns();
-  std::vector<uint64_t> last_bits(n_cols);
-  std::vector<std::string> last_text(n_cols);
-  std::vector<bool> have(n_cols, false);
-  char buf[40];
+  head += '\n';
+  // Formatting is most of the cost of a run's output, and a column often repeats its last value
+  // (a body at rest, a state flag, rows copied to the end): each column remembers where its last
+  // value's text is in the output and copies it when the bits are the same (so -0 and 0 stay
+  // apart). The text itself is formatG12's ("%.12g", the same bytes as std::to_chars with
+  // precision 12, ~4x faster). Rows are written through a pointer into a buffer that grows by
+  // doubling, with room for a whole row (32 characters a number) before each row.
+  const size_t n_cols = ts.numColumns(), row_max = n_cols * 33 + 1;
+  std::string out(head.size() + ts.numRows() * n_cols * 12 + row_max, '\0');
+  std::memcpy(out.data(), head.data(), head.size());
+  size_t pos = head.size();
+  struct Last {
+    uint64_t bits = 0;
+    size_t at = 0, len = 0;  // where the text of that value is in `out`
+    bool have = false;
+  };
+  std::vector<Last> last(n_cols);
   for (size_t r = 0; r < ts.numRows(); ++r) {
+    if (out.size() - pos < row_max) out.resize(std::max(2 * out.size(), pos + row_max));
+    char* p = out.data() + pos;
     for (size_t c = 0; c < n_cols; ++c) {
-      if (c) out += ',';
+      if (c) *p++ = ',';
       const double v = ts.at(r, static_cast<int>(c));
       if (std::isnan(v)) {
-        out += "nan";
+        std::memcpy(p, "nan", 3);
+        p += 3;
         continue;
       }
       uint64_t bits;
       std::memcpy(&bits, &v, sizeof bits);
-      if (!have[c] || bits != last_bits[c]) {
-        const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
-        last_text[c].assign(buf, res.ptr);
-        last_bits[c] = bits;
-        have[c] = true;
+      Last& l = last[c];
+      if (l.have && bits == l.bits) {
+        std::memcpy(p, out.data() + l.at, l.len);
+        p += l.len;
+      } else {
+        char* e = formatG12(p, v);
+        l = Last{bits, static_cast<size_t>(p - out.data()), static_cast<size_t>(e - p), true};
+        p = e;
       }
-      out += last_text[c];
     }
-    out += '\n';
+    *p++ = '\n';
+    pos = static_cast<size_t>(p - out.data());
   }
+  out.resize(pos);
   return out;
 }
 

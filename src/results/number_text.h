@@ -1,0 +1,16 @@
+// The text of a number in the CSV files: 12 significant digits, printf's "%.12g" (what
+// std::to_chars(first, last, v, std::chars_format::general, 12) writes), made fast for the
+// common case. Formatting was most of the cost of a run's output (issue 13): to_chars with a
+// precision takes ~400 instructions a number, this ~100.
+#pragma once
+
+namespace tailsim {
+
+// Writes v as "%.12g" would (C locale) at p, returns one past the last character. p must hold
+// 32 characters. Bit-for-bit the same text as std::to_chars(..., general, 12) for every double
+// (tests/test_number_text.cc): the fast path is taken only where its rounding is provably the
+// correctly rounded one (and for 0 and -0); every other value (ties and near-ties at the 12th
+// digit, |v| outside [1e-280, 1e280], inf, nan) goes to std::to_chars.
+char* formatG12(char* p, double v);
+
+}  // namespace tailsim
