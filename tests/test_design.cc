@@ -183,6 +183,36 @@ TEST(StrokeDesign, RestartsRunGrowingPopulationsAndKeepTheBest) {
   EXPECT_TRUE(b.best.feasible());
 }
 
+TEST(StrokeDesign, RefineRunsCmaesOnTheGlobalSearchsPopulations) {
+  StrokeProblem p;
+  p.base = baseCase(1);
+  p.space.n_links = 1;
+  p.space.limits.torque_max_Nm = 8.0;
+  OptimizerSettings de = smallBudget(5);
+  de.algorithm = "de";
+  de.generations = 5;
+  de.polish = "none";
+  OptimizerSettings refined = de;
+  refined.refine_generations = 4;
+  const OptimizeResult a = optimizeStroke(p, de), b = optimizeStroke(p, refined);
+  // The global rows are the same search; then one "refine" row per CMA-ES generation.
+  ASSERT_EQ(a.history.size(), 1u + 5u);
+  ASSERT_EQ(b.history.size(), 1u + 5u + 4u);
+  for (std::size_t g = 0; g < a.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].stage, "global");
+    EXPECT_EQ(b.history[g].evaluations, a.history[g].evaluations) << g;
+    EXPECT_EQ(b.history[g].best_objective, a.history[g].best_objective) << g;
+  }
+  for (std::size_t g = a.history.size(); g < b.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].stage, "refine");
+    EXPECT_GE(b.history[g].best_objective, b.history[g - 1].best_objective);
+  }
+  // Each refine generation evaluates islands x population points (CMA-ES keeps the population size).
+  EXPECT_EQ(b.evaluations - a.evaluations, 2L * de.population * 4);
+  EXPECT_GE(b.best.objective, a.best.objective);
+  EXPECT_TRUE(b.best.feasible());
+}
+
 class OptimizeFileTest : public ::testing::Test {
  protected:
   void SetUp() override {

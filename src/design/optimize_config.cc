@@ -45,7 +45,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& base = need(top, root, "base");  // the base experiment's own checks below point here
   const Val& opt = need(top, root, "optimize");
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
+                             "generations", "restarts", "restart_growth", "refine_generations", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -111,6 +111,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
       r.fail(*v, "gives the last restart a population of " + fmtG(last) + ", over " + std::to_string(kMaxPopulation) +
                      " (population x restart_growth^(restarts - 1))");
   }
+  if (const Val* v = Reader::get(o, "refine_generations")) os.refine_generations = r.integer(*v, 0, kMaxGenerations);
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
   if (const Val* v = Reader::get(o, "seeds")) {

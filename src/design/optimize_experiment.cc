@@ -296,6 +296,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["islands"] = spec.optimizer.islands;
   j["restarts"] = spec.optimizer.restarts;
   j["restart_growth"] = spec.optimizer.restart_growth;
+  j["refine_generations"] = spec.optimizer.refine_generations;
   j["polish"] = spec.optimizer.polish;
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};

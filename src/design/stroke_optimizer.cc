@@ -101,7 +101,7 @@ pagmo::algorithm makeAlgorithm(const OptimizerSettings& s, unsigned seed) {
 
 OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s) {
   if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
-      s.restart_growth < 1)
+      s.restart_growth < 1 || s.refine_generations < 0)
     throw std::invalid_argument("optimizer settings out of range");
   const auto t_start = Clock::now();
   auto shared = std::make_shared<const StrokeProblem>(prob);
@@ -139,6 +139,22 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
       archi.evolve(1);
       archi.wait_check();
       snapshot(++gen_count, "global");
+    }
+    // Refine: CMA-ES continues on each island's population, centred on its best point with a
+    // small step (5 % of the box): the global search (e.g. DE, which explores widely but
+    // converges slowly) finds the basin, CMA-ES converges in it.
+    if (s.refine_generations > 0) {
+      for (int i = 0; i < s.islands; ++i) {
+        const unsigned seed = static_cast<unsigned>(s.seed * 1000003u + static_cast<unsigned>(i) * 7919u +
+                                                    static_cast<unsigned>(r) * 104729u);
+        archi[static_cast<pagmo::archipelago::size_type>(i)].set_algorithm(
+            pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, 0.05, 1e-9, 1e-9, true, true, seed + 2u)));
+      }
+      for (int g = 1; g <= s.refine_generations; ++g) {
+        archi.evolve(1);
+        archi.wait_check();
+        snapshot(++gen_count, "refine");
+      }
     }
   }
 

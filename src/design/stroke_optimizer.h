@@ -20,6 +20,7 @@ struct OptimizerSettings {
   int generations = 60;             // per island and restart
   int restarts = 1;                 // independent global searches per seed (distinct sub-seeds); the best is polished
   int restart_growth = 1;           // population factor from one restart to the next (2: IPOP-CMA-ES)
+  int refine_generations = 0;       // CMA-ES generations on each island's population after its global search
   std::string polish = "cobyla";    // "cobyla" | "bobyqa" | "none" (NLopt)
   int polish_evaluations = 200;
   std::uint64_t seed = 1;
@@ -50,7 +51,7 @@ struct HistoryRow {
   long evaluations = 0;      // analytic runs so far
   double wall_s = 0.0;
   double best_objective = 0.0;  // best feasible so far (0 when none yet)
-  std::string stage;         // "global" | "polish"
+  std::string stage;         // "global" | "refine" | "polish"
 };
 
 struct OptimizeResult {
