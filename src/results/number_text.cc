@@ -38,11 +38,16 @@ char* formatG12(char* p, double v) {
   const double a = std::fabs(v);
   if (!(a >= 1e-280 && a <= 1e280)) return slow(p, v);  // zero, tiny, huge, inf, nan
   // The decimal exponent X and the 12-digit mantissa m = round(a 10^(11 - X)) in [1e11, 1e12).
-  int X = static_cast<int>(std::floor(std::log10(a)));
+  // Estimate X from the binary exponent (a = f 2^e, f in [1, 2): log10 a in [e log10 2, (e + 1)
+  // log10 2)), so it is exact or one too low; the loop below corrects it.
+  std::uint64_t bits;
+  std::memcpy(&bits, &a, sizeof bits);
+  const int e2 = static_cast<int>(bits >> 52) - 1023;
+  int X = static_cast<int>(std::floor(e2 * 0.30102999566398120));
   std::uint64_t m = 0;
   for (int attempt = 0;; ++attempt) {
     const int k = 11 - X;
-    if (k > 22 || k < -22 || attempt > 2) return slow(p, v);
+    if (k > 22 || k < -22 || attempt > 3) return slow(p, v);
     const double s = k >= 0 ? a * kPow10[k] : a / kPow10[-k];  // one rounding: |error| <= 1.2e-4
     const auto whole = static_cast<std::uint64_t>(s);          // floor: 0 < s < 2^53
     const double frac = s - static_cast<double>(whole);         // exact
