@@ -2,6 +2,9 @@
 // optimum, a brute-force optimum found, `kind: optimize` errors at file:line:col, the best
 // stroke as a ready-to-run experiment.
 #include <gtest/gtest.h>
+
+#include <random>
+#include <set>
 #include <unistd.h>
 
 #include <cmath>
@@ -9,6 +12,8 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <random>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <string>
@@ -213,6 +218,68 @@ TEST(StrokeDesign, RefineRunsCmaesOnTheGlobalSearchsPopulations) {
   EXPECT_TRUE(b.best.feasible());
 }
 
+TEST(StrokeDesign, DirectionsFixEachJointsStrokeSideAndRoundTrip) {
+  StrokeSpace sp;
+  sp.n_links = 3;
+  sp.limits.t0_max_s = 0.1;
+  sp.directions = {1, -1, 1};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 2000; ++k) {
+    std::vector<double> x(static_cast<std::size_t>(sp.dim()));
+    for (double& v : x) v = u(rng);
+    const TailTrajectory t = sp.trajectory(x);
+    for (int i = 0; i < 3; ++i) {
+      const SplitCycleParams& p = t.joints[static_cast<std::size_t>(i)].params();
+      EXPECT_GE(p.dtheta_rad * sp.directions[static_cast<std::size_t>(i)], 0.0);
+      EXPECT_GE(p.theta0_rad + p.dtheta_rad, sp.limits.theta_min_rad - 1e-12);
+      EXPECT_LE(p.theta0_rad + p.dtheta_rad, sp.limits.theta_max_rad + 1e-12);
+    }
+    // pointOf inverts trajectory (the duration is clipped by the dT range, so compare strokes).
+    std::vector<SplitCycleParams> ps;
+    for (const auto& j : t.joints) ps.push_back(j.params());
+    const TailTrajectory back = sp.trajectory(sp.pointOf(ps));
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(back.joints[static_cast<std::size_t>(i)].params().theta0_rad, ps[static_cast<std::size_t>(i)].theta0_rad, 1e-12);
+      EXPECT_NEAR(back.joints[static_cast<std::size_t>(i)].params().dtheta_rad, ps[static_cast<std::size_t>(i)].dtheta_rad, 1e-12);
+    }
+  }
+}
+
+TEST(StrokeDesign, EnumeratedDirectionsSearchEveryPatternAndKeepTheBest) {
+  StrokeProblem p;
+  p.base = baseCase(2);
+  p.space.n_links = 2;
+  OptimizerSettings s = smallBudget(3);
+  s.generations = 4;
+  s.polish_evaluations = 20;
+  s.enumerate_directions = true;
+  const OptimizeResult r = optimizeStroke(p, s);
+  ASSERT_EQ(r.by_direction.size(), 4u);
+  std::set<std::vector<int>> patterns;
+  long evaluations = 0;
+  double best = 0.0;
+  for (const DirectionResult& d : r.by_direction) {
+    patterns.insert(d.directions);
+    evaluations += d.evaluations;
+    if (d.best.feasible()) best = std::max(best, d.best.objective);
+  }
+  EXPECT_EQ(patterns.size(), 4u);
+  EXPECT_EQ(evaluations, r.evaluations);
+  EXPECT_EQ(r.best.objective, best);
+  // The result's trajectory is its point in its pattern's space, strokes on the pattern's sides,
+  // and re-evaluating it gives the same objective.
+  ASSERT_EQ(r.directions.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) EXPECT_GE(r.trajectory.joints[i].params().dtheta_rad * r.directions[i], 0.0);
+  EXPECT_EQ(evaluateStroke(p, r.trajectory).objective, r.best.objective);
+  // The history is one curve: counts and the best so far never go down.
+  for (std::size_t k = 1; k < r.history.size(); ++k) {
+    EXPECT_GE(r.history[k].evaluations, r.history[k - 1].evaluations);
+    EXPECT_GE(r.history[k].generation, r.history[k - 1].generation);
+    EXPECT_GE(r.history[k].best_objective, r.history[k - 1].best_objective);
+  }
+}
+
 class OptimizeFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -291,6 +358,12 @@ TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
       {"  family: spline\n" + std::string(kLimits) + "  restarts: 0\n", "7:13: optimize.restarts: ", "must lie in [1, 50]"},
       {"  family: spline\n" + std::string(kLimits) + "  population: 300\n  restarts: 3\n  restart_growth: 2\n",
        "9:19: optimize.restart_growth: ", "population of 1200, over 1000"},
+      {"  family: spline\n" + std::string(kLimits) + "  directions: enumerate\n", "7:15: optimize.directions: ",
+       "enumerate needs family: split_cycle"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  directions: both\n", "7:15: optimize.directions: ",
+       "not one of: free, enumerate"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  refine_generations: -1\n", "7:23: optimize.refine_generations: ",
+       "must lie in [0, 10000]"},
   };
   for (const Bad& b : cases) {
     const std::string msg = error(write(b.section));

@@ -45,7 +45,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& base = need(top, root, "base");  // the base experiment's own checks below point here
   const Val& opt = need(top, root, "optimize");
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
+                             "generations", "restarts", "restart_growth", "refine_generations", "directions", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -112,6 +112,11 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
                      " (population x restart_growth^(restarts - 1))");
   }
   if (const Val* v = Reader::get(o, "refine_generations")) os.refine_generations = r.integer(*v, 0, kMaxGenerations);
+  if (const Val* v = Reader::get(o, "directions")) {
+    os.enumerate_directions = r.choice(*v, {"free", "enumerate"}) == "enumerate";
+    if (os.enumerate_directions && sp.family != StrokeFamily::kSplitCycle)
+      r.fail(*v, "enumerate needs family: split_cycle (the spline family has no single stroke direction per joint)");
+  }
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
   if (const Val* v = Reader::get(o, "seeds")) {

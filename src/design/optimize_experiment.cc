@@ -187,7 +187,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   }
   rep.spread = hi > 0 ? (hi - lo) / hi : 0.0;
   const OptimizeResult& best = rep.per_seed[rep.best_seed_index];
-  const TailTrajectory traj = prob.space.trajectory(best.x);
+  const TailTrajectory& traj = best.trajectory;
 
   // Verification: re-simulate, check the limits on what the model ran, and run MuJoCo.
   const OutputSettings out = fullOutput(spec.base, traj);
@@ -297,6 +297,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["restarts"] = spec.optimizer.restarts;
   j["restart_growth"] = spec.optimizer.restart_growth;
   j["refine_generations"] = spec.optimizer.refine_generations;
+  j["directions"] = spec.optimizer.enumerate_directions ? "enumerate" : "free";
   j["polish"] = spec.optimizer.polish;
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};
@@ -308,6 +309,15 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   }
   j["seeds"] = seeds;
   j["seed_spread"] = rep.spread;
+  if (!best.by_direction.empty()) {  // the best seed's search per joint-direction pattern
+    nlohmann::json dirs = nlohmann::json::array();
+    for (const DirectionResult& d : best.by_direction)
+      dirs.push_back({{"directions", d.directions}, {"objective", d.best.objective},
+                      {"phi_net_deg", d.best.phi_net_rad * kDegPerRad}, {"feasible", d.best.feasible()},
+                      {"evaluations", d.evaluations}});
+    j["by_direction"] = dirs;
+  }
+  if (!best.directions.empty()) j["best_directions"] = best.directions;
   const StrokeEvaluation& b = best.best;
   nlohmann::json joints = nlohmann::json::array();
   for (const auto& jp : traj.joints) {

@@ -29,7 +29,11 @@ TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const {
     if (family == StrokeFamily::kSplitCycle) {
       SplitCycleParams p;
       p.theta0_rad = lerp(L.theta_min_rad, L.theta_max_rad, u[0]);
-      p.dtheta_rad = lerp(L.theta_min_rad, L.theta_max_rad, u[1]) - p.theta0_rad;
+      const int dir = directions.empty() ? 0 : directions.at(static_cast<std::size_t>(i));
+      const double end = dir > 0   ? lerp(p.theta0_rad, L.theta_max_rad, u[1])
+                         : dir < 0 ? lerp(p.theta0_rad, L.theta_min_rad, u[1])
+                                   : lerp(L.theta_min_rad, L.theta_max_rad, u[1]);
+      p.dtheta_rad = end - p.theta0_rad;
       // Peak speed 2 |dtheta| / dT (Eq. 23) as a share of the limit: speed kept by construction
       // unless the duration range clips dT.
       const double share = lerp(0.05, 1.0, u[2]);
@@ -59,7 +63,11 @@ std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& jo
     const double a = p.theta0_rad, b = p.theta0_rad + p.dtheta_rad;
     if (family == StrokeFamily::kSplitCycle) {
       const double speed = p.dT_s > 0 ? 2.0 * std::abs(p.dtheta_rad) / p.dT_s : L.thetadot_max_radps;
-      x.insert(x.end(), {unlerp(L.theta_min_rad, L.theta_max_rad, a), unlerp(L.theta_min_rad, L.theta_max_rad, b),
+      const int dir = directions.empty() ? 0 : directions.at(static_cast<std::size_t>(i));
+      const double u_end = dir > 0   ? unlerp(a, L.theta_max_rad, b)
+                           : dir < 0 ? (a > L.theta_min_rad ? clamp01((a - b) / (a - L.theta_min_rad)) : 0.0)
+                                     : unlerp(L.theta_min_rad, L.theta_max_rad, b);
+      x.insert(x.end(), {unlerp(L.theta_min_rad, L.theta_max_rad, a), u_end,
                          unlerp(0.05, 1.0, speed / L.thetadot_max_radps), unlerp(L.w_ss_min, L.w_ss_max, p.w_ss),
                          unlerp(0.0, L.t0_max_s, p.t0_s)});
     } else {

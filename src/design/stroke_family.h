@@ -34,6 +34,10 @@ struct StrokeSpace {
   int n_links = 1;
   int knots = 3;  // spline: interior knots K per joint
   StrokeLimits limits;
+  // Split-cycle only: each joint's stroke direction, +1 (end >= start), -1 (end <= start) or 0
+  // (free); empty = all free. With a direction, the point's second coordinate is the share of the
+  // way from the start angle to the angle limit on that side.
+  std::vector<int> directions;
 
   int dimPerJoint() const;
   int dim() const { return n_links * dimPerJoint(); }

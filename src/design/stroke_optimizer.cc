@@ -99,7 +99,10 @@ pagmo::algorithm makeAlgorithm(const OptimizerSettings& s, unsigned seed) {
 
 }  // namespace
 
-OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s) {
+namespace {
+
+// The search in one space: restarts of the global search (and refine), then the polish.
+OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s) {
   if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
       s.restart_growth < 1 || s.refine_generations < 0)
     throw std::invalid_argument("optimizer settings out of range");
@@ -220,7 +223,57 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
     res.x = x0;
     res.best = evaluateStroke(prob, x0);
   }
+  res.directions = prob.space.directions;
+  res.trajectory = prob.space.trajectory(res.x);
   return res;
+}
+
+}  // namespace
+
+OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s) {
+  if (!s.enumerate_directions) return searchSpace(prob, s);
+  if (prob.space.family != StrokeFamily::kSplitCycle)
+    throw std::invalid_argument("enumerating stroke directions needs the split-cycle family");
+  // The n = 3 problem's basins differ in which joints stroke up and which down (the best has
+  // joint 2 against joints 1 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
+  // with its own sub-seeds, finds every pattern's basin instead of the one a single search
+  // happens to fall into. All 2^n patterns, mirror images included (no symmetry of the robot or
+  // the limits is assumed).
+  const int n = prob.space.n_links;
+  OptimizeResult all;
+  double best_so_far = 0.0;
+  for (int mask = 0; mask < (1 << n); ++mask) {
+    StrokeProblem p = prob;
+    p.space.directions.assign(static_cast<std::size_t>(n), 1);
+    for (int j = 0; j < n; ++j)
+      if ((mask >> j) & 1) p.space.directions[static_cast<std::size_t>(j)] = -1;
+    OptimizerSettings ps = s;
+    ps.seed = s.seed * 4099u + static_cast<std::uint64_t>(mask);
+    OptimizeResult r = searchSpace(p, ps);
+    // History: one curve over all patterns (rows after each pattern's first continue the counts).
+    const int gen0 = all.history.empty() ? 0 : all.history.back().generation;
+    for (std::size_t k = mask == 0 ? 0 : 1; k < r.history.size(); ++k) {
+      HistoryRow row = r.history[k];
+      row.generation += gen0;
+      row.evaluations += all.evaluations;
+      row.wall_s += all.wall_s;
+      best_so_far = std::max(best_so_far, row.best_objective);
+      row.best_objective = best_so_far;
+      all.history.push_back(row);
+    }
+    all.evaluations += r.evaluations;
+    all.wall_s += r.wall_s;
+    all.by_direction.push_back({p.space.directions, r.best, r.evaluations});
+    if (mask == 0) all.start = r.start;
+    const bool better = r.best.feasible() && (!all.best.feasible() || r.best.objective > all.best.objective);
+    if (mask == 0 || better) {
+      all.x = r.x;
+      all.best = r.best;
+      all.directions = r.directions;
+      all.trajectory = r.trajectory;
+    }
+  }
+  return all;
 }
 
 }  // namespace tailsim

@@ -21,6 +21,7 @@ struct OptimizerSettings {
   int restarts = 1;                 // independent global searches per seed (distinct sub-seeds); the best is polished
   int restart_growth = 1;           // population factor from one restart to the next (2: IPOP-CMA-ES)
   int refine_generations = 0;       // CMA-ES generations on each island's population after its global search
+  bool enumerate_directions = false;  // split-cycle: one search per joint-direction pattern (2^n), the best kept
   std::string polish = "cobyla";    // "cobyla" | "bobyqa" | "none" (NLopt)
   int polish_evaluations = 200;
   std::uint64_t seed = 1;
@@ -54,8 +55,18 @@ struct HistoryRow {
   std::string stage;         // "global" | "refine" | "polish"
 };
 
+// One joint-direction pattern's search (OptimizerSettings::enumerate_directions).
+struct DirectionResult {
+  std::vector<int> directions;  // per joint, +1 or -1 (StrokeSpace::directions)
+  StrokeEvaluation best;
+  long evaluations = 0;
+};
+
 struct OptimizeResult {
   std::vector<double> x;  // best feasible point (the start point when nothing feasible beat it)
+  std::vector<int> directions;  // the space x belongs to (StrokeSpace::directions; empty: all free)
+  TailTrajectory trajectory;    // the stroke of x
+  std::vector<DirectionResult> by_direction;  // enumerate_directions: every pattern's best
   StrokeEvaluation best;
   StrokeEvaluation start;  // the base trajectory's own evaluation
   std::vector<HistoryRow> history;
