@@ -3,8 +3,6 @@
 // stroke as a ready-to-run experiment.
 #include <gtest/gtest.h>
 
-#include <random>
-#include <set>
 #include <unistd.h>
 
 #include <cmath>

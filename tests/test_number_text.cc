@@ -87,8 +87,8 @@ TEST(NumberText, SameTextAsToCharsAtTiesPowersOfTenAndTheFormatSwitch) {
     check(t * 9.9999999999949);
     check(t * 9.99999999999951);
   }
-  // Exact ties at the 12th digit (round half to even) and their neighbours: x.5 in units of the
-  // 12th digit, with exactly representable values (k / 2^j).
+  // Ties at the 12th digit and their neighbours: (k + 0.5) 10^j. For j = 0 these are exact ties
+  // (k + 0.5 is a double: round half to even); for j != 0 the nearest doubles, near-ties.
   for (long k = 100000000000; k < 100000000000 + 20000; ++k) {
     for (int j = -3; j <= 3; ++j) {
       const double v = std::ldexp(static_cast<double>(k) + 0.5, 0) * std::pow(10.0, j);

@@ -234,8 +234,8 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   if (!s.enumerate_directions) return searchSpace(prob, s);
   if (prob.space.family != StrokeFamily::kSplitCycle)
     throw std::invalid_argument("enumerating stroke directions needs the split-cycle family");
-  // The n = 3 problem's basins differ in which joints stroke up and which down (the best has
-  // joint 2 against joints 1 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
+  // The n = 3 problem's basins differ in which joints stroke up and which down (the best found has
+  // joint 1 against joints 2 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
   // with its own sub-seeds, finds every pattern's basin instead of the one a single search
   // happens to fall into. All 2^n patterns, mirror images included (no symmetry of the robot or
   // the limits is assumed).
@@ -272,6 +272,14 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
       all.directions = r.directions;
       all.trajectory = r.trajectory;
     }
+  }
+  // A guard (a stroke of zero length keeps every split-cycle limit, so some pattern is feasible
+  // unless every run fails): return the base stroke, as a single search does.
+  if (!all.best.feasible()) {
+    all.directions = prob.space.directions;
+    all.x = prob.space.pointOf(prob.base.joints);
+    all.trajectory = prob.space.trajectory(all.x);
+    all.best = evaluateStroke(prob, all.x);
   }
   return all;
 }

@@ -9,8 +9,9 @@ namespace tailsim {
 // Writes v as "%.12g" would (C locale) at p, returns one past the last character. p must hold
 // 32 characters. Bit-for-bit the same text as std::to_chars(..., general, 12) for every double
 // (tests/test_number_text.cc): the fast path is taken only where its rounding is provably the
-// correctly rounded one (and for 0 and -0); every other value (ties and near-ties at the 12th
-// digit, |v| outside [1e-280, 1e280], inf, nan) goes to std::to_chars.
+// correctly rounded one (and for 0 and -0); every other value goes to std::to_chars: ties and
+// near-ties at the 12th digit, values whose scaling needs a power of ten beyond 10^22 (|v| below
+// about 1e-11 or from about 1e34 up), inf and nan.
 char* formatG12(char* p, double v);
 
 }  // namespace tailsim
