@@ -34,6 +34,15 @@ ExperimentCase baseCase(int n) {
   return loadExperiment(kSourceDir + "/configs/design/base/eq25_n" + std::to_string(n) + ".yaml").cases.at(0);
 }
 
+// The Eq. (25) stroke of an n-link tail as the start, every joint torque within torque_max_Nm.
+StrokeProblem torqueLimitedProblem(int n, double torque_max_Nm) {
+  StrokeProblem p;
+  p.base = baseCase(n);
+  p.space.n_links = n;
+  p.space.limits.torque_max_Nm = torque_max_Nm;
+  return p;
+}
+
 OptimizerSettings smallBudget(std::uint64_t seed = 1) {
   OptimizerSettings s;
   s.islands = 2;
@@ -159,10 +168,7 @@ TEST(StrokeDesign, SameSeedSameResult) {
 // ones run fresh archipelagos with populations growing by restart_growth; the result is the best
 // over all of them, so it is never worse than the single start's global best.
 TEST(StrokeDesign, RestartsRunGrowingPopulationsAndKeepTheBest) {
-  StrokeProblem p;
-  p.base = baseCase(1);
-  p.space.n_links = 1;
-  p.space.limits.torque_max_Nm = 8.0;
+  const StrokeProblem p = torqueLimitedProblem(1, 8.0);
   OptimizerSettings one = smallBudget(5);
   one.generations = 6;
   one.polish = "none";
@@ -187,10 +193,7 @@ TEST(StrokeDesign, RestartsRunGrowingPopulationsAndKeepTheBest) {
 }
 
 TEST(StrokeDesign, RefineRunsCmaesOnTheGlobalSearchsPopulations) {
-  StrokeProblem p;
-  p.base = baseCase(1);
-  p.space.n_links = 1;
-  p.space.limits.torque_max_Nm = 8.0;
+  const StrokeProblem p = torqueLimitedProblem(1, 8.0);
   OptimizerSettings de = smallBudget(5);
   de.algorithm = "de";
   de.generations = 5;

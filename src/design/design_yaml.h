@@ -177,5 +177,23 @@ inline DesignHead readDesignHead(const Reader& r, const Val& root, const Map& to
   return h;
 }
 
+// A design file opened: its root map, its top-level keys (the head and one `section`), the head
+// read. base() and section() are the nodes later errors point at.
+struct DesignFile {
+  Val root;
+  Map top;
+  DesignHead head;
+  std::string section_key;
+  const Val& base(const Reader& r) const { return need(r, top, root, "base"); }
+  const Val& section(const Reader& r) const { return need(r, top, root, section_key.c_str()); }
+};
+inline DesignFile openDesignFile(const Reader& r, const std::string& source_file, const char* kind, const char* section) {
+  DesignFile f{Val{loadYaml(source_file), "", YAML::Mark()}, {}, {}, section};
+  if (!f.root.node.IsMap()) r.fail(f.root, "the file must be a map of key: value");
+  f.top = r.map(f.root, {"name", "description", "kind", "base", section});
+  f.head = readDesignHead(r, f.root, f.top, source_file, kind);
+  return f;
+}
+
 }  // namespace design_yaml
 }  // namespace tailsim

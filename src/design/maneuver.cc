@@ -173,18 +173,12 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   ManeuverSpec s;
   s.source_file = fs::absolute(path).lexically_normal().string();
   const Reader r(s.source_file);
-  const Val root{loadYaml(s.source_file), "", YAML::Mark()};
-  if (!root.node.IsMap()) r.fail(root, "the file must be a map of key: value");
-  const auto top = r.map(root, {"name", "description", "kind", "base", "maneuver"});
-  auto need = [&](const design_yaml::Map& m, const Val& parent, const char* k) -> const Val& {
-    return design_yaml::need(r, m, parent, k);
-  };
-  design_yaml::DesignHead head = design_yaml::readDesignHead(r, root, top, s.source_file, "maneuver");
-  s.name = std::move(head.name);
-  s.description = std::move(head.description);
-  s.base_file = std::move(head.base_file);
-  const Val& base = need(top, root, "base");  // the base experiment's own checks below point here
-  const Val& mv = need(top, root, "maneuver");
+  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "maneuver", "maneuver");
+  s.name = std::move(file.head.name);
+  s.description = std::move(file.head.description);
+  s.base_file = std::move(file.head.base_file);
+  const Val& base = file.base(r);  // the base experiment's own checks below point here
+  const Val& mv = file.section(r);
   KeyList kl;
   declareFields(kl, static_cast<const ManeuverSettings&>(s.settings));
   if (!mv.node.IsMap()) r.fail(mv, "expected a map of key: value");

@@ -32,18 +32,15 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   OptimizeSpec s;
   s.source_file = fs::absolute(path).lexically_normal().string();
   const Reader r(s.source_file);
-  const Val root{loadYaml(s.source_file), "", YAML::Mark()};
-  if (!root.node.IsMap()) r.fail(root, "the file must be a map of key: value");
-  const auto top = r.map(root, {"name", "description", "kind", "base", "optimize"});
+  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "optimize", "optimize");
+  s.name = std::move(file.head.name);
+  s.description = std::move(file.head.description);
+  s.base_file = std::move(file.head.base_file);
   auto need = [&](const design_yaml::Map& m, const Val& parent, const char* k) -> const Val& {
     return design_yaml::need(r, m, parent, k);
   };
-  design_yaml::DesignHead head = design_yaml::readDesignHead(r, root, top, s.source_file, "optimize");
-  s.name = std::move(head.name);
-  s.description = std::move(head.description);
-  s.base_file = std::move(head.base_file);
-  const Val& base = need(top, root, "base");  // the base experiment's own checks below point here
-  const Val& opt = need(top, root, "optimize");
+  const Val& base = file.base(r);  // the base experiment's own checks below point here
+  const Val& opt = file.section(r);
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
                              "generations", "restarts", "restart_growth", "refine_generations", "directions", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
   StrokeSpace& sp = s.problem.space;
