@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "analytic_model/analytic_model.h"
 #include "analytic_test_util.h"
 
 using namespace tailsim;
@@ -235,4 +236,66 @@ TEST(AnalyticSimulation, StateColumnsAndEventsMeanWhatTheySay) {
   const auto& rot = col(l, "rot_state");
   EXPECT_EQ(rot.front(), 0.0);
   EXPECT_TRUE(std::find(rot.begin(), rot.end(), 1.0) != rot.end());
+}
+
+// Work counts (deterministic): the Fig. 7 run with the DOPRI5 step control of Hairer et al. took
+// 169 steps, 21 rejected trial steps and 1,149 right-hand sides (2026-11-26); odeint's default
+// controller took 164 steps, 49 rejected trials and 1,287 right-hand sides: it rejected every
+// other step while the slide slowed to a stop (docs/scale.md "Analytic hot path").
+TEST(AnalyticSimulation, Fig7StepControlRejectsFewTrialSteps) {
+  const RunResult r = runFig7();
+  ASSERT_TRUE(r.summary.ok) << r.summary.error;
+  const double rhs = r.summary.extra.at("rhs_evaluations"), rejected = r.summary.extra.at("rejected_steps");
+  const long steps = r.summary.solver_steps;
+  std::printf("Fig. 7: %ld steps, %.0f rejected trials, %.0f right-hand sides\n", steps, rejected, rhs);
+  EXPECT_LE(rejected, 25.0);
+  EXPECT_LE(rhs, 1200.0);
+  // Each trial step (accepted or rejected) costs Dormand-Prince's 6 new stages; each of the run's
+  // segments (one per breakpoint or switch) one more to start.
+  EXPECT_GE(rhs, 6.0 * (static_cast<double>(steps) + rejected));
+  EXPECT_LE(rhs, 6.0 * (static_cast<double>(steps) + rejected) + 20.0);
+}
+
+// The tail-load cache (AnalyticWorkspace::tail_cache): every evaluation through one workspace, in
+// any order of times and decompose flags, equals a fresh workspace's, bit for bit.
+TEST(AnalyticSimulation, CachedTailLoadsEqualAFreshEvaluation) {
+  const RobotParams r = paperRobot(3);
+  const TailTrajectory tr = sameMove(3, 20, -60, 0.3, 0.4);
+  const AnalyticSettings s;
+  Effects e;
+  e.load_decomposition = true;
+  const AnalyticModel m(r, tr, s, e);
+  AnalyticWorkspace shared;
+  const State y{0.1, 0.2, 0.0, 0.0, 0.01, -0.02};
+  Modes modes;
+  modes.rot_dir = 1.0;
+  const double times[] = {0.05, 0.05, 0.05, 0.12, 0.05, 0.12, 0.12, 0.2};
+  const bool decomp[] = {false, true, false, true, false, false, true, true};
+  for (int k = 0; k < 8; ++k) {
+    AnalyticWorkspace fresh;
+    const Eval a = evaluate(m, shared, times[k], y, modes, decomp[k]);
+    const Eval b = evaluate(m, fresh, times[k], y, modes, decomp[k]);
+    EXPECT_EQ(a.loads.MzT, b.loads.MzT) << k;
+    EXPECT_EQ(a.loads.Izz_kgm2, b.loads.Izz_kgm2) << k;
+    EXPECT_EQ(a.loads.F_T_Q, b.loads.F_T_Q) << k;
+    EXPECT_EQ(a.L_F, b.L_F) << k;
+    EXPECT_EQ(a.phi_ddot, b.phi_ddot) << k;
+    EXPECT_EQ(a.a_Q, b.a_Q) << k;
+    if (decomp[k]) {
+      EXPECT_EQ(a.loads.MzT_acc, b.loads.MzT_acc) << k;
+      EXPECT_EQ(a.loads.MzT_cen, b.loads.MzT_cen) << k;
+    }
+    ASSERT_EQ(shared.joints.size(), fresh.joints.size());
+    for (std::size_t j = 0; j < fresh.joints.size(); ++j) EXPECT_EQ(shared.joints[j].theta, fresh.joints[j].theta) << k;
+  }
+}
+
+// A trajectory for another tail is refused with a clear error, not read out of bounds.
+TEST(AnalyticSimulation, TrajectoryForAnotherTailIsRefused) {
+  try {
+    (void)simulateAnalytic(paperRobot(3), sameMove(1, 0, -90, 0.25, 0.25), {}, {}, {});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("1 joint profiles for a tail of 3 links"), std::string::npos) << e.what();
+  }
 }

@@ -249,3 +249,28 @@ TEST(TimeSeriesOutput, ThinAndHdf5GiveTheFullSeriesRowsInOneFile) {
   }
   fs::remove_all(dir);
 }
+
+// appendRepeated (the analytic recorder's rows after the body comes to rest for good) writes what
+// a loop of appendRow would, the grid column included bit for bit (k * dt, as the recorder's time).
+TEST(TimeSeriesRows, AppendRepeatedEqualsAppendingEachRow) {
+  TimeSeries a, b;
+  for (const char* c : {"t_s", "x_m", "phi_deg"}) {
+    a.addColumn(c);
+    b.addColumn(c);
+  }
+  const double dt = 1e-3;
+  std::vector<double> row = {7 * dt, 0.25, -3.5};
+  a.appendRow(row);
+  b.appendRow(row);
+  for (long k = 8; k < 8 + 500; ++k) {
+    row[0] = static_cast<double>(k) * dt;
+    a.appendRow(row);
+  }
+  b.appendRepeated(row, 500, 0, 8, dt);
+  ASSERT_EQ(a.numRows(), 501u);
+  ASSERT_EQ(b.numRows(), 501u);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < a.numRows(); ++i) ASSERT_EQ(a.at(i, c), b.at(i, c)) << c << " " << i;
+  EXPECT_THROW(b.appendRepeated({1.0, 2.0}, 3, 0, 0, dt), std::logic_error);
+  EXPECT_THROW(b.appendRepeated(row, 3, 3, 0, dt), std::logic_error);
+}

@@ -124,8 +124,16 @@ void solveMotion(const AnalyticModel& m, AnalyticWorkspace& w, const State& y, c
 Eval evaluate(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes,
               bool decompose) {
   Eval ev;
-  m.traj.evaluate(t, w.joints);
-  tailLoadsAndArm(m, w, t, decompose, ev);
+  AnalyticWorkspace::TailCache& c = w.tail_cache;
+  if (c.valid && c.t == t && (c.decomposed || !decompose)) {  // w.joints are still those at t
+    ev.loads = c.loads;
+    ev.L_F = c.L_F;
+  } else {
+    c.valid = false;  // until tailLoadsAndArm returns (it throws when the robot tips)
+    m.traj.evaluate(t, w.joints);
+    tailLoadsAndArm(m, w, t, decompose, ev);
+    c = {true, decompose, t, ev.loads, ev.L_F};
+  }
   ev.FT_W = rotate(y[kPhi], ev.loads.F_T_Q);
   ev.M_break = m.mu_break * m.weight * (m.needsArm() ? ev.L_F : 0.0);
   ev.F_break = m.mu_break * m.weight;

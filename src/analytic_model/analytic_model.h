@@ -46,11 +46,20 @@ struct AnalyticModel {
   bool needsArm() const { return effects.friction != FrictionLaw::kNone && weight > 0.0; }
 };
 
-// Scratch buffers of one run (never shared between threads).
+// Scratch buffers of one run (never shared between threads, never shared between two models).
 struct AnalyticWorkspace {
-  std::vector<JointState> joints;
+  std::vector<JointState> joints;  // at the last evaluated time
   LoadScratch loads;
   TailKinematics exact_kin;
+  // The tail loads and friction arm at the last evaluated time: they depend on t alone (the
+  // trajectory), and the solver asks for the same t more than once (Dormand-Prince's last two
+  // stages, an event scan at a step's end). Valid while the model is the same.
+  struct TailCache {
+    bool valid = false, decomposed = false;
+    double t = 0.0;
+    SystemLoads loads;
+    double L_F = 0.0;
+  } tail_cache;
 };
 
 // Everything the model computes at one instant.

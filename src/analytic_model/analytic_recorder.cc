@@ -44,12 +44,10 @@ void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, doub
 }
 
 void AnalyticRecorder::repeatLastUntilDone() {
-  if (ts_.numRows() == 0) return;
-  while (!done()) {
-    row_[0] = nextTime();
-    ts_.appendRow(row_);
-    ++next_;
-  }
+  if (ts_.numRows() == 0 || done()) return;
+  // Column 0 is the time, next_ * dt_ as nextTime() gives it.
+  ts_.appendRepeated(row_, static_cast<size_t>(n_samples_ - next_), 0, next_, dt_);
+  next_ = n_samples_;
 }
 
 }  // namespace tailsim

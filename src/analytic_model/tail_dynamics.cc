@@ -12,8 +12,10 @@ TailKinematics tailKinematics(const std::vector<TailLink>& links, const std::vec
 
 void tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& k) {
   const size_t n = links.size();
-  k.psi.resize(n); k.omega.resize(n); k.alpha.resize(n);
-  k.p_J.resize(n); k.p_L.resize(n); k.v_L.resize(n); k.a_L.resize(n);
+  if (k.psi.size() != n) {  // sized once for a hot loop's scratch
+    k.psi.resize(n); k.omega.resize(n); k.alpha.resize(n);
+    k.p_J.resize(n); k.p_L.resize(n); k.v_L.resize(n); k.a_L.resize(n);
+  }
   double psi = 0, omega = 0, alpha = 0;
   Vec2 p_J = Vec2::Zero(), v_J = Vec2::Zero(), a_J = Vec2::Zero();  // joint 1 at the origin of B
   for (size_t i = 0; i < n; ++i) {

@@ -24,6 +24,19 @@ void TimeSeries::appendRow(const std::vector<double>& row) {
   for (size_t i = 0; i < row.size(); ++i) data_[i].push_back(row[i]);
 }
 
+void TimeSeries::appendRepeated(const std::vector<double>& row, size_t count, int grid_col, long first, double step) {
+  if (row.size() != names_.size() || grid_col < 0 || static_cast<size_t>(grid_col) >= names_.size())
+    throw std::logic_error("time-series row has the wrong width");
+  for (size_t c = 0; c < row.size(); ++c) {
+    std::vector<double>& col = data_[c];
+    if (static_cast<int>(c) != grid_col) {
+      col.insert(col.end(), count, row[c]);
+      continue;
+    }
+    for (size_t i = 0; i < count; ++i) col.push_back(static_cast<double>(first + static_cast<long>(i)) * step);
+  }
+}
+
 void TimeSeries::reserveRows(size_t rows) {
   for (auto& col : data_) col.reserve(rows);
 }

@@ -17,6 +17,9 @@ class TimeSeries {
   int column(const std::string& name) const;  // -1 if absent
   bool has(const std::string& name) const { return column(name) >= 0; }
   void appendRow(const std::vector<double>& row);  // row.size() == numColumns()
+  // Appends `count` copies of `row` (row.size() == numColumns()), except that column grid_col of
+  // copy i holds (first + i) * step: a grid column (the time) that goes on while the rest stays.
+  void appendRepeated(const std::vector<double>& row, size_t count, int grid_col, long first, double step);
   void reserveRows(size_t rows);                   // capacity for `rows` rows (no reallocation while appending)
   const std::vector<std::string>& names() const { return names_; }
   size_t numColumns() const { return names_.size(); }

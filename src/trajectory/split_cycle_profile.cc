@@ -19,6 +19,13 @@ JointProfile::JointProfile(const SplitCycleParams& p) : p_(p) {
   const double T2 = p.dT_s * p.dT_s;
   A_ = M_PI * p.dtheta_rad / (p.w_ss * T2);          // Eq. (23)
   B_ = M_PI * p.dtheta_rad / ((1.0 - p.w_ss) * T2);  // Eq. (23); A Delta_a = B Delta_d
+  // Constants of at() (the same expressions it would evaluate per call, so the same bits).
+  ka_ = M_PI / da_;
+  kd_ = M_PI / dd_;
+  A_over_ka_ = A_ / ka_;
+  B_over_kd_ = B_ / kd_;
+  w1_ = 2.0 * A_ / ka_;
+  th1_ = p_.theta0_rad + A_ * da_ * da_ / M_PI;
 }
 
 JointProfile::JointProfile(const SplineParams& s) : s_(s) {
@@ -101,21 +108,17 @@ JointState JointProfile::at(double t) const {
   if (tau <= 0.0) return {p_.theta0_rad, 0.0, 0.0};
   if (tau >= p_.dT_s) return {p_.theta0_rad + p_.dtheta_rad, 0.0, 0.0};
   // Eq. (20) integrated twice with Eq. (22)'s conditions at t0.
-  const double ka = M_PI / da_;
   if (tau <= da_) {
-    const double s = std::sin(ka * tau), c = std::cos(ka * tau);
-    return {p_.theta0_rad + A_ / ka * (tau - s / ka), A_ / ka * (1.0 - c), A_ * s};
+    const double s = std::sin(ka_ * tau), c = std::cos(ka_ * tau);
+    return {p_.theta0_rad + A_over_ka_ * (tau - s / ka_), A_over_ka_ * (1.0 - c), A_ * s};
   }
-  const double sigma = tau - da_;
-  const double kd = M_PI / dd_;
-  const double w1 = 2.0 * A_ / ka;                       // peak speed at t1
-  const double th1 = p_.theta0_rad + A_ * da_ * da_ / M_PI;  // angle at t1
-  const double s = std::sin(kd * sigma), c = std::cos(kd * sigma);
-  return {th1 + w1 * sigma - B_ / kd * (sigma - s / kd), w1 - B_ / kd * (1.0 - c), -B_ * s};
+  const double sigma = tau - da_;  // w1_: peak speed at t1; th1_: angle at t1
+  const double s = std::sin(kd_ * sigma), c = std::cos(kd_ * sigma);
+  return {th1_ + w1_ * sigma - B_over_kd_ * (sigma - s / kd_), w1_ - B_over_kd_ * (1.0 - c), -B_ * s};
 }
 
 void TailTrajectory::evaluate(double t, std::vector<JointState>& out) const {
-  out.resize(joints.size());
+  if (out.size() != joints.size()) out.resize(joints.size());
   for (size_t i = 0; i < joints.size(); ++i) out[i] = joints[i].at(t);
 }
 

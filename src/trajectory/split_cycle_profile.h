@@ -83,6 +83,7 @@ class JointProfile {
   JointState splineAt(double t) const;
   SplitCycleParams p_;
   double da_ = 0, dd_ = 0, A_ = 0, B_ = 0;
+  double ka_ = 0, kd_ = 0, A_over_ka_ = 0, B_over_kd_ = 0, w1_ = 0, th1_ = 0;  // split-cycle: at()'s constants
   SplineParams s_;
   std::vector<double> knots_, m_;  // spline: knot values and second derivatives
   double h_ = 0, peak_ = 0;
