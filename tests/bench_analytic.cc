@@ -36,6 +36,26 @@ static void BM_Fig7_NoTimeSeries(benchmark::State& st) {
 }
 BENCHMARK(BM_Fig7_NoTimeSeries)->Unit(benchmark::kMicrosecond);
 
+// Translation locked (effects.translation: false), two output rows: with the paper coupling the
+// yaw does not depend on the translation, so this is what a yaw-only search (tailsim optimize)
+// needs to simulate.
+static void BM_Fig7_YawOnly(benchmark::State& st) {
+  const RobotParams r = paperRobot(1);
+  const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);
+  OutputSettings o;
+  o.sample_dt_s = 0.75;
+  Effects e;
+  e.translation = false;
+  double rhs = 0;
+  for (auto _ : st) {
+    const RunResult res = simulateAnalytic(r, tr, {}, e, o);
+    rhs = res.summary.extra.at("rhs_evaluations");
+    benchmark::DoNotOptimize(res.summary.phi_net_deg);
+  }
+  st.counters["rhs"] = rhs;
+}
+BENCHMARK(BM_Fig7_YawOnly)->Unit(benchmark::kMicrosecond);
+
 // Every analytic case of configs/paper/all.yaml (Figs. 6-14), one thread, no files.
 static void BM_PaperReproduction_AnalyticCases(benchmark::State& st) {
   std::vector<ExperimentCase> cases;

@@ -89,6 +89,42 @@ TEST(StrokeDesign, JointOneTorqueIsTheBaseMoment) {
   EXPECT_NEAR(jointTorques(c.robot.tail, js)[0], tailBaseLoad(c.robot.tail, js).M_J1, 1e-12);
 }
 
+// With the paper coupling the search simulates the yaw alone (searchEffects: translation locked);
+// its phi_net is the full model's to the solver's tolerance, over random strokes of every n, and
+// the strokes and the full run's figures (torque sampling) are what the full run sees. With the
+// exact coupling the yaw depends on the translation, and the search keeps it.
+TEST(StrokeDesign, YawOnlySearchGivesTheFullModelsPhiNet) {
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst = 0.0;
+  for (int k = 0; k < 120; ++k) {
+    const int n = 1 + k % 6;
+    StrokeProblem p;
+    p.base = baseCase(n);
+    p.space.n_links = n;
+    p.space.limits.t0_max_s = 0.1;
+    std::vector<double> x(static_cast<std::size_t>(p.space.dim()));
+    for (double& v : x) v = u(rng);
+    const StrokeEvaluation e = evaluateStroke(p, x);
+    const TailTrajectory traj = p.space.trajectory(x);
+    OutputSettings out;
+    out.sample_dt_s = 0.01;
+    out.settle_s = p.base.output.settle_s;
+    const RunResult full = simulateAnalytic(p.base.robot, traj, p.base.analytic, p.base.effects, out);
+    ASSERT_EQ(e.ok, full.summary.ok) << k << " " << full.summary.error;
+    if (!e.ok) continue;
+    const double phi_full = full.summary.phi_net_deg * kDeg;
+    worst = std::max(worst, std::abs(e.phi_net_rad - phi_full) / std::max(std::abs(phi_full), 1e-3));
+  }
+  std::printf("yaw-only vs full phi_net, 120 random strokes: worst relative difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-5);
+  ExperimentCase exact = baseCase(1);
+  EXPECT_FALSE(searchEffects(exact).translation);
+  EXPECT_FALSE(searchEffects(exact).load_decomposition);
+  exact.analytic.coupling = Coupling::kExact;
+  EXPECT_EQ(searchEffects(exact).translation, exact.effects.translation);
+}
+
 // A returned optimum keeps every limit on the trajectory the model actually ran (its CSV columns),
 // not as the optimiser claims: both families, with a torque limit that binds.
 TEST(StrokeDesign, LimitsNeverViolatedOnTheResimulatedOptimum) {
@@ -424,7 +460,9 @@ void OptimizeFileTest::checkBestRuns(const std::string& family) {
   std::ifstream(dir_ / "run/summary.json") >> run;
   const double phi_run = run["cases"][0]["runs"]["analytic"]["phi_net_deg"].get<double>();
   EXPECT_NEAR(phi_run, opt["resimulated"]["analytic"]["phi_net_deg"].get<double>(), 1e-9);
-  EXPECT_NEAR(phi_run, opt["best"]["phi_net_deg"].get<double>(), 1e-9);
+  // The search ran the yaw alone (searchEffects: paper coupling, translation locked); the full run
+  // agrees to the solver's tolerance (measured 5.8e-8 deg of 12.04 deg for this case).
+  EXPECT_NEAR(phi_run, opt["best"]["phi_net_deg"].get<double>(), 1e-6 * std::abs(phi_run));
   EXPECT_GT(std::abs(phi_run), 2.43);  // beats the Eq. (25) start (2.44 deg) or equals it
   // The other models' re-runs in summary.json are what `tailsim run best.yaml` gives them.
   ASSERT_TRUE(opt["resimulated"]["perfoot"]["ok"].get<bool>()) << opt["resimulated"]["perfoot"].dump();

@@ -120,8 +120,8 @@ struct RunPlan {
   double t_end = 0;     // [s]
   long rows = 0;        // output rows
   double tail_end = 0;  // the tail stops moving  [s]
-  double h_scan = 0;    // event sampling interval  [s]
-  double h_max = 0;     // adaptive step bound while the tail moves  [s]
+  double h_scan = 0;    // event sampling interval, the shortest phase of all  [s] (segmentScales: per segment)
+  double h_max = 0;     // adaptive step bound while the tail moves, the same  [s]
   bool adaptive = true;
 };
 
@@ -255,6 +255,27 @@ void countStep(Run& run) {
                              "raise max_step_s or fixed_dt_s, or shorten the run");
 }
 
+// Event sampling interval and step bound over [t, seg_end], which lies between two breakpoints of
+// the tail profile: each joint is in one phase there (at rest, accelerating, decelerating, or one
+// spline piece). The shortest phase of the joints that move sets both (planRun's rule, restricted
+// to what moves: a joint at rest adds no load variation). With the whole tail at rest the loads
+// are constant in time, so a step's two end samples are enough (h_scan infinite).
+struct SegmentScales {
+  double h_scan, h_max;
+};
+SegmentScales segmentScales(const Run& run, double t, double seg_end) {
+  const double mid = 0.5 * (t + seg_end);
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const auto& j : run.model.traj.joints) {
+    const SplitCycleParams& p = j.params();
+    if (!(mid > p.t0_s && mid < j.t2())) continue;  // at rest over the whole segment
+    shortest = std::min(shortest, j.isSpline() || mid < j.t1() ? p.w_ss * p.dT_s : (1.0 - p.w_ss) * p.dT_s);
+  }
+  if (!std::isfinite(shortest)) return {shortest, run.plan.h_max};
+  const double max_step = run.model.settings.max_step_s;
+  return {shortest / 32.0, max_step > 0 ? max_step : shortest / 8.0};
+}
+
 // Adaptive dense-output Dormand-Prince from run.t until a located switch, a breakpoint of the
 // tail profile (seg_end), the end, or rest: the stepper restarts there.
 void adaptiveSegment(Run& run, double seg_end) {
@@ -262,7 +283,8 @@ void adaptiveSegment(Run& run, double seg_end) {
   const AnalyticSettings& s = m.settings;
   const double t_end = run.plan.t_end;
   const bool tail_moving = run.t < run.plan.tail_end;
-  const double max_dt = (tail_moving || run.modes.stuck[kRot] || run.modes.stuck[kTrans]) ? run.plan.h_max : (t_end - run.t);
+  const SegmentScales scales = segmentScales(run, run.t, seg_end);
+  const double max_dt = (tail_moving || run.modes.stuck[kRot] || run.modes.stuck[kTrans]) ? scales.h_max : (t_end - run.t);
   auto rhs = [&](const State& x, State& dx, double tt) {
     ++run.rhs;
     derivative(m, run.ws, tt, x, run.modes, dx);
@@ -294,7 +316,7 @@ void adaptiveSegment(Run& run, double seg_end) {
         stateAt(tt, yg);
         return eventMargins(m, run.ws, run.v_stop, tt, yg, run.modes);
       };
-      f = findSwitch(gAt, run.modes, ta, tb, run.plan.h_scan, s.event_tol_s, have_g_end ? &g_end : nullptr, &g_end);
+      f = findSwitch(gAt, run.modes, ta, tb, scales.h_scan, s.event_tol_s, have_g_end ? &g_end : nullptr, &g_end);
       have_g_end = !f.hit && tb == tb_raw;
     }
     const double t_cut = f.hit ? f.t : tb;

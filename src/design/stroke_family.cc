@@ -86,11 +86,13 @@ std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& jo
   return x;
 }
 
-std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints) {
+void jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& kin,
+                  std::vector<double>& tau) {
   // Eqs. (5)-(7) from the tip to the base, as tailBaseLoad, keeping every joint's moment.
-  const TailKinematics k = tailKinematics(links, joints);
+  tailKinematics(links, joints, kin);
+  const TailKinematics& k = kin;
   const int n = static_cast<int>(links.size());
-  std::vector<double> tau(static_cast<std::size_t>(n));
+  tau.resize(static_cast<std::size_t>(n));
   Vec2 F_next = Vec2::Zero();
   double M_next = 0.0;
   for (int i = n - 1; i >= 0; --i) {
@@ -99,8 +101,14 @@ std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::
     if (i + 1 < n) M += cross2(k.p_J[i + 1] - k.p_L[i], F_next);
     F_next = F;
     M_next = M;
-    tau[i] = M;
+    tau[static_cast<std::size_t>(i)] = M;
   }
+}
+
+std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints) {
+  TailKinematics kin;
+  std::vector<double> tau;
+  jointTorques(links, joints, kin, tau);
   return tau;
 }
 
@@ -116,9 +124,11 @@ StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajec
   traj.evaluate(t_b + 1.0, js1);
   f.theta_min_rad = f.theta_max_rad = js0.empty() ? 0.0 : js0[0].theta;
   double prev_t = ts.empty() ? 0.0 : ts.front(), prev_p = 0.0;
+  TailKinematics kin;       // scratch: no allocation per sample
+  std::vector<double> tau;
   for (double t : ts) {
     traj.evaluate(t, js);
-    const std::vector<double> tau = jointTorques(links, js);
+    jointTorques(links, js, kin, tau);
     double p = 0.0;
     for (std::size_t i = 0; i < js.size(); ++i) {
       f.theta_min_rad = std::min(f.theta_min_rad, js[i].theta);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "analytic_model/tail_dynamics.h"
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 
@@ -48,6 +49,9 @@ struct StrokeSpace {
 
 // Joint torques tau_i = M_J,i (the Newton-Euler recursion of Eqs. 5-7, tail base held still).
 std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
+// The same into tau, with kin as scratch (no allocation once sized): for sampling loops.
+void jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& kin,
+                  std::vector<double>& tau);
 
 struct StrokeFigures {
   double theta_min_rad = 0, theta_max_rad = 0;  // over all joints and samples

@@ -44,6 +44,12 @@ struct StrokeEvaluation {
   double fitness() const;    // minimised: -objective when feasible, else violation (> any feasible), 10 when failed
 };
 
+// The effects a search simulates with: the base's, without the output-only load decomposition and,
+// with the paper coupling, with the translation locked (the yaw does not depend on it there). The
+// optimum is re-run with the base's own effects (optimize_experiment.cc).
+Effects searchEffects(const ExperimentCase& base);
+
+// Runs the analytic model on traj (with searchEffects) and judges it against the limits.
 StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj);
 StrokeEvaluation evaluateStroke(const StrokeProblem& p, const std::vector<double>& x);
 
