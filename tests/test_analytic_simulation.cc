@@ -261,7 +261,9 @@ TEST(AnalyticSimulation, Fig7StepControlRejectsFewTrialSteps) {
 TEST(AnalyticSimulation, CachedTailLoadsEqualAFreshEvaluation) {
   const RobotParams r = paperRobot(3);
   const TailTrajectory tr = sameMove(3, 20, -60, 0.3, 0.4);
-  const AnalyticSettings s;
+  for (Coupling coupling : {Coupling::kPaper, Coupling::kExact}) {
+  AnalyticSettings s;
+  s.coupling = coupling;  // exact: exactCoupling() re-reads w.joints after a cache hit
   Effects e;
   e.load_decomposition = true;
   const AnalyticModel m(r, tr, s, e);
@@ -287,6 +289,7 @@ TEST(AnalyticSimulation, CachedTailLoadsEqualAFreshEvaluation) {
     }
     ASSERT_EQ(shared.joints.size(), fresh.joints.size());
     for (std::size_t j = 0; j < fresh.joints.size(); ++j) EXPECT_EQ(shared.joints[j].theta, fresh.joints[j].theta) << k;
+  }
   }
 }
 

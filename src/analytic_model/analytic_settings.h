@@ -25,7 +25,7 @@ struct AnalyticSettings {
   double abs_tol = 1e-10;           // adaptive: absolute error tolerance
   double fixed_dt_s = 1e-4;         // fixed: step  [s]
   double event_tol_s = 1e-12;       // stick/slip event location tolerance in time  [s]
-  double max_step_s = 0.0;          // adaptive: step bound while the tail moves; 0 = dT/50  [s]
+  double max_step_s = 0.0;          // adaptive: step bound while the tail moves; 0 = 1/8 of the moving joints' shortest phase  [s]
   // Translation: sliding speed below which the body is declared stopped  [m/s]. Near zero speed
   // the 2-D velocity turns ever faster (paper-notes point 4); stopping at v_stop instead of 0
   // moves the body by at most v_stop^2 / (2 a) (~5e-9 m here) and saves ~10^4 tiny steps.
@@ -49,7 +49,7 @@ settings::For<S, AnalyticSettings> declareFields(V& v, S& s) {
   v.number(Field{"abs_tol", "adaptive: absolute error tolerance"}, s.abs_tol, Limits::positive());
   v.number(Field{"fixed_dt_s", "fixed: step [s]"}, s.fixed_dt_s, Limits::positive());
   v.number(Field{"event_tol_s", "stick/slip event location tolerance in time [s]"}, s.event_tol_s, Limits::positive());
-  v.number(Field{"max_step_s", "adaptive: step bound while the tail moves; 0 = dT/50 [s]"}, s.max_step_s,
+  v.number(Field{"max_step_s", "adaptive: step bound while the tail moves; 0 = 1/8 of the shortest phase of the joints moving [s]"}, s.max_step_s,
            Limits::nonNegative());
   v.number(Field{"v_stop_mps", "sliding speed below which the body is declared stopped [m/s]"}, s.v_stop_mps,
            Limits::positive());

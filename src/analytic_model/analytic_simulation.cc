@@ -72,7 +72,7 @@ bool allFinite(const State& y) {
 // step by err^(-1/3) and grows an accepted one by err^(-1/5) only below err = 0.5: where the local
 // error rises faster than h^5 (a sliding translation slowing to a stop, whose direction turns ever
 // faster), it overshrinks, regrows and is rejected again, one rejection every step. This one
-// grows and shrinks by err^(-1/5) with the previous accepted error damping the growth, and never
+// grows and shrinks by err^-(0.2 - 0.75 beta) with the previous accepted error damping the growth, and never
 // grows the step right after a rejection: the same accuracy with far fewer rejected trials
 // (docs/scale.md "Hot path").
 class StabilizedStepAdjuster {
@@ -90,9 +90,10 @@ class StabilizedStepAdjuster {
   }
   // Accepted (err <= 1): grow by at most 10, damped by the previous accepted error.
   double increase_step(double dt, double err, int /*stepper_order*/) const {
+    if (!(err >= 0.0)) return clampMax(dt / kMaxShrink);  // NaN error (odeint accepts it): shrink
     const double fac11 = std::pow(err, kExpo1);
     const double fac = std::clamp(fac11 / std::pow(err_old_, kBeta) / kSafety, 1.0 / kMaxGrow, kMaxShrink);
-    err_old_ = std::max(err, 1e-4);
+    err_old_ = std::max(1e-4, err);
     double h = dt / fac;
     if (rejected_) h = std::min(h, dt);
     rejected_ = false;
@@ -256,24 +257,26 @@ void countStep(Run& run) {
 }
 
 // Event sampling interval and step bound over [t, seg_end], which lies between two breakpoints of
-// the tail profile: each joint is in one phase there (at rest, accelerating, decelerating, or one
-// spline piece). The shortest phase of the joints that move sets both (planRun's rule, restricted
-// to what moves: a joint at rest adds no load variation). With the whole tail at rest the loads
-// are constant in time, so a step's two end samples are enough (h_scan infinite).
+// the tail profile: each joint is in one phase there. The step bound follows the shortest phase of
+// the joints that move (planRun's rule restricted to what moves: a joint at rest adds no load
+// variation). The event sampling keeps the whole run's shortest phase while the tail moves: a
+// margin's dip between two samples is found only when both neighbours of its lowest sample lie in
+// the same step (docs/accuracy.md "Known limit: a dip at a step boundary"), and a sparser sampling
+// would make that rarer case likelier. With the whole tail at rest its loads vanish (no joint
+// speed or acceleration); with the paper coupling every margin is then monotone in time (constant
+// friction decelerations, no tail force), so a step's midpoint and end suffice. With the exact
+// coupling the rotation and the translation still exchange momentum: the run's sampling stays.
 struct SegmentScales {
   double h_scan, h_max;
 };
 SegmentScales segmentScales(const Run& run, double t, double seg_end) {
-  const double mid = 0.5 * (t + seg_end);
-  double shortest = std::numeric_limits<double>::infinity();
-  for (const auto& j : run.model.traj.joints) {
-    const SplitCycleParams& p = j.params();
-    if (!(mid > p.t0_s && mid < j.t2())) continue;  // at rest over the whole segment
-    shortest = std::min(shortest, j.isSpline() || mid < j.t1() ? p.w_ss * p.dT_s : (1.0 - p.w_ss) * p.dT_s);
+  const double shortest = run.model.traj.shortestActivePhase(0.5 * (t + seg_end));
+  if (!std::isfinite(shortest)) {
+    const bool paper = run.model.settings.coupling == Coupling::kPaper;
+    return {paper ? shortest : run.plan.h_scan, run.plan.h_max};
   }
-  if (!std::isfinite(shortest)) return {shortest, run.plan.h_max};
   const double max_step = run.model.settings.max_step_s;
-  return {shortest / 32.0, max_step > 0 ? max_step : shortest / 8.0};
+  return {run.plan.h_scan, max_step > 0 ? max_step : shortest / 8.0};
 }
 
 // Adaptive dense-output Dormand-Prince from run.t until a located switch, a breakpoint of the
@@ -457,9 +460,7 @@ void paperCouplingDiagnostic(Run& run, RunSummary& sum) {
 
 RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& trajectory, const AnalyticSettings& settings,
                            const Effects& effects, const OutputSettings& output) {
-  if (trajectory.joints.size() != robot.tail.size())
-    throw std::invalid_argument("the trajectory has " + std::to_string(trajectory.joints.size()) +
-                                " joint profiles for a tail of " + std::to_string(robot.tail.size()) + " links");
+  requireOneJointPerLink(trajectory.joints.size(), robot.tail.size());
   const RunPlan plan = planRun(trajectory, settings, output);
   const auto wall0 = std::chrono::steady_clock::now();
   RunResult result;
@@ -485,6 +486,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
 }
 
 RunResult evaluatePose(const RobotParams& robot, const std::vector<JointState>& joints, const Effects& effects) {
+  requireOneJointPerLink(joints.size(), robot.tail.size());
   RunResult r;
   r.summary.model = "analytic";
   const auto wall0 = std::chrono::steady_clock::now();

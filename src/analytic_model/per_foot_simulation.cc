@@ -405,6 +405,7 @@ std::array<double, 4> PrescribedNormalLoads::at(double t) const {
 namespace {
 RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
                               const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads* loads) {
+  requireOneJointPerLink(trajectory.joints.size(), robot.tail.size());
   if (!(settings.rel_tol > 0) || !(settings.abs_tol > 0)) throw std::invalid_argument("perfoot tolerances must be > 0");
   if (!(settings.event_tol_s > 0)) throw std::invalid_argument("perfoot event_tol_s must be > 0");
   if (!(settings.v_stop_mps > 0)) throw std::invalid_argument("perfoot v_stop_mps must be > 0");

@@ -1,8 +1,16 @@
 #include "analytic_model/tail_dynamics.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace tailsim {
+
+void requireOneJointPerLink(std::size_t joints, std::size_t links) {
+  if (joints != links)
+    throw std::invalid_argument("the trajectory has " + std::to_string(joints) + " joint profiles for a tail of " +
+                                std::to_string(links) + " links");
+}
 
 TailKinematics tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints) {
   TailKinematics k;

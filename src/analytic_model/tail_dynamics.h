@@ -22,6 +22,10 @@ inline Vec2 rotate(double angle, const Vec2& a) {
   return Vec2(c * a.x() - s * a.y(), s * a.x() + c * a.y());
 }
 
+// Throws std::invalid_argument unless there is one joint state (or profile) per tail link: the
+// recursions read joint i for link i.
+void requireOneJointPerLink(std::size_t joints, std::size_t links);
+
 // Link-by-link kinematics in frame B.
 struct TailKinematics {
   std::vector<double> psi, omega, alpha;  // link angle, angular velocity, angular acceleration (Eq. 4)

@@ -32,7 +32,7 @@ Effects searchEffects(const ExperimentCase& base) {
   e.load_decomposition = false;  // output rows only
   // Eq. (9) as the paper writes it is diagonal and the rotational friction (Eq. 16, or the ADAMS
   // law) needs only the tail pose and phi_dot: the yaw does not depend on the translation. Locked,
-  // the run skips the slide's two stiff phases (Fig. 7: 367 right-hand sides instead of 1,149).
+  // the run skips the slide's two stiff phases (Fig. 7: 362 right-hand sides instead of 1,149).
   if (base.analytic.coupling == Coupling::kPaper) e.translation = false;
   return e;
 }

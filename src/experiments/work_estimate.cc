@@ -47,16 +47,27 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
   if (has(c.models, "analytic")) {
     cols = std::max(cols, analyticColumns(n));
     // While the tail moves (t0 delay included) the adaptive step is at most max_step_s, by default
-    // 1/8 of the shortest acceleration or deceleration phase; the fixed step is fixed_dt_s.
-    double shortest = std::numeric_limits<double>::infinity();
-    for (const JointProfile& j : traj.joints) {  // a spline's envelope: w_ss dT = its knot spacing
-      const SplitCycleParams& p = j.params();
-      shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
+    // 1/8 of the shortest phase of the joints moving in each segment between two breakpoints
+    // (analytic_simulation.cc segmentScales); the fixed step is fixed_dt_s.
+    const double moving_until = std::min(tail_end, w.sim_time_s);
+    if (c.analytic.solver == AnalyticSolver::kFixed || c.analytic.max_step_s > 0) {
+      const double h = c.analytic.solver == AnalyticSolver::kFixed ? c.analytic.fixed_dt_s : c.analytic.max_step_s;
+      w.analytic_steps = moving_until / h;
+    } else {
+      // A segment where no joint moves before the tail's end (a start delay) keeps the run's bound.
+      double shortest = std::numeric_limits<double>::infinity();
+      for (const JointProfile& j : traj.joints) {  // a spline's envelope: w_ss dT = its knot spacing
+        const SplitCycleParams& p = j.params();
+        shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
+      }
+      std::vector<double> b = traj.breakpoints();
+      b.insert(b.begin(), 0.0);
+      for (std::size_t k = 0; k + 1 < b.size() && b[k] < moving_until; ++k) {
+        const double lo = b[k], hi = std::min(b[k + 1], moving_until);
+        const double phase = traj.shortestActivePhase(0.5 * (lo + hi));
+        if (hi > lo) w.analytic_steps += (hi - lo) / ((std::isfinite(phase) ? phase : shortest) / 8.0);
+      }
     }
-    const double h = c.analytic.solver == AnalyticSolver::kFixed ? c.analytic.fixed_dt_s
-                     : c.analytic.max_step_s > 0 ? c.analytic.max_step_s
-                                                 : shortest / 8.0;
-    w.analytic_steps = std::min(tail_end, w.sim_time_s) / h;
   }
   if (has(c.models, "mujoco")) {
     cols = std::max(cols, mujocoColumns(n));
@@ -97,7 +108,8 @@ WorkExcess checkWork(const ExperimentCase& c) {
              " s), more than the limit " + g(limits::kMaxAnalyticSteps) + see;
     if (!fixed && !(c.analytic.max_step_s > 0))
       x.what = "the analytic model would take at least " + g(w.analytic_steps) +
-               " steps (its step is at most 1/8 of the shortest acceleration phase while the tail moves), more "
+               " steps (its step is at most 1/8 of the shortest acceleration or deceleration phase of the joints "
+               "moving at each time), more "
                "than the limit " + g(limits::kMaxAnalyticSteps) + see;
     return x;
   }

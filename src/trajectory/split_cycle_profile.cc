@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -140,6 +141,16 @@ std::vector<double> TailTrajectory::breakpoints() const {
   std::sort(b.begin(), b.end());
   b.erase(std::unique(b.begin(), b.end()), b.end());
   return b;
+}
+
+double TailTrajectory::shortestActivePhase(double t) const {
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const JointProfile& j : joints) {
+    const SplitCycleParams& p = j.params();
+    if (!(t > p.t0_s && t < j.t2())) continue;  // at rest
+    shortest = std::min(shortest, j.isSpline() || t < j.t1() ? p.w_ss * p.dT_s : (1.0 - p.w_ss) * p.dT_s);
+  }
+  return shortest;
 }
 
 SplitCycleParams equalPeakSpeedParams(int n_links, double thetadot_max_radps, double w_ss, double t0_s) {

@@ -98,6 +98,10 @@ struct TailTrajectory {
   double endTime() const;    // latest t2: the tail is at rest afterwards
   // Times where some joint's acceleration changes formula (JointProfile::breakpoints), sorted.
   std::vector<double> breakpoints() const;
+  // The shortest acceleration or deceleration phase (split-cycle) or knot spacing (spline) of the
+  // joints moving at time t  [s]; +inf when every joint is at rest there. Between two breakpoints
+  // each joint stays in one phase, so this is the time scale of the loads over that segment.
+  double shortestActivePhase(double t) const;
 };
 
 // Eq. (25) with the misprint fixes of paper-notes: dtheta = -360 deg / (n+1),
