@@ -349,8 +349,8 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
 HeatMapLayout heatMapLayout(size_t nx, size_t ny) {
   HeatMapLayout l;
   nx = std::max<size_t>(nx, 1), ny = std::max<size_t>(ny, 1);
-  l.cell_w = static_cast<int>(std::clamp<size_t>(2000 / nx, 2, 105));
-  l.cell_h = static_cast<int>(std::clamp<size_t>(1400 / ny, 2, 82));
+  l.cell_w = static_cast<int>(std::clamp<size_t>(2000 / nx, 1, 105));
+  l.cell_h = static_cast<int>(std::clamp<size_t>(1400 / ny, 1, 82));
   l.values_in_cells = l.cell_w >= 60 && l.cell_h >= 30;  // "-12.3" in 15 pt Sans: ~50 x 20 px
   l.xtic_every = (80 + l.cell_w - 1) / l.cell_w;  // a tic label: up to ~8 characters, 80 px
   l.ytic_every = (24 + l.cell_h - 1) / l.cell_h;  // one line of 15 pt text

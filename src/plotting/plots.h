@@ -36,7 +36,7 @@ struct PlotFile {
 // The size of a heat map's cells (px), whether each cell prints its value, and every how many
 // values a tic is labelled, for nx x ny cells: 105 x 82 px cells with values up to 19 x 17
 // cells, smaller cells without values beyond (the whole grid in about 2000 x 1400 px, cells at
-// least 2 px: a 50 x 100 or 100 x 1,000 sweep is one readable picture within cairo's 32767 px).
+// least 1 px: a 50 x 100 or 100 x 1,000 sweep is one readable picture within cairo's 32767 px).
 struct HeatMapLayout {
   int cell_w = 105, cell_h = 82;
   bool values_in_cells = true;
