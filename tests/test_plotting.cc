@@ -12,10 +12,12 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "experiments/experiment_loader.h"
 #include "plotting/figure_sheet.h"
 #include "plotting/findings.h"
+#include "plotting/gnuplot.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
 #include "plotting/style.h"
@@ -533,6 +535,147 @@ TEST(AxisLabel, UnitsFromNames) {
   EXPECT_EQ(axisLabel("trajectory.dtheta_deg[2]"), "Δθ [deg] (joint 2)");
   EXPECT_EQ(axisLabel("foo.bar_Nm"), "bar [N m]");
   EXPECT_EQ(leafKey("a.b.c_s"), "c_s");
+}
+
+}  // namespace
+}  // namespace tailsim
+
+namespace tailsim {
+namespace {
+
+// Fig. 9 draws seven curves (d_Q2B) in one panel: no two series may share colour, dash and point.
+TEST(FigureStyle, SeriesStylesAreDistinctAndNeverAModelColour) {
+  std::set<std::tuple<std::string, int, int>> seen;
+  for (size_t i = 0; i < 20; ++i) {
+    EXPECT_TRUE(seen.emplace(seriesColor(i), seriesDash(i), seriesPoint(i)).second) << "series " << i;
+    EXPECT_NE(seriesColor(i), modelColor("analytic"));
+    EXPECT_NE(seriesColor(i), modelColor("mujoco"));
+  }
+  // the first five are five different colours, solid
+  std::set<std::string> first;
+  for (size_t i = 0; i < numSeriesColors(); ++i) {
+    first.insert(seriesColor(i));
+    EXPECT_EQ(seriesDash(i), 1);
+  }
+  EXPECT_EQ(first.size(), numSeriesColors());
+  EXPECT_NE(seriesDash(numSeriesColors()), 1);
+}
+
+TEST(FigureTitles, VisibleWidthIgnoresMarkup) {
+  EXPECT_EQ(gpTextWidth("φ_{net} over θ_0"), std::string("φnet over θ0").size() - 2);  // φ, θ: 2 bytes each
+  EXPECT_EQ(gpTextWidth("d\\_Q2B"), 5u);
+  EXPECT_EQ(gpTextWidth("φ̇"), 1u);  // combining dot above
+}
+
+TEST(FigureTitles, LongTitlesAreWrappedAtSpacesOutsideGroups) {
+  const std::string t =
+      "Fig. 7 case with μ_s and μ_d swapped (μ_s 0.30, μ_d 0.25) — body yaw φ(t), 1-link tail: analytic vs MuJoCo";
+  EXPECT_EQ(wrapGpText(t, 200), t);  // fits: unchanged
+  const std::string w = wrapGpText(t, 80);
+  // broken after the dash between the figure's name and what it shows
+  EXPECT_EQ(w, "Fig. 7 case with μ_s and μ_d swapped (μ_s 0.30, μ_d 0.25) —\nbody yaw φ(t), 1-link tail: analytic vs MuJoCo");
+  for (size_t max : {10u, 20u, 35u}) {
+    const std::string n = wrapGpText(t, max);
+    std::string joined = n;
+    std::replace(joined.begin(), joined.end(), '\n', ' ');
+    EXPECT_EQ(joined, t) << "only spaces become line breaks";
+    std::istringstream lines(n);
+    for (std::string l; std::getline(lines, l);)
+      if (l.find(' ') != std::string::npos) {  // a single long word may exceed
+        EXPECT_LE(gpTextWidth(l), max) << l;
+      }
+  }
+  EXPECT_EQ(wrapGpText("a M_{z, T} b", 3), "a\nM_{z, T}\nb");  // never inside a {group}
+  // the quoted title is one gnuplot string expression
+  EXPECT_EQ(gpQuote("a\nb's"), "'a'.\"\\n\".'b''s'");
+  EXPECT_EQ(gpTitle("short", 1000), "'short'");
+  EXPECT_GT(titleChars(1000, 15), 80u);
+  EXPECT_LT(titleChars(1000, 15), 100u);
+  EXPECT_EQ(gpFigureName("Fig. 7 case with mu_s and mu_d swapped (mu_s 0.30)", "x"),
+            "Fig. 7 case with μ_s and μ_d swapped (μ_s 0.30)");
+}
+
+SweepAxis axis(const std::string& key, std::vector<std::string> values) {
+  SweepAxis a;
+  a.key = key;
+  a.values = std::move(values);
+  for (const std::string& v : a.values) a.numeric = a.numeric && parseNumber(v).has_value();
+  return a;
+}
+
+TEST(FigureTitles, PanelTitlesSayWhatTheyCompare) {
+  const SweepAxis coupling = axis("analytic.coupling", {"paper", "exact"});
+  const SweepAxis friction = axis("effects.friction", {"stiction", "continuous"});
+  EXPECT_EQ(gpPanelTitle("analytic", {friction, coupling}), "analytic: stiction vs continuous × paper vs exact coupling");
+  EXPECT_EQ(gpPanelTitle("mujoco", {friction, coupling}), "MuJoCo (contact): stiction vs continuous; coupling not used");
+  // numeric keys are on the axes: the model's title alone
+  EXPECT_EQ(gpPanelTitle("analytic", {axis("quadruped.d_Q2B_m", {"0", "0.025"}), axis("trajectory.theta0_deg", {"0", "15"})}),
+            "analytic (stiction)");
+}
+
+TEST(HeatMap, LayoutKeepsSmallGridsAndShrinksLargeOnes) {
+  const HeatMapLayout f9 = heatMapLayout(7, 7);  // Fig. 9: as before, values in the cells
+  EXPECT_EQ(f9.cell_w, 105);
+  EXPECT_EQ(f9.cell_h, 82);
+  EXPECT_TRUE(f9.values_in_cells);
+  EXPECT_EQ(f9.panel_w, 7 * 105 + 420);
+  for (auto [nx, ny] : {std::pair<size_t, size_t>{100, 50}, {50, 100}, {1000, 100}, {10000, 10000}}) {
+    const HeatMapLayout l = heatMapLayout(nx, ny);
+    EXPECT_FALSE(l.values_in_cells) << nx << "x" << ny;
+    EXPECT_LE(l.panel_w, 2 * 10000 + 420);
+    EXPECT_LT(2 * l.panel_w, 32767) << "two panels side by side within cairo's limit";
+    EXPECT_LT(2 * l.panel_h, 32767);
+    EXPECT_GE(l.cell_w * l.xtic_every, 80) << "tic labels do not overlap";
+    EXPECT_GE(l.cell_h * l.ytic_every, 24);
+  }
+}
+
+// A 100 x 50 sweep (5,000 cases) and a 10 x 400 sweep (wider than cairo's 32767 px at the old
+// 105 px cells: gnuplot failed and `tailsim plot` stopped): each gets its phi_net map, with every
+// case in its own cell.
+TEST(HeatMap, LargeSweepsGetTheirMap) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_large_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  for (auto [ny, nx] : {std::pair<int, int>{50, 100}, {10, 400}}) {
+    const std::string name = "grid_" + std::to_string(ny) + "x" + std::to_string(nx);
+    std::vector<SynthCase> cs;
+    for (int iy = 0; iy < ny; ++iy)
+      for (int ix = 0; ix < nx; ++ix)
+        cs.push_back({{{"trajectory.theta0_deg", -49 + 2 * iy}, {"trajectory.dtheta_deg", -150.5 + 3 * ix}},
+                      {{"analytic", 0.01 * (iy * nx + ix)}},
+                      {}});
+    // cases in reverse order: the grid comes from the values, not from the order of summary.json
+    std::reverse(cs.begin(), cs.end());
+    writeExperiment(root / name, name, {"trajectory.theta0_deg", "trajectory.dtheta_deg"}, cs, "name: " + name + "\n");
+    const ExperimentResults r = loadResults((root / name).string());
+    ASSERT_EQ(r.axes.size(), 2u);
+    const auto grid = caseGrid(r, r.axes[0], r.axes[1]);
+    ASSERT_EQ(grid.size(), size_t(ny));
+    for (int iy = 0; iy < ny; ++iy)
+      for (int ix = 0; ix < nx; ++ix) {
+        ASSERT_NE(grid[iy][ix], nullptr);
+        ASSERT_NEAR(r.phiNet(*grid[iy][ix], "analytic"), 0.01 * (iy * nx + ix), 1e-9) << iy << " " << ix;
+      }
+    const std::vector<PlotFile> plots = plotExperiment(r);
+    const fs::path map = root / name / "plots" / (name + "_phi_net_map.png");
+    ASSERT_TRUE(fs::exists(map)) << name;
+    const auto [w, h] = pngSize(map);
+    EXPECT_GT(w, 1000u);
+    EXPECT_LT(w, 3000u) << "one readable picture";
+    EXPECT_LT(h, 2000u);
+    // the data file holds every cell with its value
+    std::ifstream dat(root / name / "plots" / (name + "_phi_net_map_analytic.dat"));
+    std::string line;
+    std::getline(dat, line);  // header
+    int rows = 0;
+    double ix, iy, v;
+    while (dat >> ix >> iy >> v) {
+      EXPECT_NEAR(v, 0.01 * (iy * nx + ix), 1e-9);
+      ++rows;
+    }
+    EXPECT_EQ(rows, nx * ny);
+  }
+  fs::remove_all(root);
 }
 
 }  // namespace

@@ -28,7 +28,8 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
     std::ostringstream body;
     body << "set logscale xy\nset grid\nset format y '10^{%L}'\nset xlabel 'wall time per run [ms]'\n"
          << "set ylabel '|φ_{net} − reference| [deg]'\nset title "
-         << gpQuote("Work-precision: error of φ_{net} against wall time, case " + gpText(st.case_name))
+         << gpTitle("Work-precision: error of φ_{net} against wall time, case " + gpText(st.case_name),
+                    1000)  // 1300 px less the key outside
          << "\nset key outside right top\n";
     std::vector<std::string> parts;
     int k = 0;

@@ -25,7 +25,11 @@ namespace fs = std::filesystem;
 
 std::string gpQuote(const std::string& s) {
   std::string out = "'";
-  for (char c : s) out += (c == '\'') ? std::string("''") : std::string(1, c);
+  for (char c : s) {
+    if (c == '\'') out += "''";
+    else if (c == '\n') out += "'.\"\\n\".'";
+    else out += c;
+  }
   return out + "'";
 }
 

@@ -25,7 +25,8 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
 void writeDataFile(const std::string& path, const std::vector<std::string>& header,
                    const std::vector<std::vector<double>>& rows);
 
-// Quotes a string for a gnuplot single-quoted literal.
+// Quotes a string for a gnuplot single-quoted literal; a line break becomes '."\n".' (a string
+// expression: `set title`, `set multiplot title`, `plot ... title` all take one).
 std::string gpQuote(const std::string& s);
 
 }  // namespace tailsim

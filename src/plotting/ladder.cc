@@ -161,7 +161,8 @@ void tableOf(std::ostringstream& o, const std::vector<LadderCase>& cs) {
 std::string plotFigure(const std::string& plots, const std::string& exp, const std::vector<LadderCase>& cs) {
   const std::string stem = exp.rfind("ladder_", 0) == 0 ? exp : "ladder_" + exp;
   std::ostringstream body;
-  body << "set title " << gpQuote(gpText("Gap ladder, " + exp + ": φ_net on each rung")) << "\n"
+  body << "set title " << gpTitle(gpText("Gap ladder, " + exp + ": ") + "φ_{net} on each rung", 900)  // key outside
+       << "\n"
        << "set ylabel 'φ_{net} [deg]'\nset grid\nset key outside right top box\n";
   std::vector<std::vector<double>> rows;
   std::vector<std::string> header;
@@ -179,7 +180,8 @@ std::string plotFigure(const std::string& plots, const std::string& exp, const s
     body << ") rotate by -25\nset xrange [0.5:" << rungs().size() + 0.5 << "]\nplot ";
     for (size_t k = 0; k < cs.size(); ++k)
       body << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << k + 2
-           << " with linespoints lw 2 pt 7 lc rgb " << gpQuote(seriesColor(k)) << " title "
+           << " with linespoints lw 2 pt " << seriesPoint(k) << " dt " << seriesDash(k) << " lc rgb "
+           << gpQuote(seriesColor(k)) << " title "
            << gpQuote(gpText(cs[k].name));
   } else {  // x: the cases, one line a rung
     header = {"case"};
@@ -192,7 +194,8 @@ std::string plotFigure(const std::string& plots, const std::string& exp, const s
     body << "set xlabel 'case (ladder.csv order)'\nplot ";
     for (size_t i = 0; i < rungs().size(); ++i)
       body << (i ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << i + 2
-           << " with linespoints lw 1.5 pt 7 ps 0.6 lc rgb " << gpQuote(seriesColor(i)) << " title "
+           << " with linespoints lw 1.5 pt " << seriesPoint(i) << " ps 0.6 dt " << seriesDash(i) << " lc rgb "
+           << gpQuote(seriesColor(i)) << " title "
            << gpQuote(gpText(rungs()[i].title));
   }
   body << "\n";

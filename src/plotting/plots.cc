@@ -73,10 +73,11 @@ struct Ctx {
   }
 };
 
-std::string header(const Txt& title, const std::string& xlabel, const std::string& ylabel) {
+// width_px: the figure's width, so that a long title is wrapped to fit it.
+std::string header(const Txt& title, const std::string& xlabel, const std::string& ylabel, int width_px = 1000) {
   std::ostringstream o;
   o << "reset\nset grid\nset key top left box opaque\n";
-  o << "set title " << gpQuote(title.gp) << "\n";
+  o << "set title " << gpTitle(title.gp, width_px) << "\n";
   o << "set xlabel " << gpQuote(xlabel) << "\nset ylabel " << gpQuote(ylabel) << "\n";
   return o.str();
 }
@@ -303,7 +304,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   const auto [ylo, yhi] = span(yv, 0.12);
   const Txt mom_title = ctx.title(W("moments about the system COM") + ctx.tail);
   std::ostringstream mb;
-  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << gpQuote(mom_title.gp) << " font 'Sans,17'\n"
+  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << gpTitle(mom_title.gp, 1000, 17) << " font 'Sans,17'\n"
      << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string()) << phaseObjects(phases, t_end);
   for (const std::string& m : mm) {
     const TimeSeries& s = ts[m];
@@ -319,7 +320,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     writeDataFile(ctx.data(stem), names, rows);
     std::string panel = gpText(modelTitle(m));
     if (m == "mujoco") panel += ": impulse-averaged over each output interval";
-    mb << "set grid\nset key bottom right box opaque\nset title " << gpQuote(panel)
+    mb << "set grid\nset key bottom right box opaque\nset title " << gpTitle(panel, 1000)
        << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
     int n = 0;
     for (size_t j = 0; j < cols.size(); ++j) {
@@ -343,6 +344,23 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
 
 // ---- heat maps ------------------------------------------------------------------------------
 
+}  // namespace
+
+HeatMapLayout heatMapLayout(size_t nx, size_t ny) {
+  HeatMapLayout l;
+  nx = std::max<size_t>(nx, 1), ny = std::max<size_t>(ny, 1);
+  l.cell_w = static_cast<int>(std::clamp<size_t>(2000 / nx, 1, 105));
+  l.cell_h = static_cast<int>(std::clamp<size_t>(1400 / ny, 1, 82));
+  l.values_in_cells = l.cell_w >= 60 && l.cell_h >= 30;  // "-12.3" in 15 pt Sans: ~50 x 20 px
+  l.xtic_every = (80 + l.cell_w - 1) / l.cell_w;  // a tic label: up to ~8 characters, 80 px
+  l.ytic_every = (24 + l.cell_h - 1) / l.cell_h;  // one line of 15 pt text
+  l.panel_w = static_cast<int>(std::max<size_t>(4, nx)) * l.cell_w + 420;
+  l.panel_h = static_cast<int>(std::max<size_t>(3, ny)) * l.cell_h + 230;
+  return l;
+}
+
+namespace {
+
 // values[model][iy][ix]; x = axes[1], y = axes[0]. A signed quantity (or any map with both signs)
 // gets a diverging colour map centred on zero; cell text is white on dark cells, a value that rounds to zero prints unsigned.
 void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::string& cblabel, const SweepAxis& ax,
@@ -359,10 +377,12 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
   double cblo = lo, cbhi = hi;
   if (is_signed) cbhi = std::max(std::fabs(lo), std::fabs(hi)), cblo = -cbhi;
   if (cbhi <= cblo) cbhi = cblo + 1.0;
-  auto tics = [](const SweepAxis& a, const char* axis) {
+  const HeatMapLayout lay = heatMapLayout(ax.values.size(), ay.values.size());
+  auto tics = [](const SweepAxis& a, const char* axis, size_t every) {
     std::ostringstream o;
     o << "set " << axis << "tics (";
-    for (size_t i = 0; i < a.values.size(); ++i) o << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
+    for (size_t i = 0; i < a.values.size(); i += every)
+      o << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
     o << ")\n";
     return o.str();
   };
@@ -371,33 +391,39 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
                                      : "($3 > " + fmt("%.6g", cblo + 0.6 * (cbhi - cblo)) + ")";
   const std::string text = "(abs($3) < 0.05 ? '0.0' : sprintf('%.1f', $3))";
   const bool stacked = ax.values.size() > ay.values.size() && values.size() > 1;
-  const int pw = static_cast<int>(std::max<size_t>(4, ax.values.size()) * 105 + 420);
-  const int ph = static_cast<int>(std::max<size_t>(3, ay.values.size()) * 82 + 230);
+  const int pw = lay.panel_w, ph = lay.panel_h;
+  const int n = static_cast<int>(values.size());
+  const int w = stacked ? pw : pw * n, h = (stacked ? ph * n : ph) + 40;
   const Txt title = ctx.title(what + ctx.tail);
   std::ostringstream b;
   b << "reset\nset multiplot layout " << (stacked ? values.size() : 1) << "," << (stacked ? 1 : values.size())
-    << " title " << gpQuote(title.gp) << " font 'Sans,17'\n";
+    << " title " << gpTitle(title.gp, w, 17) << " font 'Sans,17'\n";
   for (const auto& [m, grid] : values) {
     const std::string dstem = stem + "_" + m;
     std::vector<std::vector<double>> rows;
     for (size_t iy = 0; iy < grid.size(); ++iy)
       for (size_t ix = 0; ix < grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), grid[iy][ix]});
     writeDataFile(ctx.data(dstem), {"ix", "iy", "value"}, rows);
-    b << "set title " << gpQuote(gpText(modelTitle(m))) << "\n"
+    b << "set title " << gpTitle(gpPanelTitle(m, {ax, ay}), pw - 120) << "\n"
       << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel " << gpQuote(gpAxisLabel(ay.key)) << "\n"
       << "set xrange [-0.5:" << ax.values.size() - 0.5 << "]\nset yrange [-0.5:" << ay.values.size() - 0.5 << "]\n"
-      << tics(ax, "x") << tics(ay, "y") << range("cb", cblo, cbhi) << "set cblabel " << gpQuote(cblabel)
-      << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
-      << (is_signed ? divergingPalette() : sequentialPalette())
-      << "plot " << gpQuote(dstem + ".dat")
-      << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
-      << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
-      << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
+      << tics(ax, "x", lay.xtic_every) << tics(ay, "y", lay.ytic_every) << range("cb", cblo, cbhi)
+      << "set cblabel " << gpQuote(cblabel) << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
+      << (is_signed ? divergingPalette() : sequentialPalette());
+    if (lay.values_in_cells)
+      b << "plot " << gpQuote(dstem + ".dat")
+        << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
+        << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
+        << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
+    else  // one pixel block per cell (the rows are a full grid, ix fastest); NaN cells stay empty
+      b << "set xtics rotate by -45\nplot " << gpQuote(dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
   }
   b << "unset multiplot\n";
-  const int n = static_cast<int>(values.size());
-  const int w = stacked ? pw : pw * n, h = (stacked ? ph * n : ph) + 40;
-  std::string cap = title.plain + ". " + caption_more + " One panel per model, one colour scale";
+  std::string cap = title.plain + ". " + caption_more;
+  if (!lay.values_in_cells)
+    cap += " (" + std::to_string(ax.values.size()) + " × " + std::to_string(ay.values.size()) +
+           " cells: too many to print the values, they are in the .dat files).";
+  cap += " One panel per model, one colour scale";
   cap += is_signed ? " (diverging, centred on zero: blue negative, vermillion positive)." : ".";
   ctx.render(stem, b.str(), title, cap, w, h);
 }
@@ -483,10 +509,10 @@ void plotOneKey(Ctx& ctx) {
   const auto [ylo, yhi] = span(phis, 0.06);
   const Txt ttitle = ctx.title(W("body yaw phi(t) for each ") + K(a.key) + ctx.tail);
   std::ostringstream t;
-  t << "reset\nset multiplot layout " << panels.size() << ",1 title " << gpQuote(ttitle.gp) << " font 'Sans,17'\n"
+  t << "reset\nset multiplot layout " << panels.size() << ",1 title " << gpTitle(ttitle.gp, 1150, 17) << " font 'Sans,17'\n"
     << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
   for (const auto& [m, curves] : panels) {
-    t << "set grid\nset key outside right box\nset title " << gpQuote(gpText(modelTitle(m)))
+    t << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {a}), 900)
       << "\nset xlabel 't [s]'\nset ylabel 'φ [deg]'\nplot ";
     for (size_t n = 0; n < curves.size(); ++n)
       t << (n ? ", \\\n     " : "") << gpQuote(curves[n].dat) << " using 1:2 with lines lw 2 dt "
@@ -507,11 +533,12 @@ void plotTwoKeys(Ctx& ctx) {
   const SweepAxis& ax = r.axes[1];
   std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
   std::vector<double> all;
+  const auto cells = caseGrid(r, ay, ax);
   for (const std::string& m : r.models) {
     std::vector<std::vector<double>> g(ay.values.size(), std::vector<double>(ax.values.size(), kNaN));
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       for (size_t ix = 0; ix < ax.values.size(); ++ix)
-        if (const CaseRecord* c = r.find({{ay.key, ay.values[iy]}, {ax.key, ax.values[ix]}})) {
+        if (const CaseRecord* c = cells[iy][ix]) {
           g[iy][ix] = r.phiNet(*c, m);
           all.push_back(g[iy][ix]);
         }
@@ -525,7 +552,8 @@ void plotTwoKeys(Ctx& ctx) {
   const auto [ylo, yhi] = span(all, 0.08);
   const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(ay.key) + ctx.tail);
   std::ostringstream b;
-  b << "reset\nset multiplot layout 1," << grids.size() << " title " << gpQuote(title.gp) << " font 'Sans,17'\n"
+  const int panel_w = 1100, fig_w = panel_w * static_cast<int>(grids.size());
+  b << "reset\nset multiplot layout 1," << grids.size() << " title " << gpTitle(title.gp, fig_w, 17) << " font 'Sans,17'\n"
     << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
   if (!ax.numeric) {
     b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
@@ -543,20 +571,18 @@ void plotTwoKeys(Ctx& ctx) {
     std::vector<std::string> names = {leafKey(ax.key)};
     for (const std::string& v : ay.values) names.push_back(leafKey(ay.key) + "=" + v);
     writeDataFile(ctx.data(dstem), names, rows);
-    b << "set grid\nset key outside right box\nset title " << gpQuote(gpText(modelTitle(m))) << "\n"
+    b << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {ax, ay}), panel_w - 250) << "\n"
       << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel 'φ_{net} [deg]'\nplot ";
-    static const int pts[] = {7, 5, 9, 11, 13};
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       b << (iy ? ", \\\n     " : "") << gpQuote(dstem + ".dat") << " using 1:" << iy + 2
-        << " with linespoints lw 2 pt " << pts[iy % 5] << " ps 1.3 dt " << (seriesDash(iy) + int(iy % 2))
-        << " lc rgb " << gpQuote(seriesColor(iy)) << " title " << gpQuote(V(ay.key, ay.values[iy]).gp);
+        << " with linespoints lw 2 pt " << seriesPoint(iy) << " ps 1.3 dt " << seriesDash(iy) << " lc rgb " << gpQuote(seriesColor(iy)) << " title " << gpQuote(V(ay.key, ay.values[iy]).gp);
     b << "\n";
   }
   b << "unset multiplot\n";
   ctx.render(r.name + "_phi_net_lines", b.str(), title,
              title.plain + ". φ_net over " + K(ax.key).plain + ", one curve per value of " + K(ay.key).plain +
                  ", one panel per model, same y scale.",
-             std::max(1100, 900) * static_cast<int>(grids.size()), 720);
+             fig_w, 720);
 }
 
 void plotManyKeys(Ctx& ctx) {
@@ -636,9 +662,9 @@ void plotPoseOneKey(Ctx& ctx) {
     const std::string ylabel = perIzz ? "contribution to φ̈ [rad/s^2]" : "moment [N m]";
     const Txt title = ctx.title(Txt{"tail moment contributions over ", "tail moment contributions over "} + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << "reset\nset multiplot layout 1,2 title " << gpQuote(title.gp) << " font 'Sans,17'\n";
+    b << "reset\nset multiplot layout 1,2 title " << gpTitle(title.gp, 1600, 17) << " font 'Sans,17'\n";
     for (int j = 0; j < 2; ++j)
-      b << "set grid\nunset key\nset xzeroaxis lt -1\nset title " << gpQuote(parts[j].gp) << "\nset xlabel "
+      b << "set grid\nunset key\nset xzeroaxis lt -1\nset title " << gpTitle(parts[j].gp, 800) << "\nset xlabel "
         << gpQuote(gpAxisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpQuote(stem + ".dat")
         << " using 1:" << j + 2 << " with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
     b << "unset multiplot\n";
@@ -666,12 +692,13 @@ void plotPoseTwoKeys(Ctx& ctx) {
   const SweepAxis& ay = r.axes[0];
   const SweepAxis& ax = r.axes[1];
   std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
+  const auto cells = caseGrid(r, ay, ax);
   for (const std::string& m : r.models) {
     std::vector<std::vector<double>> g(ay.values.size(), std::vector<double>(ax.values.size(), kNaN));
     bool any = false;
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       for (size_t ix = 0; ix < ax.values.size(); ++ix) {
-        g[iy][ix] = 1e3 * poseValue(r, r.find({{ay.key, ay.values[iy]}, {ax.key, ax.values[ix]}}), m, col::kLF);
+        g[iy][ix] = 1e3 * poseValue(r, cells[iy][ix], m, col::kLF);
         any = any || std::isfinite(g[iy][ix]);
       }
     if (any) grids.emplace_back(m, g);
@@ -686,7 +713,7 @@ void plotPoseTwoKeys(Ctx& ctx) {
 std::vector<PlotFile> plotExperiment(const ExperimentResults& r) {
   Ctx ctx{r, (fs::path(r.dir) / "plots").string(), {}, {}, {}};
   const std::string name = figureName(r.description, r.name);
-  ctx.fig = {gpSymbols(name), name};
+  ctx.fig = {gpFigureName(r.description, r.name), name};
   if (r.links > 0) {
     const std::string t = ", " + std::to_string(r.links) + "-link tail";
     // the figure name may say it already ("Fig. 6 1-link case")

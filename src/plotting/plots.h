@@ -5,7 +5,8 @@
 //   simulate, 1 swept key   -> phi_net over the key, one curve per model (bars side by side when
 //                              the key is the number of tail links); phi(t) of every case when
 //                              there are at most 12                              (Figs. 11, 13, 14)
-//   simulate, 2 swept keys  -> heat map of phi_net with the values in the cells, one per model
+//   simulate, 2 swept keys  -> heat map of phi_net with the values in the cells (large grids:
+//                              smaller cells, no values; heatMapLayout), one per model
 //                              side by side; phi_net over the faster key, one curve per value of
 //                              the slower one                                        (Figs. 9, 12)
 //   simulate, 3+ swept keys -> phi_net over the case index
@@ -31,6 +32,18 @@ struct PlotFile {
   std::string caption;  // what the figure shows, in words (plain Unicode, no markup)
   std::string title;    // the figure's title as drawn, in plain Unicode ("Fig. 7 — moments ...")
 };
+
+// The size of a heat map's cells (px), whether each cell prints its value, and every how many
+// values a tic is labelled, for nx x ny cells: 105 x 82 px cells with values up to 19 x 17
+// cells, smaller cells without values beyond (the whole grid in about 2000 x 1400 px, cells at
+// least 1 px: a 50 x 100 or 100 x 1,000 sweep is one readable picture within cairo's 32767 px).
+struct HeatMapLayout {
+  int cell_w = 105, cell_h = 82;
+  bool values_in_cells = true;
+  size_t xtic_every = 1, ytic_every = 1;
+  int panel_w = 0, panel_h = 0;  // one panel: the cells, axes, colour box and titles
+};
+HeatMapLayout heatMapLayout(size_t nx, size_t ny);
 
 // Draws the figures of one experiment into r.dir/plots/. Throws std::runtime_error if gnuplot
 // fails; a model whose CSV is missing is left out of the figures that need it.

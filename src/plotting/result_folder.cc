@@ -2,6 +2,7 @@
 
 
 #include <algorithm>
+#include <unordered_map>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -171,6 +172,26 @@ const CaseRecord* ExperimentResults::find(const std::map<std::string, std::strin
     if (all) return &c;
   }
   return nullptr;
+}
+
+std::vector<std::vector<const CaseRecord*>> caseGrid(const ExperimentResults& r, const SweepAxis& ay,
+                                                     const SweepAxis& ax) {
+  std::vector<std::vector<const CaseRecord*>> g(ay.values.size(), std::vector<const CaseRecord*>(ax.values.size()));
+  auto index = [](const SweepAxis& a) {
+    std::unordered_map<std::string, size_t> m;
+    for (size_t i = 0; i < a.values.size(); ++i) m.emplace(a.values[i], i);
+    return m;
+  };
+  const auto iy_of = index(ay), ix_of = index(ax);
+  for (const CaseRecord& c : r.cases) {
+    const auto vy = c.sweep.find(ay.key), vx = c.sweep.find(ax.key);
+    if (vy == c.sweep.end() || vx == c.sweep.end()) continue;
+    const auto iy = iy_of.find(vy->second), ix = ix_of.find(vx->second);
+    if (iy == iy_of.end() || ix == ix_of.end()) continue;
+    const CaseRecord*& cell = g[iy->second][ix->second];
+    if (!cell) cell = &c;
+  }
+  return g;
 }
 
 ExperimentResults loadResults(const std::string& dir) {

@@ -75,6 +75,12 @@ struct ExperimentResults {
   const CaseRecord* find(const std::map<std::string, std::string>& sweep) const;
 };
 
+// The case of each cell of the grid of two swept keys, [iy][ix] for ay.values[iy] and
+// ax.values[ix] (the first such case, as ExperimentResults::find), nullptr where there is none.
+// One pass over the cases: find() per cell is quadratic (100 x 1,000 cases: minutes).
+std::vector<std::vector<const CaseRecord*>> caseGrid(const ExperimentResults& r, const SweepAxis& ay,
+                                                     const SweepAxis& ax);
+
 // Reads DIR/summary.json (falling back to DIR/cases/*/result.json for an interrupted run).
 // Throws std::runtime_error if DIR holds neither.
 ExperimentResults loadResults(const std::string& dir);

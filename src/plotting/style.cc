@@ -1,5 +1,6 @@
 #include "plotting/style.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <map>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "experiments/model_registry.h"
+#include "plotting/gnuplot.h"
 #include "plotting/result_folder.h"
 
 namespace tailsim {
@@ -25,6 +27,42 @@ std::string modelTitle(const std::string& model) {
   return m ? m->title : model;
 }
 
+std::string gpPanelTitle(const std::string& model, const std::vector<SweepAxis>& axes) {
+  std::string title = modelTitle(model);
+  // "analytic (stiction)" with the friction law swept: the parenthesis would name one of its values
+  if (const size_t open = title.find(" ("); open != std::string::npos && title.back() == ')') {
+    const std::string inside = title.substr(open + 2, title.size() - open - 3);
+    for (const SweepAxis& a : axes)
+      if (std::find(a.values.begin(), a.values.end(), inside) != a.values.end()) title.erase(open);
+  }
+  std::string out = gpText(title), compared, unused;
+  const std::vector<std::string> models = modelNames();
+  for (const SweepAxis& a : axes) {
+    const std::string section = a.key.substr(0, a.key.find('.'));
+    if (section != model && std::find(models.begin(), models.end(), section) != models.end()) {
+      unused += (unused.empty() ? "" : ", ") + keyDisplay(a.key).symbol;
+      continue;
+    }
+    if (a.numeric) continue;
+    std::vector<std::string> labels;
+    for (const std::string& v : a.values) labels.push_back(gpValueLabel(a.key, v, false));
+    // "paper coupling", "exact coupling" -> "paper vs exact coupling"
+    const size_t sp = labels[0].rfind(' ');
+    const std::string tail = sp == std::string::npos ? std::string() : labels[0].substr(sp);
+    bool shared = !tail.empty();
+    for (const std::string& l : labels)
+      shared = shared && l.size() > tail.size() && l.compare(l.size() - tail.size(), tail.size(), tail) == 0;
+    std::string vs;
+    for (size_t i = 0; i < labels.size(); ++i)
+      vs += (i ? " vs " : "") + (shared && i + 1 < labels.size() ? labels[i].substr(0, labels[i].size() - tail.size())
+                                                                 : labels[i]);
+    compared += (compared.empty() ? "" : " × ") + vs;
+  }
+  if (!compared.empty()) out += ": " + compared;
+  if (!unused.empty()) out += (compared.empty() ? ": " : "; ") + unused + " not used";
+  return out;
+}
+
 namespace {
 // Series colours leave out the two model colours (blue, vermillion): a case curve never looks
 // like a model curve.
@@ -34,6 +72,12 @@ constexpr size_t kNumSeries = sizeof kSeries / sizeof kSeries[0];
 
 std::string seriesColor(size_t i) { return kSeries[i % kNumSeries]; }
 int seriesDash(size_t i) { return 1 + static_cast<int>((i / kNumSeries) % 4); }
+int seriesPoint(size_t i) {
+  // filled circle, square, triangle up, triangle down, diamond; the same open; plus, cross, star
+  static const int pt[] = {7, 5, 9, 11, 13, 6, 4, 8, 10, 12, 1, 2, 3};
+  return pt[i % (sizeof pt / sizeof pt[0])];
+}
+size_t numSeriesColors() { return kNumSeries; }
 
 std::string categoricalColor(size_t i) {
   static const char* const c[] = {oi::kBlue, oi::kOrange, oi::kGreen, oi::kVermillion, oi::kPurple, oi::kSkyBlue, oi::kBlack};
@@ -120,6 +164,82 @@ std::string num(double v) {
 std::string gpSymbols(const std::string& s) { return convert(s, true); }
 std::string plainSymbols(const std::string& s) { return convert(s, false); }
 
+size_t gpTextWidth(const std::string& s) {
+  size_t n = 0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c == '\\' && i + 1 < s.size()) continue;  // the escaped character counts, not the backslash
+    if ((c == '_' || c == '^' || c == '{' || c == '}' || c == '@' || c == '&' || c == '~') &&
+        (i == 0 || s[i - 1] != '\\'))
+      continue;
+    if ((c & 0xC0) == 0x80) continue;  // UTF-8 continuation byte
+    // U+0300-U+036F (combining marks) are 0xCC 0x80-0xBF and 0xCD 0x80-0xAF
+    if (c == 0xCC || (c == 0xCD && i + 1 < s.size() && static_cast<unsigned char>(s[i + 1]) < 0xB0)) continue;
+    ++n;
+  }
+  return n;
+}
+
+std::string wrapGpText(const std::string& s, size_t max_chars) {
+  if (gpTextWidth(s) <= max_chars) return s;
+  // words: split at spaces outside {groups}
+  std::vector<std::string> words;
+  std::string w;
+  int depth = 0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const char c = s[i];
+    const bool escaped = i > 0 && s[i - 1] == '\\';
+    if (!escaped && c == '{') ++depth;
+    if (!escaped && c == '}' && depth > 0) --depth;
+    if (c == ' ' && depth == 0) {
+      if (!w.empty()) words.push_back(w);
+      w.clear();
+    } else {
+      w += c;
+    }
+  }
+  if (!w.empty()) words.push_back(w);
+  // segments: the words up to and including each " — ", kept on one line where they fit
+  std::vector<std::vector<std::string>> segments(1);
+  for (const std::string& word : words) {
+    segments.back().push_back(word);
+    if (word == "—") segments.emplace_back();
+  }
+  std::vector<std::string> lines(1);
+  auto width = [](const std::string& t) { return gpTextWidth(t); };
+  for (const auto& seg : segments) {
+    std::string joined;
+    for (const std::string& word : seg) joined += (joined.empty() ? "" : " ") + word;
+    if (joined.empty()) continue;
+    const std::string& cur = lines.back();
+    if (cur.empty() ? width(joined) <= max_chars : width(cur) + 1 + width(joined) <= max_chars) {
+      lines.back() += (cur.empty() ? "" : " ") + joined;
+      continue;
+    }
+    if (!cur.empty() && width(joined) <= max_chars) {  // the whole segment on a line of its own
+      lines.push_back(joined);
+      continue;
+    }
+    for (const std::string& word : seg) {  // too long for any line: word by word
+      const std::string& l = lines.back();
+      if (l.empty() || width(l) + 1 + width(word) <= max_chars) lines.back() += (l.empty() ? "" : " ") + word;
+      else lines.push_back(word);
+    }
+  }
+  std::string out;
+  for (const std::string& l : lines) out += (out.empty() ? "" : "\n") + l;
+  return out;
+}
+
+size_t titleChars(int width_px, double font_pt) {
+  const double per_char_px = 0.65 * font_pt;  // measured: 9.7 px for 15 pt Sans (pngcairo)
+  return static_cast<size_t>(std::max(10.0, 0.88 * width_px / per_char_px));
+}
+
+std::string gpTitle(const std::string& enhanced, int width_px, double font_pt) {
+  return gpQuote(wrapGpText(enhanced, titleChars(width_px, font_pt)));
+}
+
 KeyDisplay keyDisplay(const std::string& key) {
   std::string leaf = leafKey(key);
   std::string joint;
@@ -203,16 +323,28 @@ std::string plainValueLabel(const std::string& key, const std::string& value) {
   return valueLabel(key, value, true, false);
 }
 
-std::string figureName(const std::string& description, const std::string& experiment) {
+namespace {
+// The words of the figure name: the description up to its colon, "Fig. 6(a)" as "Fig. 6a"; the
+// experiment's name with spaces for underscores when there is no description.
+std::string figureHead(const std::string& description, const std::string& experiment) {
   if (description.empty()) {
     std::string s = experiment;
     for (char& c : s)
       if (c == '_') c = ' ';
     return s;
   }
-  std::string head = description.substr(0, description.find(':'));
-  head = std::regex_replace(head, std::regex(R"(Fig\. (\d+)\(([a-z])\))"), "Fig. $1$2");
-  return plainSymbols(head);
+  const std::string head = description.substr(0, description.find(':'));
+  return std::regex_replace(head, std::regex(R"(Fig\. (\d+)\(([a-z])\))"), "Fig. $1$2");
+}
+}  // namespace
+
+std::string figureName(const std::string& description, const std::string& experiment) {
+  return description.empty() ? figureHead(description, experiment) : plainSymbols(figureHead(description, experiment));
+}
+
+std::string gpFigureName(const std::string& description, const std::string& experiment) {
+  return description.empty() ? gpText(figureHead(description, experiment))
+                             : gpSymbols(figureHead(description, experiment));
 }
 
 double figureOrder(const std::string& description) {

@@ -7,7 +7,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
+#include "plotting/result_folder.h"
 #include "results/palette.h"
 
 namespace tailsim {
@@ -18,10 +20,22 @@ namespace tailsim {
 std::string modelColor(const std::string& model);
 // Legend / panel name of a model: "analytic (stiction)", "MuJoCo (contact)".
 std::string modelTitle(const std::string& model);
-// Curves that are not models (one per case or per value of a key): Okabe-Ito colours in an order
-// that keeps neighbours apart, then again with dashes (seriesDash) after the 7th.
+// The title of one model's panel in a figure over swept keys (enhanced text): what the panel
+// compares. The model's title, without its parenthesis when that names a value of a swept key
+// ("analytic", not "analytic (stiction)", when the friction law is swept); then the values of each
+// non-numeric key ("stiction vs continuous × paper vs exact coupling"; numeric keys are on the
+// axes); then each swept key the model does not read ("analytic.coupling" for MuJoCo): "coupling
+// not used". Only numeric keys, all read: the model's title.
+std::string gpPanelTitle(const std::string& model, const std::vector<SweepAxis>& axes);
+// Curves that are not models (one per case or per value of a key), in every figure the same way:
+// the five Okabe-Ito line colours that are not a model's (orange, sky blue, bluish green, reddish
+// purple, black) in that order, solid with filled points for the first five, then the same colours
+// dashed with open points, then dotted, ...: (colour, dash, point) differs for every i < 20, so no
+// two curves of a figure look alike (Fig. 9: seven values of d_Q2B).
 std::string seriesColor(size_t i);
-int seriesDash(size_t i);  // gnuplot dashtype: 1 solid for the first 7, then 2, 3, ...
+int seriesDash(size_t i);   // gnuplot dashtype: 1 solid for the first 5, then 2, 3, 4, 1, ...
+int seriesPoint(size_t i);  // gnuplot pointtype (pngcairo/svg): 13 distinct, filled then open
+size_t numSeriesColors();   // 5
 // Every Okabe-Ito line colour (yellow left out), for plots whose series are neither models nor
 // cases (the accuracy study's integrator families): 7 distinct colours.
 std::string categoricalColor(size_t i);
@@ -41,6 +55,22 @@ std::string gpText(const std::string& s);
 std::string gpSymbols(const std::string& s);
 // Same in plain Unicode for HTML/Markdown captions ("φ_net over θ0 and d_Q2B").
 std::string plainSymbols(const std::string& s);
+
+// ---- titles that fit ---------------------------------------------------------------------------
+// Visible characters of enhanced text: markup (unescaped _ ^ { } @ & ~ and the backslash of an
+// escape) counts nothing, a UTF-8 character one, a combining mark (U+0300-U+036F, the dot of φ̇)
+// nothing. Subscripts count as full characters (a safe over-estimate).
+size_t gpTextWidth(const std::string& enhanced);
+// Enhanced text broken into lines ('\n' between them) of at most max_chars visible characters,
+// at spaces outside {groups} only, preferring the " — " between a figure's name and what it shows;
+// a word longer than a line stays whole. Text that fits is returned unchanged.
+std::string wrapGpText(const std::string& enhanced, size_t max_chars);
+// How many characters of a title line fit across width_px pixels in a font_pt Sans font (pngcairo
+// and svg draw 15 pt Sans at ~9.7 px per character on average; 12 % is left for the margins).
+size_t titleChars(int width_px, double font_pt);
+// A title for `set title`, `set multiplot ... title`: wrapped to width_px and quoted (gpQuote
+// writes the line breaks as "\n"). font_pt: the title's font (15 default, 17 multiplot titles).
+std::string gpTitle(const std::string& enhanced, int width_px, double font_pt = 15);
 
 // A swept key as shown on an axis or in a legend, and how to show its values.
 struct KeyDisplay {
@@ -65,5 +95,7 @@ std::string figureName(const std::string& description, const std::string& experi
 // Sort key for paper order: the figure number (6.0 for "Fig. 6(a)", 6.1 for "Fig. 6(b)"), or a
 // large number when the description names no figure.
 double figureOrder(const std::string& description);
+// figureName in enhanced text: "Fig. 7 case with μ_s and μ_d swapped" with subscripts.
+std::string gpFigureName(const std::string& description, const std::string& experiment);
 
 }  // namespace tailsim
