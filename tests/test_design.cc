@@ -281,6 +281,79 @@ TEST(StrokeDesign, EnumeratedDirectionsSearchEveryPatternAndKeepTheBest) {
   }
 }
 
+// Local restarts: after the global search, CMA-ES runs centred on the best point so far. The
+// global rows are the same search; each local run evaluates its random population, the incumbent
+// placed in it, and population points per generation on every island; the best never goes down.
+TEST(StrokeDesign, LocalRestartsContinueFromTheBestAndNeverLose) {
+  const StrokeProblem p = torqueLimitedProblem(1, 8.0);
+  OptimizerSettings global = smallBudget(5);
+  global.generations = 6;
+  global.polish = "none";
+  OptimizerSettings local = global;
+  local.local_restarts = 3;
+  local.local_step = 0.05;
+  const OptimizeResult a = optimizeStroke(p, global), b = optimizeStroke(p, local);
+  ASSERT_EQ(a.history.size(), 1u + 6u);
+  ASSERT_EQ(b.history.size(), 1u + 6u + 3u * 6u);
+  for (std::size_t g = 0; g < a.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].stage, "global");
+    EXPECT_EQ(b.history[g].evaluations, a.history[g].evaluations) << g;
+    EXPECT_EQ(b.history[g].best_objective, a.history[g].best_objective) << g;
+  }
+  for (std::size_t g = a.history.size(); g < b.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].stage, "local");
+    EXPECT_GE(b.history[g].best_objective, b.history[g - 1].best_objective);
+  }
+  EXPECT_EQ(b.evaluations - a.evaluations, 3L * 2L * ((6 + 1) * global.population + 1));
+  EXPECT_GE(b.best.objective, a.best.objective);
+  EXPECT_TRUE(b.best.feasible());
+}
+
+// Successive halving over the joint-direction patterns: every pattern's global stage runs, the
+// local restarts and the polish only in the directions_kept patterns whose global stage found the
+// most. The other patterns' results are exactly their global stage (the same sub-seeds).
+TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
+  StrokeProblem p;
+  p.base = baseCase(2);
+  p.space.n_links = 2;
+  OptimizerSettings global = smallBudget(3);
+  global.generations = 4;
+  global.polish = "none";
+  global.enumerate_directions = true;
+  OptimizerSettings kept = global;
+  kept.polish = "cobyla";
+  kept.polish_evaluations = 20;
+  kept.local_restarts = 1;
+  kept.directions_kept = 1;
+  const OptimizeResult a = optimizeStroke(p, global), b = optimizeStroke(p, kept);
+  ASSERT_EQ(a.by_direction.size(), 4u);
+  ASSERT_EQ(b.by_direction.size(), 4u);
+  std::size_t top = 0;
+  for (std::size_t m = 1; m < 4; ++m)
+    if (a.by_direction[m].best.objective > a.by_direction[top].best.objective) top = m;
+  for (std::size_t m = 0; m < 4; ++m) {
+    EXPECT_EQ(b.by_direction[m].directions, a.by_direction[m].directions);
+    if (m == top) {
+      EXPECT_GT(b.by_direction[m].evaluations, a.by_direction[m].evaluations + 2L * 5 * 8);
+      EXPECT_GE(b.by_direction[m].best.objective, a.by_direction[m].best.objective);
+    } else {
+      EXPECT_EQ(b.by_direction[m].evaluations, a.by_direction[m].evaluations) << m;
+      EXPECT_EQ(b.by_direction[m].best.objective, a.by_direction[m].best.objective) << m;
+    }
+  }
+  EXPECT_GE(b.best.objective, a.best.objective);
+  // Keeping every pattern is the plain enumeration (each pattern's search runs through).
+  OptimizerSettings all = kept;
+  all.directions_kept = 4;
+  OptimizerSettings none = kept;
+  none.directions_kept = 0;
+  const OptimizeResult c = optimizeStroke(p, all), d = optimizeStroke(p, none);
+  for (std::size_t m = 0; m < 4; ++m) {
+    EXPECT_EQ(c.by_direction[m].evaluations, d.by_direction[m].evaluations);
+    EXPECT_EQ(c.by_direction[m].best.objective, d.by_direction[m].best.objective);
+  }
+}
+
 class OptimizeFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -332,6 +405,15 @@ TEST_F(OptimizeFileTest, GoodFileLoads) {
               strokeFigures(t.base.robot.tail, t.base.trajectory()).peak_torque_Nm, 1e-12);
   EXPECT_GT(t.problem.space.limits.torque_max_Nm, 8.0);
   EXPECT_LT(t.problem.space.limits.torque_max_Nm, 9.0);
+  // The search-stage keys (defaults: no local restarts, step 0.1, every pattern kept).
+  EXPECT_EQ(s.optimizer.local_restarts, 0);
+  EXPECT_EQ(s.optimizer.directions_kept, 0);
+  const OptimizeSpec u = loadOptimizeSpec(write(std::string("  family: split_cycle\n") + kLimits +
+                                                "  local_restarts: 7\n  local_step: 0.2\n  directions: enumerate\n  directions_kept: 2\n"));
+  EXPECT_EQ(u.optimizer.local_restarts, 7);
+  EXPECT_EQ(u.optimizer.local_step, 0.2);
+  EXPECT_TRUE(u.optimizer.enumerate_directions);
+  EXPECT_EQ(u.optimizer.directions_kept, 2);
 }
 
 TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
@@ -365,6 +447,13 @@ TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
        "not one of: free, enumerate"},
       {"  family: split_cycle\n" + std::string(kLimits) + "  refine_generations: -1\n", "7:23: optimize.refine_generations: ",
        "must lie in [0, 10000]"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  local_restarts: 201\n", "7:19: optimize.local_restarts: ",
+       "must lie in [0, 200]"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  local_step: 0\n", "7:15: optimize.local_step: ", "must be > 0"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  directions_kept: 1\n", "7:20: optimize.directions_kept: ",
+       "only used with directions: enumerate"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  directions: enumerate\n  directions_kept: 3\n",
+       "8:20: optimize.directions_kept: ", "an n = 1 tail has only 2"},
   };
   for (const Bad& b : cases) {
     const std::string msg = error(write(b.section));

@@ -297,7 +297,10 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["restarts"] = spec.optimizer.restarts;
   j["restart_growth"] = spec.optimizer.restart_growth;
   j["refine_generations"] = spec.optimizer.refine_generations;
+  j["local_restarts"] = spec.optimizer.local_restarts;
+  j["local_step"] = spec.optimizer.local_step;
   j["directions"] = spec.optimizer.enumerate_directions ? "enumerate" : "free";
+  j["directions_kept"] = spec.optimizer.directions_kept;
   j["polish"] = spec.optimizer.polish;
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};
