@@ -120,6 +120,37 @@ TEST(StrokeDesign, LimitsNeverViolatedOnTheResimulatedOptimum) {
   }
 }
 
+// The unit box's bounds are feasible: a split-cycle stroke at speed share 1 peaks at the speed limit
+// and one ending at the angle bound ends on it, each measured to rounding (1 ulp over). The n = 3
+// optimum lies there; counted strictly those points were infeasible. A real excess still counts.
+TEST(StrokeDesign, StrokesOnTheBoxBoundsKeepTheLimits) {
+  StrokeSpace sp;
+  sp.n_links = 3;
+  sp.limits.t0_max_s = 0.1;
+  int measured_over = 0;  // points whose measured peak speed or angle lies (by rounding) past the limit
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 200; ++k) {
+    sp.directions = {k % 2 ? 1 : -1, k % 3 ? 1 : -1, k % 5 ? -1 : 1};
+    std::vector<double> x(static_cast<std::size_t>(sp.dim()));
+    for (double& v : x) v = u(rng);
+    for (int i = 0; i < 3; ++i) {
+      x[static_cast<std::size_t>(5 * i + 1)] = 1.0;  // the end angle on its side's limit
+      x[static_cast<std::size_t>(5 * i + 2)] = 1.0;  // the peak speed at the limit
+    }
+    const StrokeFigures f = strokeFigures(baseCase(3).robot.tail, sp.trajectory(x));
+    if (f.peak_speed_radps > sp.limits.thetadot_max_radps || f.theta_max_rad > sp.limits.theta_max_rad ||
+        f.theta_min_rad < sp.limits.theta_min_rad)
+      ++measured_over;
+    EXPECT_NEAR(f.peak_speed_radps, sp.limits.thetadot_max_radps, 1e-12 * sp.limits.thetadot_max_radps);
+    EXPECT_EQ(limitViolation(f, sp.limits), 0.0) << k;
+    StrokeLimits tighter = sp.limits;
+    tighter.thetadot_max_radps *= 1.0 - 1e-6;
+    EXPECT_NEAR(limitViolation(f, tighter), 1e-6, 1e-8) << k;
+  }
+  EXPECT_GT(measured_over, 0);  // the case the tolerance is for does occur
+}
+
 // A tiny problem solved by brute force: n = 1, w_ss and start fixed, so the free parameters are
 // the start angle, the end angle and the speed share. The optimiser must reach the best point of
 // a 14^3 grid (it may beat it: the grid is coarse).
@@ -309,9 +340,10 @@ TEST(StrokeDesign, LocalRestartsContinueFromTheBestAndNeverLose) {
   EXPECT_TRUE(b.best.feasible());
 }
 
-// Successive halving over the joint-direction patterns: every pattern's global stage runs, the
-// local restarts and the polish only in the directions_kept patterns whose global stage found the
-// most. The other patterns' results are exactly their global stage (the same sub-seeds).
+// Successive halving over the joint-direction patterns: every pattern's first global restart runs,
+// the other restarts, the local restarts and the polish only in the directions_kept patterns whose
+// first restart found the most. The other patterns' results are exactly their first restart (the
+// same sub-seeds), the kept ones' exactly the whole search.
 TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
   StrokeProblem p;
   p.base = baseCase(2);
@@ -321,11 +353,15 @@ TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
   global.polish = "none";
   global.enumerate_directions = true;
   OptimizerSettings kept = global;
+  kept.restarts = 2;
+  kept.restart_growth = 2;
   kept.polish = "cobyla";
   kept.polish_evaluations = 20;
   kept.local_restarts = 1;
   kept.directions_kept = 1;
-  const OptimizeResult a = optimizeStroke(p, global), b = optimizeStroke(p, kept);
+  OptimizerSettings whole = kept;
+  whole.directions_kept = 0;
+  const OptimizeResult a = optimizeStroke(p, global), b = optimizeStroke(p, kept), w = optimizeStroke(p, whole);
   ASSERT_EQ(a.by_direction.size(), 4u);
   ASSERT_EQ(b.by_direction.size(), 4u);
   std::size_t top = 0;
@@ -334,7 +370,9 @@ TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
   for (std::size_t m = 0; m < 4; ++m) {
     EXPECT_EQ(b.by_direction[m].directions, a.by_direction[m].directions);
     if (m == top) {
-      EXPECT_GT(b.by_direction[m].evaluations, a.by_direction[m].evaluations + 2L * 5 * 8);
+      EXPECT_EQ(b.by_direction[m].evaluations, w.by_direction[m].evaluations);
+      EXPECT_EQ(b.by_direction[m].best.objective, w.by_direction[m].best.objective);
+      EXPECT_GT(b.by_direction[m].evaluations, a.by_direction[m].evaluations + 2L * 5 * 16);
       EXPECT_GE(b.by_direction[m].best.objective, a.by_direction[m].best.objective);
     } else {
       EXPECT_EQ(b.by_direction[m].evaluations, a.by_direction[m].evaluations) << m;
@@ -345,12 +383,10 @@ TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
   // Keeping every pattern is the plain enumeration (each pattern's search runs through).
   OptimizerSettings all = kept;
   all.directions_kept = 4;
-  OptimizerSettings none = kept;
-  none.directions_kept = 0;
-  const OptimizeResult c = optimizeStroke(p, all), d = optimizeStroke(p, none);
+  const OptimizeResult c = optimizeStroke(p, all);
   for (std::size_t m = 0; m < 4; ++m) {
-    EXPECT_EQ(c.by_direction[m].evaluations, d.by_direction[m].evaluations);
-    EXPECT_EQ(c.by_direction[m].best.objective, d.by_direction[m].best.objective);
+    EXPECT_EQ(c.by_direction[m].evaluations, w.by_direction[m].evaluations);
+    EXPECT_EQ(c.by_direction[m].best.objective, w.by_direction[m].best.objective);
   }
 }
 

@@ -93,8 +93,7 @@ LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSer
       for (int i = 0; i < n; ++i)
         f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js[i].theta - ts.at(0, ts.column("theta" + std::to_string(i + 1) + "_deg")) * d2r));
   }
-  const double tol = 1e-9;
-  auto over = [&](double v, double lim) { return v > lim + tol * std::max(1.0, std::abs(lim)); };
+  auto over = exceedsLimit;  // the optimiser's rule (limitViolation)
   if (over(f.theta_max_rad, L.theta_max_rad) || over(L.theta_min_rad, f.theta_min_rad))
     c.violations.push_back("joint angle " + std::to_string(f.theta_min_rad * kDegPerRad) + ".." +
                            std::to_string(f.theta_max_rad * kDegPerRad) + " deg outside the range");

@@ -130,10 +130,12 @@ class SpaceSearch {
   // and random populations; only the first holds the start point (CMA-ES centres on a population's
   // best, so the start in every restart would pull each back to the same basin). IPOP: the
   // population grows by restart_growth per restart. The tracker keeps the best over all restarts.
-  void globalStage() {
+  // Restarts [first, last) of the global search.
+  void globalStage(int first, int last) {
     stage_start_ = Clock::now();
     long pop_size = s_.population;
-    for (int r = 0; r < s_.restarts; ++r, pop_size *= s_.restart_growth) {
+    for (int r = 0; r < first; ++r) pop_size *= s_.restart_growth;
+    for (int r = first; r < last; ++r, pop_size *= s_.restart_growth) {
       pagmo::archipelago archi;
       for (int i = 0; i < s_.islands; ++i) {
         const unsigned seed = subSeed(i, r);
@@ -289,7 +291,7 @@ class SpaceSearch {
 
 OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s) {
   SpaceSearch search(prob, s);
-  search.globalStage();
+  search.globalStage(0, s.restarts);
   search.localStageAndPolish();
   return search.finish();
 }
@@ -304,9 +306,10 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   // joint 1 against joints 2 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
   // with its own sub-seeds, finds every pattern's basin instead of the one a single search
   // happens to fall into. All 2^n patterns, mirror images included (no symmetry of the robot or
-  // the limits is assumed). Successive halving (directions_kept = K > 0): the global stage runs in
-  // every pattern, the local restarts and the polish only in the K patterns whose global stage
-  // found the most (ties: the lower pattern index); the others keep their global stage's best.
+  // the limits is assumed). Successive halving (directions_kept = K > 0): the first global restart
+  // runs in every pattern; the other restarts, the local restarts and the polish only in the K
+  // patterns whose first restart found the most (ties: the lower pattern index); the others keep
+  // their first restart's best. A pattern's search is the same either way (same sub-seeds).
   const int n = prob.space.n_links;
   const int patterns = 1 << n;
   std::vector<StrokeProblem> problems(static_cast<std::size_t>(patterns), prob);
@@ -321,18 +324,22 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
     searches.push_back(std::make_unique<SpaceSearch>(p, ps));
     // Without successive halving each pattern's search runs through (as before the option).
     if (s.directions_kept == 0 || s.directions_kept >= patterns) {
-      searches.back()->globalStage();
+      searches.back()->globalStage(0, s.restarts);
       searches.back()->localStageAndPolish();
     }
   }
   if (s.directions_kept > 0 && s.directions_kept < patterns) {
-    for (auto& search : searches) search->globalStage();
+    for (auto& search : searches) search->globalStage(0, 1);
     std::vector<int> order(static_cast<std::size_t>(patterns));
     for (int m = 0; m < patterns; ++m) order[static_cast<std::size_t>(m)] = m;
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
       return searches[static_cast<std::size_t>(a)]->bestObjective() > searches[static_cast<std::size_t>(b)]->bestObjective();
     });
-    for (int k = 0; k < s.directions_kept; ++k) searches[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])]->localStageAndPolish();
+    for (int k = 0; k < s.directions_kept; ++k) {
+      SpaceSearch& kept = *searches[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+      kept.globalStage(1, s.restarts);
+      kept.localStageAndPolish();
+    }
   }
 
   OptimizeResult all;
