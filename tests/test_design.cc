@@ -156,6 +156,37 @@ TEST(StrokeDesign, LimitsNeverViolatedOnTheResimulatedOptimum) {
   }
 }
 
+// The unit box's bounds are feasible: a split-cycle stroke at speed share 1 peaks at the speed limit
+// and one ending at the angle bound ends on it, each measured to rounding (1 ulp over). The n = 3
+// optimum lies there; counted strictly those points were infeasible. A real excess still counts.
+TEST(StrokeDesign, StrokesOnTheBoxBoundsKeepTheLimits) {
+  StrokeSpace sp;
+  sp.n_links = 3;
+  sp.limits.t0_max_s = 0.1;
+  int measured_over = 0;  // points whose measured peak speed or angle lies (by rounding) past the limit
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int k = 0; k < 200; ++k) {
+    sp.directions = {k % 2 ? 1 : -1, k % 3 ? 1 : -1, k % 5 ? -1 : 1};
+    std::vector<double> x(static_cast<std::size_t>(sp.dim()));
+    for (double& v : x) v = u(rng);
+    for (int i = 0; i < 3; ++i) {
+      x[static_cast<std::size_t>(5 * i + 1)] = 1.0;  // the end angle on its side's limit
+      x[static_cast<std::size_t>(5 * i + 2)] = 1.0;  // the peak speed at the limit
+    }
+    const StrokeFigures f = strokeFigures(baseCase(3).robot.tail, sp.trajectory(x));
+    if (f.peak_speed_radps > sp.limits.thetadot_max_radps || f.theta_max_rad > sp.limits.theta_max_rad ||
+        f.theta_min_rad < sp.limits.theta_min_rad)
+      ++measured_over;
+    EXPECT_NEAR(f.peak_speed_radps, sp.limits.thetadot_max_radps, 1e-12 * sp.limits.thetadot_max_radps);
+    EXPECT_EQ(limitViolation(f, sp.limits), 0.0) << k;
+    StrokeLimits tighter = sp.limits;
+    tighter.thetadot_max_radps *= 1.0 - 1e-6;
+    EXPECT_NEAR(limitViolation(f, tighter), 1e-6, 1e-8) << k;
+  }
+  EXPECT_GT(measured_over, 0);  // the case the tolerance is for does occur
+}
+
 // A tiny problem solved by brute force: n = 1, w_ss and start fixed, so the free parameters are
 // the start angle, the end angle and the speed share. The optimiser must reach the best point of
 // a 14^3 grid (it may beat it: the grid is coarse).
@@ -317,6 +348,84 @@ TEST(StrokeDesign, EnumeratedDirectionsSearchEveryPatternAndKeepTheBest) {
   }
 }
 
+// Local restarts: after the global search, CMA-ES runs centred on the best point so far. The
+// global rows are the same search; each local run evaluates its random population, the incumbent
+// placed in it, and population points per generation on every island; the best never goes down.
+TEST(StrokeDesign, LocalRestartsContinueFromTheBestAndNeverLose) {
+  const StrokeProblem p = torqueLimitedProblem(1, 8.0);
+  OptimizerSettings global = smallBudget(5);
+  global.generations = 6;
+  global.polish = "none";
+  OptimizerSettings local = global;
+  local.local_restarts = 3;
+  local.local_step = 0.05;
+  const OptimizeResult a = optimizeStroke(p, global), b = optimizeStroke(p, local);
+  ASSERT_EQ(a.history.size(), 1u + 6u);
+  ASSERT_EQ(b.history.size(), 1u + 6u + 3u * 6u);
+  for (std::size_t g = 0; g < a.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].stage, "global");
+    EXPECT_EQ(b.history[g].evaluations, a.history[g].evaluations) << g;
+    EXPECT_EQ(b.history[g].best_objective, a.history[g].best_objective) << g;
+  }
+  for (std::size_t g = a.history.size(); g < b.history.size(); ++g) {
+    EXPECT_EQ(b.history[g].stage, "local");
+    EXPECT_GE(b.history[g].best_objective, b.history[g - 1].best_objective);
+  }
+  EXPECT_EQ(b.evaluations - a.evaluations, 3L * 2L * ((6 + 1) * global.population + 1));
+  EXPECT_GE(b.best.objective, a.best.objective);
+  EXPECT_TRUE(b.best.feasible());
+}
+
+// Successive halving over the joint-direction patterns: every pattern's first global restart runs,
+// the other restarts, the local restarts and the polish only in the directions_kept patterns whose
+// first restart found the most. The other patterns' results are exactly their first restart (the
+// same sub-seeds), the kept ones' exactly the whole search.
+TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
+  StrokeProblem p;
+  p.base = baseCase(2);
+  p.space.n_links = 2;
+  OptimizerSettings global = smallBudget(3);
+  global.generations = 4;
+  global.polish = "none";
+  global.enumerate_directions = true;
+  OptimizerSettings kept = global;
+  kept.restarts = 2;
+  kept.restart_growth = 2;
+  kept.polish = "cobyla";
+  kept.polish_evaluations = 20;
+  kept.local_restarts = 1;
+  kept.directions_kept = 1;
+  OptimizerSettings whole = kept;
+  whole.directions_kept = 0;
+  const OptimizeResult a = optimizeStroke(p, global), b = optimizeStroke(p, kept), w = optimizeStroke(p, whole);
+  ASSERT_EQ(a.by_direction.size(), 4u);
+  ASSERT_EQ(b.by_direction.size(), 4u);
+  std::size_t top = 0;
+  for (std::size_t m = 1; m < 4; ++m)
+    if (a.by_direction[m].best.objective > a.by_direction[top].best.objective) top = m;
+  for (std::size_t m = 0; m < 4; ++m) {
+    EXPECT_EQ(b.by_direction[m].directions, a.by_direction[m].directions);
+    if (m == top) {
+      EXPECT_EQ(b.by_direction[m].evaluations, w.by_direction[m].evaluations);
+      EXPECT_EQ(b.by_direction[m].best.objective, w.by_direction[m].best.objective);
+      EXPECT_GT(b.by_direction[m].evaluations, a.by_direction[m].evaluations + 2L * 5 * 16);
+      EXPECT_GE(b.by_direction[m].best.objective, a.by_direction[m].best.objective);
+    } else {
+      EXPECT_EQ(b.by_direction[m].evaluations, a.by_direction[m].evaluations) << m;
+      EXPECT_EQ(b.by_direction[m].best.objective, a.by_direction[m].best.objective) << m;
+    }
+  }
+  EXPECT_GE(b.best.objective, a.best.objective);
+  // Keeping every pattern is the plain enumeration (each pattern's search runs through).
+  OptimizerSettings all = kept;
+  all.directions_kept = 4;
+  const OptimizeResult c = optimizeStroke(p, all);
+  for (std::size_t m = 0; m < 4; ++m) {
+    EXPECT_EQ(c.by_direction[m].evaluations, w.by_direction[m].evaluations);
+    EXPECT_EQ(c.by_direction[m].best.objective, w.by_direction[m].best.objective);
+  }
+}
+
 class OptimizeFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -368,6 +477,15 @@ TEST_F(OptimizeFileTest, GoodFileLoads) {
               strokeFigures(t.base.robot.tail, t.base.trajectory()).peak_torque_Nm, 1e-12);
   EXPECT_GT(t.problem.space.limits.torque_max_Nm, 8.0);
   EXPECT_LT(t.problem.space.limits.torque_max_Nm, 9.0);
+  // The search-stage keys (defaults: no local restarts, step 0.1, every pattern kept).
+  EXPECT_EQ(s.optimizer.local_restarts, 0);
+  EXPECT_EQ(s.optimizer.directions_kept, 0);
+  const OptimizeSpec u = loadOptimizeSpec(write(std::string("  family: split_cycle\n") + kLimits +
+                                                "  local_restarts: 7\n  local_step: 0.2\n  directions: enumerate\n  directions_kept: 2\n"));
+  EXPECT_EQ(u.optimizer.local_restarts, 7);
+  EXPECT_EQ(u.optimizer.local_step, 0.2);
+  EXPECT_TRUE(u.optimizer.enumerate_directions);
+  EXPECT_EQ(u.optimizer.directions_kept, 2);
 }
 
 TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
@@ -401,6 +519,13 @@ TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
        "not one of: free, enumerate"},
       {"  family: split_cycle\n" + std::string(kLimits) + "  refine_generations: -1\n", "7:23: optimize.refine_generations: ",
        "must lie in [0, 10000]"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  local_restarts: 201\n", "7:19: optimize.local_restarts: ",
+       "must lie in [0, 200]"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  local_step: 0\n", "7:15: optimize.local_step: ", "must be > 0"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  directions_kept: 1\n", "7:20: optimize.directions_kept: ",
+       "only used with directions: enumerate"},
+      {"  family: split_cycle\n" + std::string(kLimits) + "  directions: enumerate\n  directions_kept: 3\n",
+       "8:20: optimize.directions_kept: ", "an n = 1 tail has only 2"},
   };
   for (const Bad& b : cases) {
     const std::string msg = error(write(b.section));

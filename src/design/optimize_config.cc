@@ -42,7 +42,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& base = file.base(r);  // the base experiment's own checks below point here
   const Val& opt = file.section(r);
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "directions", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
+                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -114,6 +114,16 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     if (os.enumerate_directions && sp.family != StrokeFamily::kSplitCycle)
       r.fail(*v, "enumerate needs family: split_cycle (the spline family has no single stroke direction per joint)");
   }
+  if (const Val* v = Reader::get(o, "local_restarts")) os.local_restarts = r.integer(*v, 0, kMaxLocalRestarts);
+  if (const Val* v = Reader::get(o, "local_step")) {
+    os.local_step = r.inRange(*v, 0.0, 1.0);
+    if (!(os.local_step > 0.0)) r.fail(*v, "must be > 0 (a share of the unit box), got " + fmtG(os.local_step));
+  }
+  const Val* kept = Reader::get(o, "directions_kept");
+  if (kept) {
+    os.directions_kept = r.integer(*kept, 0, 1 << kMaxKeptDirectionsLog2);
+    if (!os.enumerate_directions) r.fail(*kept, "only used with directions: enumerate");
+  }
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
   if (const Val* v = Reader::get(o, "seeds")) {
@@ -140,6 +150,9 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   if (!s.base.splines.empty())
     r.fail(base, "the base experiment's trajectory is the search's start and must be split-cycle (not family: spline)");
   sp.n_links = s.base.robot.numLinks();
+  if (kept && sp.n_links <= kMaxKeptDirectionsLog2 && os.directions_kept > (1 << sp.n_links))
+    r.fail(*kept, "keeps " + std::to_string(os.directions_kept) + " patterns, but an n = " + std::to_string(sp.n_links) +
+                      " tail has only " + std::to_string(1 << sp.n_links));
   if (torque && L.torque_max_Nm == 0.0) {  // torque_max_Nm: base -- the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");

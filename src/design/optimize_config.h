@@ -33,6 +33,8 @@ constexpr int kMaxIslands = 64;
 constexpr int kMaxPopulation = 1000;
 constexpr int kMaxGenerations = 10000;
 constexpr int kMaxRestarts = 50;
+constexpr int kMaxLocalRestarts = 200;
+constexpr int kMaxKeptDirectionsLog2 = 12;  // directions_kept <= 2^12 (and <= 2^n)
 constexpr int kMaxPolishEvaluations = 100000;
 constexpr int kMaxSeeds = 20;
 constexpr int kMaxParetoPoints = 20;

@@ -93,8 +93,7 @@ LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSer
       for (int i = 0; i < n; ++i)
         f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js[i].theta - ts.at(0, ts.column("theta" + std::to_string(i + 1) + "_deg")) * d2r));
   }
-  const double tol = 1e-9;
-  auto over = [&](double v, double lim) { return v > lim + tol * std::max(1.0, std::abs(lim)); };
+  auto over = exceedsLimit;  // the optimiser's rule (limitViolation)
   if (over(f.theta_max_rad, L.theta_max_rad) || over(L.theta_min_rad, f.theta_min_rad))
     c.violations.push_back("joint angle " + std::to_string(f.theta_min_rad * kDegPerRad) + ".." +
                            std::to_string(f.theta_max_rad * kDegPerRad) + " deg outside the range");
@@ -297,7 +296,10 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["restarts"] = spec.optimizer.restarts;
   j["restart_growth"] = spec.optimizer.restart_growth;
   j["refine_generations"] = spec.optimizer.refine_generations;
+  j["local_restarts"] = spec.optimizer.local_restarts;
+  j["local_step"] = spec.optimizer.local_step;
   j["directions"] = spec.optimizer.enumerate_directions ? "enumerate" : "free";
+  j["directions_kept"] = spec.optimizer.directions_kept;
   j["polish"] = spec.optimizer.polish;
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};

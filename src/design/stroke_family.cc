@@ -148,10 +148,16 @@ StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajec
 }
 
 double limitViolation(const StrokeFigures& f, const StrokeLimits& L) {
+  // An excess within the tolerance (exceedsLimit) is rounding, not a violation: a split-cycle
+  // stroke at the box's speed-share bound (share 1) peaks at the speed limit measured 1 ulp over
+  // it, and an end angle at the angle bound lands 1 ulp outside. Counted strictly, those points
+  // were infeasible, so the search was pushed off the bounds the n = 3 optimum lies on
+  // (docs/design-a-tail-stroke.md). checkLimitsOnSeries (the re-run's check) uses the same rule.
   const double range = std::max(L.theta_max_rad - L.theta_min_rad, 1e-9);
-  double v = std::max(0.0, (f.theta_max_rad - L.theta_max_rad) / range) + std::max(0.0, (L.theta_min_rad - f.theta_min_rad) / range);
-  v += std::max(0.0, f.peak_speed_radps / L.thetadot_max_radps - 1.0);
-  if (L.torque_max_Nm > 0) v += std::max(0.0, f.peak_torque_Nm / L.torque_max_Nm - 1.0);
+  auto excess = [](double value, double limit, double scale) { return exceedsLimit(value, limit) ? (value - limit) / scale : 0.0; };
+  double v = excess(f.theta_max_rad, L.theta_max_rad, range) + excess(-f.theta_min_rad, -L.theta_min_rad, range);
+  v += excess(f.peak_speed_radps, L.thetadot_max_radps, L.thetadot_max_radps);
+  if (L.torque_max_Nm > 0) v += excess(f.peak_torque_Nm, L.torque_max_Nm, L.torque_max_Nm);
   if (L.end == StrokeEnd::kAtStart) v += f.end_offset_rad / range;
   return v;
 }

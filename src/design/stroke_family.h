@@ -3,6 +3,7 @@
 // sampled trajectory. SI units inside (radians); degrees only in the YAML (optimize_config.h).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -65,7 +66,11 @@ struct StrokeFigures {
 // dt = 0.5 ms holds the 1 ms output grid, so the re-simulated series never shows more.
 StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt = 5e-4);
 
-// Relative excess over each limit (0 when all are kept): the sum of max(0, value/limit - 1).
+// A value exceeds its limit when over it by more than 1e-9 of max(1, |limit|) (less is rounding).
+inline bool exceedsLimit(double value, double limit) { return value > limit + 1e-9 * std::max(1.0, std::abs(limit)); }
+
+// Relative excess over each limit (0 when all are kept, exceedsLimit): the sum of the excesses, each
+// relative to its limit (angles: to the angle range).
 double limitViolation(const StrokeFigures& f, const StrokeLimits& lim);
 
 // The objective's value for a signed phi_net [rad] (the optimiser maximises |phi_net| / divisor).

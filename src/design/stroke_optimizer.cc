@@ -111,73 +111,135 @@ pagmo::algorithm makeAlgorithm(const OptimizerSettings& s, unsigned seed) {
 
 namespace {
 
-// The search in one space: restarts of the global search (and refine), then the polish.
-OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s) {
-  if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
-      s.restart_growth < 1 || s.refine_generations < 0)
-    throw std::invalid_argument("optimizer settings out of range");
-  const auto t_start = Clock::now();
-  auto shared = std::make_shared<const StrokeProblem>(prob);
-  auto tracker = std::make_shared<Tracker>();
-  OptimizeResult res;
+// The search in one space, in stages: restarts of the global search (and refine), the local
+// restarts, the polish. Enumerated directions run the global stage in every pattern first and the
+// later stages only in the best patterns (directions_kept), so the stages are separate calls.
+class SpaceSearch {
+ public:
+  SpaceSearch(const StrokeProblem& prob, const OptimizerSettings& s)
+      : prob_(prob), s_(s), shared_(std::make_shared<const StrokeProblem>(prob)), tracker_(std::make_shared<Tracker>()),
+        pp_(PagmoStroke{shared_, tracker_}) {
+    if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
+        s.restart_growth < 1 || s.refine_generations < 0 || s.local_restarts < 0 || !(s.local_step > 0.0) ||
+        s.directions_kept < 0)
+      throw std::invalid_argument("optimizer settings out of range");
+    // The start: the base experiment's own trajectory (e.g. Eq. 25), in every island's population.
+    x0_ = prob.space.pointOf(prob.base.joints);
+    res_.start = evaluateStroke(prob, prob.base.trajectory());
+    tracker_->record(x0_, evaluateStroke(prob, x0_));
+    snapshot("global");
+    endStage();
+  }
 
-  // The start: the base experiment's own trajectory (e.g. Eq. 25), in every island's population.
-  const std::vector<double> x0 = prob.space.pointOf(prob.base.joints);
-  res.start = evaluateStroke(prob, prob.base.trajectory());
-  tracker->record(x0, evaluateStroke(prob, x0));
+  double bestObjective() const {
+    std::lock_guard<std::mutex> lock(tracker_->mu);
+    return tracker_->have_best ? tracker_->best_objective : -1.0;
+  }
 
-  pagmo::problem pp{PagmoStroke{shared, tracker}};
-  auto snapshot = [&](int gen, const char* stage) {
-    std::lock_guard<std::mutex> lock(tracker->mu);
-    res.history.push_back({gen, tracker->evaluations, std::chrono::duration<double>(Clock::now() - t_start).count(),
-                           tracker->have_best ? tracker->best_objective : 0.0, stage});
-  };
-  snapshot(0, "global");
   // Restarts (issue 12: a multimodal problem): each is a fresh archipelago with its own sub-seeds
   // and random populations; only the first holds the start point (CMA-ES centres on a population's
   // best, so the start in every restart would pull each back to the same basin). IPOP: the
   // population grows by restart_growth per restart. The tracker keeps the best over all restarts.
-  int gen_count = 0;
-  long pop_size = s.population;
-  for (int r = 0; r < s.restarts; ++r, pop_size *= s.restart_growth) {
-    pagmo::archipelago archi;
-    for (int i = 0; i < s.islands; ++i) {
-      const unsigned seed = static_cast<unsigned>(s.seed * 1000003u + static_cast<unsigned>(i) * 7919u +
-                                                  static_cast<unsigned>(r) * 104729u);
-      pagmo::population pop(pp, static_cast<pagmo::population::size_type>(pop_size), seed);
-      if (r == 0) pop.set_x(0, x0);
-      archi.push_back(pagmo::thread_island{}, makeAlgorithm(s, seed + 1u), std::move(pop));
+  // Restarts [first, last) of the global search.
+  void globalStage(int first, int last) {
+    stage_start_ = Clock::now();
+    long pop_size = s_.population;
+    for (int r = 0; r < first; ++r) pop_size *= s_.restart_growth;
+    for (int r = first; r < last; ++r, pop_size *= s_.restart_growth) {
+      pagmo::archipelago archi;
+      for (int i = 0; i < s_.islands; ++i) {
+        const unsigned seed = subSeed(i, r);
+        pagmo::population pop(pp_, static_cast<pagmo::population::size_type>(pop_size), seed);
+        if (r == 0) pop.set_x(0, x0_);
+        archi.push_back(pagmo::thread_island{}, makeAlgorithm(s_, seed + 1u), std::move(pop));
+      }
+      evolve(archi, s_.generations, "global");
+      // Refine: CMA-ES continues on each island's population, centred on its best point with a
+      // small step (5 % of the box): the global search (e.g. DE, which explores widely but
+      // converges slowly) finds the basin, CMA-ES converges in it.
+      if (s_.refine_generations > 0) {
+        for (int i = 0; i < s_.islands; ++i)
+          archi[static_cast<pagmo::archipelago::size_type>(i)].set_algorithm(
+              pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, 0.05, 1e-9, 1e-9, true, true, subSeed(i, r) + 2u)));
+        evolve(archi, s_.refine_generations, "refine");
+      }
     }
-    for (int g = 1; g <= s.generations; ++g) {
+    endStage();
+  }
+
+  // Local restarts: CMA-ES runs with a small step (local_step of the box), each centred on the
+  // best point found so far (pagmo's CMA-ES centres its first generation on the population's
+  // best: the incumbent, placed in a random population). Iterated local search: each run starts
+  // from the best of all before it, so the search moves on to better neighbouring basins and
+  // converges further in the best one (the optimum lies on many bounds at once, where one short
+  // CMA-ES run stops early). Then the polish from the best feasible point (NLopt, same unit box).
+  void localStageAndPolish() {
+    stage_start_ = Clock::now();
+    for (int k = 0; k < s_.local_restarts; ++k) {
+      std::vector<double> centre;
+      {
+        std::lock_guard<std::mutex> lock(tracker_->mu);
+        centre = tracker_->have_best ? tracker_->best_x : x0_;
+      }
+      pagmo::archipelago archi;
+      for (int i = 0; i < s_.islands; ++i) {
+        const unsigned seed = subSeed(i, s_.restarts + k) + 5u;
+        pagmo::population pop(pp_, static_cast<pagmo::population::size_type>(s_.population), seed);
+        pop.set_x(0, centre);
+        archi.push_back(pagmo::thread_island{},
+                        pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, s_.local_step, 1e-9, 1e-9, true, true, seed + 1u)),
+                        std::move(pop));
+      }
+      evolve(archi, s_.generations, "local");
+    }
+    if (s_.polish != "none" && s_.polish_evaluations > 0 && tracker_->have_best) polish();
+    endStage();
+  }
+
+  OptimizeResult finish() {
+    res_.evaluations = tracker_->evaluations;
+    res_.wall_s = wall_s_;
+    if (tracker_->have_best) {
+      res_.x = tracker_->best_x;
+      res_.best = tracker_->best;
+    } else {
+      res_.x = x0_;
+      res_.best = evaluateStroke(prob_, x0_);
+    }
+    res_.directions = prob_.space.directions;
+    res_.trajectory = prob_.space.trajectory(res_.x);
+    return std::move(res_);
+  }
+
+ private:
+  unsigned subSeed(int island, int restart) const {
+    return static_cast<unsigned>(s_.seed * 1000003u + static_cast<unsigned>(island) * 7919u +
+                                 static_cast<unsigned>(restart) * 104729u);
+  }
+
+  void evolve(pagmo::archipelago& archi, int generations, const char* stage) {
+    for (int g = 1; g <= generations; ++g) {
       archi.evolve(1);
       archi.wait_check();
-      snapshot(++gen_count, "global");
-    }
-    // Refine: CMA-ES continues on each island's population, centred on its best point with a
-    // small step (5 % of the box): the global search (e.g. DE, which explores widely but
-    // converges slowly) finds the basin, CMA-ES converges in it.
-    if (s.refine_generations > 0) {
-      for (int i = 0; i < s.islands; ++i) {
-        const unsigned seed = static_cast<unsigned>(s.seed * 1000003u + static_cast<unsigned>(i) * 7919u +
-                                                    static_cast<unsigned>(r) * 104729u);
-        archi[static_cast<pagmo::archipelago::size_type>(i)].set_algorithm(
-            pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, 0.05, 1e-9, 1e-9, true, true, seed + 2u)));
-      }
-      for (int g = 1; g <= s.refine_generations; ++g) {
-        archi.evolve(1);
-        archi.wait_check();
-        snapshot(++gen_count, "refine");
-      }
+      ++gen_count_;
+      snapshot(stage);
     }
   }
 
-  // Polish from the best feasible point (NLopt works on the same unit box).
-  if (s.polish != "none" && s.polish_evaluations > 0 && tracker->have_best) {
-    const unsigned d = static_cast<unsigned>(prob.space.dim());
-    nlopt::opt opt(s.polish == "cobyla" ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, d);
+  void endStage() { wall_s_ += std::chrono::duration<double>(Clock::now() - stage_start_).count(); }
+
+  void snapshot(const char* stage) {
+    std::lock_guard<std::mutex> lock(tracker_->mu);
+    res_.history.push_back({gen_count_, tracker_->evaluations, wall_s_ + std::chrono::duration<double>(Clock::now() - stage_start_).count(),
+                            tracker_->have_best ? tracker_->best_objective : 0.0, stage});
+  }
+
+  void polish() {
+    const unsigned d = static_cast<unsigned>(prob_.space.dim());
+    nlopt::opt opt(s_.polish == "cobyla" ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, d);
     opt.set_lower_bounds(std::vector<double>(d, 0.0));
     opt.set_upper_bounds(std::vector<double>(d, 1.0));
-    opt.set_maxeval(s.polish_evaluations);
+    opt.set_maxeval(s_.polish_evaluations);
     opt.set_xtol_rel(1e-7);
     opt.set_initial_step(0.02);
     struct Ctx {
@@ -194,7 +256,7 @@ OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s
         }
         return last;
       }
-    } ctx{&prob, tracker.get(), {}, {}, s.polish == "bobyqa"};
+    } ctx{&prob_, tracker_.get(), {}, {}, s_.polish == "bobyqa"};
     opt.set_max_objective(
         [](const std::vector<double>& x, std::vector<double>&, void* data) {
           auto* c = static_cast<Ctx*>(data);
@@ -203,7 +265,7 @@ OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s
           return c->bobyqa ? -e.fitness() : e.objective;
         },
         &ctx);
-    if (s.polish == "cobyla")
+    if (s_.polish == "cobyla")
       opt.add_inequality_constraint(
           [](const std::vector<double>& x, std::vector<double>&, void* data) {
             const StrokeEvaluation& e = static_cast<Ctx*>(data)->eval(x);
@@ -212,8 +274,8 @@ OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s
           &ctx, 0.0);
     std::vector<double> x;
     {
-      std::lock_guard<std::mutex> lock(tracker->mu);
-      x = tracker->best_x;
+      std::lock_guard<std::mutex> lock(tracker_->mu);
+      x = tracker_->best_x;
     }
     double f = 0.0;
     try {
@@ -221,21 +283,27 @@ OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s
     } catch (const std::exception&) {
       // NLopt's roundoff/forced stops: the tracker holds the best feasible point seen.
     }
-    snapshot(gen_count + 1, "polish");
+    ++gen_count_;
+    snapshot("polish");
   }
 
-  res.evaluations = tracker->evaluations;
-  res.wall_s = std::chrono::duration<double>(Clock::now() - t_start).count();
-  if (tracker->have_best) {
-    res.x = tracker->best_x;
-    res.best = tracker->best;
-  } else {
-    res.x = x0;
-    res.best = evaluateStroke(prob, x0);
-  }
-  res.directions = prob.space.directions;
-  res.trajectory = prob.space.trajectory(res.x);
-  return res;
+  const StrokeProblem& prob_;
+  OptimizerSettings s_;
+  std::shared_ptr<const StrokeProblem> shared_;
+  std::shared_ptr<Tracker> tracker_;
+  pagmo::problem pp_;
+  std::vector<double> x0_;
+  OptimizeResult res_;
+  int gen_count_ = 0;
+  double wall_s_ = 0.0;
+  Clock::time_point stage_start_ = Clock::now();  // wall time counts the stages only (not the waits between)
+};
+
+OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s) {
+  SpaceSearch search(prob, s);
+  search.globalStage(0, s.restarts);
+  search.localStageAndPolish();
+  return search.finish();
 }
 
 }  // namespace
@@ -248,18 +316,46 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   // joint 1 against joints 2 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
   // with its own sub-seeds, finds every pattern's basin instead of the one a single search
   // happens to fall into. All 2^n patterns, mirror images included (no symmetry of the robot or
-  // the limits is assumed).
+  // the limits is assumed). Successive halving (directions_kept = K > 0): the first global restart
+  // runs in every pattern; the other restarts, the local restarts and the polish only in the K
+  // patterns whose first restart found the most (ties: the lower pattern index); the others keep
+  // their first restart's best. A pattern's search is the same either way (same sub-seeds).
   const int n = prob.space.n_links;
-  OptimizeResult all;
-  double best_so_far = 0.0;
-  for (int mask = 0; mask < (1 << n); ++mask) {
-    StrokeProblem p = prob;
+  const int patterns = 1 << n;
+  std::vector<StrokeProblem> problems(static_cast<std::size_t>(patterns), prob);
+  std::vector<std::unique_ptr<SpaceSearch>> searches;
+  for (int mask = 0; mask < patterns; ++mask) {
+    StrokeProblem& p = problems[static_cast<std::size_t>(mask)];
     p.space.directions.assign(static_cast<std::size_t>(n), 1);
     for (int j = 0; j < n; ++j)
       if ((mask >> j) & 1) p.space.directions[static_cast<std::size_t>(j)] = -1;
     OptimizerSettings ps = s;
     ps.seed = s.seed * 4099u + static_cast<std::uint64_t>(mask);
-    OptimizeResult r = searchSpace(p, ps);
+    searches.push_back(std::make_unique<SpaceSearch>(p, ps));
+    // Without successive halving each pattern's search runs through (as before the option).
+    if (s.directions_kept == 0 || s.directions_kept >= patterns) {
+      searches.back()->globalStage(0, s.restarts);
+      searches.back()->localStageAndPolish();
+    }
+  }
+  if (s.directions_kept > 0 && s.directions_kept < patterns) {
+    for (auto& search : searches) search->globalStage(0, 1);
+    std::vector<int> order(static_cast<std::size_t>(patterns));
+    for (int m = 0; m < patterns; ++m) order[static_cast<std::size_t>(m)] = m;
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return searches[static_cast<std::size_t>(a)]->bestObjective() > searches[static_cast<std::size_t>(b)]->bestObjective();
+    });
+    for (int k = 0; k < s.directions_kept; ++k) {
+      SpaceSearch& kept = *searches[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+      kept.globalStage(1, s.restarts);
+      kept.localStageAndPolish();
+    }
+  }
+
+  OptimizeResult all;
+  double best_so_far = 0.0;
+  for (int mask = 0; mask < patterns; ++mask) {
+    OptimizeResult r = searches[static_cast<std::size_t>(mask)]->finish();
     // History: one curve over all patterns (rows after each pattern's first continue the counts).
     const int gen0 = all.history.empty() ? 0 : all.history.back().generation;
     for (std::size_t k = mask == 0 ? 0 : 1; k < r.history.size(); ++k) {
@@ -273,7 +369,7 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
     }
     all.evaluations += r.evaluations;
     all.wall_s += r.wall_s;
-    all.by_direction.push_back({p.space.directions, r.best, r.evaluations});
+    all.by_direction.push_back({r.directions, r.best, r.evaluations});
     if (mask == 0) all.start = r.start;
     const bool better = r.best.feasible() && (!all.best.feasible() || r.best.objective > all.best.objective);
     if (mask == 0 || better) {

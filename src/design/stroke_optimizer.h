@@ -22,6 +22,9 @@ struct OptimizerSettings {
   int restart_growth = 1;           // population factor from one restart to the next (2: IPOP-CMA-ES)
   int refine_generations = 0;       // CMA-ES generations on each island's population after its global search
   bool enumerate_directions = false;  // split-cycle: one search per joint-direction pattern (2^n), the best kept
+  int local_restarts = 0;           // CMA-ES runs (population, generations) centred on the best point so far, after the global search
+  double local_step = 0.1;          // their initial step, a share of the unit box
+  int directions_kept = 0;          // enumerate: local restarts and polish only in the K best patterns (0: all)
   std::string polish = "cobyla";    // "cobyla" | "bobyqa" | "none" (NLopt)
   int polish_evaluations = 200;
   std::uint64_t seed = 1;
