@@ -81,6 +81,14 @@ TEST(SplineProfile, PassesThroughItsKnotsAtRestAtBothEnds) {
   EXPECT_THROW(JointProfile(SplineParams{{0.1}, 0.3, 0.0}), std::invalid_argument);
 }
 
+// A short global search with no polish: its generation rows are the whole history.
+OptimizerSettings globalOnly(std::uint64_t seed, int generations) {
+  OptimizerSettings s = smallBudget(seed);
+  s.generations = generations;
+  s.polish = "none";
+  return s;
+}
+
 TEST(StrokeDesign, JointOneTorqueIsTheBaseMoment) {
   const ExperimentCase c = baseCase(3);
   const TailTrajectory t = c.trajectory();
@@ -236,9 +244,7 @@ TEST(StrokeDesign, SameSeedSameResult) {
 // over all of them, so it is never worse than the single start's global best.
 TEST(StrokeDesign, RestartsRunGrowingPopulationsAndKeepTheBest) {
   const StrokeProblem p = torqueLimitedProblem(1, 8.0);
-  OptimizerSettings one = smallBudget(5);
-  one.generations = 6;
-  one.polish = "none";
+  const OptimizerSettings one = globalOnly(5, 6);
   OptimizerSettings three = one;
   three.restarts = 3;
   three.restart_growth = 2;
@@ -353,9 +359,7 @@ TEST(StrokeDesign, EnumeratedDirectionsSearchEveryPatternAndKeepTheBest) {
 // placed in it, and population points per generation on every island; the best never goes down.
 TEST(StrokeDesign, LocalRestartsContinueFromTheBestAndNeverLose) {
   const StrokeProblem p = torqueLimitedProblem(1, 8.0);
-  OptimizerSettings global = smallBudget(5);
-  global.generations = 6;
-  global.polish = "none";
+  const OptimizerSettings global = globalOnly(5, 6);
   OptimizerSettings local = global;
   local.local_restarts = 3;
   local.local_step = 0.05;
@@ -384,9 +388,7 @@ TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
   StrokeProblem p;
   p.base = baseCase(2);
   p.space.n_links = 2;
-  OptimizerSettings global = smallBudget(3);
-  global.generations = 4;
-  global.polish = "none";
+  OptimizerSettings global = globalOnly(3, 4);
   global.enumerate_directions = true;
   OptimizerSettings kept = global;
   kept.restarts = 2;
