@@ -149,9 +149,7 @@ RunPlan planRun(const TailTrajectory& trajectory, const AnalyticSettings& settin
   plan.rows = static_cast<long>(rows);
   plan.tail_end = trajectory.endTime();
   // Shortest acceleration or deceleration phase sets the event sampling and the step bound.
-  double shortest = std::numeric_limits<double>::infinity();
-  for (const auto& j : trajectory.joints)
-    shortest = std::min({shortest, j.params().w_ss * j.params().dT_s, (1 - j.params().w_ss) * j.params().dT_s});
+  const double shortest = trajectory.shortestPhase();
   plan.h_scan = shortest / 32.0;
   plan.h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
   plan.adaptive = settings.solver == AnalyticSolver::kAdaptive;

@@ -423,9 +423,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   RunSummary& sum = result.summary;
   sum.model = "perfoot";
   const double tail_end = trajectory.endTime();
-  double shortest = std::numeric_limits<double>::infinity();
-  for (const auto& j : trajectory.joints)
-    shortest = std::min({shortest, j.params().w_ss * j.params().dT_s, (1 - j.params().w_ss) * j.params().dT_s});
+  double shortest = trajectory.shortestPhase();
   if (!std::isfinite(shortest)) shortest = t_end;
   const double h_scan = shortest / 32.0;
   const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;

@@ -55,11 +55,7 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
       w.analytic_steps = moving_until / h;
     } else {
       // A segment where no joint moves before the tail's end (a start delay) keeps the run's bound.
-      double shortest = std::numeric_limits<double>::infinity();
-      for (const JointProfile& j : traj.joints) {  // a spline's envelope: w_ss dT = its knot spacing
-        const SplitCycleParams& p = j.params();
-        shortest = std::min({shortest, p.w_ss * p.dT_s, (1 - p.w_ss) * p.dT_s});
-      }
+      const double shortest = traj.shortestPhase();
       std::vector<double> b = traj.breakpoints();
       b.insert(b.begin(), 0.0);
       for (std::size_t k = 0; k + 1 < b.size() && b[k] < moving_until; ++k) {

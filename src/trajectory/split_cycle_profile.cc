@@ -143,6 +143,13 @@ std::vector<double> TailTrajectory::breakpoints() const {
   return b;
 }
 
+double TailTrajectory::shortestPhase() const {
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const JointProfile& j : joints)
+    shortest = std::min({shortest, j.params().w_ss * j.params().dT_s, (1 - j.params().w_ss) * j.params().dT_s});
+  return shortest;
+}
+
 double TailTrajectory::shortestActivePhase(double t) const {
   double shortest = std::numeric_limits<double>::infinity();
   for (const JointProfile& j : joints) {

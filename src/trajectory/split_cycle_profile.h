@@ -102,6 +102,9 @@ struct TailTrajectory {
   // joints moving at time t  [s]; +inf when every joint is at rest there. Between two breakpoints
   // each joint stays in one phase, so this is the time scale of the loads over that segment.
   double shortestActivePhase(double t) const;
+  // The shortest acceleration or deceleration phase of any joint over the whole motion  [s]
+  // (+inf without joints): min(w_ss, 1 - w_ss) dT; a spline's w_ss dT is its knot spacing.
+  double shortestPhase() const;
 };
 
 // Eq. (25) with the misprint fixes of paper-notes: dtheta = -360 deg / (n+1),
