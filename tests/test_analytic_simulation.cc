@@ -325,3 +325,39 @@ TEST(AnalyticSimulation, ShortAccelerationDoesNotBoundTheLongDeceleration) {
   // (w_ss dT / 8 = 2.5 ms) as the bound: 324 steps, 2,113 right-hand sides, the same phi_net.
   EXPECT_LE(a.summary.solver_steps, 200);
 }
+
+// A load peak a hair above the static limit, next to a solver step's boundary (docs/accuracy.md
+// "A dip across a step boundary"). The critical coefficient comes from the tail loads and the foot
+// loads alone on a 1 us grid (no simulation): just below it the rotation must break away, just
+// above it nothing may move. The peak lies about 0.1 ms before a step boundary; before the fix
+// its lowest margin sample was a step's last one and the run reported no event.
+TEST(AnalyticSimulation, LoadPeakAtAStepBoundaryBreaksStiction) {
+  RobotParams r = paperRobot(2);
+  TailTrajectory tr;
+  tr.joints.emplace_back(SplitCycleParams{0.0, -0.2 * M_PI / 180, 0.04, 0.2, 0.0});
+  tr.joints.emplace_back(SplitCycleParams{0.0, -60 * M_PI / 180, 0.6, 0.5, 0.1});
+  std::vector<JointState> js;
+  SystemLoads sl;
+  LoadScratch scratch;
+  double crit = 0, t_peak = 0;
+  const double weight = r.systemMass() * r.gravity_mps2;
+  for (long i = 0; i * 1e-6 <= tr.endTime(); ++i) {
+    tr.evaluate(i * 1e-6, js);
+    systemLoads(r, js, false, sl, scratch);
+    const double ratio = std::abs(sl.MzT) / (weight * footLoads(r.quadruped, sl.p_QC).L_F);
+    if (ratio > crit) crit = ratio, t_peak = i * 1e-6;
+  }
+  std::printf("critical mu %.9f at t = %.6f s\n", crit, t_peak);
+  for (const double f : {1.0 - 1e-5, 1.0 + 1e-5}) {
+    r.friction.mu_s = r.friction.mu_d = f * crit;
+    const RunResult res = simulateAnalytic(r, tr, {}, {}, {});
+    ASSERT_TRUE(res.summary.ok) << res.summary.error;
+    if (f < 1) {
+      EXPECT_GE(res.summary.stick_slip_events, 1) << "mu = (1 - 1e-5) x critical";
+      EXPECT_EQ(res.summary.extra.at("ever_rotated"), 1.0);
+    } else {
+      EXPECT_EQ(res.summary.stick_slip_events, 0) << "mu = (1 + 1e-5) x critical";
+      EXPECT_EQ(res.summary.phi_net_deg, 0.0);
+    }
+  }
+}

@@ -117,3 +117,49 @@ TEST(StickSlip, FindSwitchReportsASwitchAlreadyPastAtTheStart) {
   EXPECT_EQ(f.t, 2.0);
   EXPECT_EQ(f.which, kRot);
 }
+
+// A stuck margin's narrow dip (below zero for about 1 ms) whose lowest sample is the first scan's
+// last one (t = 1.02) and so the second scan's first: only a scan that starts from the first one's
+// last two samples (ScanEnd, `across`) sees both of its neighbours. The dip's first zero lies after
+// the boundary (centre 1.025) or before it (centre 1.018: the switch is found in the first scan's
+// interval, which its caller's deferred rows and kept dense output allow).
+TEST(StickSlip, FindSwitchCatchesADipAcrossTwoScans) {
+  Modes m;
+  m.stuck[kRot] = m.stuck[kTrans] = true;
+  for (const double centre : {1.025, 1.018}) {
+    auto gAt = [centre](double t) {
+      const double u = (t - centre) / 0.005;
+      return Margins{1.0 - 1.01 * std::exp(-u * u), 1.0};
+    };
+    ScanEnd first;
+    ASSERT_FALSE(findSwitch(gAt, m, 0.0, 1.02, 0.1, 1e-12, nullptr, &first).hit);
+    EXPECT_NEAR(first.t_before, 1.02 * 10 / 11, 1e-15);
+    EXPECT_EQ(first.g_end[kRot], gAt(1.02)[kRot]);
+    ASSERT_TRUE(dipMayCross(m, first)) << centre;  // the margin still falls at the boundary
+    // Without the first scan's samples the dip is missed (the limit before the fix).
+    EXPECT_FALSE(findSwitch(gAt, m, 1.02, 2.0, 0.1, 1e-12, &first, nullptr, false).hit);
+    const Found f = findSwitch(gAt, m, 1.02, 2.0, 0.1, 1e-12, &first, nullptr, true);
+    ASSERT_TRUE(f.hit) << centre;
+    EXPECT_EQ(f.which, kRot);
+    const double first_zero = centre - 0.005 * std::sqrt(std::log(1.01));  // g = 0 on the way down
+    EXPECT_NEAR(f.t, first_zero, 1e-9) << centre;
+  }
+}
+
+// A slide that has just begun (margin exactly 0) rises and falls back below zero inside the first
+// sample interval: its stop is where the margin falls through zero (t = 0.01), not the start.
+// Before the fix the switch was put at the start, the DOF re-stuck, broke away again at once, and
+// the run crept forward by the event tolerance per step until its step budget ran out.
+TEST(StickSlip, FindSwitchLocatesTheStopOfASlideThatJustBegan) {
+  Modes sliding;
+  sliding.stuck[kTrans] = true;
+  auto gAt = [](double t) { return Margins{t * (0.01 - t), 1.0}; };
+  const Found f = findSwitch(gAt, sliding, 0.0, 1.0, 0.1, 1e-12);
+  ASSERT_TRUE(f.hit);
+  EXPECT_EQ(f.which, kRot);
+  EXPECT_NEAR(f.t, 0.01, 1e-9);
+  // A margin that never rises still stops at the start.
+  const Found g = findSwitch([](double t) { return Margins{-t, 1.0}; }, sliding, 0.0, 1.0, 0.1, 1e-12);
+  ASSERT_TRUE(g.hit);
+  EXPECT_NEAR(g.t, 0.0, 1e-12);
+}

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -178,6 +179,16 @@ struct Run {
   long rhs = 0;           // right-hand sides the solver evaluated (accepted and rejected trial steps)
   long rejected = 0;      // adaptive: trial steps the error control rejected
   double dt_resume = 0.0;  // the step to restart with after a tail breakpoint (0: after a switch)
+  // The last step's scan, kept while the modes stay (adaptiveSegment): its end margins start the
+  // next scan; when a stuck margin was still falling there (dipMayCross), its last two samples
+  // and its dense output too, and the rows after its second-last sample wait for the next step.
+  struct Carry {
+    bool have = false;    // end holds the scan of the step that ended at t_end
+    bool across = false;  // and stepper its dense output: the next scan looks across t_end
+    double t_end = 0;
+    ScanEnd end;
+    std::optional<DenseDopri5> stepper;
+  } carry;
 };
 
 // The fixed-step solver checks once per step: a slide slower than one step's friction
@@ -298,8 +309,6 @@ void adaptiveSegment(Run& run, double seg_end) {
   const double dt0 = std::min(max_dt, run.dt_resume > 0 ? run.dt_resume : 1e-4);
   run.dt_resume = 0.0;
   stepper.initialize(run.y, run.t, dt0);
-  Margins g_end{};
-  bool have_g_end = false;  // g_end holds the margins at the last step's end (modes unchanged since)
   for (;;) {
     // A step that would cross the next breakpoint (where the tail acceleration jumps) ends on it
     // instead: across it the error estimate fails and the step is rejected over and over.
@@ -309,26 +318,44 @@ void adaptiveSegment(Run& run, double seg_end) {
     const auto [ta, tb_raw] = stepper.do_step(rhs);
     countStep(run);
     const double tb = std::min(tb_raw, seg_end);
-    auto stateAt = [&](double tt, State& ys) { stepper.calc_state(tt, ys); };
+    Run::Carry& carry = run.carry;
+    const bool have = carry.have && carry.t_end == ta, across = have && carry.across;
+    // Before ta (a dip looked for across the boundary): the previous step's dense output.
+    auto stateAt = [&](double tt, State& ys) {
+      if (across && tt < ta)
+        carry.stepper->calc_state(tt, ys);
+      else
+        stepper.calc_state(tt, ys);
+    };
     Found f;
+    ScanEnd end;
     if (m.stiction()) {
       State yg;
       auto gAt = [&](double tt) {
         stateAt(tt, yg);
         return eventMargins(m, run.ws, run.v_stop, tt, yg, run.modes);
       };
-      f = findSwitch(gAt, run.modes, ta, tb, scales.h_scan, s.event_tol_s, have_g_end ? &g_end : nullptr, &g_end);
-      have_g_end = !f.hit && tb == tb_raw;
+      f = findSwitch(gAt, run.modes, ta, tb, scales.h_scan, s.event_tol_s, have ? &carry.end : nullptr, &end, across);
     }
     const double t_cut = f.hit ? f.t : tb;
-    recordUpTo(run, t_cut, stateAt);
-    stepper.calc_state(t_cut, run.y);
+    // A margin still falling at tb may dip below zero just after it: the rows after the last
+    // sample before tb wait until the next step's scan has looked (the switch may come first).
+    const bool defer = !f.hit && m.stiction() && dipMayCross(run.modes, end) && tb < t_end - 1e-15 &&
+                       !(tb >= run.plan.tail_end && stuckForGood(run));
+    recordUpTo(run, defer ? end.t_before : t_cut, stateAt);
+    stateAt(t_cut, run.y);
     run.t = t_cut;
     checkFinite(run, [&] { return "tighten analytic.rel_tol (" + std::to_string(s.rel_tol) + ")"; });
     if (f.hit) {
+      carry.have = carry.across = false;
       switchAt(run, f.which);
       return;
     }
+    carry.have = m.stiction();
+    carry.across = defer;
+    carry.t_end = tb;
+    carry.end = end;
+    if (defer) carry.stepper = stepper;
     if (tb_raw >= seg_end - 1e-15) {  // a breakpoint of the tail profile: restart the step there
       if (tb_raw <= seg_end + 1e-12) run.dt_resume = std::max(stepper.current_time_step(), tb_raw - ta);
       return;

@@ -11,6 +11,7 @@
 
 #include "analytic_model/analytic_simulation.h"
 #include "analytic_model/per_foot_model.h"
+#include "analytic_model/stick_slip.h"
 #include "robot/friction_law.h"
 
 namespace tailsim {
@@ -261,65 +262,24 @@ double margin(const Model& model, double t, const State& y, bool stuck, double v
   return std::max(fast, model.evaluate(t, y, true).load_factor - 1.0);
 }
 
-// Illinois (modified regula falsi) on g over [a, b] with g(a) > 0 >= g(b).
-template <class G>
-double illinois(const G& g, double a, double b, double ga, double gb, double tol) {
-  if (!(ga > 0)) return a + std::min(tol, b - a);
-  int side = 0;
-  for (int it = 0; it < 100 && b - a > tol; ++it) {
-    double c = (a * gb - b * ga) / (gb - ga);
-    if (!(c > a && c < b)) c = 0.5 * (a + b);
-    const double gc = g(c);
-    if (gc > 0) {
-      a = c; ga = gc;
-      if (side == -1) gb *= 0.5;
-      side = -1;
-    } else {
-      b = c; gb = gc;
-      if (side == +1) ga *= 0.5;
-      side = +1;
-    }
-  }
-  return b;
-}
-
-template <class G>
-std::pair<double, double> goldenMin(const G& g, double a, double b, double tol) {
-  const double r = 0.5 * (std::sqrt(5.0) - 1.0);
-  double c = b - r * (b - a), d = a + r * (b - a);
-  double gc = g(c), gd = g(d);
-  for (int it = 0; it < 60 && b - a > tol; ++it) {
-    if (gc < gd) { b = d; d = c; gd = gc; c = b - r * (b - a); gc = g(c); }
-    else { a = c; c = d; gc = gd; d = a + r * (b - a); gd = g(d); }
-  }
-  return gc < gd ? std::make_pair(c, gc) : std::make_pair(d, gd);
-}
-
-// First switch in [ta, tb]: margins sampled every h_scan; a crossing is located by Illinois; a dip
-// of a stuck margin between samples by golden section. Returns +inf if none.
+// First switch in [ta, tb], or +inf: the analytic model's scan (stick_slip.h findSwitch) on this
+// model's one margin, as its rotation DOF (the other margin, held at 1, never switches): margins
+// sampled every h_scan, a crossing located by Illinois, a dip of a stuck margin between samples by
+// golden section. `prev` (the last scan's end, same mode, ending at ta; stateAt must answer before
+// ta too) lets a dip across the boundary be found; `end` is set when nothing switches.
 template <class StateAt>
 double findSwitch(const Model& model, bool stuck, double v_stop, double ta, double tb, double h_scan, double tol,
-                  const StateAt& stateAt) {
-  const int k = std::max(2, static_cast<int>(std::ceil((tb - ta) / h_scan)));
+                  const StateAt& stateAt, const ScanEnd* prev = nullptr, ScanEnd* end = nullptr) {
   State y;
-  auto g = [&](double t) {
+  Modes modes;
+  modes.stuck[kRot] = stuck;
+  modes.stuck[kTrans] = true;
+  auto gAt = [&](double t) {
     stateAt(t, y);
-    return margin(model, t, y, stuck, v_stop);
+    return Margins{margin(model, t, y, stuck, v_stop), 1.0};
   };
-  double g_prev = g(ta), g_prev2 = g_prev, t_prev = ta, t_prev2 = ta;
-  if ((stuck && g_prev <= 0) || (!stuck && g_prev < 0)) return ta;
-  for (int i = 1; i <= k; ++i) {
-    const double t = ta + (tb - ta) * i / k;
-    const double gt = g(t);
-    if ((g_prev > 0 && gt <= 0) || (!stuck && g_prev >= 0 && gt < 0)) return illinois(g, t_prev, t, g_prev, gt, tol);
-    if (stuck && i >= 2 && g_prev < g_prev2 && g_prev < gt && g_prev > 0) {
-      const auto [tm, gm] = goldenMin(g, t_prev2, t, tol * 1e3);
-      if (gm <= 0) return illinois(g, t_prev2, tm, g_prev2, gm, tol);
-    }
-    t_prev2 = t_prev; g_prev2 = g_prev;
-    t_prev = t; g_prev = gt;
-  }
-  return std::numeric_limits<double>::infinity();
+  const Found f = tailsim::findSwitch(gAt, modes, ta, tb, h_scan, tol, prev, end, prev != nullptr);
+  return f.hit ? f.t : std::numeric_limits<double>::infinity();
 }
 
 class Recorder {
@@ -478,6 +438,11 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       return t_end;
     };
     auto rhs = [&](const State& x, State& dx, double tt) { model.derivative(tt, x, dx); };
+    struct {
+      bool have = false;  // end holds the scan of the stuck chunk that ended at t_end
+      double t_end = 0;
+      ScanEnd end;
+    } chunk;
     double dt_resume = 0.0;  // the step to go on with after a tail breakpoint (0: start small)
 
     while (t < t_end - 1e-15) {
@@ -491,19 +456,30 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       }
       const double seg_end = nextBreak(t);
       if (stuck) {
-        // Nothing moves: scan the load factor up to the next breakpoint (h_max at a time).
+        // Nothing moves: scan the load factor up to the next breakpoint (h_max at a time). A margin
+        // still falling at a chunk's end goes on into the next chunk's scan (a dip across the
+        // boundary), and the rows after its second-last sample wait for that scan.
         const double tb = std::min(seg_end, t + h_max);
         auto stateAt = [&](double, State& ys) { ys = y; };
         max_load_factor = std::max(max_load_factor, 1.0 - margin(model, tb, y, true, v_stop));
-        const double ts = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt);
+        const bool have = chunk.have && chunk.t_end == t;
+        ScanEnd end;
+        const double ts = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt,
+                                     have ? &chunk.end : nullptr, &end);
+        const bool hit = ts <= tb;
+        Modes held;
+        held.stuck[kRot] = held.stuck[kTrans] = true;
+        const bool defer = !hit && dipMayCross(held, end) && tb < t_end - 1e-15 && !settled(tb);
         const double t_cut = std::min(ts, tb);
-        recordUpTo(t_cut, stateAt);
+        recordUpTo(defer ? end.t_before : t_cut, stateAt);
         t = t_cut;
+        chunk = {!hit, tb, end};
         ++steps;
-        if (ts <= tb) settle();
+        if (hit) settle();
         if (steps > settings.max_steps) throw std::runtime_error("step budget exhausted");
         continue;
       }
+      chunk.have = false;
       const double max_dt = t < tail_end ? h_max : t_end - t;
       auto stepper = odeint::make_dense_output(settings.abs_tol, settings.rel_tol, max_dt,
                                                odeint::runge_kutta_dopri5<State>());

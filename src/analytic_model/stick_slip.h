@@ -92,24 +92,44 @@ struct Found {
   int which = 0;
 };
 
+// The last two margin samples of a scan that found no switch: a dip whose lowest sample is the
+// scan's last one (g_end below g_before) can only be seen by the next scan.
+struct ScanEnd {
+  double t_before = 0;  // the sample before the last  [s]
+  Margins g_before{};   // the margins there
+  Margins g_end{};      // the margins at the scan's end (tb)
+};
+
+// A stuck DOF's margin still falling at the scan's end (and above zero): its dip, if any, may lie
+// across the boundary, so the next scan must start from these two samples.
+inline bool dipMayCross(const Modes& m, const ScanEnd& e) {
+  for (int w : {kRot, kTrans})
+    if (m.stuck[w] && e.g_end[w] < e.g_before[w] && e.g_end[w] > 0) return true;
+  return false;
+}
+
 // Searches [ta, tb] for the first switch of either DOF, with gAt(t) -> Margins. Both margins are
 // sampled together every h_scan (so a short load peak between two solver steps is not stepped
 // over: paper-notes point 4); in the first sample interval where any margin reaches zero, every
 // DOF that crosses there is located and the earliest wins, so no DOF's switch can hide behind
-// another's. A dip of a stuck DOF's margin between samples (all samples positive) is refined by
-// golden section. g_ta: the margins at ta when the caller has them (the previous step's last
-// sample, same modes: saves one evaluation a step); g_tb: set to the margins at tb when nothing
+// another's. A dip of a stuck DOF's margin between samples (all samples positive, the lowest
+// between two higher ones) is refined by golden section. `prev`: the previous scan's end, same
+// modes, when the caller has it (saves the evaluation at ta); with `across` also its sample
+// before ta, so a dip whose lowest sample is ta is refined over [prev->t_before, ta + h]: gAt
+// must then answer there too, and a switch may be found before ta. `end`: set when nothing
 // switches.
 template <class GAt>
 Found findSwitch(const GAt& gAt, const Modes& m, double ta, double tb, double h_scan, double tol,
-                 const Margins* g_ta = nullptr, Margins* g_tb = nullptr) {
+                 const ScanEnd* prev = nullptr, ScanEnd* end = nullptr, bool across = false) {
   const int k = std::max(2, static_cast<int>(std::ceil((tb - ta) / h_scan)));
   // A stuck margin reaching 0 from above, or a sliding one turning negative (a stop).
   auto crosses = [&](int w, double g0, double g1) { return (g0 > 0 && g1 <= 0) || (!m.stuck[w] && g0 >= 0 && g1 < 0); };
-  Margins g_prev = g_ta ? *g_ta : gAt(ta), g_prev2 = g_prev;
+  Margins g_prev = prev ? prev->g_end : gAt(ta);
   for (int w : {kRot, kTrans})  // already past the switch (settleModes normally resolves this)
     if ((m.stuck[w] && g_prev[w] <= 0) || (!m.stuck[w] && g_prev[w] < 0)) return {true, ta, w};
-  double t_prev = ta, t_prev2 = ta;
+  const bool before = prev && across && prev->t_before < ta;
+  double t_prev = ta, t_prev2 = before ? prev->t_before : ta;
+  Margins g_prev2 = before ? prev->g_before : g_prev;
   for (int i = 1; i <= k; ++i) {
     const double t = ta + (tb - ta) * i / k;
     const Margins gt = gAt(t);
@@ -119,9 +139,14 @@ Found findSwitch(const GAt& gAt, const Modes& m, double ta, double tb, double h_
       double ts = 0;
       bool hit = false;
       if (crosses(w, g_prev[w], gt[w])) {
-        ts = illinois(gw, t_prev, t, g_prev[w], gt[w], tol);
+        double a = t_prev, ga = g_prev[w];
+        if (!(ga > 0)) {  // a slide that has just begun (margin 0) may rise and fall back inside
+          const auto [tm, neg_gm] = goldenMin([&](double tt) { return -gw(tt); }, t_prev, t, tol * 1e3);
+          if (-neg_gm > 0) a = tm, ga = -neg_gm;  // it did: its stop is the root after the peak
+        }
+        ts = illinois(gw, a, t, ga, gt[w], tol);
         hit = true;
-      } else if (m.stuck[w] && i >= 2 && g_prev[w] < g_prev2[w] && g_prev[w] < gt[w] && g_prev[w] > 0) {
+      } else if (m.stuck[w] && t_prev2 < t_prev && g_prev[w] < g_prev2[w] && g_prev[w] < gt[w] && g_prev[w] > 0) {
         const auto [tm, gm] = goldenMin(gw, t_prev2, t, tol * 1e3);
         if (gm <= 0) {
           ts = illinois(gw, t_prev2, tm, g_prev2[w], gm, tol);
@@ -134,7 +159,7 @@ Found findSwitch(const GAt& gAt, const Modes& m, double ta, double tb, double h_
     t_prev2 = t_prev; g_prev2 = g_prev;
     t_prev = t; g_prev = gt;
   }
-  if (g_tb) *g_tb = g_prev;
+  if (end) *end = {t_prev2, g_prev2, g_prev};
   return {};
 }
 
