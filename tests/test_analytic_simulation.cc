@@ -356,6 +356,15 @@ TEST(AnalyticSimulation, LoadPeakAtAStepBoundaryBreaksStiction) {
     if (f < 1) {
       EXPECT_GE(res.summary.stick_slip_events, 1) << "mu = (1 - 1e-5) x critical";
       EXPECT_EQ(res.summary.extra.at("ever_rotated"), 1.0);
+      // The row at t = 4 ms lies inside the slide (3.989 to 4.023 ms) and after the step boundary
+      // at 4.1 ms's previous scan: it is recorded only once the next scan has found the breakaway.
+      const auto& t = col(res, "t_s");
+      ASSERT_GT(t.size(), 4u);
+      ASSERT_NEAR(t[4], 0.004, 1e-12);
+      EXPECT_EQ(col(res, "rot_state")[4], 1.0) << "the 4 ms row shows the body stuck";
+      EXPECT_NE(col(res, "phidot_dps")[4], 0.0);
+      EXPECT_EQ(col(res, "rot_state")[3], 0.0);
+      EXPECT_EQ(col(res, "rot_state")[5], 0.0);
     } else {
       EXPECT_EQ(res.summary.stick_slip_events, 0) << "mu = (1 + 1e-5) x critical";
       EXPECT_EQ(res.summary.phi_net_deg, 0.0);

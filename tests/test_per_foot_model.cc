@@ -359,3 +359,39 @@ TEST(PerFootModel, RandomSweepNoNanBoundedSteps) {
   std::printf("perfoot random sweep: %d cases ran, steps median %ld, max %ld\n", ok, steps[steps.size() / 2],
               steps.back());
 }
+
+// The per-foot model's stuck scan runs in chunks of the run's shortest phase / 8, sampled every
+// shortest phase / 32. Joint 2 (which moves only from 0.1 s) sets that phase to 7.96 ms, so the
+// chunk boundary at 4 x 0.995 = 3.98 ms lies just before joint 1's load peak at 4 ms and its sample
+// is the lowest near the peak (the next one is at 4.229 ms): the dip lies across the boundary
+// (docs/accuracy.md "A dip across a step boundary"). The critical coefficient comes from a run
+// that holds (mu = 1): the load factor s is proportional to 1 / mu (the discs' radii are mu N_i),
+// so mu_crit = s_max, the largest load_factor of 1 us rows. Just below it the body must break
+// away; just above it nothing may move.
+TEST(PerFootModel, LoadPeakAtAChunkBoundaryBreaksStiction) {
+  RobotParams r = paperRobot(2);
+  TailTrajectory tr;
+  tr.joints.emplace_back(SplitCycleParams{0.0, -0.2 * M_PI / 180, 0.04, 0.2, 0.0});
+  tr.joints.emplace_back(SplitCycleParams{0.0, -0.01 * M_PI / 180, 0.0398, 0.2, 0.1});  // 20x smaller loads
+  r.friction.mu_s = r.friction.mu_d = 1.0;
+  OutputSettings fine;
+  fine.sample_dt_s = 1e-6;
+  fine.duration_s = 0.02;
+  const RunResult held = simulatePerFoot(r, tr, {}, {}, fine);
+  ASSERT_TRUE(held.summary.ok) << held.summary.error;
+  const auto& s = held.series.values("load_factor");
+  const auto& t = held.series.values("t_s");
+  const size_t i_max = static_cast<size_t>(std::max_element(s.begin(), s.end()) - s.begin());
+  const double crit = s[i_max];  // x mu = 1
+  std::printf("per-foot critical mu %.9f at t = %.6f s\n", crit, t[i_max]);
+  ASSERT_NEAR(t[i_max], 0.004, 2e-6);  // 20 us after the chunk boundary
+  for (const double f : {1.0 - 1e-5, 1.0 + 1e-5}) {
+    r.friction.mu_s = r.friction.mu_d = f * crit;
+    const RunResult res = simulatePerFoot(r, tr, {}, {}, {});
+    ASSERT_TRUE(res.summary.ok) << res.summary.error;
+    if (f < 1)
+      EXPECT_GE(res.summary.stick_slip_events, 1) << "mu = (1 - 1e-5) x critical";
+    else
+      EXPECT_EQ(res.summary.stick_slip_events, 0) << "mu = (1 + 1e-5) x critical";
+  }
+}

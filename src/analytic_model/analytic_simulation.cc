@@ -269,9 +269,9 @@ void countStep(Run& run) {
 // the tail profile: each joint is in one phase there. The step bound follows the shortest phase of
 // the joints that move (planRun's rule restricted to what moves: a joint at rest adds no load
 // variation). The event sampling keeps the whole run's shortest phase while the tail moves: a
-// margin's dip between two samples is found only when both neighbours of its lowest sample lie in
-// the same step (docs/accuracy.md "Known limit: a dip at a step boundary"), and a sparser sampling
-// would make that rarer case likelier. With the whole tail at rest its loads vanish (no joint
+// margin's dip is found only when it spans at most two sample intervals (chosen when a dip across a
+// step boundary was still missed, docs/accuracy.md "A dip across a step boundary"; a sparser
+// sampling per segment has not been measured since that fix). With the whole tail at rest its loads vanish (no joint
 // speed or acceleration); with the paper coupling every margin is then monotone in time (constant
 // friction decelerations, no tail force), so a step's midpoint and end suffice. With the exact
 // coupling the rotation and the translation still exchange momentum: the run's sampling stays.
