@@ -9,6 +9,7 @@
 
 #include "analytic_model/per_foot_model.h"
 #include "analytic_test_util.h"
+#include "random_cases.h"
 
 using namespace tailsim;
 using namespace tailsim::testing;
@@ -394,4 +395,71 @@ TEST(PerFootModel, LoadPeakAtAChunkBoundaryBreaksStiction) {
     else
       EXPECT_EQ(res.summary.stick_slip_events, 0) << "mu = (1 + 1e-5) x critical";
   }
+}
+
+// The held load factor the model's stuck margin uses, at any time, equals the time series' column.
+TEST(PerFootModel, HeldLoadFactorMatchesTheTimeSeries) {
+  RobotParams r = paperRobot(2);
+  r.friction.mu_s = r.friction.mu_d = 5.0;  // holds throughout
+  const TailTrajectory tr = sameMove(2, 10, -40, 0.3, 0.3);
+  const RunResult run = simulatePerFoot(r, tr, {}, {}, {});
+  ASSERT_TRUE(run.summary.ok) << run.summary.error;
+  ASSERT_EQ(run.summary.stick_slip_events, 0);
+  const auto& t = run.series.values("t_s");
+  const auto& s = run.series.values("load_factor");
+  const std::vector<double> s2 = perFootHeldLoadFactor(r, tr, {}, t);
+  ASSERT_EQ(s2.size(), s.size());
+  for (size_t i = 0; i < s.size(); ++i) EXPECT_EQ(s2[i], s[i]) << t[i];
+  EXPECT_GT(*std::max_element(s.begin(), s.end()), 0.01);
+}
+
+// Seeded random strokes at the edge of stiction, per-foot model (the analytic model's test of the
+// same name): the critical coefficient is the largest held load factor at mu = 1 (s scales as
+// 1 / mu), found from perFootHeldLoadFactor alone (samples every 20 us and at both sides of every
+// breakpoint, golden section around the five highest local maxima), not from a run. At (1 - 1e-6)
+// times it the body must break away; at (1 + 1e-6) times it nothing may move.
+TEST(PerFootModel, RandomStrokesAtTheEdgeOfStictionBreakExactlyBelowIt) {
+  RandomCases cases(11262026);
+  int tested = 0;
+  for (int k = 0; k < 12; ++k) {
+    RandomCase c = cases.next();
+    c.effects.friction = FrictionLaw::kStiction;
+    c.robot.friction.mu_s = c.robot.friction.mu_d = 1.0;
+    const TailTrajectory& tr = c.trajectory;
+    auto s = [&](double t) { return perFootHeldLoadFactor(c.robot, tr, c.effects, {t})[0]; };
+    const double h = 2e-5;
+    std::vector<double> times;
+    for (long i = 0; i * h <= tr.endTime() + h; ++i) times.push_back(i * h);
+    std::vector<double> v;
+    try {
+      v = perFootHeldLoadFactor(c.robot, tr, c.effects, times);
+    } catch (const TippingError&) {
+      continue;  // tips over: no stiction edge to test
+    }
+    std::vector<std::pair<double, double>> peaks;
+    for (size_t i = 1; i + 1 < v.size(); ++i)
+      if (v[i] >= v[i - 1] && v[i] >= v[i + 1]) peaks.emplace_back(v[i], times[i]);
+    double crit = std::max(v.front(), v.back());
+    for (double b : tr.breakpoints())
+      for (double t : {b, std::nextafter(b, 0.0), b - 1e-12}) crit = std::max(crit, s(t));
+    std::sort(peaks.rbegin(), peaks.rend());
+    for (size_t p = 0; p < std::min<size_t>(5, peaks.size()); ++p) {
+      const auto [tm, neg] = goldenMin([&](double t) { return -s(t); }, std::max(0.0, peaks[p].second - h),
+                                       peaks[p].second + h, 1e-13);
+      crit = std::max({crit, peaks[p].first, -neg});
+    }
+    if (!(crit > 1e-6)) continue;
+    ++tested;
+    for (const double f : {1.0 - 1e-6, 1.0 + 1e-6}) {
+      c.robot.friction.mu_s = c.robot.friction.mu_d = f * crit;
+      const RunResult res = simulatePerFoot(c.robot, tr, {}, c.effects, {});
+      ASSERT_TRUE(res.summary.ok) << describe(c) << ": " << res.summary.error;
+      if (f < 1)
+        EXPECT_GE(res.summary.stick_slip_events, 1) << "case " << k << " (" << describe(c) << "), mu = (1 - 1e-6) x " << crit;
+      else
+        EXPECT_EQ(res.summary.stick_slip_events, 0) << "case " << k << " (" << describe(c) << "), mu = (1 + 1e-6) x " << crit;
+    }
+  }
+  std::printf("%d strokes tested at their critical coefficient\n", tested);
+  EXPECT_GE(tested, 8);
 }

@@ -70,6 +70,13 @@ settings::For<S, PerFootSettings> declareFields(V& v, S& s) {
 RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
                           const Effects& effects, const OutputSettings& output);
 
+// How close a body held at rest is to breaking away: the load factor s of the wrench that holds it
+// at each time in `times` (held iff s <= 1; s scales as 1 / mu, the discs' radii being mu N_i, so
+// the largest s over a stroke at mu = 1 is the stroke's critical coefficient). The tail follows
+// `trajectory`; the body stays at its initial pose. Throws TippingError where the robot tips.
+std::vector<double> perFootHeldLoadFactor(const RobotParams& robot, const TailTrajectory& trajectory,
+                                          const Effects& effects, const std::vector<double>& times);
+
 // Diagnostic input, not a setting: the four feet's normal loads prescribed over time instead of
 // computed (`normal_loads` and `effects.foot_loads` are then unused), e.g. MuJoCo's recorded
 // foot<k>_Fn_N, to isolate the load distribution in the gap between the two models

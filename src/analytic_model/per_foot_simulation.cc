@@ -551,6 +551,17 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
   return simulatePerFootImpl(robot, trajectory, settings, effects, output, nullptr);
 }
 
+std::vector<double> perFootHeldLoadFactor(const RobotParams& robot, const TailTrajectory& trajectory,
+                                          const Effects& effects, const std::vector<double>& times) {
+  requireOneJointPerLink(trajectory.joints.size(), robot.tail.size());
+  const Model model(robot, trajectory, PerFootSettings{}, effects, nullptr);
+  std::vector<double> s;
+  s.reserve(times.size());
+  const State at_rest{};
+  for (double t : times) s.push_back(model.evaluate(t, at_rest, true).load_factor);
+  return s;
+}
+
 RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
                           const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads& loads) {
   if (loads.t_s.empty() || loads.t_s.size() != loads.N.size())
