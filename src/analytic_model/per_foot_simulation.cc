@@ -267,13 +267,18 @@ double margin(const Model& model, double t, const State& y, bool stuck, double v
 // sampled every h_scan, a crossing located by Illinois, a dip of a stuck margin between samples by
 // golden section. `prev` (the last scan's end, same mode, ending at ta; stateAt must answer before
 // ta too) lets a dip across the boundary be found; `end` is set when nothing switches.
+Modes scanModes(bool stuck) {
+  Modes modes;
+  modes.stuck[kRot] = stuck;
+  modes.stuck[kTrans] = true;
+  return modes;
+}
+
 template <class StateAt>
 double findSwitch(const Model& model, bool stuck, double v_stop, double ta, double tb, double h_scan, double tol,
                   const StateAt& stateAt, const ScanEnd* prev = nullptr, ScanEnd* end = nullptr) {
   State y;
-  Modes modes;
-  modes.stuck[kRot] = stuck;
-  modes.stuck[kTrans] = true;
+  const Modes modes = scanModes(stuck);
   auto gAt = [&](double t) {
     stateAt(t, y);
     return Margins{margin(model, t, y, stuck, v_stop), 1.0};
@@ -461,15 +466,14 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
         // boundary), and the rows after its second-last sample wait for that scan.
         const double tb = std::min(seg_end, t + h_max);
         auto stateAt = [&](double, State& ys) { ys = y; };
-        max_load_factor = std::max(max_load_factor, 1.0 - margin(model, tb, y, true, v_stop));
         const bool have = chunk.have && chunk.t_end == t;
         ScanEnd end;
         const double ts = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt,
                                      have ? &chunk.end : nullptr, &end);
         const bool hit = ts <= tb;
-        Modes held;
-        held.stuck[kRot] = held.stuck[kTrans] = true;
-        const bool defer = !hit && dipMayCross(held, end) && tb < t_end - 1e-15 && !settled(tb);
+        // The load factor at the chunk's end: the scan's last sample when it got there.
+        max_load_factor = std::max(max_load_factor, 1.0 - (hit ? margin(model, tb, y, true, v_stop) : end.g_end[kRot]));
+        const bool defer = !hit && dipMayCross(scanModes(true), end) && tb < t_end - 1e-15 && !settled(tb);
         const double t_cut = std::min(ts, tb);
         recordUpTo(defer ? end.t_before : t_cut, stateAt);
         t = t_cut;
