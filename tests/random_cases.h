@@ -2,10 +2,15 @@
 // (worst-case work, failures, NaN) that hand-picked hard cases miss.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "analytic_model/stick_slip.h"
 #include "analytic_test_util.h"
 
 namespace tailsim::testing {
@@ -56,5 +61,29 @@ class RandomCases {
   std::mt19937 rng_;
   std::uniform_real_distribution<double> dist_{0.0, 1.0};
 };
+
+// The largest value of a load measure over a stroke, found without a simulator (the critical
+// friction coefficient of the edge-of-stiction tests): samples every h from 0 to the tail's end,
+// both sides of every breakpoint, and golden section around the five highest local maxima of the
+// samples. `many(times)` gives the measure at many times at once, `one(t)` at one.
+template <class One, class Many>
+double strokeMaximum(const TailTrajectory& tr, double h, const One& one, const Many& many) {
+  std::vector<double> times;
+  for (long i = 0; i * h <= tr.endTime() + h; ++i) times.push_back(i * h);
+  const std::vector<double> v = many(times);
+  std::vector<std::pair<double, double>> peaks;  // (value, t) of local maxima of the samples
+  for (size_t i = 1; i + 1 < v.size(); ++i)
+    if (v[i] >= v[i - 1] && v[i] >= v[i + 1]) peaks.emplace_back(v[i], times[i]);
+  double best = std::max(v.front(), v.back());
+  for (double b : tr.breakpoints())
+    for (double t : {b, std::nextafter(b, 0.0), b - 1e-12}) best = std::max(best, one(t));
+  std::sort(peaks.rbegin(), peaks.rend());
+  for (size_t p = 0; p < std::min<size_t>(5, peaks.size()); ++p) {
+    const auto [tm, neg] = goldenMin([&](double t) { return -one(t); }, std::max(0.0, peaks[p].second - h),
+                                     peaks[p].second + h, 1e-13);
+    best = std::max({best, peaks[p].first, -neg});
+  }
+  return best;
+}
 
 }  // namespace tailsim::testing

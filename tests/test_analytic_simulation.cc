@@ -398,23 +398,11 @@ TEST(AnalyticSimulation, RandomStrokesAtTheEdgeOfStictionBreakExactlyBelowIt) {
       systemLoads(c.robot, js, false, sl, scratch);
       return std::abs(sl.MzT) / (weight * footLoads(c.robot.quadruped, sl.p_QC).L_F);
     };
-    const double h = 1e-5;
-    std::vector<std::pair<double, double>> peaks;  // (ratio, t) of local maxima of the samples
-    double r_prev2 = 0, r_prev = ratio(0.0);
-    for (long i = 1; i * h <= tr.endTime() + h; ++i) {
-      const double r = ratio(i * h);
-      if (r_prev >= r_prev2 && r_prev >= r) peaks.emplace_back(r_prev, (i - 1) * h);
-      r_prev2 = r_prev, r_prev = r;
-    }
-    double crit = std::max(ratio(0.0), r_prev);
-    for (double b : tr.breakpoints())
-      for (double t : {b, std::nextafter(b, 0.0), b - 1e-12}) crit = std::max(crit, ratio(t));
-    std::sort(peaks.rbegin(), peaks.rend());
-    for (size_t p = 0; p < std::min<size_t>(5, peaks.size()); ++p) {
-      const double t0 = std::max(0.0, peaks[p].second - h), t1 = peaks[p].second + h;
-      const auto [tm, neg] = goldenMin([&](double t) { return -ratio(t); }, t0, t1, 1e-13);
-      crit = std::max({crit, peaks[p].first, -neg});
-    }
+    const double crit = strokeMaximum(tr, 1e-5, ratio, [&](const std::vector<double>& times) {
+      std::vector<double> v;
+      for (double t : times) v.push_back(ratio(t));
+      return v;
+    });
     if (!(crit > 1e-6)) continue;  // no load worth a test
     for (const double f : {1.0 - 1e-6, 1.0 + 1e-6}) {
       c.robot.friction.mu_s = c.robot.friction.mu_d = f * crit;

@@ -427,26 +427,12 @@ TEST(PerFootModel, RandomStrokesAtTheEdgeOfStictionBreakExactlyBelowIt) {
     c.robot.friction.mu_s = c.robot.friction.mu_d = 1.0;
     const TailTrajectory& tr = c.trajectory;
     auto s = [&](double t) { return perFootHeldLoadFactor(c.robot, tr, c.effects, {t})[0]; };
-    const double h = 2e-5;
-    std::vector<double> times;
-    for (long i = 0; i * h <= tr.endTime() + h; ++i) times.push_back(i * h);
-    std::vector<double> v;
+    auto many = [&](const std::vector<double>& times) { return perFootHeldLoadFactor(c.robot, tr, c.effects, times); };
+    double crit = 0;
     try {
-      v = perFootHeldLoadFactor(c.robot, tr, c.effects, times);
+      crit = strokeMaximum(tr, 2e-5, s, many);
     } catch (const TippingError&) {
       continue;  // tips over: no stiction edge to test
-    }
-    std::vector<std::pair<double, double>> peaks;
-    for (size_t i = 1; i + 1 < v.size(); ++i)
-      if (v[i] >= v[i - 1] && v[i] >= v[i + 1]) peaks.emplace_back(v[i], times[i]);
-    double crit = std::max(v.front(), v.back());
-    for (double b : tr.breakpoints())
-      for (double t : {b, std::nextafter(b, 0.0), b - 1e-12}) crit = std::max(crit, s(t));
-    std::sort(peaks.rbegin(), peaks.rend());
-    for (size_t p = 0; p < std::min<size_t>(5, peaks.size()); ++p) {
-      const auto [tm, neg] = goldenMin([&](double t) { return -s(t); }, std::max(0.0, peaks[p].second - h),
-                                       peaks[p].second + h, 1e-13);
-      crit = std::max({crit, peaks[p].first, -neg});
     }
     if (!(crit > 1e-6)) continue;
     ++tested;
