@@ -96,6 +96,16 @@ TEST(TailDynamics, DecompositionAddsUpForAnyN) {
     const double mQ_over_m = r.quadruped.mass_kg / s.mass_kg;
     EXPECT_NEAR(s.MzT_tan, mQ_over_m * cross2(s.p_QB, a.F_T_Q), 1e-12 * (1 + std::abs(s.MzT))) << "n=" << n;
     EXPECT_NEAR(s.MzT_cen, mQ_over_m * cross2(s.p_QB, v.F_T_Q), 1e-12 * (1 + std::abs(s.MzT))) << "n=" << n;
+    // The acceleration-driven part comes from the same kinematics pass (a_L_acc): the same
+    // numbers, bit for bit, as a second pass with the joint speeds zeroed, and so the same load.
+    TailKinematics one, zeroed;
+    tailKinematics(r.tail, js, one, true);
+    tailKinematics(r.tail, acc_only, zeroed);
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(one.a_L_acc[i].x(), zeroed.a_L[i].x()) << "n=" << n << " link " << i;
+      EXPECT_EQ(one.a_L_acc[i].y(), zeroed.a_L[i].y()) << "n=" << n << " link " << i;
+    }
+    EXPECT_EQ(s.MzT_acc, a.MzT) << "n=" << n;
   }
 }
 

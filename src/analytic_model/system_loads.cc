@@ -37,17 +37,13 @@ SystemLoads systemLoads(const RobotParams& robot, const std::vector<JointState>&
 void systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose, SystemLoads& s,
                  LoadScratch& scratch) {
   TailKinematics& kin = scratch.kin;
-  tailKinematics(robot.tail, joints, kin);
+  tailKinematics(robot.tail, joints, kin, decompose);
   systemMassProperties(robot, kin, s);
   const Vec2 p_CB = s.p_QB - s.p_QC;  // p_B - p_COM
   netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, s.F_T_Q, s.MzT);
   if (decompose) {
     Vec2 F_acc, F_speed;
-    std::vector<JointState>& part = scratch.joints;
-    part = joints;
-    for (auto& j : part) j.theta_dot = 0.0;  // acceleration-driven
-    tailKinematics(robot.tail, part, kin);
-    netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, F_acc, s.MzT_acc);
+    netTailLoad(tailBaseLoad(robot.tail, kin, kin.a_L_acc), p_CB, F_acc, s.MzT_acc);  // acceleration-driven
     // Speed-driven: the rest. The planar Newton-Euler loads are linear in the joint accelerations
     // and carry no other term (no gravity in the plane), so total = acceleration- + speed-driven
     // to round-off (test SystemLoads.DecompositionPartsSumToTheTotal): one recursion, not two.

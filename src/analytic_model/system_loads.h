@@ -30,7 +30,6 @@ SystemLoads systemLoads(const RobotParams& robot, const std::vector<JointState>&
 // The same, reusing `scratch` between calls (no allocation in a hot loop).
 struct LoadScratch {
   TailKinematics kin;
-  std::vector<JointState> joints;
 };
 void systemLoads(const RobotParams& robot, const std::vector<JointState>& joints, bool decompose, SystemLoads& out,
                  LoadScratch& scratch);

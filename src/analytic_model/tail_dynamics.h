@@ -31,11 +31,16 @@ struct TailKinematics {
   std::vector<double> psi, omega, alpha;  // link angle, angular velocity, angular acceleration (Eq. 4)
   std::vector<Vec2> p_J;                  // joint i position (Eq. 3, with the paper-notes misprint fix)
   std::vector<Vec2> p_L, v_L, a_L;        // link i COM position, velocity, acceleration
+  // Link i COM acceleration from the joint accelerations alone (joint speeds zeroed): filled
+  // only when tailKinematics is asked for it (the acceleration-driven part of M_z,T).
+  std::vector<Vec2> a_L_acc;
 };
 
 TailKinematics tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
-// The same into `out`, reusing its storage (no allocation once sized): for hot loops.
-void tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& out);
+// The same into `out`, reusing its storage (no allocation once sized): for hot loops. With
+// `acceleration_part`, also out.a_L_acc, in the same pass (the same angles, no second sin/cos).
+void tailKinematics(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& out,
+                    bool acceleration_part = false);
 
 // Load of link 1 on the base, as the paper writes it: F_J,1 and M_J,1 (Eqs. 5-6) in B.
 // The quadruped feels F_B = -R_B F_J,1, M_B = -M_J,1 (Eq. 8).
@@ -46,6 +51,9 @@ struct TailLoad {
 
 // Recursive Newton-Euler from link n to link 1 (Eqs. 5-7).
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin);
+// The same with the link COM accelerations a_L and angular accelerations alpha given (e.g.
+// kin.a_L_acc: the load of the joint accelerations alone); positions from kin.
+TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin, const std::vector<Vec2>& a_L);
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
 
 // Distance from the tail base to link i's COM (used for the Sec. 4.7 check).
