@@ -53,6 +53,38 @@ TEST(AnalyticSimulation, MomentBelowStaticFrictionMovesNothing) {
   for (size_t i = 0; i < mzt.size(); ++i) EXPECT_EQ(mzt[i] + mzf[i], 0.0);
 }
 
+// A body held by stiction does not move, so nothing is integrated (heldChunk): every step is a
+// scan of the margins, no right-hand side is evaluated, and every row still carries the tail's
+// loads at its own time, for either coupling.
+TEST(AnalyticSimulation, HeldBodyIsScannedNotIntegrated) {
+  RobotParams robot = paperRobot(2);
+  robot.friction.mu_s = robot.friction.mu_d = 2.0;
+  const TailTrajectory tr = sameMove(2, 10, -60, 0.3, 0.3);
+  for (Coupling coupling : {Coupling::kPaper, Coupling::kExact}) {
+    AnalyticSettings s;
+    s.coupling = coupling;
+    const RunResult r = simulateAnalytic(robot, tr, s, {}, {});
+    ASSERT_TRUE(r.summary.ok) << r.summary.error;
+    EXPECT_EQ(r.summary.extra.at("rhs_evaluations"), 0.0);
+    EXPECT_EQ(r.summary.extra.at("held_steps"), static_cast<double>(r.summary.solver_steps));
+    // The step bound is 1/8 of the shortest phase (0.09 s): the 0.3 s move takes 4 chunks per
+    // segment at most, then the run is settled.
+    EXPECT_LE(r.summary.solver_steps, 4 * 4);
+    EXPECT_EQ(r.summary.phi_net_deg, 0.0);
+    EXPECT_TRUE(r.summary.at_rest);
+    const auto& t = col(r, "t_s");
+    const auto& mzt = col(r, "MzT_Nm");
+    const auto& izz = col(r, "Izz_kgm2");
+    std::vector<JointState> js;
+    for (size_t i = 0; i < t.size(); ++i) {
+      tr.evaluate(t[i], js);
+      const SystemLoads sl = systemLoads(robot, js, false);
+      ASSERT_EQ(mzt[i], sl.MzT) << "row " << i;
+      ASSERT_EQ(izz[i], sl.Izz_kgm2) << "row " << i;
+    }
+  }
+}
+
 // Largest ratio |M_z,T| / (m g L_F) over the Fig. 7 move: the mu at which breakaway just happens.
 static double criticalMu() {
   const RobotParams robot = paperRobot(1);
@@ -247,10 +279,15 @@ TEST(AnalyticSimulation, Fig7StepControlRejectsFewTrialSteps) {
   const RunResult r = runFig7();
   ASSERT_TRUE(r.summary.ok) << r.summary.error;
   const double rhs = r.summary.extra.at("rhs_evaluations"), rejected = r.summary.extra.at("rejected_steps");
-  const long steps = r.summary.solver_steps;
-  std::printf("Fig. 7: %ld steps, %.0f rejected trials, %.0f right-hand sides\n", steps, rejected, rhs);
+  const double held = r.summary.extra.at("held_steps");
+  const long steps = r.summary.solver_steps - static_cast<long>(held);  // integrated
+  std::printf("Fig. 7: %ld integrated steps, %.0f held, %.0f rejected trials, %.0f right-hand sides\n", steps, held,
+              rejected, rhs);
   EXPECT_LE(rejected, 25.0);
   EXPECT_LE(rhs, 1200.0);
+  // Held (every DOF stuck): scanned, not integrated, no right-hand side. Here the body is held
+  // from t = 0 to its breakaway at 3.88 ms (one chunk) and after its 2-D slide stops.
+  EXPECT_EQ(held, 2.0);
   // Each trial step (accepted or rejected) costs Dormand-Prince's 6 new stages; each of the run's
   // segments (one per breakpoint or switch) one more to start.
   EXPECT_GE(rhs, 6.0 * (static_cast<double>(steps) + rejected));

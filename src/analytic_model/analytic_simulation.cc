@@ -178,6 +178,7 @@ struct Run {
   long steps = 0;         // accepted solver steps
   long rhs = 0;           // right-hand sides the solver evaluated (accepted and rejected trial steps)
   long rejected = 0;      // adaptive: trial steps the error control rejected
+  long held = 0;          // adaptive: steps with every DOF stuck (heldChunk: scanned, not integrated)
   double dt_resume = 0.0;  // the step to restart with after a tail breakpoint (0: after a switch)
   // The last step's scan, kept while the modes stay (adaptiveSegment): its end margins start the
   // next scan; when a stuck margin was still falling there (dipMayCross), its last two samples
@@ -286,6 +287,44 @@ SegmentScales segmentScales(const Run& run, double t, double seg_end) {
   }
   const double max_step = run.model.settings.max_step_s;
   return {run.plan.h_scan, max_step > 0 ? max_step : shortest / 8.0};
+}
+
+// While every DOF is stuck (both, or the rotation with the translation locked) the body does not
+// move: its state is constant and there is nothing to integrate. The margins are scanned over
+// [run.t, min(seg_end, run.t + h_max)] as a solver step's would be, with the state held; a margin
+// still falling at the chunk's end carries into the next chunk's scan (a dip across the boundary),
+// and the rows after its second-last sample wait for that scan. One chunk counts as one solver
+// step and costs no right-hand side (the per-foot model holds its stuck body the same way).
+void heldChunk(Run& run, double seg_end) {
+  const AnalyticModel& m = run.model;
+  const double t_end = run.plan.t_end;
+  const SegmentScales scales = segmentScales(run, run.t, seg_end);
+  const double ta = run.t, tb = std::min(seg_end, ta + scales.h_max);
+  const State y = run.y;
+  auto stateAt = [&](double, State& ys) { ys = y; };
+  auto gAt = [&](double tt) { return eventMargins(m, run.ws, run.v_stop, tt, y, run.modes); };
+  Run::Carry& carry = run.carry;
+  const bool have = carry.have && carry.t_end == ta;
+  ScanEnd end;
+  const Found f = findSwitch(gAt, run.modes, ta, tb, scales.h_scan, m.settings.event_tol_s, have ? &carry.end : nullptr,
+                             &end, have && carry.across);
+  countStep(run);
+  ++run.held;
+  run.dt_resume = 0.0;
+  const double t_cut = f.hit ? f.t : tb;
+  const bool defer = !f.hit && dipMayCross(run.modes, end) && tb < t_end - 1e-15 && !(tb >= run.plan.tail_end);
+  recordUpTo(run, defer ? end.t_before : t_cut, stateAt);
+  run.t = t_cut;
+  carry.stepper.reset();
+  if (f.hit) {
+    carry.have = carry.across = false;
+    switchAt(run, f.which);
+    return;
+  }
+  carry.have = true;
+  carry.across = defer;
+  carry.t_end = tb;
+  carry.end = end;
 }
 
 // Adaptive dense-output Dormand-Prince from run.t until a located switch, a breakpoint of the
@@ -427,7 +466,9 @@ void integrate(Run& run) {
       break;
     }
     const double seg_end = nextBreak(run, run.t);
-    if (run.plan.adaptive)
+    if (run.plan.adaptive && stuckForGood(run))
+      heldChunk(run, seg_end);
+    else if (run.plan.adaptive)
       adaptiveSegment(run, seg_end);
     else
       fixedStep(run, seg_end);
@@ -445,6 +486,7 @@ void summarize(const Run& run, RunSummary& sum) {
   sum.solver_steps = run.steps;
   sum.extra["rhs_evaluations"] = static_cast<double>(run.rhs);
   sum.extra["rejected_steps"] = static_cast<double>(run.rejected);
+  sum.extra["held_steps"] = static_cast<double>(run.held);
   sum.extra["final_x_m"] = y[kX];
   sum.extra["final_y_m"] = y[kY];
   sum.extra["final_phidot_dps"] = y[kPhiDot] * 180.0 / M_PI;
