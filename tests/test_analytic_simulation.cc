@@ -309,9 +309,12 @@ TEST(AnalyticSimulation, CachedTailLoadsEqualAFreshEvaluation) {
   const State y{0.1, 0.2, 0.0, 0.0, 0.01, -0.02};
   Modes modes;
   modes.rot_dir = 1.0;
-  const double times[] = {0.05, 0.05, 0.05, 0.12, 0.05, 0.12, 0.12, 0.2};
-  const bool decomp[] = {false, true, false, true, false, false, true, true};
-  for (int k = 0; k < 8; ++k) {
+  // The move ends at 0.3 s: from then on one evaluation serves every later time (and one just
+  // before the end must not be taken for it).
+  const double times[] = {0.05, 0.05, 0.05, 0.12, 0.05, 0.12, 0.12, 0.2, 0.3, 0.35, 0.35, 0.9, 0.3 - 1e-9, 0.9, 0.31};
+  const bool decomp[] = {false, true, false, true, false, false, true, true, false, false, true, true, false, false, true};
+  static_assert(std::size(times) == std::size(decomp));
+  for (std::size_t k = 0; k < std::size(times); ++k) {
     AnalyticWorkspace fresh;
     const Eval a = evaluate(m, shared, times[k], y, modes, decomp[k]);
     const Eval b = evaluate(m, fresh, times[k], y, modes, decomp[k]);
@@ -326,7 +329,11 @@ TEST(AnalyticSimulation, CachedTailLoadsEqualAFreshEvaluation) {
       EXPECT_EQ(a.loads.MzT_cen, b.loads.MzT_cen) << k;
     }
     ASSERT_EQ(shared.joints.size(), fresh.joints.size());
-    for (std::size_t j = 0; j < fresh.joints.size(); ++j) EXPECT_EQ(shared.joints[j].theta, fresh.joints[j].theta) << k;
+    for (std::size_t j = 0; j < fresh.joints.size(); ++j) {
+      EXPECT_EQ(shared.joints[j].theta, fresh.joints[j].theta) << k;
+      EXPECT_EQ(shared.joints[j].theta_dot, fresh.joints[j].theta_dot) << k;
+      EXPECT_EQ(shared.joints[j].theta_ddot, fresh.joints[j].theta_ddot) << k;
+    }
   }
   }
 }

@@ -125,14 +125,15 @@ Eval evaluate(const AnalyticModel& m, AnalyticWorkspace& w, double t, const Stat
               bool decompose) {
   Eval ev;
   AnalyticWorkspace::TailCache& c = w.tail_cache;
-  if (c.valid && c.t == t && (c.decomposed || !decompose)) {  // w.joints are still those at t
+  // w.joints are still those at t: the same time, or both times after the tail's motion.
+  if (c.valid && (c.t == t || (c.finished && m.traj.finished(t))) && (c.decomposed || !decompose)) {
     ev.loads = c.loads;
     ev.L_F = c.L_F;
   } else {
     c.valid = false;  // until tailLoadsAndArm returns (it throws when the robot tips)
     m.traj.evaluate(t, w.joints);
     tailLoadsAndArm(m, w, t, decompose, ev);
-    c = {true, decompose, t, ev.loads, ev.L_F};
+    c = {true, decompose, m.traj.finished(t), t, ev.loads, ev.L_F};
   }
   ev.FT_W = rotate(y[kPhi], ev.loads.F_T_Q);
   ev.M_break = m.mu_break * m.weight * (m.needsArm() ? ev.L_F : 0.0);

@@ -53,9 +53,11 @@ struct AnalyticWorkspace {
   TailKinematics exact_kin;
   // The tail loads and friction arm at the last evaluated time: they depend on t alone (the
   // trajectory), and the solver asks for the same t more than once (Dormand-Prince's last two
-  // stages, an event scan at a step's end). Valid while the model is the same.
+  // stages, an event scan at a step's end). Once every joint has finished its motion they no
+  // longer depend on t at all (TailTrajectory::finished): one evaluation serves the rest of the
+  // run. Valid while the model is the same.
   struct TailCache {
-    bool valid = false, decomposed = false;
+    bool valid = false, decomposed = false, finished = false;
     double t = 0.0;
     SystemLoads loads;
     double L_F = 0.0;

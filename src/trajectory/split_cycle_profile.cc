@@ -123,6 +123,12 @@ void TailTrajectory::evaluate(double t, std::vector<JointState>& out) const {
   for (size_t i = 0; i < joints.size(); ++i) out[i] = joints[i].at(t);
 }
 
+bool TailTrajectory::finished(double t) const {
+  for (const JointProfile& j : joints)
+    if (!j.finished(t)) return false;
+  return true;
+}
+
 double TailTrajectory::startTime() const {
   double t = joints.empty() ? 0.0 : joints[0].params().t0_s;
   for (const auto& j : joints) t = std::min(t, j.params().t0_s);

@@ -75,6 +75,8 @@ class JointProfile {
   double decelAmplitude() const { return B_; }  // B of Eq. (23)  [rad/s^2] (0 for a spline)
   double t1() const { return p_.t0_s + da_; }   // split-cycle: end of acceleration; spline: peak |speed|
   double t2() const { return p_.t0_s + p_.dT_s; }
+  // At its final rest at t: at(t) is {theta0 + dtheta, 0, 0} (the same test at() makes).
+  bool finished(double t) const { return t - p_.t0_s >= p_.dT_s; }
   double peakSpeed() const { return isSpline() ? peak_ : 2.0 * p_.dtheta_rad / p_.dT_s; }  // signed, at t1
   // Times where the acceleration changes formula: t0, t1, t2 (split-cycle) or every knot (spline).
   void breakpoints(std::vector<double>& out) const;
@@ -96,6 +98,9 @@ struct TailTrajectory {
   void evaluate(double t, std::vector<JointState>& out) const;
   double startTime() const;  // earliest t0
   double endTime() const;    // latest t2: the tail is at rest afterwards
+  // Every joint at its final rest at t (JointProfile::finished): evaluate(t) is then the same for
+  // every such t.
+  bool finished(double t) const;
   // Times where some joint's acceleration changes formula (JointProfile::breakpoints), sorted.
   std::vector<double> breakpoints() const;
   // The shortest acceleration or deceleration phase (split-cycle) or knot spacing (spline) of the
