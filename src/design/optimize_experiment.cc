@@ -13,6 +13,7 @@
 
 #include "analytic_model/analytic_simulation.h"
 #include "analytic_model/per_foot_model.h"
+#include "experiments/experiment_loader.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
@@ -186,7 +187,12 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   }
   rep.spread = hi > 0 ? (hi - lo) / hi : 0.0;
   const OptimizeResult& best = rep.per_seed[rep.best_seed_index];
-  const TailTrajectory& traj = best.trajectory;
+  // The re-simulations run the stroke as best.yaml writes it, read back by the experiment loader:
+  // its angles are decimal degrees there, which need not convert back to the search's radians to
+  // the last bit, and `tailsim run best.yaml` must give what summary.json reports.
+  const std::string best_yaml = bestExperimentYaml(spec, best.trajectory);
+  const TailTrajectory traj =
+      loadExperimentText(best_yaml, (fs::path(out_dir) / "best.yaml").string()).cases.at(0).trajectory();
 
   // Verification: re-simulate, check the limits on what the model ran, and run MuJoCo.
   const OutputSettings out = fullOutput(spec.base, traj);
@@ -217,7 +223,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   writeCsvAtomic((fs::path(out_dir) / "best_trajectory.csv").string(),
                  trajectorySeries(spec.base.robot.tail, traj, 1e-3, traj.endTime()));
   rep.files.push_back("best_trajectory.csv");
-  writeFileAtomic((fs::path(out_dir) / "best.yaml").string(), bestExperimentYaml(spec, traj));
+  writeFileAtomic((fs::path(out_dir) / "best.yaml").string(), best_yaml);
   rep.files.push_back("best.yaml");
 
   // Convergence history.
