@@ -122,7 +122,7 @@ struct RunPlan {
   double t_end = 0;     // [s]
   long rows = 0;        // output rows
   double tail_end = 0;  // the tail stops moving  [s]
-  double h_scan = 0;    // event sampling interval, the shortest phase of all  [s] (segmentScales: per segment)
+  double h_scan = 0;    // event sampling interval, the shortest phase of all / 32  [s] (segmentScales: per segment)
   double h_max = 0;     // adaptive step bound while the tail moves, the same  [s]
   bool adaptive = true;
 };
@@ -267,15 +267,16 @@ void countStep(Run& run) {
 }
 
 // Event sampling interval and step bound over [t, seg_end], which lies between two breakpoints of
-// the tail profile: each joint is in one phase there. The step bound follows the shortest phase of
-// the joints that move (planRun's rule restricted to what moves: a joint at rest adds no load
-// variation). The event sampling keeps the whole run's shortest phase while the tail moves: a
-// margin's dip is found only when it spans at most two sample intervals (chosen when a dip across a
-// step boundary was still missed, docs/accuracy.md "A dip across a step boundary"; a sparser
-// sampling per segment has not been measured since that fix). With the whole tail at rest its loads vanish (no joint
-// speed or acceleration); with the paper coupling every margin is then monotone in time (constant
-// friction decelerations, no tail force), so a step's midpoint and end suffice. With the exact
-// coupling the rotation and the translation still exchange momentum: the run's sampling stays.
+// the tail profile: each joint is in one phase there. Both follow the shortest phase of the joints
+// that move (planRun's rules restricted to what moves: a joint at rest adds no load variation, and
+// a load peak is as wide as the phase that makes it): step bound 1/8 of it, sampling 1/32. A
+// margin's dip is found when it spans at most two sample intervals, also across a step's end
+// (docs/accuracy.md "A dip across a step boundary"; the sampling followed the whole run's shortest
+// phase until that fix was in, docs/scale.md "Analytic hot path"). With the whole tail at rest its
+// loads vanish (no joint speed or acceleration); with the paper coupling every margin is then
+// monotone in time (constant friction decelerations, no tail force), so a step's midpoint and end
+// suffice. With the exact coupling the rotation and the translation still exchange momentum: the
+// run's sampling stays.
 struct SegmentScales {
   double h_scan, h_max;
 };
@@ -286,7 +287,7 @@ SegmentScales segmentScales(const Run& run, double t, double seg_end) {
     return {paper ? shortest : run.plan.h_scan, run.plan.h_max};
   }
   const double max_step = run.model.settings.max_step_s;
-  return {run.plan.h_scan, max_step > 0 ? max_step : shortest / 8.0};
+  return {shortest / 32.0, max_step > 0 ? max_step : shortest / 8.0};
 }
 
 // While every DOF is stuck (both, or the rotation with the translation locked) the body does not
