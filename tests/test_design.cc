@@ -462,6 +462,28 @@ class OptimizeFileTest : public ::testing::Test {
 
 constexpr const char* kLimits = "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n";
 
+// best.yaml runs its stroke to the tail's end + settle, as the re-runs in summary.json do, even
+// when the base experiment cut its runs short (output.duration_s); without an output section it
+// gets none.
+TEST_F(OptimizeFileTest, BestYamlRunsTheStrokeToItsEnd) {
+  for (const bool cut : {true, false}) {
+    std::ofstream(dir_ / "base.yaml") << "name: b\nrobot: " << kSourceDir
+                                       << "/configs/robots/paper_quadruped.yaml\ntail: {links: 1}\n"
+                                          "trajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\nmodels: [analytic]\n"
+                                       << (cut ? "output: {duration_s: 0.05, sample_dt_s: 0.01}\n" : "");
+    const OptimizeSpec s = loadOptimizeSpec(write(std::string("  family: split_cycle\n") + kLimits + "  seeds: [1]\n"));
+    EXPECT_EQ(s.base.output.duration_s, cut ? 0.05 : 0.0);
+    const std::string y = bestExperimentYaml(s, s.base.trajectory());
+    const Experiment e = loadExperimentText(y, "best.yaml");
+    ASSERT_EQ(e.cases.size(), 1u);
+    EXPECT_EQ(e.cases[0].output.duration_s, 0.0) << y;
+    if (cut) {
+      EXPECT_EQ(e.cases[0].output.sample_dt_s, 0.01) << y;  // the rest of the section stays
+    }
+    EXPECT_EQ(y.find("output") != std::string::npos, cut) << y;
+  }
+}
+
 TEST_F(OptimizeFileTest, GoodFileLoads) {
   const OptimizeSpec s = loadOptimizeSpec(write(std::string("  family: spline\n  knots: 2\n") + kLimits +
                                                 "  seeds: [1, 2]\n  islands: 3\n  objective: phi_net_per_energy\n"));

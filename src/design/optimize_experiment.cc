@@ -150,6 +150,9 @@ std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& t
     }
   }
   doc["trajectory"] = t;
+  // The re-runs simulate to the tail's end + settle (fullOutput); so does the file.
+  const YAML::Node& base = doc;  // const: looking up a key must not add it
+  if (base["output"] && base["output"].IsMap() && base["output"]["duration_s"]) doc["output"]["duration_s"] = 0;
   YAML::Node models(YAML::NodeType::Sequence);
   models.SetStyle(YAML::EmitterStyle::Flow);
   models.push_back("analytic");
@@ -190,9 +193,15 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   // The re-simulations run the stroke as best.yaml writes it, read back by the experiment loader:
   // its angles are decimal degrees there, which need not convert back to the search's radians to
   // the last bit, and `tailsim run best.yaml` must give what summary.json reports.
+  // It cannot fail the search's work: if the loader refuses the file, the re-runs use the search's
+  // trajectory and the report says why (best.yaml is still written).
   const std::string best_yaml = bestExperimentYaml(spec, best.trajectory);
-  const TailTrajectory traj =
-      loadExperimentText(best_yaml, (fs::path(out_dir) / "best.yaml").string()).cases.at(0).trajectory();
+  TailTrajectory traj = best.trajectory;
+  try {
+    traj = loadExperimentText(best_yaml, (fs::path(out_dir) / "best.yaml").string()).cases.at(0).trajectory();
+  } catch (const std::exception& e) {
+    rep.best_yaml_error = e.what();
+  }
 
   // Verification: re-simulate, check the limits on what the model ran, and run MuJoCo.
   const OutputSettings out = fullOutput(spec.base, traj);
@@ -369,6 +378,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["evaluations"] = rep.evaluations;
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;
+  if (!rep.best_yaml_error.empty()) j["best_yaml_error"] = rep.best_yaml_error;
   writeFileAtomic((fs::path(out_dir) / "summary.json").string(), j.dump(2) + "\n");
   rep.files.push_back("summary.json");
   return rep;

@@ -39,6 +39,10 @@ struct OptimizeReport {
   long evaluations = 0;
   double wall_s = 0.0;
   std::vector<std::string> files;  // written, relative to DIR
+  // Not empty when best.yaml could not be read back by the experiment loader (e.g. a limit the
+  // base never met on this stroke): the re-runs then use the search's own trajectory, and
+  // `tailsim run best.yaml` gives this error instead of their results.
+  std::string best_yaml_error;
 };
 
 OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress);

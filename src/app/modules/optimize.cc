@@ -50,6 +50,9 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
                 r.limits_analytic.ok ? "kept" : "VIOLATED", r.per_seed.size(), 100.0 * r.spread, r.evaluations, r.wall_s);
     for (const std::string& f : r.files) std::printf("%s/%s\n", out_dir, f.c_str());
     std::fflush(stdout);
+    if (!r.best_yaml_error.empty())
+      std::fprintf(stderr, "warning: %s/best.yaml does not load back (%s): the re-runs used the search's trajectory\n",
+                   out_dir, r.best_yaml_error.c_str());
     return r.limits_analytic.ok ? 0 : 3;
   });
 }
