@@ -67,9 +67,9 @@ TEST(AnalyticSimulation, HeldBodyIsScannedNotIntegrated) {
     ASSERT_TRUE(r.summary.ok) << r.summary.error;
     EXPECT_EQ(r.summary.extra.at("rhs_evaluations"), 0.0);
     EXPECT_EQ(r.summary.extra.at("held_steps"), static_cast<double>(r.summary.solver_steps));
-    // The step bound is 1/8 of the shortest phase (0.09 s): the 0.3 s move takes 4 chunks per
-    // segment at most, then the run is settled.
-    EXPECT_LE(r.summary.solver_steps, 4 * 4);
+    // One chunk per step bound, 1/8 of the phase in progress: 8 over the acceleration (0.09 s), 8
+    // over the deceleration (0.21 s); then the run is settled.
+    EXPECT_EQ(r.summary.solver_steps, 8 + 8);
     EXPECT_EQ(r.summary.phi_net_deg, 0.0);
     EXPECT_TRUE(r.summary.at_rest);
     const auto& t = col(r, "t_s");
@@ -393,27 +393,41 @@ TEST(AnalyticSimulation, LoadPeakAtAStepBoundaryBreaksStiction) {
     if (ratio > crit) crit = ratio, t_peak = i * 1e-6;
   }
   std::printf("critical mu %.9f at t = %.6f s\n", crit, t_peak);
-  for (const double f : {1.0 - 1e-5, 1.0 + 1e-5}) {
-    r.friction.mu_s = r.friction.mu_d = f * crit;
-    const RunResult res = simulateAnalytic(r, tr, {}, {}, {});
-    ASSERT_TRUE(res.summary.ok) << res.summary.error;
-    if (f < 1) {
-      EXPECT_GE(res.summary.stick_slip_events, 1) << "mu = (1 - 1e-5) x critical";
-      EXPECT_EQ(res.summary.extra.at("ever_rotated"), 1.0);
-      // The row at t = 4 ms lies inside the slide (3.989 to 4.023 ms) and after the step boundary
-      // at 4.1 ms's previous scan: it is recorded only once the next scan has found the breakaway.
-      const auto& t = col(res, "t_s");
-      ASSERT_GT(t.size(), 4u);
-      ASSERT_NEAR(t[4], 0.004, 1e-12);
-      EXPECT_EQ(col(res, "rot_state")[4], 1.0) << "the 4 ms row shows the body stuck";
-      EXPECT_NE(col(res, "phidot_dps")[4], 0.0);
-      EXPECT_EQ(col(res, "rot_state")[3], 0.0);
-      EXPECT_EQ(col(res, "rot_state")[5], 0.0);
-    } else {
-      EXPECT_EQ(res.summary.stick_slip_events, 0) << "mu = (1 + 1e-5) x critical";
-      EXPECT_EQ(res.summary.phi_net_deg, 0.0);
+  // The body is held until the breakaway: it is scanned in chunks of the step bound (heldChunk),
+  // 1 ms here (1/8 of the 8 ms acceleration), so the peak at 4 ms is a chunk's last sample and the
+  // scan of [3, 4] ms sees the crossing. With the step bound 1.00375 ms a chunk ends 15 us after
+  // the peak, where the margin is back above zero: that chunk only sees its margin still falling,
+  // and the next chunk's scan, looking back across its start (4.015 ms), finds the breakaway
+  // before it. Both must give the same breakaway and the same slide.
+  double t_stop[2] = {0, 0};
+  for (int grid = 0; grid < 2; ++grid) {
+    AnalyticSettings s;
+    s.max_step_s = grid == 0 ? 0.0 : 1.00375e-3;
+    for (const double f : {1.0 - 1e-5, 1.0 + 1e-5}) {
+      r.friction.mu_s = r.friction.mu_d = f * crit;
+      const RunResult res = simulateAnalytic(r, tr, s, {}, {});
+      ASSERT_TRUE(res.summary.ok) << res.summary.error;
+      if (f < 1) {
+        EXPECT_GE(res.summary.stick_slip_events, 1) << "mu = (1 - 1e-5) x critical, grid " << grid;
+        EXPECT_EQ(res.summary.extra.at("ever_rotated"), 1.0);
+        t_stop[grid] = res.summary.t_stop_s;
+        // The row at t = 4 ms lies inside the slide (3.989 to 4.023 ms), after the last sample of the
+        // scan before it: it is recorded only once the scan that finds the breakaway has looked.
+        const auto& t = col(res, "t_s");
+        ASSERT_GT(t.size(), 4u);
+        ASSERT_NEAR(t[4], 0.004, 1e-12);
+        EXPECT_EQ(col(res, "rot_state")[4], 1.0) << "the 4 ms row shows the body stuck, grid " << grid;
+        EXPECT_NE(col(res, "phidot_dps")[4], 0.0);
+        EXPECT_EQ(col(res, "rot_state")[3], 0.0);
+        EXPECT_EQ(col(res, "rot_state")[5], 0.0);
+      } else {
+        EXPECT_EQ(res.summary.stick_slip_events, 0) << "mu = (1 + 1e-5) x critical, grid " << grid;
+        EXPECT_EQ(res.summary.phi_net_deg, 0.0);
+      }
     }
   }
+  EXPECT_NEAR(t_stop[0], 0.004023, 1e-6);
+  EXPECT_NEAR(t_stop[1], t_stop[0], 1e-9);
 }
 
 // Seeded random strokes at the edge of stiction: with translation locked and the paper coupling,

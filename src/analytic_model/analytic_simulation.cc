@@ -123,7 +123,7 @@ struct RunPlan {
   long rows = 0;        // output rows
   double tail_end = 0;  // the tail stops moving  [s]
   double h_scan = 0;    // event sampling interval, the shortest phase of all / 32  [s] (segmentScales: per segment)
-  double h_max = 0;     // adaptive step bound while the tail moves, the same  [s]
+  double h_max = 0;     // adaptive step bound while the tail moves, the shortest phase of all / 8  [s] (idem)
   bool adaptive = true;
 };
 
