@@ -67,9 +67,11 @@ TEST(AnalyticSimulation, HeldBodyIsScannedNotIntegrated) {
     ASSERT_TRUE(r.summary.ok) << r.summary.error;
     EXPECT_EQ(r.summary.extra.at("rhs_evaluations"), 0.0);
     EXPECT_EQ(r.summary.extra.at("held_steps"), static_cast<double>(r.summary.solver_steps));
-    // One chunk per step bound, 1/8 of the phase in progress: 8 over the acceleration (0.09 s), 8
-    // over the deceleration (0.21 s); then the run is settled.
-    EXPECT_EQ(r.summary.solver_steps, 8 + 8);
+    // Chunks grow tenfold from 1e-4 s up to the step bound, 1/8 of the phase in progress. The
+    // acceleration (0.09 s): 1e-4, 1e-3, 1e-2 s, then 8 of 11.25 ms, the last one cut to 0.14 ms
+    // at the breakpoint; the deceleration (0.21 s): 1.4 ms, 14 ms, then 8 of 26.25 ms (the last
+    // one cut); then the run is settled.
+    EXPECT_EQ(r.summary.solver_steps, 3 + 8 + 2 + 8);
     EXPECT_EQ(r.summary.phi_net_deg, 0.0);
     EXPECT_TRUE(r.summary.at_rest);
     const auto& t = col(r, "t_s");
@@ -286,8 +288,9 @@ TEST(AnalyticSimulation, Fig7StepControlRejectsFewTrialSteps) {
   EXPECT_LE(rejected, 25.0);
   EXPECT_LE(rhs, 1200.0);
   // Held (every DOF stuck): scanned, not integrated, no right-hand side. Here the body is held
-  // from t = 0 to its breakaway at 3.88 ms (one chunk) and after its 2-D slide stops.
-  EXPECT_EQ(held, 2.0);
+  // from t = 0 to its breakaway at 3.88 ms (chunks of 0.1 ms, 1 ms, then to the breakaway) and
+  // after its 2-D slide stops at 248.3 ms (0.1 ms, 1 ms, then to the tail's end at 250 ms).
+  EXPECT_EQ(held, 6.0);
   // Each trial step (accepted or rejected) costs Dormand-Prince's 6 new stages; each of the run's
   // segments (one per breakpoint or switch) one more to start.
   EXPECT_GE(rhs, 6.0 * (static_cast<double>(steps) + rejected));
@@ -393,12 +396,13 @@ TEST(AnalyticSimulation, LoadPeakAtAStepBoundaryBreaksStiction) {
     if (ratio > crit) crit = ratio, t_peak = i * 1e-6;
   }
   std::printf("critical mu %.9f at t = %.6f s\n", crit, t_peak);
-  // The body is held until the breakaway: it is scanned in chunks of the step bound (heldChunk),
-  // 1 ms here (1/8 of the 8 ms acceleration), so the peak at 4 ms is a chunk's last sample and the
-  // scan of [3, 4] ms sees the crossing. With the step bound 1.00375 ms a chunk ends 15 us after
-  // the peak, where the margin is back above zero: that chunk only sees its margin still falling,
-  // and the next chunk's scan, looking back across its start (4.015 ms), finds the breakaway
-  // before it. Both must give the same breakaway and the same slide.
+  // The body is held until the breakaway, scanned in chunks (heldChunk) of 0.1 ms, 1 ms, then the
+  // step bound, 1 ms here (1/8 of the 8 ms acceleration): they end at 0.1, 1.1, ..., 4.1 ms. The
+  // chunk [3.1, 4.1] ms only sees its margin still falling at its end (the peak is 0.1 ms before,
+  // where the margin dips below zero for about 20 us), and the next chunk's scan, looking back
+  // across its start, finds the breakaway at 3.989 ms, before it. With the step bound 1.00375 ms
+  // the peak lies inside the chunk [3.1075, 4.11125] ms, whose own samples show the dip. Both
+  // must give the same breakaway and the same slide.
   double t_stop[2] = {0, 0};
   for (int grid = 0; grid < 2; ++grid) {
     AnalyticSettings s;
@@ -411,8 +415,8 @@ TEST(AnalyticSimulation, LoadPeakAtAStepBoundaryBreaksStiction) {
         EXPECT_GE(res.summary.stick_slip_events, 1) << "mu = (1 - 1e-5) x critical, grid " << grid;
         EXPECT_EQ(res.summary.extra.at("ever_rotated"), 1.0);
         t_stop[grid] = res.summary.t_stop_s;
-        // The row at t = 4 ms lies inside the slide (3.989 to 4.023 ms), after the last sample of the
-        // scan before it: it is recorded only once the scan that finds the breakaway has looked.
+        // The row at t = 4 ms lies inside the slide (3.989 to 4.023 ms), after the second-last sample
+        // of the chunk before it: it is recorded only once the scan that finds the breakaway has looked.
         const auto& t = col(res, "t_s");
         ASSERT_GT(t.size(), 4u);
         ASSERT_NEAR(t[4], 0.004, 1e-12);
@@ -440,9 +444,19 @@ TEST(AnalyticSimulation, LoadPeakAtAStepBoundaryBreaksStiction) {
 // windows that close within the first sample interval).
 TEST(AnalyticSimulation, RandomStrokesAtTheEdgeOfStictionBreakExactlyBelowIt) {
   RandomCases cases(20261126);
+  std::mt19937 own_phases(7);  // every other stroke: each joint its own dT and w_ss
+  std::uniform_real_distribution<double> u(0.0, 1.0);
   int broke = 0, held = 0;
   for (int k = 0; k < 60; ++k) {
     RandomCase c = cases.next();
+    if (k % 2) {  // the sampling follows the joints that move: segments of unequal phases
+      for (SplitCycleProfile& j : c.trajectory.joints) {
+        SplitCycleParams p = j.params();
+        p.dT_s = 0.05 + 0.95 * u(own_phases);
+        p.w_ss = 0.02 + 0.96 * u(own_phases);
+        j = SplitCycleProfile(p);
+      }
+    }
     c.effects.friction = FrictionLaw::kStiction;
     c.effects.translation = false;
     c.settings.coupling = Coupling::kPaper;

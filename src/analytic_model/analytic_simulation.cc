@@ -180,6 +180,7 @@ struct Run {
   long rejected = 0;      // adaptive: trial steps the error control rejected
   long held = 0;          // adaptive: steps with every DOF stuck (heldChunk: scanned, not integrated)
   double dt_resume = 0.0;  // the step to restart with after a tail breakpoint (0: after a switch)
+  double held_dt = 0.0;    // heldChunk: the chunk to go on with (0: after a switch, start small)
   // The last step's scan, kept while the modes stay (adaptiveSegment): its end margins start the
   // next scan; when a stuck margin was still falling there (dipMayCross), its last two samples
   // and its dense output too, and the rows after its second-last sample wait for the next step.
@@ -203,6 +204,7 @@ double stopSpeed(const AnalyticModel& m, const RunPlan& plan) {
 // Switches DOF `which` (or none, -1) at run.t, then settles the modes; keeps the summary counters.
 void switchAt(Run& run, int which) {
   const Modes before = run.modes;
+  run.held_dt = 0.0;
   if (which >= 0) {
     applySwitch(run.model, run.ws, which, run.t, run.y, run.modes);
     ++run.switches;
@@ -291,16 +293,20 @@ SegmentScales segmentScales(const Run& run, double t, double seg_end) {
 }
 
 // While every DOF is stuck (both, or the rotation with the translation locked) the body does not
-// move: its state is constant and there is nothing to integrate. The margins are scanned over
-// [run.t, min(seg_end, run.t + h_max)] as a solver step's would be, with the state held; a margin
-// still falling at the chunk's end carries into the next chunk's scan (a dip across the boundary),
-// and the rows after its second-last sample wait for that scan. One chunk counts as one solver
-// step and costs no right-hand side (the per-foot model holds its stuck body the same way).
+// move: its state is constant and there is nothing to integrate. The margins are scanned chunk by
+// chunk as a solver step's would be, with the state held; a margin still falling at the chunk's
+// end carries into the next chunk's scan (a dip across the boundary), and the rows after its
+// second-last sample wait for that scan. The chunks grow as the solver's steps would with no error
+// to control: 1e-4 s after a switch, then 10 times the last one, up to the step bound (across a
+// tail breakpoint too). So a margin's dip right after a switch is
+// sampled finely: a chunk has no sample before its start to show a dip whose lowest sample is
+// that start. One chunk counts as one solver step and costs no right-hand side.
 void heldChunk(Run& run, double seg_end) {
   const AnalyticModel& m = run.model;
   const double t_end = run.plan.t_end;
   const SegmentScales scales = segmentScales(run, run.t, seg_end);
-  const double ta = run.t, tb = std::min(seg_end, ta + scales.h_max);
+  const double dt = std::min(run.held_dt > 0.0 ? run.held_dt : 1e-4, scales.h_max);
+  const double ta = run.t, tb = std::min(seg_end, ta + dt);
   const State y = run.y;
   auto stateAt = [&](double, State& ys) { ys = y; };
   auto gAt = [&](double tt) { return eventMargins(m, run.ws, run.v_stop, tt, y, run.modes); };
@@ -312,6 +318,7 @@ void heldChunk(Run& run, double seg_end) {
   countStep(run);
   ++run.held;
   run.dt_resume = 0.0;
+  run.held_dt = 10.0 * (tb - ta);  // (switchAt below resets it)
   const double t_cut = f.hit ? f.t : tb;
   const bool defer = !f.hit && dipMayCross(run.modes, end) && tb < t_end - 1e-15 && !(tb >= run.plan.tail_end);
   recordUpTo(run, defer ? end.t_before : t_cut, stateAt);
