@@ -449,3 +449,21 @@ TEST(PerFootModel, RandomStrokesAtTheEdgeOfStictionBreakExactlyBelowIt) {
   std::printf("%d strokes tested at their critical coefficient\n", tested);
   EXPECT_GE(tested, 8);
 }
+
+// max_load_factor_stuck is the largest load factor while held, and a held body has s <= 1 (it breaks
+// away where s reaches 1). A chunk that broke away used to contribute s at its end, after the
+// breakaway: up to 60 over these runs.
+TEST(PerFootModel, MaxLoadFactorWhileHeldIsAtMostOne) {
+  RandomCases gen(12345);
+  int checked = 0;
+  for (int k = 0; k < 400; ++k) {
+    const RandomCase c = gen.next();
+    if (c.robot.numLinks() > 3 || c.effects.friction != FrictionLaw::kStiction) continue;
+    const RunResult r = simulatePerFoot(c.robot, c.trajectory, {}, c.effects, {});
+    if (!r.summary.ok) continue;
+    const double s = r.summary.extra.at("max_load_factor_stuck");
+    EXPECT_LE(s, 1.0 + 1e-6) << "case " << k << ": " << describe(c);
+    ++checked;
+  }
+  EXPECT_GT(checked, 100);
+}

@@ -406,9 +406,11 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     int switches = 0, breakaways = 0;
     long steps = 0;
 
+    double held_dt = 0.0;  // the stuck chunk to go on with (0: after a switch, start small)
     // Makes the mode consistent with (t, y): a held wrench outside the limit surface breaks away, a
     // slide slower than v_stop whose holding wrench is inside sticks (twist set to zero).
     auto settle = [&]() {
+      held_dt = 0.0;
       if (!model.stiction()) return;
       for (int n = 0;; ++n) {
         if (n > 8) throw std::runtime_error("stick/slip modes do not settle at t=" + std::to_string(t) + " s");
@@ -461,18 +463,22 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       }
       const double seg_end = nextBreak(t);
       if (stuck) {
-        // Nothing moves: scan the load factor up to the next breakpoint (h_max at a time). A margin
+        // Nothing moves: scan the load factor up to the next breakpoint, chunk by chunk. A margin
         // still falling at a chunk's end goes on into the next chunk's scan (a dip across the
-        // boundary), and the rows after its second-last sample wait for that scan.
-        const double tb = std::min(seg_end, t + h_max);
+        // boundary), and the rows after its second-last sample wait for that scan. The chunks grow
+        // as the solver's steps would: 1e-4 s after a switch, then tenfold up to h_max, so a dip
+        // just after the switch is sampled finely (analytic model: heldChunk).
+        const double tb = std::min(seg_end, t + std::min(held_dt > 0.0 ? held_dt : 1e-4, h_max));
+        held_dt = 10.0 * (tb - t);  // (settle() resets it)
         auto stateAt = [&](double, State& ys) { ys = y; };
         const bool have = chunk.have && chunk.t_end == t;
         ScanEnd end;
         const double ts = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt,
                                      have ? &chunk.end : nullptr, &end);
         const bool hit = ts <= tb;
-        // The load factor at the chunk's end: the scan's last sample when it got there.
-        max_load_factor = std::max(max_load_factor, 1.0 - (hit ? margin(model, tb, y, true, v_stop) : end.g_end[kRot]));
+        // The load factor at the chunk's end (the scan's last sample), or where it broke away (about
+        // 1): not at tb then, where the held body no longer exists (that read up to 18 on random runs).
+        max_load_factor = std::max(max_load_factor, 1.0 - (hit ? margin(model, ts, y, true, v_stop) : end.g_end[kRot]));
         const bool defer = !hit && dipMayCross(scanModes(true), end) && tb < t_end - 1e-15 && !settled(tb);
         const double t_cut = std::min(ts, tb);
         recordUpTo(defer ? end.t_before : t_cut, stateAt);
