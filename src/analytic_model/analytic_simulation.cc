@@ -298,9 +298,9 @@ SegmentScales segmentScales(const Run& run, double t, double seg_end) {
 // end carries into the next chunk's scan (a dip across the boundary), and the rows after its
 // second-last sample wait for that scan. The chunks grow as the solver's steps would with no error
 // to control: 1e-4 s after a switch, then 10 times the last one, up to the step bound (across a
-// tail breakpoint too). So a margin's dip right after a switch is
-// sampled finely: a chunk has no sample before its start to show a dip whose lowest sample is
-// that start. One chunk counts as one solver step and costs no right-hand side.
+// tail breakpoint too). So a margin's dip right after a switch is sampled finely: a chunk has no
+// sample before its start to show a dip whose lowest sample is that start. One chunk counts as
+// one solver step and costs no right-hand side.
 void heldChunk(Run& run, double seg_end) {
   const AnalyticModel& m = run.model;
   const double t_end = run.plan.t_end;

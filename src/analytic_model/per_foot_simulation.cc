@@ -477,7 +477,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
                                      have ? &chunk.end : nullptr, &end);
         const bool hit = ts <= tb;
         // The load factor at the chunk's end (the scan's last sample), or where it broke away (about
-        // 1): not at tb then, where the held body no longer exists (that read up to 18 on random runs).
+        // 1): not at tb then, where the held body no longer exists (that read up to 60 on random runs).
         max_load_factor = std::max(max_load_factor, 1.0 - (hit ? margin(model, ts, y, true, v_stop) : end.g_end[kRot]));
         const bool defer = !hit && dipMayCross(scanModes(true), end) && tb < t_end - 1e-15 && !settled(tb);
         const double t_cut = std::min(ts, tb);

@@ -51,8 +51,8 @@ struct TailLoad {
 
 // Recursive Newton-Euler from link n to link 1 (Eqs. 5-7).
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin);
-// The same with the link COM accelerations a_L and angular accelerations alpha given (e.g.
-// kin.a_L_acc: the load of the joint accelerations alone); positions from kin.
+// The same with the link COM accelerations a_L given (e.g. kin.a_L_acc: the load of the joint
+// accelerations alone); positions and angular accelerations from kin.
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin, const std::vector<Vec2>& a_L);
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
 
