@@ -7,11 +7,14 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "analytic_test_util.h"
+#include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/model_registry.h"
 #include "experiments/time_series_h5.h"
 #include "plotting/result_folder.h"
 #include "results/atomic_file.h"
@@ -273,4 +276,64 @@ TEST(TimeSeriesRows, AppendRepeatedEqualsAppendingEachRow) {
     for (std::size_t i = 0; i < a.numRows(); ++i) ASSERT_EQ(a.at(i, c), b.at(i, c)) << c << " " << i;
   EXPECT_THROW(b.appendRepeated({1.0, 2.0}, 3, 0, 0, dt), std::logic_error);
   EXPECT_THROW(b.appendRepeated(row, 3, 3, 0, dt), std::logic_error);
+}
+
+// With time_series none (and no video) the analytic and per-foot runs record two rows, t = 0 and
+// the end, instead of one per sample_dt_s: nothing reads the others. Every summary field of every
+// run is the same as with the full series, bit for bit (wall times aside): the summaries come
+// from the state, and a row's evaluation does not feed back into the run. Strokes that slide,
+// stick and break away again (stiction, two links with their own timings) and the ADAMS law.
+TEST(TimeSeriesOutput, NoneRecordsTwoRowsAndSummarizesTheSame) {
+  const fs::path dir = tempDir("none_same");
+  auto write = [&](const std::string& output) {
+    const fs::path f = dir / ("sweep_" + output + ".yaml");
+    std::ofstream(f) << "name: ts_same\nrobot: paper\ntail: {links: 2}\n"
+                     << "friction: {mu_s: {sweep: [0.15, 0.4]}}\n"
+                     << "trajectory: {theta0_deg: [45, 0], dtheta_deg: [-90, 60], dT_s: [0.25, 0.15], "
+                     << "w_ss: [{sweep: [0.2, 0.7]}, 0.5], t0_s: [0, 0.05]}\n"
+                     << "effects: {friction: {sweep: [stiction, continuous]}}\n"
+                     << "models: [analytic, perfoot]\noutput: {time_series: " << output << "}\n";
+    return loadExperiment(f.string());
+  };
+  const Experiment full = write("full"), none = write("none");
+  ASSERT_EQ(none.cases.size(), 8u);
+  for (const ExperimentCase& c : none.cases)
+    for (const char* m : {"analytic", "perfoot"}) {
+      const RunResult r = findModel(m)->run(c, nullptr);
+      EXPECT_EQ(r.series.numRows(), 2u) << m << " " << c.name;
+    }
+  RunOptions o;
+  o.progress = false;
+  o.out_dir = (dir / "full").string();
+  runExperiment(full, o);
+  o.out_dir = (dir / "none").string();
+  runExperiment(none, o);
+  std::map<std::string, nlohmann::json> by_name;
+  std::istringstream lines(readText(dir / "none" / "cases.jsonl"));
+  for (std::string line; std::getline(lines, line);) {
+    const nlohmann::json j = nlohmann::json::parse(line);
+    by_name[j.at("name").get<std::string>()] = j.at("runs");
+  }
+  ASSERT_EQ(by_name.size(), 8u);
+  int compared = 0, cases = 0;
+  for (const fs::directory_entry& d : fs::directory_iterator(dir / "full" / "cases")) {
+    const nlohmann::json j = nlohmann::json::parse(readText(d.path() / "result.json"));
+    const std::string name = j.at("name").get<std::string>();
+    const nlohmann::json& f = j.at("runs");
+    ASSERT_TRUE(by_name.count(name)) << name;
+    const nlohmann::json& n = by_name.at(name);
+    ++cases;
+    for (const char* m : {"analytic", "perfoot"}) {
+      ASSERT_TRUE(f.contains(m) && n.contains(m)) << name;
+      EXPECT_GE(f.at(m).at("extra").size(), 5u) << name << " " << m;  // compared as one object below
+      for (const auto& [key, value] : f.at(m).items()) {
+        if (key == "wall_time_s") continue;
+        EXPECT_EQ(value, n.at(m).value(key, nlohmann::json())) << name << " " << m << " " << key;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 8);
+  EXPECT_GE(compared, 8 * 2 * 6);
+  fs::remove_all(dir);
 }

@@ -20,6 +20,19 @@ RunResult failedRun(const std::string& model, const std::string& why) {
   return r;
 }
 
+// What an analytic or per-foot run records. With output.time_series none and no video to
+// render, nothing reads its rows: the run records the two at t = 0 and at the end instead of one
+// every sample_dt_s. Their summaries come from the state, not the rows (docs/accuracy.md
+// "Summaries from the state"), and a row's evaluation does not feed back into the run, so the
+// results are bit-identical (test TimeSeriesOutput.NoneRecordsTwoRowsAndSummarizesTheSame).
+OutputSettings recordedOutput(const ExperimentCase& c, const TailTrajectory& traj) {
+  OutputSettings o = c.output;
+  if (o.time_series != TimeSeriesOutput::kNone || c.render.enabled) return o;
+  const double t_end = o.duration_s > 0 ? o.duration_s : traj.endTime() + o.settle_s;  // the models' own end
+  if (t_end > o.sample_dt_s) o.sample_dt_s = t_end;
+  return o;
+}
+
 std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
   a.insert(a.end(), b.begin(), b.end());
   return a;
@@ -31,13 +44,15 @@ const std::vector<ModelEntry>& modelRegistry() {
   static const std::vector<ModelEntry> kModels = {
       {"analytic", "analytic (stiction)", "#0072B2", false,
        [](const ExperimentCase& c, RunContext*) {
-         return simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, c.output);
+         const TailTrajectory traj = c.trajectory();
+         return simulateAnalytic(c.robot, traj, c.analytic, c.effects, recordedOutput(c, traj));
        },
        [](int n) { return concat(col::shared(n), col::analyticOnly()); }},
       {"perfoot", "per-foot (Coulomb per foot)", "#009E73", false,
        [](const ExperimentCase& c, RunContext*) {
          try {
-           return simulatePerFoot(c.robot, c.trajectory(), c.perfoot, c.effects, c.output);
+           const TailTrajectory traj = c.trajectory();
+           return simulatePerFoot(c.robot, traj, c.perfoot, c.effects, recordedOutput(c, traj));
          } catch (const std::exception& e) {
            return failedRun("perfoot", e.what());
          }
