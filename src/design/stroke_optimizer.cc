@@ -42,9 +42,11 @@ StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& tr
   e.figures = strokeFigures(p.base.robot.tail, traj);
   e.violation = limitViolation(e.figures, p.space.limits);
   OutputSettings out;
-  out.sample_dt_s = 0.01;  // phi_net does not depend on the output grid; fewer rows
   out.settle_s = p.base.output.settle_s;
   out.duration_s = 0.0;
+  // Two rows, t = 0 and the end: phi_net comes from the state, not the rows, and a row while the
+  // tail moves costs an evaluation with the M_z,T decomposition (one every 10 ms was ~1/4 of a run).
+  out.sample_dt_s = traj.endTime() + out.settle_s;
   const RunResult r = simulateAnalytic(p.base.robot, traj, p.base.analytic, searchEffects(p.base), out);
   e.ok = r.summary.ok && std::isfinite(r.summary.phi_net_deg);
   e.error = r.summary.error;
