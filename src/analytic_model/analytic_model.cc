@@ -47,8 +47,9 @@ void tailLoadsAndArm(const AnalyticModel& m, AnalyticWorkspace& w, double t, boo
 void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, double phi_dot, const Eval& ev,
                    Eigen::Matrix3d& A, Eigen::Matrix3d& E, Eigen::Vector3d& r0) {
   const RobotParams& robot = m.robot;
-  TailKinematics& kin = w.exact_kin;
-  tailKinematics(robot.tail, w.joints, kin);
+  // The kinematics systemLoads computed from w.joints for ev.loads (the same joint states: both
+  // are refreshed together whenever the tail cache misses).
+  const TailKinematics& kin = w.loads.kin;
   const double wz = phi_dot;
   const Vec2 p_QB(-robot.quadruped.d_Q2B_m, 0.0);
   Vec2 S = Vec2::Zero(), lin = Vec2::Zero();

@@ -50,7 +50,6 @@ struct AnalyticModel {
 struct AnalyticWorkspace {
   std::vector<JointState> joints;  // at the last evaluated time
   LoadScratch loads;
-  TailKinematics exact_kin;
   // The tail loads and friction arm at the last evaluated time: they depend on t alone (the
   // trajectory), and the solver asks for the same t more than once (Dormand-Prince's last two
   // stages, an event scan at a step's end). Once every joint has finished its motion they no

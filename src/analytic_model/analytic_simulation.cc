@@ -33,8 +33,8 @@ std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) 
 }
 
 // The integral of f over [a, b], where f is smooth (between two breakpoints of the tail profile):
-// 31-point Gauss-Kronrod (Boost.Math), exact for polynomials of degree 46. The interval is halved
-// while the embedded 15-point Gauss rule differs by more than 1e-12 of the integral of |f| (at
+// 21-point Gauss-Kronrod (Boost.Math), exact for polynomials of degree 31. The interval is halved
+// while the embedded 10-point Gauss rule differs by more than 1e-12 of the integral of |f| (at
 // most 5 times). A Simpson rule of 64 intervals did this before: 129 evaluations of the tail loads
 // per segment, 22 % of a random sweep's instructions, and a relative error of about 1e-7
 // (docs/scale.md "Analytic hot path").
@@ -43,7 +43,7 @@ double integrateSmooth(const F& f, double a, double b, int depth = 0) {
   const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
   double err = 0.0, L1 = 0.0;
   // On [-1, 1] itself: Boost reports err and L1 there without one consistent interval scaling.
-  const double q = boost::math::quadrature::gauss_kronrod<double, 31>::integrate(
+  const double q = boost::math::quadrature::gauss_kronrod<double, 21>::integrate(
       [&](double x) { return f(mid + half * x); }, -1.0, 1.0, 0, 0.0, &err, &L1);
   if (err <= 1e-12 * L1 || depth >= 5) return half * q;
   return integrateSmooth(f, a, mid, depth + 1) + integrateSmooth(f, mid, b, depth + 1);
