@@ -36,8 +36,8 @@ std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) 
 // 21-point Gauss-Kronrod (Boost.Math), exact for polynomials of degree 31. The interval is halved
 // while the embedded 10-point Gauss rule differs by more than 1e-12 of the integral of |f| (at
 // most 5 times). A Simpson rule of 64 intervals did this before: 129 evaluations of the tail loads
-// per segment, 22 % of a random sweep's instructions, and a relative error of about 1e-7
-// (docs/scale.md "Analytic hot path").
+// per segment, 22 % of a random sweep's instructions, and relative errors up to 8e-5
+// (docs/scale.md "Work no result needed").
 template <class F>
 double integrateSmooth(const F& f, double a, double b, int depth = 0) {
   const double mid = 0.5 * (a + b), half = 0.5 * (b - a);
