@@ -685,8 +685,8 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   // second terminates the process at once (finished cases stay saved: each is written whole).
   // The main thread sleeps in poll() on that signalfd and on an eventfd each worker writes when it
   // exits, so it wakes the moment the last case is done (a fixed sleep cost every run up to 100 ms),
-  // and otherwise once per progress period (a wake-up after every case cost ~10 % of a sweep of
-  // short cases).
+  // and otherwise once per progress period (a wake-up after every case doubled the system time of
+  // a sweep of short cases: docs/scale.md "Work no result needed").
   sigset_t int_set, old_mask;
   sigemptyset(&int_set);
   sigaddset(&int_set, SIGINT);
@@ -732,7 +732,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
                                      "same command again to resume)"
                                    : "");
       }
-      ++done;  // (no wake-up per case: a syscall and a context switch each, ~10 % of a none sweep)
+      ++done;  // (no wake-up per case: a syscall and a context switch each)
     }
     {
       std::lock_guard<std::mutex> lock(mu);
