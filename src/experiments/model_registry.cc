@@ -27,10 +27,10 @@ RunResult failedRun(const std::string& model, const std::string& why) {
 // results are bit-identical (test TimeSeriesOutput.NoneRecordsTwoRowsAndSummarizesTheSame) except
 // where a row alone would have caught the robot tipping over (footLoads throws at any evaluation):
 // a COM outside the support for less than a row interval, between two solver evaluations.
-OutputSettings recordedOutput(const ExperimentCase& c, const TailTrajectory& traj) {
+OutputSettings recordedOutput(const ExperimentCase& c) {
   OutputSettings o = c.output;
   if (o.time_series != TimeSeriesOutput::kNone || c.render.enabled) return o;
-  const double t_end = o.duration_s > 0 ? o.duration_s : traj.endTime() + o.settle_s;  // the models' own end
+  const double t_end = c.simDuration();  // the models' own end (planRun)
   if (t_end > o.sample_dt_s) o.sample_dt_s = t_end;
   return o;
 }
@@ -46,15 +46,13 @@ const std::vector<ModelEntry>& modelRegistry() {
   static const std::vector<ModelEntry> kModels = {
       {"analytic", "analytic (stiction)", "#0072B2", false,
        [](const ExperimentCase& c, RunContext*) {
-         const TailTrajectory traj = c.trajectory();
-         return simulateAnalytic(c.robot, traj, c.analytic, c.effects, recordedOutput(c, traj));
+         return simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, recordedOutput(c));
        },
        [](int n) { return concat(col::shared(n), col::analyticOnly()); }},
       {"perfoot", "per-foot (Coulomb per foot)", "#009E73", false,
        [](const ExperimentCase& c, RunContext*) {
          try {
-           const TailTrajectory traj = c.trajectory();
-           return simulatePerFoot(c.robot, traj, c.perfoot, c.effects, recordedOutput(c, traj));
+           return simulatePerFoot(c.robot, c.trajectory(), c.perfoot, c.effects, recordedOutput(c));
          } catch (const std::exception& e) {
            return failedRun("perfoot", e.what());
          }
