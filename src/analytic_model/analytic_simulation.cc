@@ -15,6 +15,8 @@
 
 #include "analytic_model/analytic_model.h"
 #include "analytic_model/analytic_recorder.h"
+#include "analytic_model/foot_loads.h"
+#include "analytic_model/support_check.h"
 #include "results/work_limits.h"
 
 namespace tailsim {
@@ -552,6 +554,11 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
   sum.model = "analytic";
   try {
     const AnalyticModel model(robot, trajectory, settings, effects);
+    // Tipping over depends on the trajectory alone: checked along all of it before the run, not
+    // only where the loads happen to be evaluated (docs/paper-notes.md point 5).
+    if (model.needsArm() && effects.foot_loads == FootLoadModel::kDistributed)
+      if (const auto loss = firstSupportLoss(robot, trajectory, plan.t_end))
+        throw TippingError(supportLossMessage(robot.quadruped, *loss));
     Run run(model, plan, output.sample_dt_s, stopSpeed(model, plan));
     startAtRest(run);
     integrate(run);

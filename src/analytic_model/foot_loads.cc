@@ -6,13 +6,17 @@
 
 namespace tailsim {
 
-namespace {
-// Out of line: the message's stream would otherwise give every call a large stack frame.
-[[noreturn]] __attribute__((noinline, cold)) void throwTipping(double xe, double ye, double l, double w) {
+std::string tippingMessage(const QuadrupedParams& q, double xe, double ye) {
   std::ostringstream os;
   os << "system COM at (" << xe << ", " << ye << ") m from the foot centroid is outside the support "
-     << "rectangle (+-" << 0.5 * l << ", +-" << 0.5 * w << ") m: the robot tips over";
-  throw TippingError(os.str());
+     << "rectangle (+-" << 0.5 * q.l_F_m << ", +-" << 0.5 * q.w_F_m << ") m: the robot tips over";
+  return os.str();
+}
+
+namespace {
+// Out of line: the message's stream would otherwise give every call a large stack frame.
+[[noreturn]] __attribute__((noinline, cold)) void throwTipping(const QuadrupedParams& q, double xe, double ye) {
+  throw TippingError(tippingMessage(q, xe, ye));
 }
 }  // namespace
 
@@ -22,7 +26,7 @@ FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
   const Vec2 p_CC = p_QC - Vec2(q.d_Q2C_m, 0.0);  // foot centroid -> system COM
   const double xe = p_CC.x(), ye = p_CC.y();       // Eq. (A3)
   const double slack = 1e-12 * (l + w);  // a COM on an edge (up to round-off) still stands
-  if (std::abs(xe) > 0.5 * l + slack || std::abs(ye) > 0.5 * w + slack) throwTipping(xe, ye, l, w);
+  if (std::abs(xe) > 0.5 * l + slack || std::abs(ye) > 0.5 * w + slack) throwTipping(q, xe, ye);
   // Eq. (A3) solved (paper-notes point 5): ellipse with a/b = l_F/w_F,
   //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).
   // Eqs. (A4)-(A5), f_i = 1/4 + B sin(xi + C_i) with B = b sqrt(2) / (2 w_F), expanded with

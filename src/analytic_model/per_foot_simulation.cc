@@ -12,6 +12,7 @@
 #include "analytic_model/analytic_simulation.h"
 #include "analytic_model/per_foot_model.h"
 #include "analytic_model/stick_slip.h"
+#include "analytic_model/support_check.h"
 #include "robot/friction_law.h"
 
 namespace tailsim {
@@ -394,6 +395,12 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
 
   try {
+    // Every evaluation with friction takes the paper's arm L_F at the system COM, which fails outside
+    // the support rectangle: checked along the whole trajectory first (support_check.h). The load
+    // transfer's shifted centre of pressure depends on the state: it is checked where evaluated.
+    if (effects.friction != FrictionLaw::kNone && effects.gravity && robot.systemMass() * robot.gravity_mps2 > 0.0)
+      if (const auto loss = firstSupportLoss(robot, trajectory, t_end))
+        throw TippingError(supportLossMessage(robot.quadruped, *loss));
     const Model model(robot, trajectory, settings, effects, loads);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
     const double v_stop = settings.v_stop_mps;

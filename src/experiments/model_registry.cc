@@ -24,9 +24,10 @@ RunResult failedRun(const std::string& model, const std::string& why) {
 // render, nothing reads its rows: the run records the two at t = 0 and at the end instead of one
 // every sample_dt_s. Their summaries come from the state, not the rows (docs/accuracy.md
 // "Summaries from the state"), and a row's evaluation does not feed back into the run, so the
-// results are bit-identical (test TimeSeriesOutput.NoneRecordsTwoRowsAndSummarizesTheSame) except
-// where a row alone would have caught the robot tipping over (footLoads throws at any evaluation):
-// a COM outside the support for less than a row interval, between two solver evaluations.
+// results are bit-identical (test TimeSeriesOutput.NoneRecordsTwoRowsAndSummarizesTheSame). Tipping
+// over does not depend on the rows either: it is checked along the whole trajectory before the run
+// (support_check.h); only the per-foot load transfer's shifted centre of pressure, which depends on
+// the state, is checked where the loads are evaluated.
 OutputSettings recordedOutput(const ExperimentCase& c) {
   OutputSettings o = c.output;
   if (o.time_series != TimeSeriesOutput::kNone || c.render.enabled) return o;

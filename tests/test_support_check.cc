@@ -1,0 +1,159 @@
+// Tipping over is a property of the trajectory (support_check.h): found along all of it, not
+// where a solver or an output row happens to evaluate the loads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "analytic_model/analytic_simulation.h"
+#include "analytic_model/foot_loads.h"
+#include "analytic_model/per_foot_model.h"
+#include "analytic_model/support_check.h"
+#include "analytic_model/system_loads.h"
+#include "analytic_test_util.h"
+
+using namespace tailsim;
+using namespace tailsim::testing;
+
+namespace {
+
+// The support margin at t as footLoads judges it: does it throw?
+bool outsideAt(const RobotParams& r, const TailTrajectory& tr, double t) {
+  std::vector<JointState> js;
+  tr.evaluate(t, js);
+  SystemLoads sl;
+  systemMassProperties(r, tailKinematics(r.tail, js), sl);
+  try {
+    footLoads(r.quadruped, sl.p_QC);
+    return false;
+  } catch (const TippingError&) {
+    return true;
+  }
+}
+
+// One heavy link (COM at mid-length) on a base at the quadruped COM (d_Q2B = 0), swinging from
+// 45 to 135 deg: the system COM's lateral offset is (m_t / m) c sin(theta), largest at 90 deg
+// (mid-swing, peak speed). The tail mass puts that peak `delta` beyond the side edge (w_F / 2).
+struct SideSwing {
+  RobotParams robot;
+  TailTrajectory trajectory = sameMove(1, 45, 90, 0.25, 0.5);
+  double r = 0;  // m_t / m
+  double c = 0.3;
+};
+SideSwing sideSwing(double delta_m) {
+  SideSwing s;
+  s.robot = paperRobot(1, 0.0);
+  const double half_w = 0.5 * s.robot.quadruped.w_F_m;
+  s.r = (half_w + delta_m) / s.c;
+  TailLink& l = s.robot.tail[0];
+  l.length_m = 2 * s.c;
+  l.com_offset_m = s.c;
+  l.mass_kg = s.robot.quadruped.mass_kg * s.r / (1 - s.r);
+  l.izz_kgm2 = l.mass_kg * 4 * s.c * s.c / 12;
+  s.r = l.mass_kg / s.robot.systemMass();  // as the model computes it
+  return s;
+}
+
+}  // namespace
+
+// A brief exit (the COM beyond the side edge for about 60 us around mid-swing) between any two
+// evaluations: found at the time the closed form gives, and every output choice and both
+// friction models now fail the run the same way. 2 nm further in, every run stands.
+TEST(SupportCheck, ABriefExitFailsTheRunWhateverItRecords) {
+  const SideSwing out = sideSwing(1e-8);
+  const double half_w = 0.5 * out.robot.quadruped.w_F_m, slack = 1e-12 * (out.robot.quadruped.l_F_m + half_w * 2);
+  // Closed form of the first exit: (m_t/m) c sin(theta*) = w_F / 2 + slack, theta rising to 90 deg.
+  const double theta_star = std::asin((half_w + slack) / (out.r * out.c));
+  double lo = 0, hi = 0.125;  // theta(t) rises from 45 to 90 deg over the first half
+  for (int k = 0; k < 200; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (out.trajectory.joints[0].at(mid).theta < theta_star ? lo : hi) = mid;
+  }
+  const auto loss = firstSupportLoss(out.robot, out.trajectory, 0.75);
+  ASSERT_TRUE(loss.has_value());
+  EXPECT_NEAR(loss->t_s, lo, 1e-9);
+  EXPECT_GT(std::abs(loss->p_CC.y()), half_w);
+  const double exit_s = 2 * (0.125 - lo);
+  EXPECT_LT(exit_s, 1e-4);  // shorter than the rows' interval: sampling could miss it
+  std::printf("outside for %.3g s from t = %.12f s\n", exit_s, loss->t_s);
+
+  OutputSettings two_rows;
+  two_rows.sample_dt_s = 0.75;
+  for (const OutputSettings& o : {OutputSettings{}, two_rows}) {
+    for (const RunResult& res : {simulateAnalytic(out.robot, out.trajectory, {}, {}, o),
+                                 simulatePerFoot(out.robot, out.trajectory, {}, {}, o)}) {
+      SCOPED_TRACE(res.summary.model + " sample_dt_s " + std::to_string(o.sample_dt_s));
+      EXPECT_FALSE(res.summary.ok);
+      EXPECT_NE(res.summary.error.find("the robot tips over at t = 0.1249"), std::string::npos) << res.summary.error;
+    }
+  }
+  const SideSwing in = sideSwing(-2e-9);
+  EXPECT_FALSE(firstSupportLoss(in.robot, in.trajectory, 0.75).has_value());
+  for (const OutputSettings& o : {OutputSettings{}, two_rows}) {
+    EXPECT_TRUE(simulateAnalytic(in.robot, in.trajectory, {}, {}, o).summary.ok);
+    EXPECT_TRUE(simulatePerFoot(in.robot, in.trajectory, {}, {}, o).summary.ok);
+  }
+}
+
+// Random tails (1-6 links, 1-10x the paper's link masses, split-cycle or spline strokes with
+// start delays) against a dense scan of footLoads every 20 us: the search never reports later
+// than the scan's first outside sample, nothing before the time it reports is outside, and the
+// robot is outside at that time. Where the scan sees nothing the search may still find a brief
+// exit between its samples, which the check at the reported time confirms.
+TEST(SupportCheck, AgreesWithADenseScanOfRandomTails) {
+  std::mt19937 rng(20261126);
+  std::uniform_real_distribution<double> u(0, 1);
+  int tipped = 0, standing = 0, between_samples = 0;
+  for (int k = 0; k < 300; ++k) {
+    const int n = 1 + static_cast<int>(u(rng) * 6);
+    RobotParams r = paperRobot(n, 0.2 * u(rng));
+    const double scale = 1 + 9 * u(rng);
+    for (TailLink& l : r.tail) {
+      l.mass_kg *= scale;
+      l.izz_kgm2 *= scale;
+    }
+    TailTrajectory tr;
+    const double dT = 0.1 + 0.5 * u(rng);
+    for (int i = 0; i < n; ++i) {
+      const double t0 = 0.05 * u(rng);
+      if (u(rng) < 0.3) {
+        SplineParams sp;
+        sp.dT_s = dT;
+        sp.t0_s = t0;
+        for (int q = 0; q < 5; ++q) sp.knots_rad.push_back(deg(-120 + 240 * u(rng)));
+        tr.joints.emplace_back(sp);
+      } else {
+        tr.joints.emplace_back(SplitCycleParams{deg(-90 + 180 * u(rng)), deg(-180 + 360 * u(rng)), dT, 0.05 + 0.9 * u(rng), t0});
+      }
+    }
+    const double t_end = tr.endTime() + 0.1;
+    SCOPED_TRACE("case " + std::to_string(k));
+    const auto loss = firstSupportLoss(r, tr, t_end);
+    double scan_first = -1;
+    for (double t = 0; t <= tr.endTime() + 1e-12; t += 2e-5)
+      if (outsideAt(r, tr, t)) {
+        scan_first = t;
+        break;
+      }
+    if (scan_first >= 0) {
+      ASSERT_TRUE(loss.has_value());
+      EXPECT_LE(loss->t_s, scan_first + 1e-12);
+    }
+    if (!loss) {
+      ++standing;
+      continue;
+    }
+    ++tipped;
+    if (scan_first < 0) ++between_samples;
+    EXPECT_TRUE(outsideAt(r, tr, loss->t_s)) << loss->t_s;
+    // Inside just before (the exit is located to 1e-12 s), and at every scan sample before it.
+    if (loss->t_s > 0) {
+      EXPECT_FALSE(outsideAt(r, tr, loss->t_s - 2e-12)) << loss->t_s;
+    }
+    for (double t = 0; t < loss->t_s - 1e-12; t += 2e-5) ASSERT_FALSE(outsideAt(r, tr, t)) << t;
+  }
+  std::printf("random tails: %d tip over (%d between the scan's samples), %d stand\n", tipped, between_samples,
+              standing);
+  EXPECT_GT(tipped, 50);
+  EXPECT_GT(standing, 50);
+}
