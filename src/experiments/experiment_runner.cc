@@ -223,8 +223,8 @@ class CaseJournal {
 
 // The finished cases of DIR/cases.jsonl by name (a later line wins). A last line without its
 // newline (torn by a kill or a full disk) is cut off the file, so the next append starts a line.
-std::map<std::string, json> readJournal(const fs::path& p, bool repair) {
-  std::map<std::string, json> out;
+std::map<std::string, std::string> readJournal(const fs::path& p, bool repair) {
+  std::map<std::string, std::string> out;
   std::ifstream in(p, std::ios::binary);
   if (!in) return out;
   std::ostringstream os;
@@ -235,11 +235,9 @@ std::map<std::string, json> readJournal(const fs::path& p, bool repair) {
   size_t at = 0;
   while (at < whole) {
     const size_t nl = text.find('\n', at);
-    json j = json::parse(text.begin() + static_cast<long>(at), text.begin() + static_cast<long>(nl), nullptr, false);
-    if (j.is_object() && j.contains("name") && j["name"].is_string()) {
-      const std::string name = j["name"].get<std::string>();  // before j is moved (C++17: right side first)
-      out[name] = std::move(j);
-    }
+    const json j = json::parse(text.begin() + static_cast<long>(at), text.begin() + static_cast<long>(nl), nullptr, false);
+    if (j.is_object() && j.contains("name") && j["name"].is_string())
+      out[j["name"].get<std::string>()] = text.substr(at, nl - at);  // as text: see Job::entries
     at = nl + 1;
   }
   if (repair && whole < text.size()) {
@@ -256,12 +254,15 @@ struct Job {
   bool render = false;
   std::vector<std::string> keys;  // per case: caseKey()
   std::vector<std::string> dirs;  // per case: caseDirName()
-  std::vector<json> entries;      // per case; null = not finished
+  // Per case: its entry (result.json's content, a line of cases.jsonl) as compact JSON text; empty =
+  // not finished. Text, not parsed JSON: a parsed entry takes ~10x its text's memory (10^5 cases
+  // held 1.3 GB that way); writeSummary parses them one at a time.
+  std::vector<std::string> entries;
   std::vector<size_t> todo;       // case indices to run now
   std::string source;             // recordedSource(*e), as found before the folder is written
   int total = 0, resumed = 0;
   std::unique_ptr<CaseJournal> journal;     // DIR/cases.jsonl (cases without a folder)
-  std::vector<json> other_lines;            // per case: its journal line when not run now (else null)
+  std::vector<std::string> other_lines;     // per case: its journal line when not run now (else empty)
   std::unique_ptr<TimeSeriesH5Writer> h5;   // DIR/time_series.h5 (cases with time_series_file: hdf5)
 };
 
@@ -497,7 +498,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   const bool any_journal =
       std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return !e.cases[i].output.caseFolder(); });
   const bool any_h5 = std::any_of(e.cases.begin(), e.cases.end(), [](const ExperimentCase& c) { return inH5(c); });
-  std::map<std::string, json> journal = readJournal(root / "cases.jsonl", true);
+  std::map<std::string, std::string> journal = readJournal(root / "cases.jsonl", true);
   {  // the lines of cases not run now (--case, another shard's) are kept when the journal is rewritten
     std::vector<char> now(e.cases.size(), 0);
     for (size_t i : todo_all) now[i] = 1;
@@ -517,7 +518,8 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       const fs::path rj = root / "cases" / job.dirs[i] / "result.json";
       if (fs::exists(rj)) j = readJsonFile(rj);
     } else if (auto it = journal.find(c.name); it != journal.end()) {
-      j = std::move(it->second);
+      j = json::parse(it->second);
+      std::string().swap(it->second);
     }
     // A case is reused only when everything its results depend on is unchanged (caseKey).
     bool reuse = j.is_object() && j.value("key", std::string()) == job.keys[i] && j.value("name", std::string()) == c.name;
@@ -529,7 +531,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       if (reuse) copy_h5.push_back(i);
     }
     if (reuse) {
-      job.entries[i] = std::move(j);
+      job.entries[i] = j.dump();
       ++job.resumed;
       continue;
     }
@@ -543,7 +545,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     job.h5 = std::make_unique<TimeSeriesH5Writer>((root / "time_series.h5").string());
     for (size_t i : copy_h5) job.h5->copyCase(*published, job.dirs[i]);
     for (size_t i = 0; i < e.cases.size(); ++i)  // cases not run now keep their group
-      if (!job.other_lines[i].is_null() && inH5(e.cases[i]) &&
+      if (!job.other_lines[i].empty() && inH5(e.cases[i]) &&
           published->hasCase(job.dirs[i], job.keys[i], {}))
         job.h5->copyCase(*published, job.dirs[i]);
   }
@@ -551,7 +553,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
 }
 
 // Runs one case and writes its folder; result.json last, as the "finished" marker.
-json runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
+std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
   const ExperimentCase& c = job.e->cases[i];
   const std::vector<RunResult> runs = runCase(c, &ctx);
   const fs::path dir = job.root / "cases" / job.dirs[i];
@@ -608,22 +610,37 @@ json runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
     }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
+  std::string line = j.dump();
   if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
-  else job.journal->append(j.dump() + "\n");  // one line, one write(): the case is finished
-  return j;
+  else job.journal->append(line + "\n");  // one line, one write(): the case is finished
+  return line;
+}
+
+// The finished entries of a job, in case order, each parsed on its own (Job::entries).
+template <class F>
+void forEachEntry(const Job& job, const F& f) {
+  for (const std::string& text : job.entries)
+    if (!text.empty()) f(json::parse(text));
+}
+
+// One experiment's rows of a results table, read from its job's entries.
+ResultsCsvInput tableInput(const Job& job) {
+  return {job.e->name, job.e->swept_keys,
+          [&job](const std::function<void(const json&)>& f) { forEachEntry(job, f); }};
 }
 
 // Writes DIR/summary.json and DIR/results.csv (from the same entries: every finished case,
-// resumed ones included) and returns the summary. The entries move into it (a sweep of 10^5
-// cases held them twice: 0.4 GB).
-json writeSummary(Job& job) {
+// resumed ones included). summary.json is s.dump(1) of {header..., "cases": [entries...]}, written
+// from the entries' text one at a time instead of from one JSON tree of all of them (a sweep of
+// 10^5 cases held them as parsed JSON: 1.3 GB).
+void writeSummary(Job& job) {
   const Experiment& e = *job.e;
   if (job.journal) {  // the finished cases without a folder, in case order (CaseJournal)
     job.journal->close();
     std::string lines;
     for (size_t i = 0; i < job.entries.size(); ++i)
-      if (!job.entries[i].is_null() && !e.cases[i].output.caseFolder()) lines += job.entries[i].dump() + "\n";
-      else if (!job.other_lines[i].is_null()) lines += job.other_lines[i].dump() + "\n";
+      if (!job.entries[i].empty() && !e.cases[i].output.caseFolder()) lines += job.entries[i] + "\n";
+      else if (!job.other_lines[i].empty()) lines += job.other_lines[i] + "\n";
     writeFileAtomic((job.root / "cases.jsonl").string(), lines);
   }
   if (job.h5) job.h5->publish();
@@ -636,17 +653,33 @@ json writeSummary(Job& job) {
   s["kind"] = e.cases.empty() ? "simulate" : name(e.cases.front().kind);
   s["swept_keys"] = e.swept_keys;
   s["cases"] = json::array();
-  for (json& entry : job.entries)
-    if (!entry.is_null()) {
-      entry.erase("experiment");  // said once, above
-      entry.erase("source");
-      entry.erase("tailsim_version");
-      entry.erase("tailsim_git_commit");
-      s["cases"].push_back(std::move(entry));
+  // "cases" is the first key (sorted), so its empty array is the first match; JSON strings cannot
+  // hold an unescaped quote, so no string value matches.
+  std::string text = s.dump(1);
+  const std::string empty = "\"cases\": []";
+  const size_t at = text.find(empty);
+  std::string cases = "[";
+  bool first = true;
+  forEachEntry(job, [&](json entry) {
+    entry.erase("experiment");  // said once, in the header
+    entry.erase("source");
+    entry.erase("tailsim_version");
+    entry.erase("tailsim_git_commit");
+    // An element of an array at depth 1 of an indent-1 dump: every line two spaces further in.
+    std::string d = entry.dump(1);
+    std::string nested;
+    nested.reserve(d.size() + d.size() / 8);
+    for (char ch : d) {
+      nested += ch;
+      if (ch == '\n') nested += "  ";
     }
-  writeFileAtomic((job.root / "summary.json").string(), s.dump(1));
-  writeFileAtomic((job.root / "results.csv").string(), resultsCsv({s}));
-  return s;
+    cases += (first ? "\n  " : ",\n  ") + nested;
+    first = false;
+  });
+  cases += first ? "]" : "\n ]";
+  text.replace(at + empty.size() - 2, 2, cases);
+  writeFileAtomic((job.root / "summary.json").string(), text);
+  writeFileAtomic((job.root / "results.csv").string(), resultsCsv({tableInput(job)}));
 }
 
 // All cases of all experiments share one pool of workers (workers share nothing mutable but
@@ -717,9 +750,9 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
       const Task& t = tasks[k];
       try {
         int f = 0;
-        json j = runAndWrite(*t.job, t.i, f, ctx);
+        std::string entry = runAndWrite(*t.job, t.i, f, ctx);
         failed += f;
-        t.job->entries[t.i] = std::move(j);  // distinct element per task: no lock needed
+        t.job->entries[t.i] = std::move(entry);  // distinct element per task: no lock needed
       } catch (const std::exception& ex) {
         // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);
@@ -824,9 +857,12 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   else if (line_open) std::fprintf(stderr, "\n");
   stats.interrupted = stop.load();
   try {
-    std::vector<json> summaries;
-    for (Job& job : jobs) summaries.push_back(writeSummary(job));  // also after a failure: finished cases count
-    if (!suite_root.empty()) writeFileAtomic((suite_root / "results.csv").string(), resultsCsv(summaries));
+    std::vector<ResultsCsvInput> tables;
+    for (Job& job : jobs) {
+      writeSummary(job);  // also after a failure: finished cases count
+      tables.push_back(tableInput(job));
+    }
+    if (!suite_root.empty()) writeFileAtomic((suite_root / "results.csv").string(), resultsCsv(tables));
   } catch (const std::exception&) {
     if (first_error.empty()) throw;  // else report the first error (a full disk fails the summary too)
   }

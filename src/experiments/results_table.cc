@@ -36,35 +36,51 @@ const json& field(const json& o, const char* key) {
 
 }  // namespace
 
-std::string resultsCsv(const std::vector<json>& summaries) {
+std::string resultsCsv(const std::vector<ResultsCsvInput>& experiments) {
   static const char* const kSummaryFields[] = {"phi_net_deg", "t_stop_s", "stick_slip_events", "solver_steps",
                                                "wall_time_s", "ok",       "error",             "at_rest",
                                                "warnings"};
   std::vector<std::string> swept;
   std::set<std::string> extras;
-  for (const json& s : summaries) {
-    for (const json& k : field(s, "swept_keys"))
+  for (const ResultsCsvInput& s : experiments) {
+    for (const json& k : s.swept_keys)
       if (k.is_string() && std::find(swept.begin(), swept.end(), k.get<std::string>()) == swept.end())
         swept.push_back(k.get<std::string>());
-    for (const json& c : field(s, "cases"))
+    s.for_each_case([&](const json& c) {
       for (const auto& [model, run] : field(c, "runs").items())
         for (const auto& [name, v] : field(run, "extra").items()) extras.insert(name);
+    });
   }
   std::string out = "experiment,case,model";
   for (const std::string& k : swept) out += "," + csvField(k);
   for (const char* f : kSummaryFields) out += std::string(",") + f;
   for (const std::string& x : extras) out += "," + csvField(x);
   out += "\n";
-  for (const json& s : summaries)
-    for (const json& c : field(s, "cases"))
+  for (const ResultsCsvInput& s : experiments)
+    s.for_each_case([&](const json& c) {
       for (const auto& [model, run] : field(c, "runs").items()) {
-        out += csvField(cell(field(s, "experiment"))) + "," + csvField(cell(field(c, "name"))) + "," + csvField(model);
+        out += csvField(cell(s.experiment)) + "," + csvField(cell(field(c, "name"))) + "," + csvField(model);
         for (const std::string& k : swept) out += "," + csvField(cell(field(field(c, "sweep"), k.c_str())));
         for (const char* f : kSummaryFields) out += "," + csvField(cell(field(run, f)));
         for (const std::string& x : extras) out += "," + csvField(cell(field(field(run, "extra"), x.c_str())));
         out += "\n";
       }
+    });
   return out;
+}
+
+std::string resultsCsv(const std::vector<json>& summaries) {
+  std::vector<ResultsCsvInput> in;
+  for (const json& s : summaries) {
+    const json& swept = field(s, "swept_keys");
+    in.push_back({field(s, "experiment"), swept.is_array() ? swept : json::array(),
+                  [&s](const std::function<void(const json&)>& f) {
+                    const json& cases = field(s, "cases");
+                    if (cases.is_array())
+                      for (const json& c : cases) f(c);
+                  }});
+  }
+  return resultsCsv(in);
 }
 
 }  // namespace tailsim

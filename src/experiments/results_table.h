@@ -2,6 +2,7 @@
 // "Result folder"), built from their summary.json objects, so a resumed run rebuilds it whole.
 #pragma once
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -17,5 +18,15 @@ namespace tailsim {
 // true/false, RFC 4180 quoting. `summaries`: summary.json objects ({"experiment", "swept_keys",
 // "cases": [{"name", "sweep", "runs"}]}).
 std::string resultsCsv(const std::vector<nlohmann::json>& summaries);
+
+// The same from each experiment's name, swept keys and a function that calls its argument with
+// each case entry in turn (summary.json's "cases" items): a sweep of 10^5 cases need not hold
+// them all parsed. The entries are read twice (the columns, then the rows).
+struct ResultsCsvInput {
+  nlohmann::json experiment;  // the experiment's name
+  nlohmann::json swept_keys;  // array of dotted keys
+  std::function<void(const std::function<void(const nlohmann::json&)>&)> for_each_case;
+};
+std::string resultsCsv(const std::vector<ResultsCsvInput>& experiments);
 
 }  // namespace tailsim
