@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -28,23 +29,53 @@ AnalyticModel::AnalyticModel(const RobotParams& r, const TailTrajectory& tr, con
 
 namespace {
 
-// Tail loads, mass properties and the friction arm at the joint states w.joints.
-void tailLoadsAndArm(const AnalyticModel& m, AnalyticWorkspace& w, double t, bool decompose, Eval& ev) {
+// Tail loads, mass properties and the friction arm at the joint states w.joints, into `loads`
+// and `L_F` (NaN without friction). Without `decompose` the decomposition's fields are zero.
+void tailLoadsAndArm(const AnalyticModel& m, AnalyticWorkspace& w, double t, bool decompose, SystemLoads& loads,
+                     double& L_F) {
   const std::vector<JointState>& js = w.joints;
-  systemLoads(m.robot, js, decompose, ev.loads, w.loads);
-  if (!std::isfinite(ev.loads.MzT) || !std::isfinite(ev.loads.F_T_Q.x()) || !std::isfinite(ev.loads.F_T_Q.y()) ||
-      !std::isfinite(ev.loads.Izz_kgm2) || !std::isfinite(js.empty() ? 0.0 : js.front().theta))
+  systemLoads(m.robot, js, decompose, loads, w.loads);
+  if (!decompose) loads.MzT_acc = loads.MzT_speed = loads.MzT_tan = loads.MzT_cen = 0.0;
+  if (!std::isfinite(loads.MzT) || !std::isfinite(loads.F_T_Q.x()) || !std::isfinite(loads.F_T_Q.y()) ||
+      !std::isfinite(loads.Izz_kgm2) || !std::isfinite(js.empty() ? 0.0 : js.front().theta))
     throw std::runtime_error("the tail loads became non-finite at t=" + std::to_string(t) +
-                             " s (M_z,T = " + std::to_string(ev.loads.MzT) + " N m): check the trajectory values");
-  if (m.needsArm())
-    ev.L_F = m.effects.foot_loads == FootLoadModel::kConstant ? m.L_F_const
-                                                               : footLoads(m.robot.quadruped, ev.loads.p_QC).L_F;
+                             " s (M_z,T = " + std::to_string(loads.MzT) + " N m): check the trajectory values");
+  L_F = !m.needsArm() ? std::numeric_limits<double>::quiet_NaN()
+        : m.effects.foot_loads == FootLoadModel::kConstant ? m.L_F_const
+                                                           : footLoads(m.robot.quadruped, loads.p_QC).L_F;
+}
+
+// The tail's loads and friction arm at t, from the cache when it holds them (it does afterwards).
+// w.joints are then those at t: the same time, or both times after the tail's motion.
+[[gnu::always_inline]] inline const AnalyticWorkspace::TailCache& tailAt(const AnalyticModel& m, AnalyticWorkspace& w, double t, bool decompose) {
+  AnalyticWorkspace::TailCache& c = w.tail_cache;
+  if (c.valid && (c.t == t || (c.finished && m.traj.finished(t))) && (c.decomposed || !decompose)) return c;
+  c.valid = false;  // until tailLoadsAndArm returns (it throws when the robot tips)
+  m.traj.evaluate(t, w.joints);
+  tailLoadsAndArm(m, w, t, decompose, c.loads, c.L_F);
+  c.valid = true;
+  c.decomposed = decompose;
+  c.finished = m.traj.finished(t);
+  c.t = t;
+  return c;
+}
+
+// rotate(phi, a) with cos and sin of phi from w.yaw when phi is the same (bit for bit) as last time.
+[[gnu::always_inline]] inline Vec2 rotateYaw(AnalyticWorkspace& w, double phi, const Vec2& a) {
+  AnalyticWorkspace::YawCache& yc = w.yaw;
+  if (!yc.valid || std::memcmp(&yc.phi, &phi, sizeof phi) != 0) {
+    yc.c = std::cos(phi);
+    yc.s = std::sin(phi);
+    yc.phi = phi;
+    yc.valid = true;
+  }
+  return rotate(yc.c, yc.s, a);
 }
 
 // paper-notes point 3: the planar multibody with the base moving. Newton-Euler of every body
 // (quadruped + links) summed: linear momentum, and angular momentum about the quadruped COM.
 // Friction: F_F acts at the system COM (no moment about it, as in Eq. 9) plus the pure M_z,F.
-void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, double phi_dot, const Eval& ev,
+void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, double phi_dot, const SystemLoads& loads,
                    Eigen::Matrix3d& A, Eigen::Matrix3d& E, Eigen::Vector3d& r0) {
   const RobotParams& robot = m.robot;
   // The kinematics systemLoads computed from w.joints for ev.loads (the same joint states: both
@@ -66,7 +97,7 @@ void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, dou
     lin += l.mass_kg * b;
     ang += l.mass_kg * cross2(rho, b) + l.izz_kgm2 * kin.alpha[i];
   }
-  const double mass = ev.loads.mass_kg;
+  const double mass = loads.mass_kg;
   A << mass, 0, -S.y(), 0, mass, S.x(), -S.y(), S.x(), J;
   r0 << -lin.x(), -lin.y(), -ang;
   const Vec2 c = S / mass;  // system COM relative to the quadruped COM, world
@@ -76,7 +107,7 @@ void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, dou
 }
 
 // Unpacks the solve: accelerations of the sliding DOFs, friction loads of the stuck ones.
-void unpackSolve(const AnalyticModel& m, const bool free_dof[3], const double u[3], const SlidingFriction& f, Eval& ev) {
+[[gnu::always_inline]] inline void unpackSolve(const AnalyticModel& m, const bool free_dof[3], const double u[3], const SlidingFriction& f, Motion& ev) {
   ev.a_Q = Vec2(free_dof[0] ? u[0] : 0.0, free_dof[1] ? u[1] : 0.0);
   ev.phi_ddot = free_dof[2] ? u[2] : 0.0;
   ev.FF_W = free_dof[0] ? f.FF : Vec2(u[0], u[1]);
@@ -88,15 +119,15 @@ void unpackSolve(const AnalyticModel& m, const bool free_dof[3], const double u[
 
 // Equations of motion  A z = r0 + E f,  z = (a_Qx, a_Qy, phi_ddot), f = (F_Fx, F_Fy, M_zF): the
 // accelerations of the sliding DOFs and the friction loads of the stuck ones.
-void solveMotion(const AnalyticModel& m, AnalyticWorkspace& w, const State& y, const Modes& modes,
-                 const SlidingFriction& f, Eval& ev) {
+[[gnu::always_inline]] inline void solveMotion(const AnalyticModel& m, AnalyticWorkspace& w, const State& y, const Modes& modes,
+                 const SlidingFriction& f, const SystemLoads& loads, Motion& ev) {
   const bool free_dof[3] = {m.translation() && !modes.stuck[kTrans], m.translation() && !modes.stuck[kTrans],
                             !modes.stuck[kRot]};
   const double f_known[3] = {f.FF.x(), f.FF.y(), f.MzF};
   if (m.settings.coupling == Coupling::kPaper) {
     // Eq. (9): m a = F_T + F_F, I_zz phi_ddot = M_z,T + M_z,F; diagonal: each DOF on its own.
-    const double A[3] = {ev.loads.mass_kg, ev.loads.mass_kg, ev.loads.Izz_kgm2};
-    const double r0[3] = {ev.FT_W.x(), ev.FT_W.y(), ev.loads.MzT};
+    const double A[3] = {loads.mass_kg, loads.mass_kg, loads.Izz_kgm2};
+    const double r0[3] = {ev.FT_W.x(), ev.FT_W.y(), loads.MzT};
     double u[3];
     for (int j = 0; j < 3; ++j) u[j] = free_dof[j] ? (r0[j] + f_known[j]) / A[j] : -r0[j];
     unpackSolve(m, free_dof, u, f, ev);
@@ -104,7 +135,7 @@ void solveMotion(const AnalyticModel& m, AnalyticWorkspace& w, const State& y, c
   }
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero(), E = Eigen::Matrix3d::Identity();
   Eigen::Vector3d r0;
-  exactCoupling(m, w, y[kPhi], y[kPhiDot], ev, A, E, r0);
+  exactCoupling(m, w, y[kPhi], y[kPhiDot], loads, A, E, r0);
   Eigen::Matrix3d K;
   Eigen::Vector3d rhs = r0;
   for (int j = 0; j < 3; ++j) {
@@ -120,35 +151,34 @@ void solveMotion(const AnalyticModel& m, AnalyticWorkspace& w, const State& y, c
   unpackSolve(m, free_dof, u, f, ev);
 }
 
+// The motion at (t, y) in modes `modes` caused by the tail's loads and arm c (tailAt at t).
+[[gnu::always_inline]] inline void motionAt(const AnalyticModel& m, AnalyticWorkspace& w, const AnalyticWorkspace::TailCache& c, const State& y,
+              const Modes& modes, Motion& ev) {
+  ev.FT_W = rotateYaw(w, y[kPhi], c.loads.F_T_Q);
+  ev.M_break = m.mu_break * m.weight * (m.needsArm() ? c.L_F : 0.0);
+  ev.F_break = m.mu_break * m.weight;
+  // Friction loads of the DOFs that slide (known); stuck DOFs get theirs from the solve.
+  const SlidingFriction f = m.needsArm() ? slidingFriction(m.effects.friction, m.robot.friction, m.weight, c.L_F,
+                                                           modes.rot_dir, y[kPhiDot], Vec2(y[kVx], y[kVy]), m.v_reg)
+                                         : SlidingFriction{};
+  solveMotion(m, w, y, modes, f, c.loads, ev);
+}
+
 }  // namespace
 
 Eval evaluate(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes,
               bool decompose) {
   Eval ev;
-  AnalyticWorkspace::TailCache& c = w.tail_cache;
-  // w.joints are still those at t: the same time, or both times after the tail's motion.
-  if (c.valid && (c.t == t || (c.finished && m.traj.finished(t))) && (c.decomposed || !decompose)) {
-    ev.loads = c.loads;
-    ev.L_F = c.L_F;
-  } else {
-    c.valid = false;  // until tailLoadsAndArm returns (it throws when the robot tips)
-    m.traj.evaluate(t, w.joints);
-    tailLoadsAndArm(m, w, t, decompose, ev);
-    c = {true, decompose, m.traj.finished(t), t, ev.loads, ev.L_F};
-  }
-  ev.FT_W = rotate(y[kPhi], ev.loads.F_T_Q);
-  ev.M_break = m.mu_break * m.weight * (m.needsArm() ? ev.L_F : 0.0);
-  ev.F_break = m.mu_break * m.weight;
-  // Friction loads of the DOFs that slide (known); stuck DOFs get theirs from the solve.
-  const SlidingFriction f = m.needsArm() ? slidingFriction(m.effects.friction, m.robot.friction, m.weight, ev.L_F,
-                                                           modes.rot_dir, y[kPhiDot], Vec2(y[kVx], y[kVy]), m.v_reg)
-                                         : SlidingFriction{};
-  solveMotion(m, w, y, modes, f, ev);
+  const AnalyticWorkspace::TailCache& c = tailAt(m, w, t, decompose);
+  ev.loads = c.loads;
+  ev.L_F = c.L_F;
+  motionAt(m, w, c, y, modes, ev);
   return ev;
 }
 
 void derivative(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes, State& dy) {
-  const Eval ev = evaluate(m, w, t, y, modes);
+  Motion ev;  // evaluate() without the copy of the loads
+  motionAt(m, w, tailAt(m, w, t, false), y, modes, ev);
   dy[kPhi] = modes.stuck[kRot] ? 0.0 : y[kPhiDot];
   dy[kPhiDot] = ev.phi_ddot;
   const bool moving = m.translation() && !modes.stuck[kTrans];
@@ -162,8 +192,8 @@ Margins eventMargins(const AnalyticModel& m, AnalyticWorkspace& w, double v_stop
                      const Modes& modes) {
   Margins out{1.0, 1.0};
   const bool trans = m.translation();
-  Eval ev;
-  if (modes.stuck[kRot] || (trans && modes.stuck[kTrans])) ev = evaluate(m, w, t, y, modes);
+  Motion ev;
+  if (modes.stuck[kRot] || (trans && modes.stuck[kTrans])) motionAt(m, w, tailAt(m, w, t, false), y, modes, ev);
   out[kRot] = modes.stuck[kRot] ? ev.M_break - std::abs(ev.M_required) : modes.rot_dir * y[kPhiDot];
   if (!trans) return out;
   if (modes.stuck[kTrans]) {
@@ -176,7 +206,8 @@ Margins eventMargins(const AnalyticModel& m, AnalyticWorkspace& w, double v_stop
   } else {
     Modes probe = modes;
     probe.stuck[kTrans] = true;
-    const Eval pe = evaluate(m, w, t, y, probe);
+    Motion pe;
+    motionAt(m, w, tailAt(m, w, t, false), y, probe, pe);
     out[kTrans] = std::max(fast, pe.F_required.norm() - pe.F_break);
   }
   return out;

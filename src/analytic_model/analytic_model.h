@@ -61,12 +61,16 @@ struct AnalyticWorkspace {
     SystemLoads loads;
     double L_F = 0.0;
   } tail_cache;
+  // cos and sin of the last yaw angle rotate() was asked for: while the rotation is stuck (and
+  // in a probe at the same state) the angle repeats, and so would their sincos call.
+  struct YawCache {
+    bool valid = false;
+    double phi = 0.0, c = 1.0, s = 0.0;
+  } yaw;
 };
 
-// Everything the model computes at one instant.
-struct Eval {
-  SystemLoads loads;
-  double L_F = std::numeric_limits<double>::quiet_NaN();
+// What the model computes at one instant besides the tail's loads: the motion they cause.
+struct Motion {
   Vec2 FT_W = Vec2::Zero();   // tail force, world
   double MzF = 0.0;           // friction moment about the system COM
   Vec2 FF_W = Vec2::Zero();   // friction force, world
@@ -75,6 +79,12 @@ struct Eval {
   double M_required = 0.0;    // friction moment a stuck rotation needs
   Vec2 F_required = Vec2::Zero();  // friction force a stuck translation needs
   double M_break = 0.0, F_break = 0.0;  // static limits (max(mu_s, mu_d) m g L_F, ... m g)
+};
+
+// Everything the model computes at one instant.
+struct Eval : Motion {
+  SystemLoads loads;
+  double L_F = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Loads, friction and accelerations at (t, y) in modes m. `decompose`: also the acceleration-/

@@ -17,10 +17,9 @@ using Vec2 = Eigen::Vector2d;
 
 inline double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 inline Vec2 perp(const Vec2& a) { return Vec2(-a.y(), a.x()); }  // z x a
-inline Vec2 rotate(double angle, const Vec2& a) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  return Vec2(c * a.x() - s * a.y(), s * a.x() + c * a.y());
-}
+// By the angle whose cosine and sine are c and s.
+inline Vec2 rotate(double c, double s, const Vec2& a) { return Vec2(c * a.x() - s * a.y(), s * a.x() + c * a.y()); }
+inline Vec2 rotate(double angle, const Vec2& a) { return rotate(std::cos(angle), std::sin(angle), a); }
 
 // Throws std::invalid_argument unless there is one joint state (or profile) per tail link: the
 // recursions read joint i for link i.
