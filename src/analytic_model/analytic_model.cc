@@ -42,7 +42,7 @@ void tailLoadsAndArm(const AnalyticModel& m, AnalyticWorkspace& w, double t, boo
                              " s (M_z,T = " + std::to_string(loads.MzT) + " N m): check the trajectory values");
   L_F = !m.needsArm() ? std::numeric_limits<double>::quiet_NaN()
         : m.effects.foot_loads == FootLoadModel::kConstant ? m.L_F_const
-                                                           : footLoads(m.robot.quadruped, loads.p_QC).L_F;
+                                                           : frictionArm(m.robot.quadruped, loads.p_QC);
 }
 
 // The tail's loads and friction arm at t, from the cache when it holds them (it does afterwards).

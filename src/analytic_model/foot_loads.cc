@@ -20,7 +20,12 @@ namespace {
 }
 }  // namespace
 
-FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
+namespace {
+// Eqs. (A1)-(A5), (17) and (19): the loads f (clipped: a negative one was zeroed) and L_F, the
+// returned value; the foot positions into p_F unless it is null. footLoads() and frictionArm()
+// share it (frictionArm, the analytic model's hot path, needs L_F alone).
+[[gnu::always_inline]] inline double footLoadsCore(const QuadrupedParams& q, const Vec2& p_QC, std::array<double, 4>& f,
+                                                   bool& clipped, std::array<Vec2, 4>* p_F) {
   const double l = q.l_F_m, w = q.w_F_m;
   // Eq. (A2), typo fixed: the centroid offset is body-fixed, so subtract it in Q.
   const Vec2 p_CC = p_QC - Vec2(q.d_Q2C_m, 0.0);  // foot centroid -> system COM
@@ -34,28 +39,42 @@ FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
   //   f_1,2 = 1/4 + x_e/(2 l_F) +- y_e/(2 w_F),  f_3,4 = 1/4 - x_e/(2 l_F) -+ y_e/(2 w_F).
   // (tests/test_foot_loads.cc checks this against (A4) as printed.)
   const double ax = xe / (2.0 * l), ay = ye / (2.0 * w);
-  FootLoads out;
-  out.f_C = {0.25 + ax + ay, 0.25 + ax - ay, 0.25 - ax - ay, 0.25 - ax + ay};
+  f = {0.25 + ax + ay, 0.25 + ax - ay, 0.25 - ax - ay, 0.25 - ax + ay};
   // Every solution of Eq. (A1) is f + lambda (1, -1, 1, -1). (A4) gives lambda = 0; when a load
   // is negative (possible for b > w_F/(2 sqrt 2) off the axes), choose the lambda closest to 0
   // that makes all loads >= 0: this zeroes the negative load and solves (A1) for the other three.
   // Feasible lambda: [max(-f1, -f3), min(f2, f4)], non-empty exactly when the COM is inside.
-  const auto& f = out.f_C;
   const double lo = std::max(-f[0], -f[2]), hi = std::min(f[1], f[3]);
   const double lambda = std::clamp(0.0, lo, std::max(lo, hi));
+  clipped = false;
   if (lambda != 0.0) {
-    out.clipped = true;
-    out.f_C[0] += lambda; out.f_C[1] -= lambda; out.f_C[2] += lambda; out.f_C[3] -= lambda;
-    for (double& v : out.f_C) v = std::max(v, 0.0);  // round-off at exactly zero
+    clipped = true;
+    f[0] += lambda; f[1] -= lambda; f[2] += lambda; f[3] -= lambda;
+    for (double& v : f) v = std::max(v, 0.0);  // round-off at exactly zero
   }
   // Eq. (17): foot positions relative to the system COM, in Q; Eq. (19): L_F.
   static const double kX[4] = {0.5, 0.5, -0.5, -0.5}, kY[4] = {0.5, -0.5, -0.5, 0.5};
   const Vec2 p_Q2Centroid(q.d_Q2C_m, 0.0);
+  double L_F = 0;
   for (int i = 0; i < 4; ++i) {
-    out.p_F[i] = p_Q2Centroid + Vec2(kX[i] * l, kY[i] * w) - p_QC;
-    out.L_F += out.f_C[i] * out.p_F[i].norm();
+    const Vec2 p = p_Q2Centroid + Vec2(kX[i] * l, kY[i] * w) - p_QC;
+    if (p_F) (*p_F)[i] = p;
+    L_F += f[i] * p.norm();
   }
+  return L_F;
+}
+}  // namespace
+
+FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC) {
+  FootLoads out;
+  out.L_F = footLoadsCore(q, p_QC, out.f_C, out.clipped, &out.p_F);
   return out;
+}
+
+double frictionArm(const QuadrupedParams& q, const Vec2& p_QC) {
+  std::array<double, 4> f;
+  bool clipped;
+  return footLoadsCore(q, p_QC, f, clipped, nullptr);
 }
 
 }  // namespace tailsim

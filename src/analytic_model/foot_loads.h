@@ -25,6 +25,8 @@ struct FootLoads {
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
 // support rectangle (a COM exactly on an edge is allowed).
 FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);
+// footLoads(q, p_QC).L_F alone (the same arithmetic, bit for bit), without the rest.
+double frictionArm(const QuadrupedParams& q, const Vec2& p_QC);
 
 // The TippingError message for a system COM at (xe, ye) from the foot centroid.
 std::string tippingMessage(const QuadrupedParams& q, double xe, double ye);

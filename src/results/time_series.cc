@@ -21,7 +21,8 @@ int TimeSeries::column(const std::string& name) const {
 
 void TimeSeries::appendRow(const std::vector<double>& row) {
   if (row.size() != names_.size()) throw std::logic_error("time-series row has the wrong width");
-  for (size_t i = 0; i < row.size(); ++i) data_[i].push_back(row[i]);
+  const double* v = row.data();
+  for (std::vector<double>& col : data_) col.push_back(*v++);
 }
 
 void TimeSeries::appendRepeated(const std::vector<double>& row, size_t count, int grid_col, long first, double step) {
