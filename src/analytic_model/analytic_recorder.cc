@@ -17,7 +17,7 @@ AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples) : dt_
                         col::kLF, col::kFTx, col::kFTy, col::kFFx, col::kFFy, col::kRotState, col::kTransState})
     ts_.addColumn(c);
   ts_.reserveRows(static_cast<size_t>(n_samples));  // bounded by limits::kMaxRowsPerRun (planRun)
-  row_.reserve(ts_.numColumns());
+  row_.assign(ts_.numColumns(), 0.0);
 }
 
 void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
@@ -26,19 +26,21 @@ void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, doub
   const bool decomp = m.effects.load_decomposition;
   const Eval ev = evaluate(m, w, t, y, modes, decomp);
   const std::vector<JointState>& js = w.joints;  // the joint states at t (evaluate())
-  row_.clear();
-  row_.push_back(t);
+  // Written in place (row_ has one slot per column): no capacity check per value.
+  double* r = row_.data();
+  *r++ = t;
   const double d = 180.0 / M_PI;
-  for (const auto& j : js) row_.push_back(j.theta * d);
-  for (const auto& j : js) row_.push_back(j.theta_dot * d);
-  for (const auto& j : js) row_.push_back(j.theta_ddot * d);
+  for (const auto& j : js) *r++ = j.theta * d;
+  for (const auto& j : js) *r++ = j.theta_dot * d;
+  for (const auto& j : js) *r++ = j.theta_ddot * d;
   const bool stiction = m.stiction();
-  row_.insert(row_.end(), {y[kX], y[kY], y[kPhi] * d, y[kPhiDot] * d, ev.phi_ddot * d, ev.loads.MzT,
-                           decomp ? ev.loads.MzT_acc : kNaN, decomp ? ev.loads.MzT_speed : kNaN,
-                           decomp ? ev.loads.MzT_tan : kNaN, decomp ? ev.loads.MzT_cen : kNaN, ev.MzF,
-                           ev.loads.Izz_kgm2 * ev.phi_ddot, ev.loads.Izz_kgm2, ev.L_F, ev.FT_W.x(), ev.FT_W.y(),
-                           ev.FF_W.x(), ev.FF_W.y(), stiction ? (modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
-                           stiction && m.translation() ? (modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN});
+  for (double v : {y[kX], y[kY], y[kPhi] * d, y[kPhiDot] * d, ev.phi_ddot * d, ev.loads.MzT,
+                   decomp ? ev.loads.MzT_acc : kNaN, decomp ? ev.loads.MzT_speed : kNaN,
+                   decomp ? ev.loads.MzT_tan : kNaN, decomp ? ev.loads.MzT_cen : kNaN, ev.MzF,
+                   ev.loads.Izz_kgm2 * ev.phi_ddot, ev.loads.Izz_kgm2, ev.L_F, ev.FT_W.x(), ev.FT_W.y(),
+                   ev.FF_W.x(), ev.FF_W.y(), stiction ? (modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
+                   stiction && m.translation() ? (modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN})
+    *r++ = v;
   ts_.appendRow(row_);
   ++next_;
 }
