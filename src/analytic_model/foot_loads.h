@@ -25,7 +25,7 @@ struct FootLoads {
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
 // support rectangle (a COM exactly on an edge is allowed).
 FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);
-// footLoads(q, p_QC).L_F alone (the same arithmetic, bit for bit), without the rest.
+// footLoads(q, p_QC).L_F alone (the same arithmetic, bit for bit, and the same TippingError).
 double frictionArm(const QuadrupedParams& q, const Vec2& p_QC);
 
 // The TippingError message for a system COM at (xe, ye) from the foot centroid.
