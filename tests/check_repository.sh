@@ -4,7 +4,8 @@
 #    beside it (dot-dot-slash shared) or to an absolute /work path (docs/paper-notes.md holds the
 #    notes now);
 #  - every relative Markdown link in a tracked *.md file points to a file or folder that exists
-#    inside the repository, and no link is an absolute file path.
+#    inside the repository, and no link is an absolute file path;
+#  - every tracked file with a #! line is executable.
 # Usage: check_repository.sh REPO_ROOT. Prints every problem as file:line: what; exit 1 if any.
 set -uo pipefail
 root=$(cd "${1:?usage: check_repository.sh REPO_ROOT}" && pwd -P) || exit 2
@@ -69,6 +70,19 @@ while IFS= read -r hit; do
 done < <(grep -rnE 'yaml-cpp|YAML::' "$root/src/plotting" "$root/src/app" 2>/dev/null || true)
 grep -qE '^tailsim_layer\(tailsim_plotting [^)]*yaml' "$root/CMakeLists.txt" &&
   report "CMakeLists.txt: tailsim_plotting links yaml-cpp"
+
+# Every script with a #! line can be run the way the docs write it (scripts/bench_scale.sh ...):
+# executable in a checkout (git's mode 100755) or, unpacked, on disk.
+for f in "${files[@]}"; do
+  [ -f "$f" ] || continue
+  head -c 2 -- "$f" | grep -q '^#!' || continue
+  if git -C "$root" rev-parse --is-inside-work-tree >/dev/null 2>&1; then
+    mode=$(git -C "$root" ls-files -s -- "$f" | cut -d' ' -f1)
+    [ "$mode" = 100755 ] || report "$f: has a #! line but is not executable (git mode $mode: git update-index --chmod=+x)"
+  else
+    [ -x "$f" ] || report "$f: has a #! line but is not executable"
+  fi
+done
 
 if [ "$problems" -gt 0 ]; then
   echo "$problems problem(s): the repository must stand alone (reading notes: docs/paper-notes.md)"
