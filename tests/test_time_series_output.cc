@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -12,6 +13,7 @@
 #include <sstream>
 
 #include "analytic_test_util.h"
+#include "random_cases.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
@@ -336,4 +338,56 @@ TEST(TimeSeriesOutput, NoneRecordsTwoRowsAndSummarizesTheSame) {
   EXPECT_EQ(cases, 8);
   EXPECT_GE(compared, 8 * 2 * 6);
   fs::remove_all(dir);
+}
+
+// With time_series thin the analytic model keeps every row's state and evaluates only the rows
+// thinning keeps (AnalyticRecorder): the series equals thinRows of the full series, every value
+// bit for bit (NaN where NaN), and the summary is the same. Fig. 7 and 400 seeded random cases
+// (n 1-6, stiction / ADAMS law / none, paper and exact coupling, bodies at rest for good before
+// the end, whose rows are copies of one: random_cases.h).
+TEST(TimeSeriesOutput, ThinRowsEvaluatedLazilyEqualThinningTheFullSeries) {
+  using namespace tailsim::testing;
+  auto same = [](const RunResult& full, const RunResult& thin, const std::vector<double>& marks, const std::string& what) {
+    ASSERT_FALSE(full.series_thinned);
+    ASSERT_TRUE(thin.series_thinned);
+    const TimeSeries want = thinRows(full.series, marks);
+    ASSERT_EQ(want.names(), thin.series.names()) << what;
+    ASSERT_EQ(want.numRows(), thin.series.numRows()) << what;
+    EXPECT_LT(thin.series.numRows(), full.series.numRows()) << what;
+    for (size_t c = 0; c < want.numColumns(); ++c)
+      for (size_t k = 0; k < want.numRows(); ++k) {
+        const double a = want.at(k, static_cast<int>(c)), b = thin.series.at(k, static_cast<int>(c));
+        if (!(std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b))))
+          FAIL() << what << ": row " << k << " column " << want.names()[c] << ": " << a << " vs " << b;
+      }
+    EXPECT_EQ(full.summary.phi_net_deg, thin.summary.phi_net_deg) << what;
+    EXPECT_EQ(full.summary.solver_steps, thin.summary.solver_steps) << what;
+    EXPECT_EQ(full.summary.extra, thin.summary.extra) << what;
+    EXPECT_EQ(full.summary.ok, thin.summary.ok) << what;
+  };
+  OutputSettings thin;
+  thin.time_series = TimeSeriesOutput::kThin;
+  {
+    const RobotParams r = paperRobot(1);
+    const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);
+    same(simulateAnalytic(r, tr, {}, {}, {}), simulateAnalytic(r, tr, {}, {}, thin), tr.breakpoints(), "fig7");
+  }
+  RandomCases gen(4242);
+  int repeated = 0;
+  for (int k = 0; k < 400; ++k) {
+    const RandomCase c = gen.next();
+    const RunResult full = simulateAnalytic(c.robot, c.trajectory, c.settings, c.effects, {});
+    if (!full.summary.ok) continue;
+    const size_t n = full.series.numRows();
+    bool copies = n > 2;  // the last two rows differ only in t: rows at rest, repeated
+    for (size_t col = 1; copies && col < full.series.numColumns(); ++col) {
+      const double a = full.series.at(n - 1, static_cast<int>(col)), b = full.series.at(n - 2, static_cast<int>(col));
+      copies = a == b || (std::isnan(a) && std::isnan(b));
+    }
+    repeated += copies;
+    same(full, simulateAnalytic(c.robot, c.trajectory, c.settings, c.effects, thin), c.trajectory.breakpoints(),
+         "random case " + std::to_string(k) + ": " + describe(c));
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(repeated, 50);
 }

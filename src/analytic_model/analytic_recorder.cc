@@ -4,10 +4,12 @@
 #include <string>
 
 #include "results/columns.h"
+#include "results/thin_series.h"
 
 namespace tailsim {
 
-AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples) : dt_(dt), n_samples_(n_samples) {
+AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples, const std::vector<double>* thin_marks)
+    : dt_(dt), n_samples_(n_samples), marks_(thin_marks) {
   ts_.addColumn(col::kT);
   for (int i = 1; i <= n_links; ++i) ts_.addColumn(col::theta(i));
   for (int i = 1; i <= n_links; ++i) ts_.addColumn(col::thetadot(i));
@@ -16,12 +18,25 @@ AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples) : dt_
                         col::kMzTSpeed, col::kMzTTan, col::kMzTCen, col::kMzF, col::kIzzPhiddot, col::kIzz,
                         col::kLF, col::kFTx, col::kFTy, col::kFFx, col::kFFy, col::kRotState, col::kTransState})
     ts_.addColumn(c);
-  ts_.reserveRows(static_cast<size_t>(n_samples));  // bounded by limits::kMaxRowsPerRun (planRun)
+  // Bounded by limits::kMaxRowsPerRun (planRun).
+  if (thin_marks) pending_.reserve(static_cast<size_t>(n_samples));
+  else ts_.reserveRows(static_cast<size_t>(n_samples));
   row_.assign(ts_.numColumns(), 0.0);
 }
 
 void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
                               const Modes& modes) {
+  if (marks_) {
+    pending_.push_back({t, y, modes});
+  } else {
+    fillRow(m, w, t, y, modes);
+    ts_.appendRow(row_);
+  }
+  ++next_;
+}
+
+void AnalyticRecorder::fillRow(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
+                               const Modes& modes) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const bool decomp = m.effects.load_decomposition;
   const Eval ev = evaluate(m, w, t, y, modes, decomp);
@@ -41,15 +56,61 @@ void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, doub
                    ev.FF_W.x(), ev.FF_W.y(), stiction ? (modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
                    stiction && m.translation() ? (modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN})
     *r++ = v;
-  ts_.appendRow(row_);
-  ++next_;
 }
 
 void AnalyticRecorder::repeatLastUntilDone() {
+  if (marks_) {
+    if (pending_.empty() || done()) return;
+    repeat_first_ = next_;
+    repeat_count_ = n_samples_ - next_;
+    next_ = n_samples_;
+    return;
+  }
   if (ts_.numRows() == 0 || done()) return;
   // Column 0 is the time, next_ * dt_ as nextTime() gives it.
   ts_.appendRepeated(row_, static_cast<size_t>(n_samples_ - next_), 0, next_, dt_);
   next_ = n_samples_;
+}
+
+TimeSeries AnalyticRecorder::take(const AnalyticModel& m, AnalyticWorkspace& w) {
+  if (!marks_) return std::move(ts_);
+  // The columns the thinning rule reads, as fillRow writes them.
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const double d = 180.0 / M_PI;
+  const bool stiction = m.stiction(), trans = stiction && m.translation();
+  TimeSeries light;
+  for (const char* c : {col::kT, col::kPhi, col::kRotState, col::kTransState}) light.addColumn(c);
+  const size_t n_pending = pending_.size();
+  light.reserveRows(n_pending + static_cast<size_t>(repeat_count_));
+  std::vector<double> r(4);
+  auto lightRow = [&](double t, const Pending& p) {
+    r = {t, p.y[kPhi] * d, stiction ? (p.modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
+         trans ? (p.modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN};
+    light.appendRow(r);
+  };
+  for (const Pending& p : pending_) lightRow(p.t, p);
+  for (long i = 0; i < repeat_count_; ++i)  // TimeSeries::appendRepeated's times
+    lightRow(static_cast<double>(repeat_first_ + i) * dt_, pending_.back());
+  const std::vector<size_t> keep = thinRowIndices(light, *marks_);
+  ts_.reserveRows(keep.size());
+  bool row_is_last = false;  // row_ holds the last pending row (the repeated rows' source)
+  for (size_t k : keep) {
+    if (k < n_pending) {
+      const Pending& p = pending_[k];
+      fillRow(m, w, p.t, p.y, p.modes);
+      ts_.appendRow(row_);
+      row_is_last = k + 1 == n_pending;
+      continue;
+    }
+    if (!row_is_last) {
+      const Pending& p = pending_.back();
+      fillRow(m, w, p.t, p.y, p.modes);
+      row_is_last = true;
+    }
+    ts_.appendRepeated(row_, 1, 0, repeat_first_ + static_cast<long>(k - n_pending), dt_);
+  }
+  std::vector<Pending>().swap(pending_);
+  return std::move(ts_);
 }
 
 }  // namespace tailsim

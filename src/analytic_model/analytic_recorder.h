@@ -13,26 +13,43 @@ namespace tailsim {
 class AnalyticRecorder {
  public:
   // n_samples: rows on the grid 0, dt, ... <= t_end (bounded by the caller before any work).
-  AnalyticRecorder(int n_links, double dt, long n_samples);
+  // thin_marks (output.time_series: thin): the tail's phase boundaries. The rows are then kept as
+  // states and evaluated in take(), only those thinRowIndices keeps (results/thin_series.h): the
+  // rule reads t, phi and the stick/slip states alone, which the state gives without evaluating
+  // the model. The same rows, bit for bit, as thinning the full series.
+  AnalyticRecorder(int n_links, double dt, long n_samples, const std::vector<double>* thin_marks = nullptr);
 
   // Next sample time not yet written (or +inf when done).
   double nextTime() const { return next_ < n_samples_ ? next_ * dt_ : std::numeric_limits<double>::infinity(); }
   bool done() const { return next_ >= n_samples_; }
 
-  // Evaluates the model at (t, y) in modes and appends the row.
+  // Evaluates the model at (t, y) in modes and appends the row (thin: keeps the state for take()).
   void record(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes);
 
   // Once everything is at rest for good (tail stopped, body stuck), every remaining row is the
   // last one with a later time: copy it instead of re-evaluating the model.
   void repeatLastUntilDone();
 
-  TimeSeries take() { return std::move(ts_); }
+  // The rows (thin: the kept ones, evaluated now with m and w).
+  TimeSeries take(const AnalyticModel& m, AnalyticWorkspace& w);
+  // take() gives the thin subset, not every sample.
+  bool thinned() const { return marks_ != nullptr; }
 
  private:
+  // row_ = the row of (t, y, modes).
+  void fillRow(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes);
+  struct Pending {
+    double t;
+    State y;
+    Modes modes;
+  };
   double dt_;
   long n_samples_ = 0, next_ = 0;
   TimeSeries ts_;
   std::vector<double> row_;
+  const std::vector<double>* marks_ = nullptr;
+  std::vector<Pending> pending_;      // thin: the states of the rows recorded so far
+  long repeat_first_ = 0, repeat_count_ = 0;  // thin: repeatLastUntilDone's rows (grid index, count)
 };
 
 }  // namespace tailsim

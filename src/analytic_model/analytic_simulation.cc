@@ -170,16 +170,17 @@ RunPlan planRun(const TailTrajectory& trajectory, const AnalyticSettings& settin
 
 // One run in progress: the constant model and plan, the workspace, the output and the state.
 struct Run {
-  Run(const AnalyticModel& m, const RunPlan& p, double sample_dt_s, double v_stop_mps)
-      : model(m), plan(p), rec(m.robot.numLinks(), sample_dt_s, p.rows), v_stop(v_stop_mps),
-        breakpoints(m.traj.breakpoints()) {}
+  // thin: output.time_series thin (the recorder evaluates only the rows that thinning keeps).
+  Run(const AnalyticModel& m, const RunPlan& p, double sample_dt_s, double v_stop_mps, bool thin)
+      : model(m), plan(p), breakpoints(m.traj.breakpoints()),
+        rec(m.robot.numLinks(), sample_dt_s, p.rows, thin ? &breakpoints : nullptr), v_stop(v_stop_mps) {}
 
   const AnalyticModel& model;
   const RunPlan& plan;
   AnalyticWorkspace ws;
+  std::vector<double> breakpoints;  // of the tail profile (also thinning's marks)
   AnalyticRecorder rec;
   double v_stop;  // a slide below this speed may stick (fixed solver: at least one step's friction)
-  std::vector<double> breakpoints;
   State y{};
   Modes modes;
   double t = 0.0;
@@ -559,10 +560,11 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     if (model.needsArm() && effects.foot_loads == FootLoadModel::kDistributed)
       if (const auto loss = firstSupportLoss(robot, trajectory, plan.t_end))
         throw TippingError(supportLossMessage(robot.quadruped, *loss));
-    Run run(model, plan, output.sample_dt_s, stopSpeed(model, plan));
+    Run run(model, plan, output.sample_dt_s, stopSpeed(model, plan), output.time_series == TimeSeriesOutput::kThin);
     startAtRest(run);
     integrate(run);
-    result.series = run.rec.take();
+    result.series = run.rec.take(model, run.ws);
+    result.series_thinned = run.rec.thinned();
     summarize(run, sum);
     if (settings.coupling == Coupling::kPaper) paperCouplingDiagnostic(run, sum);
   } catch (const TippingError& e) {

@@ -18,6 +18,8 @@ namespace tailsim {
 // Integrates from t = 0 (tail at rest at theta_0, body at rest) to the output duration.
 // Never throws for physics failures: summary.ok = false with the reason (e.g. tipping).
 // Throws std::invalid_argument for settings it cannot run with (e.g. a negative tolerance).
+// With output.time_series thin the series holds only the rows thinRowIndices keeps, and only those
+// are evaluated (RunResult::series_thinned); otherwise every sample.
 RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& trajectory,
                            const AnalyticSettings& settings, const Effects& effects,
                            const OutputSettings& output);

@@ -586,7 +586,7 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     // Every model's CSV in the one column order (docs/ARCHITECTURE.md "Time-series columns").
     if (keepsSeries(c)) {
       TimeSeries ordered = col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series)));
-      if (thin) ordered = thinRows(ordered, marks);
+      if (thin && !r.series_thinned) ordered = thinRows(ordered, marks);
       if (folder) writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), ordered);
       else job.h5->write(job.dirs[i], c.name, job.keys[i], c.sweep_values, r.summary.model,
                          settings::nameOf(timeSeriesOutputNames(), c.output.time_series), ordered);

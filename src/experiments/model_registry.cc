@@ -28,8 +28,13 @@ RunResult failedRun(const std::string& model, const std::string& why) {
 // over does not depend on the rows either: it is checked along the whole trajectory before the run
 // (support_check.h); only the per-foot load transfer's shifted centre of pressure, which depends on
 // the state, is checked where the loads are evaluated.
+//
+// With thin and no video, the analytic model evaluates only the rows thinning keeps (it returns
+// them with RunResult::series_thinned); a video needs every row, so with one it records them all
+// and the runner thins the CSV's copy.
 OutputSettings recordedOutput(const ExperimentCase& c) {
   OutputSettings o = c.output;
+  if (c.render.enabled) o.time_series = TimeSeriesOutput::kFull;
   if (o.time_series != TimeSeriesOutput::kNone || c.render.enabled) return o;
   const double t_end = c.simDuration();  // the models' own end (planRun)
   if (t_end > o.sample_dt_s) o.sample_dt_s = t_end;

@@ -51,6 +51,9 @@ struct RunSummary {
 struct RunResult {
   RunSummary summary;
   TimeSeries series;
+  // The model already kept only output.time_series: thin's rows (thinRowIndices); else every
+  // sample, and the caller thins.
+  bool series_thinned = false;
 };
 
 }  // namespace tailsim
