@@ -17,18 +17,17 @@ using namespace tailsim::testing;
 
 namespace {
 
-// The support margin at t as footLoads judges it: does it throw?
-bool outsideAt(const RobotParams& r, const TailTrajectory& tr, double t) {
+// How far the system COM is beyond the support rectangle at t (negative: inside), in units of
+// the check's resolution kSupportSlack (l_F + w_F): computed here from the mass properties.
+double beyondAt(const RobotParams& r, const TailTrajectory& tr, double t) {
   std::vector<JointState> js;
   tr.evaluate(t, js);
   SystemLoads sl;
   systemMassProperties(r, tailKinematics(r.tail, js), sl);
-  try {
-    footLoads(r.quadruped, sl.p_QC);
-    return false;
-  } catch (const TippingError&) {
-    return true;
-  }
+  const QuadrupedParams& q = r.quadruped;
+  const Vec2 p = sl.p_QC - Vec2(q.d_Q2C_m, 0.0);
+  const double beyond = std::max(std::abs(p.x()) - 0.5 * q.l_F_m, std::abs(p.y()) - 0.5 * q.w_F_m);
+  return beyond / (kSupportSlack * (q.l_F_m + q.w_F_m));
 }
 
 // One heavy link (COM at mid-length) on a base at the quadruped COM (d_Q2B = 0), swinging from
@@ -62,7 +61,8 @@ SideSwing sideSwing(double delta_m) {
 // friction models now fail the run the same way. 2 nm further in, every run stands.
 TEST(SupportCheck, ABriefExitFailsTheRunWhateverItRecords) {
   const SideSwing out = sideSwing(1e-8);
-  const double half_w = 0.5 * out.robot.quadruped.w_F_m, slack = 1e-12 * (out.robot.quadruped.l_F_m + half_w * 2);
+  const double half_w = 0.5 * out.robot.quadruped.w_F_m,
+               slack = kSupportSlack * (out.robot.quadruped.l_F_m + half_w * 2);
   // Closed form of the first exit: (m_t/m) c sin(theta*) = w_F / 2 + slack, theta rising to 90 deg.
   const double theta_star = std::asin((half_w + slack) / (out.r * out.c));
   auto timeOf = [&](double theta) {  // theta(t) rises monotonically over the stroke
@@ -99,11 +99,13 @@ TEST(SupportCheck, ABriefExitFailsTheRunWhateverItRecords) {
   }
 }
 
-// Random tails (1-6 links, 1-10x the paper's link masses, split-cycle or spline strokes with
-// start delays) against a dense scan of footLoads every 20 us: the search never reports later
-// than the scan's first outside sample, nothing before the time it reports is outside, and the
-// robot is outside at that time. Where the scan sees nothing the search may still find a brief
-// exit between its samples, which the check at the reported time confirms.
+// Random tails (1-6 links, 1-10x the paper's link masses, split-cycle or spline strokes of 2-6
+// knots, start delays) against a dense scan every 20 us: the search never reports later than the
+// scan's first sample beyond footLoads' slack (2 kSupportSlack), no sample before the time it
+// reports is beyond that, and the COM is beyond the check's own resolution (kSupportSlack) at
+// that time. Where the scan sees nothing the search may still find a brief exit between its
+// samples, which the value at the reported time confirms. (2- and 3-knot splines have their
+// largest acceleration at an end knot: a bound that missed it let exits through.)
 TEST(SupportCheck, AgreesWithADenseScanOfRandomTails) {
   std::mt19937 rng(20261126);
   std::uniform_real_distribution<double> u(0, 1);
@@ -124,7 +126,8 @@ TEST(SupportCheck, AgreesWithADenseScanOfRandomTails) {
         SplineParams sp;
         sp.dT_s = dT;
         sp.t0_s = t0;
-        for (int q = 0; q < 5; ++q) sp.knots_rad.push_back(deg(-120 + 240 * u(rng)));
+        const int knots = 2 + static_cast<int>(u(rng) * 5);
+        for (int q = 0; q < knots; ++q) sp.knots_rad.push_back(deg(-120 + 240 * u(rng)));
         tr.joints.emplace_back(sp);
       } else {
         tr.joints.emplace_back(SplitCycleParams{deg(-90 + 180 * u(rng)), deg(-180 + 360 * u(rng)), dT, 0.05 + 0.9 * u(rng), t0});
@@ -135,7 +138,7 @@ TEST(SupportCheck, AgreesWithADenseScanOfRandomTails) {
     const auto loss = firstSupportLoss(r, tr, t_end);
     double scan_first = -1;
     for (double t = 0; t <= tr.endTime() + 1e-12; t += 2e-5)
-      if (outsideAt(r, tr, t)) {
+      if (beyondAt(r, tr, t) > 2.0) {
         scan_first = t;
         break;
       }
@@ -149,15 +152,61 @@ TEST(SupportCheck, AgreesWithADenseScanOfRandomTails) {
     }
     ++tipped;
     if (scan_first < 0) ++between_samples;
-    EXPECT_TRUE(outsideAt(r, tr, loss->t_s)) << loss->t_s;
+    EXPECT_GT(beyondAt(r, tr, loss->t_s), 1.0) << loss->t_s;
     // Inside just before (the exit is located to 1e-12 s), and at every scan sample before it.
     if (loss->t_s > 0) {
-      EXPECT_FALSE(outsideAt(r, tr, loss->t_s - 2e-12)) << loss->t_s;
+      EXPECT_LE(beyondAt(r, tr, loss->t_s - 2e-12), 2.0) << loss->t_s;
     }
-    for (double t = 0; t < loss->t_s - 1e-12; t += 2e-5) ASSERT_FALSE(outsideAt(r, tr, t)) << t;
+    for (double t = 0; t < loss->t_s - 1e-12; t += 2e-5) ASSERT_LE(beyondAt(r, tr, t), 2.0) << t;
   }
   std::printf("random tails: %d tip over (%d between the scan's samples), %d stand\n", tipped, between_samples,
               standing);
-  EXPECT_GT(tipped, 50);
+  EXPECT_GT(tipped, 30);
   EXPECT_GT(standing, 50);
+}
+
+// Two joints, each a 2-knot spline (constant speed change: the largest acceleration at the end
+// knots, where JointProfile::at gives 0, at rest), the second starting later: the COM's lateral
+// offset peaks once, mid-motion. With the side edge 1e-6 m and 1e-8 m inside that peak, the exit
+// is found (found in review: a curvature bound from at() at the knots was 0 and certified it away).
+TEST(SupportCheck, TwoKnotSplinesWhoseLargestAccelerationIsAtTheirEnds) {
+  RobotParams r = paperRobot(2, 0.0);
+  r.quadruped.d_Q2C_m = 0;
+  r.tail[0] = TailLink{};
+  r.tail[0].mass_kg = 1e-3;
+  r.tail[0].length_m = 1e-4;
+  r.tail[0].com_offset_m = 0;
+  r.tail[0].izz_kgm2 = 1e-6;
+  r.tail[1].mass_kg = 3;
+  r.tail[1].length_m = 0.6;
+  r.tail[1].com_offset_m = 0.3;
+  r.tail[1].izz_kgm2 = 0.09;
+  TailTrajectory tr;
+  SplineParams a, b;
+  a.dT_s = b.dT_s = 0.25;
+  b.t0_s = 0.0973;
+  a.knots_rad = {0, 0.1};
+  b.knots_rad = {deg(45), deg(45) - 0.1};
+  tr.joints.emplace_back(a);
+  tr.joints.emplace_back(b);
+  ASSERT_GT(tr.joints[0].peakAcceleration(), 0);
+  double peak = 0, t_peak = 0;
+  for (double t = 0; t <= 0.36; t += 1e-6) {
+    std::vector<JointState> js;
+    tr.evaluate(t, js);
+    SystemLoads sl;
+    systemMassProperties(r, tailKinematics(r.tail, js), sl);
+    if (std::abs(sl.p_QC.y()) > peak) {
+      peak = std::abs(sl.p_QC.y());
+      t_peak = t;
+    }
+  }
+  ASSERT_GT(t_peak, 0.11);  // mid-motion, after the second joint started
+  for (double delta : {1e-6, 1e-8}) {
+    r.quadruped.w_F_m = 2 * (peak - delta);
+    const auto loss = firstSupportLoss(r, tr, 0.5);
+    ASSERT_TRUE(loss.has_value()) << delta;
+    EXPECT_LE(loss->t_s, t_peak) << delta;
+    EXPECT_GT(beyondAt(r, tr, loss->t_s), 1.0) << delta;
+  }
 }

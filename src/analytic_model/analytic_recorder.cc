@@ -1,6 +1,7 @@
 #include "analytic_model/analytic_recorder.h"
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "results/columns.h"
@@ -41,7 +42,8 @@ void AnalyticRecorder::fillRow(const AnalyticModel& m, AnalyticWorkspace& w, dou
   const bool decomp = m.effects.load_decomposition;
   const Eval ev = evaluate(m, w, t, y, modes, decomp);
   const std::vector<JointState>& js = w.joints;  // the joint states at t (evaluate())
-  // Written in place (row_ has one slot per column): no capacity check per value.
+  // Written in place (row_ has one slot per column: t, 3 per joint, 20 more): no capacity check per value.
+  if (row_.size() != 21 + 3 * js.size()) throw std::logic_error("analytic row: the joints do not match the columns");
   double* r = row_.data();
   *r++ = t;
   const double d = 180.0 / M_PI;

@@ -7,9 +7,16 @@
 namespace tailsim {
 
 std::string tippingMessage(const QuadrupedParams& q, double xe, double ye) {
+  // Which edge, and how far beyond it (the first exit is only just beyond: 9 digits and the distance).
+  const double beyond_x = std::abs(xe) - 0.5 * q.l_F_m, beyond_y = std::abs(ye) - 0.5 * q.w_F_m;
+  const bool side = beyond_y >= beyond_x;
+  const char* edge = side ? (ye > 0 ? "left" : "right") : (xe > 0 ? "front" : "rear");
   std::ostringstream os;
+  os.precision(9);
   os << "system COM at (" << xe << ", " << ye << ") m from the foot centroid is outside the support "
-     << "rectangle (+-" << 0.5 * q.l_F_m << ", +-" << 0.5 * q.w_F_m << ") m: the robot tips over";
+     << "rectangle (+-" << 0.5 * q.l_F_m << ", +-" << 0.5 * q.w_F_m << ") m";
+  os.precision(3);
+  os << ", " << (side ? beyond_y : beyond_x) << " m beyond its " << edge << " edge: the robot tips over";
   return os.str();
 }
 
@@ -30,7 +37,7 @@ namespace {
   // Eq. (A2), typo fixed: the centroid offset is body-fixed, so subtract it in Q.
   const Vec2 p_CC = p_QC - Vec2(q.d_Q2C_m, 0.0);  // foot centroid -> system COM
   const double xe = p_CC.x(), ye = p_CC.y();       // Eq. (A3)
-  const double slack = 1e-12 * (l + w);  // a COM on an edge (up to round-off) still stands
+  const double slack = 2.0 * kSupportSlack * (l + w);  // a COM on an edge (up to round-off) still stands
   if (std::abs(xe) > 0.5 * l + slack || std::abs(ye) > 0.5 * w + slack) throwTipping(q, xe, ye);
   // Eq. (A3) solved (paper-notes point 5): ellipse with a/b = l_F/w_F,
   //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).

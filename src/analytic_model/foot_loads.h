@@ -22,8 +22,13 @@ struct FootLoads {
   bool clipped = false;         // the (A4) fit gave a negative load that was zeroed (b > 0.5 w_F fallback)
 };
 
+// A COM this far (times l_F + w_F) beyond an edge of the support rectangle still stands: the
+// pre-run check (support_check.h) resolves margins to this, and footLoads allows twice it, so a
+// run the check passed never tips in footLoads (0.06 nm on the paper's feet: round-off, not physics).
+constexpr double kSupportSlack = 1e-10;
+
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
-// support rectangle (a COM exactly on an edge is allowed).
+// support rectangle (beyond 2 kSupportSlack (l_F + w_F)).
 FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);
 // footLoads(q, p_QC).L_F alone (the same arithmetic, bit for bit, and the same TippingError).
 double frictionArm(const QuadrupedParams& q, const Vec2& p_QC);

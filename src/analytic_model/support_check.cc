@@ -25,17 +25,11 @@ class Search {
  public:
   Search(const RobotParams& robot, const TailTrajectory& traj) : robot_(robot), traj_(traj) {
     const QuadrupedParams& q = robot.quadruped;
-    slack_ = 1e-12 * (q.l_F_m + q.w_F_m);
+    slack_ = kSupportSlack * (q.l_F_m + q.w_F_m);
     for (const JointProfile& j : traj.joints) {
       // Peak |speed| (split-cycle: 2 dtheta / dT at t1; spline: its computed peak) and peak
-      // |acceleration| (split-cycle: the larger half-sine amplitude; spline: piecewise linear, so
-      // its largest knot value).
-      double acc = std::max(std::abs(j.accelAmplitude()), std::abs(j.decelAmplitude()));
-      if (j.isSpline()) {
-        std::vector<double> knots;
-        j.breakpoints(knots);
-        for (double t : knots) acc = std::max(acc, std::abs(j.at(t).theta_ddot));
-      }
+      // |acceleration| (JointProfile::peakAcceleration, a spline's end knots included).
+      const double acc = j.peakAcceleration();
       if (!std::isfinite(j.peakSpeed()) || !std::isfinite(acc))
         throw std::runtime_error("a joint's peak speed or acceleration is non-finite: check the trajectory values");
       // A relative margin for round-off in the bounds themselves.

@@ -23,8 +23,10 @@ struct SupportLoss {
 // joints moving there, so the margin's lowest value there is at least
 // (g(a) + g(b)) / 2 - L (b - a) / 2; intervals are halved, earliest first, until that bound is
 // >= 0 (or, from the curvature bound |d^2 p_QC/dt^2| <= M, min(g(a), g(b)) - M (b - a)^2 / 8 >= 0)
-// or the exit is located to 1e-12 s. A dip no deeper than 1e-12 (l_F + w_F), the slack footLoads
-// already allows on an edge, counts as standing. Returns the first time outside, or nothing.
+// or the exit is located to 1e-12 s. Margins are measured from kSupportSlack (l_F + w_F) beyond the
+// edges, and a possible dip no deeper than that again counts as standing: within footLoads' own
+// slack, so footLoads never throws in a run this check passed. Returns the first time outside,
+// or nothing.
 std::optional<SupportLoss> firstSupportLoss(const RobotParams& robot, const TailTrajectory& traj, double t_end);
 
 // The message footLoads' TippingError gives, with the time.

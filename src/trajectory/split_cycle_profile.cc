@@ -103,6 +103,13 @@ void JointProfile::breakpoints(std::vector<double>& out) const {
   for (std::size_t k = 0; k < knots_.size(); ++k) out.push_back(p_.t0_s + h_ * static_cast<double>(k));
 }
 
+double JointProfile::peakAcceleration() const {
+  if (!isSpline()) return std::max(std::abs(A_), std::abs(B_));
+  double a = 0.0;
+  for (double m : m_) a = std::max(a, std::abs(m));
+  return a;
+}
+
 JointState JointProfile::at(double t) const {
   if (isSpline()) return splineAt(t);
   const double tau = t - p_.t0_s;

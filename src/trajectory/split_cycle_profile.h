@@ -78,6 +78,10 @@ class JointProfile {
   // At its final rest at t: at(t) is {theta0 + dtheta, 0, 0} (the same test at() makes).
   bool finished(double t) const { return t - p_.t0_s >= p_.dT_s; }
   double peakSpeed() const { return isSpline() ? peak_ : 2.0 * p_.dtheta_rad / p_.dT_s; }  // signed, at t1
+  // Largest |acceleration| over the move  [rad/s^2]: split-cycle max(|A|, |B|); spline the largest
+  // |second derivative| at a knot (linear on each piece), end knots included (at() gives 0 there:
+  // at rest outside [t0, t2]).
+  double peakAcceleration() const;
   // Times where the acceleration changes formula: t0, t1, t2 (split-cycle) or every knot (spline).
   void breakpoints(std::vector<double>& out) const;
 
