@@ -258,6 +258,7 @@ struct Job {
   // not finished. Text, not parsed JSON: a parsed entry takes ~10x its text's memory (10^5 cases
   // held 1.3 GB that way); writeSummary parses them one at a time.
   std::vector<std::string> entries;
+  std::set<std::string> extra_names;  // writeSummary: every run's extra figures (results.csv columns)
   std::vector<size_t> todo;       // case indices to run now
   std::string source;             // recordedSource(*e), as found before the folder is written
   int total = 0, resumed = 0;
@@ -623,10 +624,11 @@ void forEachEntry(const Job& job, const F& f) {
     if (!text.empty()) f(json::parse(text));
 }
 
-// One experiment's rows of a results table, read from its job's entries.
+// One experiment's rows of a results table, read from its job's entries (after writeSummary: the
+// part a table reads, {name, sweep, runs}, and the extras' names collected).
 ResultsCsvInput tableInput(const Job& job) {
-  return {job.e->name, job.e->swept_keys,
-          [&job](const std::function<void(const json&)>& f) { forEachEntry(job, f); }};
+  return {job.e->name, job.e->swept_keys, [&job](const std::function<void(const json&)>& f) { forEachEntry(job, f); },
+          &job.extra_names};
 }
 
 // Writes DIR/summary.json and DIR/results.csv (from the same entries: every finished case,
@@ -660,7 +662,9 @@ void writeSummary(Job& job) {
   const size_t at = text.find(empty);
   std::string cases = "[";
   bool first = true;
-  forEachEntry(job, [&](json entry) {
+  for (std::string& entry_text : job.entries) {
+    if (entry_text.empty()) continue;
+    json entry = json::parse(entry_text);  // the one parse of this entry
     entry.erase("experiment");  // said once, in the header
     entry.erase("source");
     entry.erase("tailsim_version");
@@ -675,7 +679,16 @@ void writeSummary(Job& job) {
     }
     cases += (first ? "\n  " : ",\n  ") + nested;
     first = false;
-  });
+    // From here on the entry serves results tables only: keep what they read.
+    json row = json::object();
+    for (const char* k : {"name", "sweep", "runs"})
+      if (auto it = entry.find(k); it != entry.end()) row[k] = std::move(*it);
+    if (const auto runs = row.find("runs"); runs != row.end() && runs->is_object())
+      for (const auto& [model, run] : runs->items())
+        if (const auto x = run.find("extra"); x != run.end() && x->is_object())
+          for (const auto& [name, v] : x->items()) job.extra_names.insert(name);
+    entry_text = row.dump();
+  }
   cases += first ? "]" : "\n ]";
   text.replace(at + empty.size() - 2, 2, cases);
   writeFileAtomic((job.root / "summary.json").string(), text);

@@ -46,6 +46,10 @@ std::string resultsCsv(const std::vector<ResultsCsvInput>& experiments) {
     for (const json& k : s.swept_keys)
       if (k.is_string() && std::find(swept.begin(), swept.end(), k.get<std::string>()) == swept.end())
         swept.push_back(k.get<std::string>());
+    if (s.extra_names) {
+      extras.insert(s.extra_names->begin(), s.extra_names->end());
+      continue;
+    }
     s.for_each_case([&](const json& c) {
       for (const auto& [model, run] : field(c, "runs").items())
         for (const auto& [name, v] : field(run, "extra").items()) extras.insert(name);

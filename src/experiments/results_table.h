@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,11 +22,14 @@ std::string resultsCsv(const std::vector<nlohmann::json>& summaries);
 
 // The same from each experiment's name, swept keys and a function that calls its argument with
 // each case entry in turn (summary.json's "cases" items): a sweep of 10^5 cases need not hold
-// them all parsed. The entries are read twice (the columns, then the rows).
+// them all parsed. The entries are read twice (the columns, then the rows) unless extra_names is given.
 struct ResultsCsvInput {
   nlohmann::json experiment;  // the experiment's name
   nlohmann::json swept_keys;  // array of dotted keys
   std::function<void(const std::function<void(const nlohmann::json&)>&)> for_each_case;
+  // The names of every run's extra figures, when the caller has them: the cases are then read
+  // once (the rows) instead of twice.
+  const std::set<std::string>* extra_names = nullptr;
 };
 std::string resultsCsv(const std::vector<ResultsCsvInput>& experiments);
 
