@@ -13,8 +13,9 @@
 namespace tailsim {
 namespace {
 
-// The four edge margins of the support rectangle at t, each >= 0 inside (footLoads' slack
-// included): l/2 - x_e, l/2 + x_e, w/2 - y_e, w/2 + y_e. Each is as smooth as p_QC(t).
+// The four edge margins of the support rectangle at t, each >= 0 inside (measured from
+// kSupportSlack (l_F + w_F) beyond the edges): l/2 - x_e, l/2 + x_e, w/2 - y_e, w/2 + y_e, each
+// as smooth as p_QC(t).
 struct EdgeMargins {
   std::array<double, 4> e;
   Vec2 p_CC;
