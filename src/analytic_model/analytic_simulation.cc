@@ -557,9 +557,7 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     const AnalyticModel model(robot, trajectory, settings, effects);
     // Tipping over depends on the trajectory alone: checked along all of it before the run, not
     // only where the loads happen to be evaluated (docs/paper-notes.md point 5).
-    if (model.needsArm() && effects.foot_loads == FootLoadModel::kDistributed)
-      if (const auto loss = firstSupportLoss(robot, trajectory, plan.t_end))
-        throw TippingError(supportLossMessage(robot.quadruped, *loss));
+    if (model.needsArm() && effects.foot_loads == FootLoadModel::kDistributed) requireSupport(robot, trajectory, plan.t_end);
     Run run(model, plan, output.sample_dt_s, stopSpeed(model, plan), output.time_series == TimeSeriesOutput::kThin);
     startAtRest(run);
     integrate(run);

@@ -34,8 +34,7 @@ namespace {
 [[gnu::always_inline]] inline double footLoadsCore(const QuadrupedParams& q, const Vec2& p_QC, std::array<double, 4>& f,
                                                    bool& clipped, std::array<Vec2, 4>* p_F) {
   const double l = q.l_F_m, w = q.w_F_m;
-  // Eq. (A2), typo fixed: the centroid offset is body-fixed, so subtract it in Q.
-  const Vec2 p_CC = p_QC - Vec2(q.d_Q2C_m, 0.0);  // foot centroid -> system COM
+  const Vec2 p_CC = comFromFootCentroid(q, p_QC);  // foot centroid -> system COM (Eq. A2)
   const double xe = p_CC.x(), ye = p_CC.y();       // Eq. (A3)
   const double slack = 2.0 * kSupportSlack * (l + w);  // a COM on an edge (up to round-off) still stands
   if (std::abs(xe) > 0.5 * l + slack || std::abs(ye) > 0.5 * w + slack) throwTipping(q, xe, ye);

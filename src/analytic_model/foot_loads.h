@@ -27,6 +27,10 @@ struct FootLoads {
 // run the check passed never tips in footLoads (0.06 nm on the paper's feet: round-off, not physics).
 constexpr double kSupportSlack = 1e-10;
 
+// Eq. (A2), typo fixed: the system COM relative to the foot centroid, in Q (the centroid offset is
+// body-fixed, so it is subtracted in Q). p_QC: system COM relative to the quadruped COM, in Q.
+inline Vec2 comFromFootCentroid(const QuadrupedParams& q, const Vec2& p_QC) { return p_QC - Vec2(q.d_Q2C_m, 0.0); }
+
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
 // support rectangle (beyond 2 kSupportSlack (l_F + w_F)).
 FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);

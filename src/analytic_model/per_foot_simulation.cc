@@ -399,8 +399,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     // the support rectangle: checked along the whole trajectory first (support_check.h). The load
     // transfer's shifted centre of pressure depends on the state: it is checked where evaluated.
     if (effects.friction != FrictionLaw::kNone && effects.gravity && robot.systemMass() * robot.gravity_mps2 > 0.0)
-      if (const auto loss = firstSupportLoss(robot, trajectory, t_end))
-        throw TippingError(supportLossMessage(robot.quadruped, *loss));
+      requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
     const double v_stop = settings.v_stop_mps;

@@ -47,7 +47,7 @@ class Search {
     tailKinematics(robot_.tail, joints_, kin_);
     systemMassProperties(robot_, kin_, loads_);
     const QuadrupedParams& q = robot_.quadruped;
-    const Vec2 p = loads_.p_QC - Vec2(q.d_Q2C_m, 0.0);  // Eq. (A2), as footLoads
+    const Vec2 p = comFromFootCentroid(q, loads_.p_QC);
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
       throw std::runtime_error("the system COM became non-finite at t=" + std::to_string(t) +
                                " s: check the trajectory values");
@@ -131,6 +131,10 @@ std::optional<SupportLoss> firstSupportLoss(const RobotParams& robot, const Tail
   const double b = std::min(t_end, traj.endTime());
   if (!(b > 0.0)) return std::nullopt;
   return s.first(0.0, b, g0, s.at(b));
+}
+
+void requireSupport(const RobotParams& robot, const TailTrajectory& traj, double t_end) {
+  if (const auto loss = firstSupportLoss(robot, traj, t_end)) throw TippingError(supportLossMessage(robot.quadruped, *loss));
 }
 
 std::string supportLossMessage(const QuadrupedParams& q, const SupportLoss& loss) {

@@ -32,4 +32,8 @@ std::optional<SupportLoss> firstSupportLoss(const RobotParams& robot, const Tail
 // The message footLoads' TippingError gives, with the time.
 std::string supportLossMessage(const QuadrupedParams& q, const SupportLoss& loss);
 
+// Throws TippingError (supportLossMessage) when firstSupportLoss finds an exit: what a model runs
+// before integrating.
+void requireSupport(const RobotParams& robot, const TailTrajectory& traj, double t_end);
+
 }  // namespace tailsim

@@ -35,7 +35,7 @@ RunResult failedRun(const std::string& model, const std::string& why) {
 OutputSettings recordedOutput(const ExperimentCase& c) {
   OutputSettings o = c.output;
   if (c.render.enabled) o.time_series = TimeSeriesOutput::kFull;
-  if (o.time_series != TimeSeriesOutput::kNone || c.render.enabled) return o;
+  if (o.time_series != TimeSeriesOutput::kNone) return o;
   const double t_end = c.simDuration();  // the models' own end (planRun)
   if (t_end > o.sample_dt_s) o.sample_dt_s = t_end;
   return o;
