@@ -7,6 +7,7 @@
 #include <string>
 
 #include "analytic_model/foot_loads.h"
+#include "numerics/sin_cos.h"
 
 namespace tailsim {
 
@@ -64,8 +65,9 @@ void tailLoadsAndArm(const AnalyticModel& m, AnalyticWorkspace& w, double t, boo
 [[gnu::always_inline]] inline Vec2 rotateYaw(AnalyticWorkspace& w, double phi, const Vec2& a) {
   AnalyticWorkspace::YawCache& yc = w.yaw;
   if (!yc.valid || std::memcmp(&yc.phi, &phi, sizeof phi) != 0) {
-    yc.c = std::cos(phi);
-    yc.s = std::sin(phi);
+    const SinCos sc = sinCos(phi);
+    yc.c = sc.c;
+    yc.s = sc.s;
     yc.phi = phi;
     yc.valid = true;
   }
@@ -200,7 +202,7 @@ Margins eventMargins(const AnalyticModel& m, AnalyticWorkspace& w, double v_stop
     out[kTrans] = ev.F_break - ev.F_required.norm();
     return out;
   }
-  const double fast = std::hypot(y[kVx], y[kVy]) - v_stop;
+  const double fast = std::sqrt(y[kVx] * y[kVx] + y[kVy] * y[kVy]) - v_stop;  // m/s: no overflow to guard
   if (fast > 0) {
     out[kTrans] = fast;  // same sign as the max below, without the probe's evaluation
   } else {

@@ -103,9 +103,10 @@ class StabilizedStepAdjuster {
   // Accepted (err <= 1): grow by at most 10, damped by the previous accepted error.
   double increase_step(double dt, double err, int /*stepper_order*/) const {
     if (!(err >= 0.0)) return clampMax(dt / kMaxShrink);  // NaN error (odeint accepts it): shrink
-    const double fac11 = std::pow(err, kExpo1);
-    const double fac = std::clamp(fac11 / std::pow(err_old_, kBeta) / kSafety, 1.0 / kMaxGrow, kMaxShrink);
-    err_old_ = std::max(1e-4, err);
+    // err^kExpo1 / err_old^kBeta as one exp (err = 0: exp(-inf) = 0, the largest growth).
+    const double log_err = std::log(err);
+    const double fac = std::clamp(std::exp(kExpo1 * log_err - kBeta * log_err_old_) / kSafety, 1.0 / kMaxGrow, kMaxShrink);
+    log_err_old_ = std::max(kLogMinErr, log_err);
     double h = dt / fac;
     if (rejected_) h = std::min(h, dt);
     rejected_ = false;
@@ -119,7 +120,8 @@ class StabilizedStepAdjuster {
   double clampMax(double dt) const { return max_dt_ > 0.0 ? std::min(dt, max_dt_) : dt; }
   double max_dt_;
   long* rejections_;  // counts rejected trial steps (may be null)
-  mutable double err_old_ = 1e-4;
+  double kLogMinErr = std::log(1e-4);  // (not const: the adjuster is copied by assignment)
+  mutable double log_err_old_ = kLogMinErr;  // log of the previous accepted error, at least 1e-4
   mutable bool rejected_ = false;
 };
 

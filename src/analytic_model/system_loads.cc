@@ -7,9 +7,13 @@ namespace tailsim {
 void systemMassProperties(const RobotParams& robot, const TailKinematics& kin, SystemLoads& s) {
   const QuadrupedParams& q = robot.quadruped;
   const Vec2 p_QB(-q.d_Q2B_m, 0.0);
-  s.mass_kg = robot.systemMass();  // Eq. (10)
   Vec2 sum = Vec2::Zero();
-  for (size_t i = 0; i < kin.p_L.size(); ++i) sum += robot.tail[i].mass_kg * (p_QB - kin.p_L[i]);
+  double tail_mass = 0.0;  // robot.tailMass(), summed in the same order
+  for (size_t i = 0; i < kin.p_L.size(); ++i) {
+    sum += robot.tail[i].mass_kg * (p_QB - kin.p_L[i]);
+    tail_mass += robot.tail[i].mass_kg;
+  }
+  s.mass_kg = q.mass_kg + tail_mass;  // Eq. (10), robot.systemMass()
   s.p_QC = sum / s.mass_kg;  // Eq. (10), quadruped COM at the origin of Q; R_Z(180 deg) v = -v
   s.p_QB = p_QB;
   double I = q.izz_kgm2 + q.mass_kg * s.p_QC.squaredNorm();  // Eqs. (11)-(12)

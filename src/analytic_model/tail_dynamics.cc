@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "numerics/sin_cos.h"
+
 namespace tailsim {
 
 void requireOneJointPerLink(std::size_t joints, std::size_t links) {
@@ -34,7 +36,8 @@ void tailKinematics(const std::vector<TailLink>& links, const std::vector<JointS
     psi += joints[i].theta;
     omega += joints[i].theta_dot;
     alpha += joints[i].theta_ddot;
-    const Vec2 e(std::cos(psi), std::sin(psi));  // R_T,i x
+    const SinCos sc = sinCos(psi);
+    const Vec2 e(sc.c, sc.s);  // R_T,i x
     const Vec2 r = links[i].com_offset_m * e;   // joint i -> COM i (paper: 0.5 L_L)
     k.psi[i] = psi; k.omega[i] = omega; k.alpha[i] = alpha;
     k.p_J[i] = p_J;

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "numerics/sin_cos.h"
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 
@@ -19,7 +20,10 @@ inline double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y(
 inline Vec2 perp(const Vec2& a) { return Vec2(-a.y(), a.x()); }  // z x a
 // By the angle whose cosine and sine are c and s.
 inline Vec2 rotate(double c, double s, const Vec2& a) { return Vec2(c * a.x() - s * a.y(), s * a.x() + c * a.y()); }
-inline Vec2 rotate(double angle, const Vec2& a) { return rotate(std::cos(angle), std::sin(angle), a); }
+inline Vec2 rotate(double angle, const Vec2& a) {
+  const SinCos sc = sinCos(angle);
+  return rotate(sc.c, sc.s, a);
+}
 
 // Throws std::invalid_argument unless there is one joint state (or profile) per tail link: the
 // recursions read joint i for link i.

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "numerics/sin_cos.h"
+
 namespace tailsim {
 
 JointProfile::JointProfile(const SplitCycleParams& p) : p_(p) {
@@ -117,11 +119,11 @@ JointState JointProfile::at(double t) const {
   if (tau >= p_.dT_s) return {p_.theta0_rad + p_.dtheta_rad, 0.0, 0.0};
   // Eq. (20) integrated twice with Eq. (22)'s conditions at t0.
   if (tau <= da_) {
-    const double s = std::sin(ka_ * tau), c = std::cos(ka_ * tau);
+    const auto [s, c] = sinCos(ka_ * tau);
     return {p_.theta0_rad + A_over_ka_ * (tau - s / ka_), A_over_ka_ * (1.0 - c), A_ * s};
   }
   const double sigma = tau - da_;  // w1_: peak speed at t1; th1_: angle at t1
-  const double s = std::sin(kd_ * sigma), c = std::cos(kd_ * sigma);
+  const auto [s, c] = sinCos(kd_ * sigma);
   return {th1_ + w1_ * sigma - B_over_kd_ * (sigma - s / kd_), w1_ - B_over_kd_ * (1.0 - c), -B_ * s};
 }
 
