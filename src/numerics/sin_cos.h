@@ -1,4 +1,4 @@
-// sin and cos of one angle together, about four times cheaper than libm's sincos on the angles
+// sin and cos of one angle together in about 45 instructions instead of libm sincos's ~110, on the angles
 // the models evaluate most (the split-cycle phase, the link angles, the yaw: |x| <= 16 rad), to
 // within 1 ulp of 1 absolute error (docs/scale.md "sin and cos from a table").
 //
