@@ -6,14 +6,14 @@
 
 namespace tailsim {
 
-std::string tippingMessage(const QuadrupedParams& q, double xe, double ye) {
+std::string tippingMessage(const QuadrupedParams& q, double xe, double ye, const char* what) {
   // Which edge, and how far beyond it (the first exit is only just beyond: 9 digits and the distance).
   const double beyond_x = std::abs(xe) - 0.5 * q.l_F_m, beyond_y = std::abs(ye) - 0.5 * q.w_F_m;
   const bool side = beyond_y >= beyond_x;
   const char* edge = side ? (ye > 0 ? "left" : "right") : (xe > 0 ? "front" : "rear");
   std::ostringstream os;
   os.precision(9);
-  os << "system COM at (" << xe << ", " << ye << ") m from the foot centroid is outside the support "
+  os << what << " at (" << xe << ", " << ye << ") m from the foot centroid is outside the support "
      << "rectangle (+-" << 0.5 * q.l_F_m << ", +-" << 0.5 * q.w_F_m << ") m";
   os.precision(3);
   os << ", " << (side ? beyond_y : beyond_x) << " m beyond its " << edge << " edge: the robot tips over";

@@ -37,7 +37,8 @@ FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);
 // footLoads(q, p_QC).L_F alone (the same arithmetic, bit for bit, and the same TippingError).
 double frictionArm(const QuadrupedParams& q, const Vec2& p_QC);
 
-// The TippingError message for a system COM at (xe, ye) from the foot centroid.
-std::string tippingMessage(const QuadrupedParams& q, double xe, double ye);
+// The TippingError message for a system COM (or `what`, e.g. the load transfer's centre of
+// pressure) at (xe, ye) from the foot centroid.
+std::string tippingMessage(const QuadrupedParams& q, double xe, double ye, const char* what = "system COM");
 
 }  // namespace tailsim

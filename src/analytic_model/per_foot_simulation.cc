@@ -38,16 +38,34 @@ struct Eval {
   double load_factor = kNaN;          // stuck: s of the required wrench (held iff s <= 1)
   Vec2 a_Q = Vec2::Zero();
   double phi_ddot = 0.0;
+  // Load transfer: the centre of pressure relative to the foot centroid (in Q) and its support
+  // margin, the distance to the nearest edge of the rectangle footLoads accepts (>= 0 standing).
+  Vec2 cop_CC = Vec2::Zero();
+  double support = std::numeric_limits<double>::infinity();
 };
 
 class Model {
  public:
   Model(const RobotParams& r, const TailTrajectory& tr, const PerFootSettings& s, const Effects& e,
-        const PrescribedNormalLoads* loads)
+        const PrescribedNormalLoads* loads, double t_end = std::numeric_limits<double>::infinity())
       : robot_(r), traj_(tr), s_(s), e_(e), prescribed_(loads) {
     weight_ = r.systemMass() * (e.gravity ? r.gravity_mps2 : 0.0);
     mu_break_ = breakawayCoefficient(r.friction);
     const QuadrupedParams& q = r.quadruped;
+    if (s.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction() && !loads &&
+        e.foot_loads != FootLoadModel::kConstant) {
+      // The summed friction is at most max(mu_s, mu_d) m g (sliding: mu_d or the ADAMS mu, at most
+      // the larger; held: capped at mu_break m g), so the centre of pressure lies within
+      // h max(mu_s, mu_d) of the system COM. If the system COM keeps that far inside every edge
+      // over the whole stroke (the pre-run search on the rectangle shrunk by it), the robot cannot
+      // tip and nothing is scanned; otherwise the support margin is scanned along the solution.
+      shift_max_ = q.com_height_m * std::max(r.friction.mu_s, r.friction.mu_d) * (1.0 + 1e-9);
+      RobotParams shrunk = r;
+      shrunk.quadruped.l_F_m -= 2.0 * shift_max_;
+      shrunk.quadruped.w_F_m -= 2.0 * shift_max_;
+      scan_support_ = !(shrunk.quadruped.l_F_m > 0 && shrunk.quadruped.w_F_m > 0) ||
+                      firstSupportLoss(shrunk, tr, t_end).has_value();
+    }
     static const double kXs[4] = {0.5, 0.5, -0.5, -0.5}, kYs[4] = {0.5, -0.5, -0.5, 0.5};
     for (int i = 0; i < 4; ++i) foot_Q_[i] = Vec2(q.d_Q2C_m + kXs[i] * q.l_F_m, kYs[i] * q.w_F_m);
     if (e.foot_loads == FootLoadModel::kConstant && hasFriction()) {
@@ -64,6 +82,10 @@ class Model {
   bool translation() const { return e_.translation; }
   double weight() const { return weight_; }
   const Effects& effects() const { return e_; }
+  // Whether the load transfer's support margin must be scanned (see the constructor), and the
+  // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
+  bool scansSupport() const { return scan_support_; }
+  double shiftMax() const { return shift_max_; }
   void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
 
   // stuck: the body is held (twist zero); the friction is the wrench that holds it and
@@ -194,7 +216,10 @@ class Model {
 
  private:
   // Normal loads from the Appendix distribution at the system COM, or (load transfer) at the
-  // centre of pressure shifted by -h F / W. Throws TippingError outside the support rectangle.
+  // centre of pressure shifted by -h F / W. Quasi-static: throws TippingError outside the support
+  // rectangle (never after requireSupport). Load transfer: ev.support is the centre of pressure's
+  // margin; outside, the loads are those of the nearest point of the rectangle (defined, so trial
+  // stages and probes do not throw): the run's scan of ev.support decides whether it tips.
   void normalLoads(Eval& ev, double t, double phi, const Vec2& F_W) const {
     if (!hasFriction()) {
       ev.N.fill(0.0);
@@ -208,9 +233,20 @@ class Model {
     if (e_.foot_loads == FootLoadModel::kConstant) {
       f = fC_const_;
     } else {
+      const QuadrupedParams& q = robot_.quadruped;
       Vec2 p = ev.loads.p_QC;
-      if (s_.normal_loads == NormalLoadModel::kLoadTransfer) p += rotate(-phi, Vec2(-robot_.quadruped.com_height_m * F_W / weight_));
-      f = footLoads(robot_.quadruped, p).f_C;
+      if (s_.normal_loads == NormalLoadModel::kLoadTransfer) {
+        p += rotate(-phi, Vec2(-q.com_height_m * F_W / weight_));
+        // footLoads' own test (foot_loads.cc): standing up to 2 kSupportSlack (l_F + w_F) beyond an edge.
+        const Vec2 c = comFromFootCentroid(q, p);
+        const double slack = 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m);
+        ev.cop_CC = c;
+        ev.support = std::min(0.5 * q.l_F_m + slack - std::abs(c.x()), 0.5 * q.w_F_m + slack - std::abs(c.y()));
+        if (ev.support < 0)
+          p = Vec2(std::clamp(c.x(), -0.5 * q.l_F_m, 0.5 * q.l_F_m), std::clamp(c.y(), -0.5 * q.w_F_m, 0.5 * q.w_F_m)) +
+              Vec2(q.d_Q2C_m, 0.0);
+      }
+      f = footLoads(q, p).f_C;
     }
     for (int i = 0; i < 4; ++i) ev.N[i] = weight_ * f[i];
   }
@@ -247,6 +283,8 @@ class Model {
   Effects e_;
   const PrescribedNormalLoads* prescribed_ = nullptr;  // diagnostic: loads given over time
   double weight_ = 0, mu_break_ = 0;
+  bool scan_support_ = false;
+  double shift_max_ = 0;
   std::array<Vec2, 4> foot_Q_ = zeros4();
   std::array<double, 4> fC_const_{};
   mutable std::vector<JointState> js_;
@@ -275,17 +313,43 @@ Modes scanModes(bool stuck) {
   return modes;
 }
 
+// The load transfer's support margin (Eval::support) rides in the scan's second slot, as a stuck
+// margin: it reaches zero from above where the centre of pressure leaves the rectangle, and a dip
+// between samples is refined by golden section. It is capped at the largest shift of the centre
+// of pressure (Model::shiftMax): samples farther inside are all equal, so no dip is refined there.
+// Without the scan (Model::scansSupport false) the slot holds 1, as before.
+constexpr int kSupport = kTrans;
+
+Margins scanMargins(const Model& model, double t, const State& y, bool stuck, double v_stop) {
+  const bool sup = model.scansSupport();
+  auto capped = [&](const Eval& ev) { return sup ? std::min(ev.support, model.shiftMax()) : 1.0; };
+  if (stuck) {
+    const Eval ev = model.evaluate(t, y, true);
+    return {1.0 - ev.load_factor, capped(ev)};
+  }
+  const double g_sup = sup ? capped(model.evaluate(t, y, false)) : 1.0;
+  if (!model.stiction()) return {1.0, g_sup};  // the continuous law: no switches
+  const double fast = model.maxFootSpeed(y) - v_stop;
+  if (fast > 0) return {fast, g_sup};
+  return {std::max(fast, model.evaluate(t, y, true).load_factor - 1.0), g_sup};
+}
+
 template <class StateAt>
-double findSwitch(const Model& model, bool stuck, double v_stop, double ta, double tb, double h_scan, double tol,
-                  const StateAt& stateAt, const ScanEnd* prev = nullptr, ScanEnd* end = nullptr) {
+Found findSwitch(const Model& model, bool stuck, double v_stop, double ta, double tb, double h_scan, double tol,
+                 const StateAt& stateAt, const ScanEnd* prev = nullptr, ScanEnd* end = nullptr) {
   State y;
   const Modes modes = scanModes(stuck);
   auto gAt = [&](double t) {
     stateAt(t, y);
-    return Margins{margin(model, t, y, stuck, v_stop), 1.0};
+    return scanMargins(model, t, y, stuck, v_stop);
   };
-  const Found f = tailsim::findSwitch(gAt, modes, ta, tb, h_scan, tol, prev, end, prev != nullptr);
-  return f.hit ? f.t : std::numeric_limits<double>::infinity();
+  return tailsim::findSwitch(gAt, modes, ta, tb, h_scan, tol, prev, end, prev != nullptr);
+}
+
+// The centre of pressure left the support at t (a located exit): the TippingError, with the time.
+[[noreturn]] void throwTipping(const Model& model, const QuadrupedParams& q, double t, const State& y, bool stuck) {
+  const Eval ev = model.evaluate(t, y, stuck);
+  throw TippingError(supportLossMessage(q, SupportLoss{t, ev.cop_CC}, "centre of pressure (load transfer)"));
 }
 
 class Recorder {
@@ -397,10 +461,12 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   try {
     // Every evaluation with friction takes the paper's arm L_F at the system COM, which fails outside
     // the support rectangle: checked along the whole trajectory first (support_check.h). The load
-    // transfer's shifted centre of pressure depends on the state: it is checked where evaluated.
+    // transfer's shifted centre of pressure depends on the state: unless the Model rules it out
+    // before the run, its margin is scanned with the stick/slip margins (scanMargins), between
+    // samples too, and an exit is located as an event.
     if (effects.friction != FrictionLaw::kNone && effects.gravity && robot.systemMass() * robot.gravity_mps2 > 0.0)
       requireSupport(robot, trajectory, t_end);
-    const Model model(robot, trajectory, settings, effects, loads);
+    const Model model(robot, trajectory, settings, effects, loads, t_end);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
     const double v_stop = settings.v_stop_mps;
     State y{};
@@ -457,6 +523,13 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       ScanEnd end;
     } chunk;
     double dt_resume = 0.0;  // the step to go on with after a tail breakpoint (0: start small)
+    using Stepper = decltype(odeint::make_dense_output(1.0, 1.0, 1.0, odeint::runge_kutta_dopri5<State>()));
+    struct {
+      bool have = false;  // the last sliding step (scanned for the support margin) ended at t_end
+      double t_end = 0;
+      ScanEnd end;
+      Stepper stepper;    // its dense output
+    } slide;
 
     while (t < t_end - 1e-15) {
       if (settled(t)) {
@@ -469,6 +542,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       }
       const double seg_end = nextBreak(t);
       if (stuck) {
+        slide.have = false;
         // Nothing moves: scan the load factor up to the next breakpoint, chunk by chunk. A margin
         // still falling at a chunk's end goes on into the next chunk's scan (a dip across the
         // boundary), and the rows after its second-last sample wait for that scan. The chunks grow
@@ -479,8 +553,10 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
         auto stateAt = [&](double, State& ys) { ys = y; };
         const bool have = chunk.have && chunk.t_end == t;
         ScanEnd end;
-        const double ts = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt,
-                                     have ? &chunk.end : nullptr, &end);
+        const Found f = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt,
+                                   have ? &chunk.end : nullptr, &end);
+        if (f.hit && f.which == kSupport) throwTipping(model, robot.quadruped, f.t, y, true);
+        const double ts = f.hit ? f.t : std::numeric_limits<double>::infinity();
         const bool hit = ts <= tb;
         // The load factor at the chunk's end (the scan's last sample), or where it broke away (about
         // 1): not at tb then, where the held body no longer exists (that read up to 60 on random runs).
@@ -515,9 +591,24 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
           throw std::runtime_error("step budget of " + std::to_string(settings.max_steps) + " steps exhausted at t=" +
                                    std::to_string(t) + " s");
         const double tb = std::min(tb_raw, seg_end);
-        auto stateAt = [&](double tt, State& ys) { stepper.calc_state(tt, ys); };
+        // Before ta (a dip of the support margin across the step boundary), the previous step's
+        // dense output answers.
+        const bool across = slide.have && slide.t_end == ta;
+        auto stateAt = [&](double tt, State& ys) { (tt < ta && across ? slide.stepper : stepper).calc_state(tt, ys); };
         double ts = std::numeric_limits<double>::infinity();
-        if (model.stiction()) ts = findSwitch(model, false, v_stop, ta, tb, h_scan, settings.event_tol_s, stateAt);
+        if (model.stiction() || model.scansSupport()) {
+          ScanEnd end;
+          const Found f = findSwitch(model, false, v_stop, ta, tb, h_scan, settings.event_tol_s, stateAt,
+                                     across ? &slide.end : nullptr, &end);
+          if (f.hit && f.which == kSupport) {
+            State ye;
+            stateAt(f.t, ye);
+            throwTipping(model, robot.quadruped, f.t, ye, false);
+          }
+          if (f.hit) ts = f.t;
+          slide.have = model.scansSupport() && !f.hit;
+          if (slide.have) slide = {true, tb, end, stepper};
+        }
         const double t_cut = std::min(ts, tb);
         recordUpTo(t_cut, stateAt);
         stepper.calc_state(t_cut, y);

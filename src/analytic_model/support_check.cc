@@ -137,10 +137,10 @@ void requireSupport(const RobotParams& robot, const TailTrajectory& traj, double
   if (const auto loss = firstSupportLoss(robot, traj, t_end)) throw TippingError(supportLossMessage(robot.quadruped, *loss));
 }
 
-std::string supportLossMessage(const QuadrupedParams& q, const SupportLoss& loss) {
+std::string supportLossMessage(const QuadrupedParams& q, const SupportLoss& loss, const char* what) {
   std::ostringstream os;
   os.precision(9);
-  os << tippingMessage(q, loss.p_CC.x(), loss.p_CC.y()) << " at t = " << loss.t_s << " s";
+  os << tippingMessage(q, loss.p_CC.x(), loss.p_CC.y(), what) << " at t = " << loss.t_s << " s";
   return os.str();
 }
 

@@ -29,8 +29,8 @@ struct SupportLoss {
 // or nothing.
 std::optional<SupportLoss> firstSupportLoss(const RobotParams& robot, const TailTrajectory& traj, double t_end);
 
-// The message footLoads' TippingError gives, with the time.
-std::string supportLossMessage(const QuadrupedParams& q, const SupportLoss& loss);
+// The message footLoads' TippingError gives, with the time (`what` as tippingMessage's).
+std::string supportLossMessage(const QuadrupedParams& q, const SupportLoss& loss, const char* what = "system COM");
 
 // Throws TippingError (supportLossMessage) when firstSupportLoss finds an exit: what a model runs
 // before integrating.

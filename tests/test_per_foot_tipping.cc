@@ -1,0 +1,167 @@
+// Tipping over under the per-foot model's load transfer (docs/per-foot-model.md "Normal loads"):
+// the shifted centre of pressure depends on the state, so it is scanned along the solution, not
+// checked before the run, and the verdict must not depend on the rows the run records.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "analytic_model/per_foot_model.h"
+#include "analytic_test_util.h"
+#include "random_cases.h"
+
+using namespace tailsim;
+using namespace tailsim::testing;
+
+namespace {
+
+// The support margin of every row: the distance of the centre of pressure to the nearest edge
+// (>= 0 inside), from the rows' normal loads alone: f_i = N_i / (m g) gives it back, x_e =
+// l_F (f1 + f2 - f3 - f4) / 2, y_e = w_F (f1 - f2 - f3 + f4) / 2 (Eqs. A4-A5; the clipping's
+// lambda (1, -1, 1, -1) cancels). A load of a centre of pressure outside would be the nearest
+// point's, on the edge: margin 0.
+std::vector<double> rowMargins(const RobotParams& robot, const RunResult& r) {
+  const QuadrupedParams& q = robot.quadruped;
+  const double W = robot.systemMass() * robot.gravity_mps2;
+  std::vector<double> m;
+  for (size_t i = 0; i < r.series.numRows(); ++i) {
+    double f[4];
+    for (int j = 0; j < 4; ++j) f[j] = r.series.values("N" + std::to_string(j + 1) + "_N")[i] / W;
+    const double x = 0.5 * q.l_F_m * (f[0] + f[1] - f[2] - f[3]), y = 0.5 * q.w_F_m * (f[0] - f[1] - f[2] + f[3]);
+    m.push_back(std::min(0.5 * q.l_F_m - std::abs(x), 0.5 * q.w_F_m - std::abs(y)));
+  }
+  return m;
+}
+
+// The time in a TippingError message ("... the robot tips over at t = 0.123 s"), or NaN.
+double exitTime(const RunResult& r) {
+  const std::string key = "tips over at t = ";
+  const size_t k = r.summary.error.find(key);
+  return k == std::string::npos ? std::nan("") : std::stod(r.summary.error.substr(k + key.size()));
+}
+
+// Two links, stiction (mu 1.5: the body is held through the stroke), COM h high: the held
+// force shifts the centre of pressure backwards while the tail accelerates, and at h = 0.46153 m
+// it leaves the rear edge from t = 0.06197 s for about 1.4 ms, at most 22 um beyond (measured from
+// the N_i rows of 1 us runs at h = 0.30 and 0.35 m, the held shift being linear in h). Found by a
+// search (critical heights by bisection, before the scan): with 1 ms rows the run failed from
+// h = 0.461465 m, with two rows (time_series: none) only from h = 0.461589 m.
+struct BriefExit {
+  RobotParams robot = paperRobot(2, 0.13);
+  TailTrajectory trajectory = sameMove(2, 43.5, 37, 0.24, 0.5);
+  PerFootSettings settings;
+  BriefExit(double h) {
+    robot.friction.mu_s = robot.friction.mu_d = 1.5;
+    robot.quadruped.com_height_m = h;
+    settings.normal_loads = NormalLoadModel::kLoadTransfer;
+  }
+  RunResult run(bool two_rows) const {
+    OutputSettings o;
+    if (two_rows) o.sample_dt_s = trajectory.endTime() + o.settle_s;  // what time_series: none records
+    return simulatePerFoot(robot, trajectory, settings, {}, o);
+  }
+};
+
+}  // namespace
+
+TEST(PerFootTipping, ABriefExitBetweenRowsFailsWhateverTheRunRecords) {
+  const BriefExit c(0.46153);
+  const RunResult full = c.run(false), none = c.run(true);
+  EXPECT_EQ(none.series.numRows(), 0u);  // a failed run keeps no rows
+  ASSERT_FALSE(full.summary.ok);
+  ASSERT_FALSE(none.summary.ok) << "two rows: the run passed";
+  std::printf("full: %s\n", full.summary.error.c_str());
+  EXPECT_NE(full.summary.error.find("centre of pressure (load transfer) at (-0.15"), std::string::npos)
+      << full.summary.error;
+  EXPECT_NE(full.summary.error.find("beyond its rear edge"), std::string::npos) << full.summary.error;
+  EXPECT_NEAR(exitTime(full), 0.06197, 1e-4) << full.summary.error;
+  EXPECT_NEAR(exitTime(full), exitTime(none), 1e-9) << full.summary.error << "\n" << none.summary.error;
+  // 35 um lower (h 0.4614 m) the dip stays 12 um inside: both stand.
+  const BriefExit inside(0.4614);
+  for (bool two_rows : {false, true}) EXPECT_TRUE(inside.run(two_rows).summary.ok) << two_rows;
+}
+
+
+// Seeded random per-foot load-transfer runs (both laws) against a brute-force scan of the support
+// margin along the same solution, rows every 20 us (the rows do not change the solution). Each
+// case's COM height is set by bisection (two-row runs) to where the centre of pressure just
+// reaches an edge, h_c, and run at h_c (1 -+ 1e-4): just inside and just beyond it, where a
+// sampled check is most easily fooled. A run that stands: every row's margin is > 0 (a row
+// outside would read 0). A run that tips at t_A: the rows up to t_A - 20 us are all inside, and
+// the margin 0.1 us before t_A is positive and about a tenth of that 1 us before (a linear
+// approach to the edge at t_A: located to well below 0.1 us).
+TEST(PerFootTipping, AgreesWithADenseScanOfTheSolution) {
+  RandomCases gen(20260412);
+  int tipped = 0, stood = 0;
+  double worst = 0;
+  for (int k = 0; k < 200 && tipped + stood < 24; ++k) {
+    RandomCase c = gen.next();
+    if (c.effects.friction == FrictionLaw::kNone) c.effects.friction = FrictionLaw::kStiction;
+    PerFootSettings s;
+    s.normal_loads = NormalLoadModel::kLoadTransfer;
+    OutputSettings none;
+    none.settle_s = 0.1;
+    none.sample_dt_s = c.trajectory.endTime() + none.settle_s;
+    auto run = [&](double h, const OutputSettings& o) {
+      c.robot.quadruped.com_height_m = h;
+      return simulatePerFoot(c.robot, c.trajectory, s, c.effects, o);
+    };
+    auto tipsByCop = [&](const RunResult& r) { return r.summary.error.find("centre of pressure") != std::string::npos; };
+    // Heights up to 0.9 l_F / mu: the load transfer's fixed point contracts by about mu h / l_F.
+    const double mu = std::max(c.robot.friction.mu_s, c.robot.friction.mu_d);
+    double lo = 0.01, hi = std::min(2.0, 0.9 * c.robot.quadruped.l_F_m / mu);
+    if (!run(lo, none).summary.ok || !tipsByCop(run(hi, none))) continue;  // the COM itself tips, or nothing does
+    bool other = false;
+    for (int it = 0; it < 30 && !other; ++it) {
+      const double h = 0.5 * (lo + hi);
+      const RunResult r = run(h, none);
+      other = !r.summary.ok && !tipsByCop(r);
+      (r.summary.ok ? lo : hi) = h;
+    }
+    if (other) continue;
+    for (const double f : {1.0 - 1e-4, 1.0 + 1e-4}) {
+      const double h = 0.5 * (lo + hi) * f;
+      const RunResult a = run(h, none);
+      if (!a.summary.ok) {
+        ASSERT_TRUE(tipsByCop(a)) << a.summary.error;
+      }
+      const double t_A = a.summary.ok ? none.sample_dt_s : exitTime(a);
+      ASSERT_TRUE(std::isfinite(t_A)) << a.summary.error;
+      if (!a.summary.ok && t_A < 5e-5) continue;  // outside at once: nothing to scan
+      OutputSettings dense = none;
+      dense.sample_dt_s = 2e-5;
+      dense.duration_s = a.summary.ok ? t_A : t_A - 2e-5;
+      const RunResult b = run(h, dense);
+      ASSERT_TRUE(b.summary.ok) << k << " " << describe(c) << " h " << h << ": " << b.summary.error;
+      const std::vector<double> m = rowMargins(c.robot, b);
+      const auto& t = b.series.values("t_s");
+      const size_t low = static_cast<size_t>(std::min_element(m.begin(), m.end()) - m.begin());
+      ASSERT_GT(m[low], 1e-12) << k << " " << describe(c) << " h " << h << ": a row outside at t = " << t[low]
+                               << ", the run " << (a.summary.ok ? "stood" : a.summary.error);
+      if (a.summary.ok) {
+        ++stood;
+        continue;
+      }
+      ++tipped;
+      // Just before t_A the centre of pressure is inside and reaching the edge: runs that end 1 us and
+      // 0.1 us before it (their last rows; the rows do not change the solution).
+      double g[2];
+      for (int j = 0; j < 2; ++j) {
+        OutputSettings o = none;
+        o.duration_s = t_A - (j == 0 ? 1e-6 : 1e-7);
+        o.sample_dt_s = o.duration_s / 4;
+        const RunResult r = run(h, o);
+        ASSERT_TRUE(r.summary.ok) << k << " " << describe(c) << " h " << h << ": " << r.summary.error;
+        g[j] = rowMargins(c.robot, r).back();
+      }
+      EXPECT_GT(g[1], 0.0) << k << " " << describe(c) << " h " << h;
+      EXPECT_LT(g[1], 0.2 * g[0]) << k << " " << describe(c) << " h " << h;  // linear: 0.1 g[0]
+      worst = std::max(worst, g[1]);
+    }
+  }
+  std::printf("%d runs tipped (0.1 us before the exit at most %.2e m inside), %d stood\n", tipped, worst, stood);
+  EXPECT_GE(tipped, 8);
+  EXPECT_GE(stood, 8);
+}
