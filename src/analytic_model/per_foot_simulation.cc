@@ -235,8 +235,8 @@ class Model {
     } else {
       const QuadrupedParams& q = robot_.quadruped;
       Vec2 p = ev.loads.p_QC;
-      if (s_.normal_loads == NormalLoadModel::kLoadTransfer) {
-        p += rotate(-phi, Vec2(-q.com_height_m * F_W / weight_));
+      if (s_.normal_loads == NormalLoadModel::kLoadTransfer) p += rotate(-phi, Vec2(-q.com_height_m * F_W / weight_));
+      if (scan_support_) {  // (otherwise ruled out before the run: never outside)
         // footLoads' own test (foot_loads.cc): standing up to 2 kSupportSlack (l_F + w_F) beyond an edge.
         const Vec2 c = comFromFootCentroid(q, p);
         const double slack = 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m);

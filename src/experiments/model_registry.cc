@@ -26,8 +26,8 @@ RunResult failedRun(const std::string& model, const std::string& why) {
 // "Summaries from the state"), and a row's evaluation does not feed back into the run, so the
 // results are bit-identical (test TimeSeriesOutput.NoneRecordsTwoRowsAndSummarizesTheSame). Tipping
 // over does not depend on the rows either: it is checked along the whole trajectory before the run
-// (support_check.h); only the per-foot load transfer's shifted centre of pressure, which depends on
-// the state, is checked where the loads are evaluated.
+// (support_check.h); the per-foot load transfer's shifted centre of pressure, which depends on the
+// state, is scanned along the solution with the stick/slip events (per_foot_simulation.cc).
 //
 // With thin and no video, the analytic model evaluates only the rows thinning keeps (it returns
 // them with RunResult::series_thinned); a video needs every row, so with one it records them all
