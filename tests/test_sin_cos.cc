@@ -56,7 +56,8 @@ TEST(SinCos, SmallAnglesAndGridPoints) {
 
 // The rounding of 64 x to the nearest grid point: halfway cases and the ends of the table.
 TEST(SinCos, TableEndsAndHalfwayPoints) {
-  for (double x : {16.0, -16.0, std::nextafter(16.0, 0.0), 15.9921875 + 1.0 / 128, 1.0 / 128, -1.0 / 128, 0.5 + 1.0 / 128}) {
+  for (double x : {16.0, -16.0, std::nextafter(16.0, 0.0), 15.9921875, -15.9921875, 1.0 / 128, -1.0 / 128, 0.5 + 1.0 / 128,
+                   std::nextafter(1.0 / 128, 1.0), std::nextafter(-1.0 / 128, -1.0)}) {
     const SinCos sc = sinCos(x);
     EXPECT_NEAR(sc.s, std::sin(x), 2.3e-16) << x;
     EXPECT_NEAR(sc.c, std::cos(x), 2.3e-16) << x;
@@ -66,7 +67,7 @@ TEST(SinCos, TableEndsAndHalfwayPoints) {
 
 // Outside the table it is libm, bit for bit; inf and NaN give NaN.
 TEST(SinCos, OutsideTheTableIsLibm) {
-  for (double x : {std::nextafter(16.0, 17.0), -16.5, 100.0, -1e6, 1e300}) {
+  for (double x : {std::nextafter(16.0, 17.0), 16.0 + 1.0 / 128 + 1e-12, 16.2, -16.2, -16.5, 100.0, -1e6, 1e300}) {
     EXPECT_TRUE(sameBits(sinCos(x).s, std::sin(x))) << x;
     EXPECT_TRUE(sameBits(sinCos(x).c, std::cos(x))) << x;
   }

@@ -120,7 +120,7 @@ class StabilizedStepAdjuster {
   double clampMax(double dt) const { return max_dt_ > 0.0 ? std::min(dt, max_dt_) : dt; }
   double max_dt_;
   long* rejections_;  // counts rejected trial steps (may be null)
-  double kLogMinErr = std::log(1e-4);  // (not const: the adjuster is copied by assignment)
+  static inline const double kLogMinErr = std::log(1e-4);
   mutable double log_err_old_ = kLogMinErr;  // log of the previous accepted error, at least 1e-4
   mutable bool rejected_ = false;
 };

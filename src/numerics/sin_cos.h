@@ -2,7 +2,7 @@
 // the models evaluate most (the split-cycle phase, the link angles, the yaw: |x| <= 16 rad), to
 // within 1 ulp of 1 absolute error (docs/scale.md "sin and cos from a table").
 //
-// x = k/64 + d with k = round(64 x), so |d| <= 1/128 and d is exact (Sterbenz). sin and cos of
+// x = k/64 + d with k the integer nearest 64 x, so |d| <= 1/128 and d is exact (Sterbenz). sin and cos of
 // k/64 come from a table (libm's values, computed once), those of d from short Taylor
 // polynomials (truncation below 1e-21), and the angle-addition formulas join them, written
 // as corrections to the table's value:
@@ -35,11 +35,14 @@ inline SinCos sinCos(double x) {
   using namespace sin_cos_detail;
   constexpr double kMax = static_cast<double>(kHalf) / kPerRad;
   if (!(std::abs(x) <= kMax)) return {std::sin(x), std::cos(x)};  // also inf and NaN
-  // Round 64 x to the nearest integer by adding and removing 1.5 * 2^52 (round to nearest).
-  constexpr double kShift = 6755399441055744.0;
-  const double kd = (x * kPerRad + kShift) - kShift;
-  const double d = x - kd * (1.0 / kPerRad);  // exact: |d| <= 1/128 and kd / 64 is within a factor 2 of x
-  const Entry& e = kTable[static_cast<int>(kd) + kHalf];
+  // The integer nearest 64 x, by truncating 64 x +- 1/2: a conversion to int, which no
+  // floating-point optimization may rewrite (-ffast-math's reassociation turned the usual
+  // add-and-subtract-1.5*2^52 trick into a plain truncation: errors up to 1/64 rad). 64 x is exact;
+  // the sum rounds up to an integer only from a halfway point, so |d| <= 1/128 + 1 ulp.
+  const int k = static_cast<int>(x * kPerRad + std::copysign(0.5, x));
+  // Exact (Sterbenz: k / 64 is within a factor 2 of x), or within 4e-19 just below x = 1/128.
+  const double d = x - static_cast<double>(k) * (1.0 / kPerRad);
+  const Entry& e = kTable[k + kHalf];
   const double d2 = d * d;
   const double sd = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040)));   // sin d
   const double cm1 = d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720)));              // cos d - 1
