@@ -35,14 +35,24 @@ inline SinCos sinCos(double x) {
   using namespace sin_cos_detail;
   constexpr double kMax = static_cast<double>(kHalf) / kPerRad;
   if (!(std::abs(x) <= kMax)) return {std::sin(x), std::cos(x)};  // also inf and NaN
-  // The integer nearest 64 x, by truncating 64 x +- 1/2: a conversion to int, which no
-  // floating-point optimization may rewrite (-ffast-math's reassociation turned the usual
-  // add-and-subtract-1.5*2^52 trick into a plain truncation: errors up to 1/64 rad). 64 x is exact;
-  // the sum rounds up to an integer only from a halfway point, so |d| <= 1/128 + 1 ulp.
-  const int k = static_cast<int>(x * kPerRad + std::copysign(0.5, x));
-  // Exact (Sterbenz: k / 64 is within a factor 2 of x), or within 4e-19 just below x = 1/128.
-  const double d = x - static_cast<double>(k) * (1.0 / kPerRad);
-  const Entry& e = kTable[k + kHalf];
+  // kd: the integer nearest 64 x (as a double). On x86-64 by adding and removing 1.5 * 2^52, with
+  // empty asm statements that hide the values from the optimizer: -ffast-math's reassociation
+  // folded the add and the subtraction into a plain truncation (errors up to 1/64 rad, found in
+  // review; CTest sin_cos_fast_math) and could distribute d's product over kd. Elsewhere by
+  // truncating 64 x +- 1/2 to int (a conversion no floating-point optimization may rewrite; one
+  // conversion more on the critical path, 4 % of Fig. 7's time on x86-64).
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(TAILSIM_SIN_COS_PORTABLE)  // (the test forces the other way)
+  constexpr double kShift = 6755399441055744.0;
+  double t = x * kPerRad + kShift;
+  asm("" : "+x"(t));
+  double kd = t - kShift;
+  asm("" : "+x"(kd));
+#else
+  const double kd = static_cast<double>(static_cast<int>(x * kPerRad + std::copysign(0.5, x)));
+#endif
+  // Exact (Sterbenz: kd / 64 is within a factor 2 of x), or within 4e-19 just below x = 1/128.
+  const double d = x - kd * (1.0 / kPerRad);
+  const Entry& e = kTable[static_cast<int>(kd) + kHalf];
   const double d2 = d * d;
   const double sd = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040)));   // sin d
   const double cm1 = d2 * (-0.5 + d2 * (1.0 / 24 + d2 * (-1.0 / 720)));              // cos d - 1
