@@ -78,7 +78,7 @@ TEST(PerFootTipping, ABriefExitBetweenRowsFailsWhateverTheRunRecords) {
   EXPECT_NE(full.summary.error.find("beyond its rear edge"), std::string::npos) << full.summary.error;
   EXPECT_NEAR(exitTime(full), 0.06197, 1e-4) << full.summary.error;
   EXPECT_NEAR(exitTime(full), exitTime(none), 1e-9) << full.summary.error << "\n" << none.summary.error;
-  // 35 um lower (h 0.4614 m) the dip stays 12 um inside: both stand.
+  // With h 0.13 mm lower (0.4614 m) the dip stays 12 um inside: both stand.
   const BriefExit inside(0.4614);
   for (bool two_rows : {false, true}) EXPECT_TRUE(inside.run(two_rows).summary.ok) << two_rows;
 }
