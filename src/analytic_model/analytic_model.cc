@@ -87,12 +87,13 @@ void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, dou
   const Vec2 p_QB(-robot.quadruped.d_Q2B_m, 0.0);
   Vec2 S = Vec2::Zero(), lin = Vec2::Zero();
   double J = robot.quadruped.izz_kgm2, ang = 0.0;
+  const SinCos R = sinCos(phi);  // one rotation by phi for every link
   for (size_t i = 0; i < robot.tail.size(); ++i) {
     const TailLink& l = robot.tail[i];
     // Link COM relative to the quadruped COM, in Q, and its rates (R_Z(180 deg) flips B).
-    const Vec2 rho = rotate(phi, Vec2(p_QB - kin.p_L[i]));
-    const Vec2 rho_dot_rel = rotate(phi, Vec2(-kin.v_L[i]));
-    const Vec2 rho_ddot_rel = rotate(phi, Vec2(-kin.a_L[i]));
+    const Vec2 rho = rotate(R.c, R.s, Vec2(p_QB - kin.p_L[i]));
+    const Vec2 rho_dot_rel = rotate(R.c, R.s, Vec2(-kin.v_L[i]));
+    const Vec2 rho_ddot_rel = rotate(R.c, R.s, Vec2(-kin.a_L[i]));
     const Vec2 b = -wz * wz * rho + 2.0 * wz * perp(rho_dot_rel) + rho_ddot_rel;  // a_i - a_Q - phi_ddot z x rho
     S += l.mass_kg * rho;
     J += l.izz_kgm2 + l.mass_kg * rho.squaredNorm();

@@ -98,11 +98,12 @@ class Model {
     if (!std::isfinite(ev.loads.MzT) || !std::isfinite(ev.loads.Izz_kgm2))
       throw std::runtime_error("the tail loads became non-finite at t=" + std::to_string(t) + " s");
     const double phi = y[kPhi], w = stuck ? 0.0 : y[kW];
-    ev.FT_W = rotate(phi, ev.loads.F_T_Q);
+    const SinCos R = sinCos(phi);  // one rotation by phi, used below
+    ev.FT_W = rotate(R.c, R.s, ev.loads.F_T_Q);
     Eigen::Matrix3d A;
     Eigen::Vector3d r0;
     exactCoupling(js, phi, w, ev, A, r0);
-    for (int i = 0; i < 4; ++i) ev.discs.r[i] = rotate(phi, foot_Q_[i]) - ev.c_W;
+    for (int i = 0; i < 4; ++i) ev.discs.r[i] = rotate(R.c, R.s, foot_Q_[i]) - ev.c_W;
     if (hasFriction()) ev.L_F = footLoads(robot_.quadruped, ev.loads.p_QC).L_F;
 
     if (stuck) {
@@ -147,7 +148,7 @@ class Model {
     const FrictionParams& fp = robot_.friction;
     if (hasFriction()) {
       for (int i = 0; i < 4; ++i) {
-        const Vec2 vi = vQ + w * perp(rotate(phi, foot_Q_[i]));
+        const Vec2 vi = vQ + w * perp(rotate(R.c, R.s, foot_Q_[i]));
         const double sp = vi.norm();
         if (e_.friction == FrictionLaw::kStiction) {
           dir[i] = -fp.mu_d * vi / std::max(sp, s_.v_stop_mps);
@@ -198,8 +199,9 @@ class Model {
   // Fastest foot's slip speed at state y.
   double maxFootSpeed(const State& y) const {
     const Vec2 vQ = translation() ? Vec2(y[kVx], y[kVy]) : Vec2::Zero();
+    const SinCos R = sinCos(y[kPhi]);
     double m = 0.0;
-    for (int i = 0; i < 4; ++i) m = std::max(m, (vQ + y[kW] * perp(rotate(y[kPhi], foot_Q_[i]))).norm());
+    for (int i = 0; i < 4; ++i) m = std::max(m, (vQ + y[kW] * perp(rotate(R.c, R.s, foot_Q_[i]))).norm());
     return m;
   }
 
@@ -260,11 +262,12 @@ class Model {
     const Vec2 p_QB(-robot_.quadruped.d_Q2B_m, 0.0);
     Vec2 S = Vec2::Zero(), lin = Vec2::Zero();
     double J = robot_.quadruped.izz_kgm2, ang = 0.0;
+    const SinCos R = sinCos(phi);
     for (size_t i = 0; i < robot_.tail.size(); ++i) {
       const TailLink& l = robot_.tail[i];
-      const Vec2 rho = rotate(phi, Vec2(p_QB - kin.p_L[i]));
-      const Vec2 rho_dot_rel = rotate(phi, Vec2(-kin.v_L[i]));
-      const Vec2 rho_ddot_rel = rotate(phi, Vec2(-kin.a_L[i]));
+      const Vec2 rho = rotate(R.c, R.s, Vec2(p_QB - kin.p_L[i]));
+      const Vec2 rho_dot_rel = rotate(R.c, R.s, Vec2(-kin.v_L[i]));
+      const Vec2 rho_ddot_rel = rotate(R.c, R.s, Vec2(-kin.a_L[i]));
       const Vec2 b = -w * w * rho + 2.0 * w * perp(rho_dot_rel) + rho_ddot_rel;
       S += l.mass_kg * rho;
       J += l.izz_kgm2 + l.mass_kg * rho.squaredNorm();
