@@ -36,8 +36,7 @@ namespace {
   const double l = q.l_F_m, w = q.w_F_m;
   const Vec2 p_CC = comFromFootCentroid(q, p_QC);  // foot centroid -> system COM (Eq. A2)
   const double xe = p_CC.x(), ye = p_CC.y();       // Eq. (A3)
-  const double slack = 2.0 * kSupportSlack * (l + w);  // a COM on an edge (up to round-off) still stands
-  if (std::abs(xe) > 0.5 * l + slack || std::abs(ye) > 0.5 * w + slack) throwTipping(q, xe, ye);
+  if (supportMargin(q, p_CC) < 0) throwTipping(q, xe, ye);
   // Eq. (A3) solved (paper-notes point 5): ellipse with a/b = l_F/w_F,
   //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).
   // Eqs. (A4)-(A5), f_i = 1/4 + B sin(xi + C_i) with B = b sqrt(2) / (2 w_F), expanded with

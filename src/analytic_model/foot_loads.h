@@ -1,7 +1,9 @@
 // Foot-load distribution and friction moment arm L_F (paper Eqs. 17-19, Appendix A1-A5).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -30,6 +32,13 @@ constexpr double kSupportSlack = 1e-10;
 // Eq. (A2), typo fixed: the system COM relative to the foot centroid, in Q (the centroid offset is
 // body-fixed, so it is subtracted in Q). p_QC: system COM relative to the quadruped COM, in Q.
 inline Vec2 comFromFootCentroid(const QuadrupedParams& q, const Vec2& p_QC) { return p_QC - Vec2(q.d_Q2C_m, 0.0); }
+
+// How far a point p_CC (relative to the foot centroid, in Q) is inside the support rectangle that
+// footLoads accepts (2 kSupportSlack (l_F + w_F) beyond the edges): >= 0 standing, < 0 tipping.
+inline double supportMargin(const QuadrupedParams& q, const Vec2& p_CC) {
+  const double slack = 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m);  // an edge up to round-off still stands
+  return std::min(0.5 * q.l_F_m + slack - std::abs(p_CC.x()), 0.5 * q.w_F_m + slack - std::abs(p_CC.y()));
+}
 
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
 // support rectangle (beyond 2 kSupportSlack (l_F + w_F)).

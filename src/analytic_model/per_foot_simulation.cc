@@ -239,11 +239,9 @@ class Model {
       Vec2 p = ev.loads.p_QC;
       if (s_.normal_loads == NormalLoadModel::kLoadTransfer) p += rotate(-phi, Vec2(-q.com_height_m * F_W / weight_));
       if (scan_support_) {  // (otherwise ruled out before the run: never outside)
-        // footLoads' own test (foot_loads.cc): standing up to 2 kSupportSlack (l_F + w_F) beyond an edge.
         const Vec2 c = comFromFootCentroid(q, p);
-        const double slack = 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m);
         ev.cop_CC = c;
-        ev.support = std::min(0.5 * q.l_F_m + slack - std::abs(c.x()), 0.5 * q.w_F_m + slack - std::abs(c.y()));
+        ev.support = supportMargin(q, c);  // footLoads' own test
         if (ev.support < 0)
           p = Vec2(std::clamp(c.x(), -0.5 * q.l_F_m, 0.5 * q.l_F_m), std::clamp(c.y(), -0.5 * q.w_F_m, 0.5 * q.w_F_m)) +
               Vec2(q.d_Q2C_m, 0.0);
