@@ -21,30 +21,39 @@ AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples, const
     ts_.addColumn(c);
   // Bounded by limits::kMaxRowsPerRun (planRun).
   if (thin_marks) pending_.reserve(static_cast<size_t>(n_samples));
-  else ts_.reserveRows(static_cast<size_t>(n_samples));
+  else {
+    ts_.reserveRows(static_cast<size_t>(n_samples));
+    rows_.reset(new double[kBlockRows * ts_.numColumns()]);  // written before read
+  }
   row_.assign(ts_.numColumns(), 0.0);
 }
 
 void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
                               const Modes& modes) {
-  if (marks_) {
-    pending_.push_back({t, y, modes});
-  } else {
-    fillRow(m, w, t, y, modes);
-    ts_.appendRow(row_);
+  if (next_ >= n_samples_) throw std::logic_error("analytic recorder: more rows than the run's grid");
+  if (marks_) pending_.push_back({t, y, modes});
+  else {
+    if (next_ - flushed_ == static_cast<long>(kBlockRows)) flushRows();
+    fillRow(m, w, t, y, modes, rows_.get() + static_cast<size_t>(next_ - flushed_) * ts_.numColumns());
   }
   ++next_;
 }
 
+void AnalyticRecorder::flushRows() {
+  if (marks_ || flushed_ == next_) return;
+  ts_.appendRowMajor(rows_.get(), static_cast<size_t>(next_ - flushed_));
+  flushed_ = next_;
+}
+
 void AnalyticRecorder::fillRow(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
-                               const Modes& modes) {
+                               const Modes& modes, double* out) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const bool decomp = m.effects.load_decomposition;
   const Eval ev = evaluate(m, w, t, y, modes, decomp);
   const std::vector<JointState>& js = w.joints;  // the joint states at t (evaluate())
-  // Written in place (row_ has one slot per column: t, 3 per joint, 20 more): no capacity check per value.
+  // Written in place (one slot per column: t, 3 per joint, 20 more): no capacity check per value.
   if (row_.size() != 21 + 3 * js.size()) throw std::logic_error("analytic row: the joints do not match the columns");
-  double* r = row_.data();
+  double* r = out;
   *r++ = t;
   const double d = 180.0 / M_PI;
   for (const auto& j : js) *r++ = j.theta * d;
@@ -68,14 +77,22 @@ void AnalyticRecorder::repeatLastUntilDone() {
     next_ = n_samples_;
     return;
   }
-  if (ts_.numRows() == 0 || done()) return;
+  if (next_ == 0 || done()) return;
+  const size_t width = ts_.numColumns();
+  if (next_ == flushed_) throw std::logic_error("analytic recorder: the last row was already flushed");
+  const double* last = rows_.get() + static_cast<size_t>(next_ - flushed_ - 1) * width;
+  row_.assign(last, last + width);
+  flushRows();
   // Column 0 is the time, next_ * dt_ as nextTime() gives it.
   ts_.appendRepeated(row_, static_cast<size_t>(n_samples_ - next_), 0, next_, dt_);
-  next_ = n_samples_;
+  next_ = flushed_ = n_samples_;
 }
 
 TimeSeries AnalyticRecorder::take(const AnalyticModel& m, AnalyticWorkspace& w) {
-  if (!marks_) return std::move(ts_);
+  if (!marks_) {
+    flushRows();
+    return std::move(ts_);
+  }
   // The columns the thinning rule reads, as fillRow writes them.
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const double d = 180.0 / M_PI;
@@ -99,14 +116,14 @@ TimeSeries AnalyticRecorder::take(const AnalyticModel& m, AnalyticWorkspace& w) 
   for (size_t k : keep) {
     if (k < n_pending) {
       const Pending& p = pending_[k];
-      fillRow(m, w, p.t, p.y, p.modes);
+      fillRow(m, w, p.t, p.y, p.modes, row_.data());
       ts_.appendRow(row_);
       row_is_last = k + 1 == n_pending;
       continue;
     }
     if (!row_is_last) {
       const Pending& p = pending_.back();
-      fillRow(m, w, p.t, p.y, p.modes);
+      fillRow(m, w, p.t, p.y, p.modes, row_.data());
       row_is_last = true;
     }
     ts_.appendRepeated(row_, 1, 0, repeat_first_ + static_cast<long>(k - n_pending), dt_);

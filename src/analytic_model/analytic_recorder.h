@@ -3,6 +3,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "analytic_model/analytic_model.h"
@@ -36,8 +37,10 @@ class AnalyticRecorder {
   bool thinned() const { return marks_ != nullptr; }
 
  private:
-  // row_ = the row of (t, y, modes).
-  void fillRow(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes);
+  // The row of (t, y, modes) into out[0 .. numColumns).
+  void fillRow(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y, const Modes& modes, double* out);
+  // Moves the rows recorded since the last flush from rows_ into ts_.
+  void flushRows();
   struct Pending {
     double t;
     State y;
@@ -46,7 +49,14 @@ class AnalyticRecorder {
   double dt_;
   long n_samples_ = 0, next_ = 0;
   TimeSeries ts_;
-  std::vector<double> row_;
+  // Every sample (not thin): up to kBlockRows rows recorded one after another, row-major, then
+  // moved into ts_'s columns in one pass (flushRows): a row written in place costs no per-column
+  // append, and the block stays small (a whole-run buffer above malloc's mmap threshold cost a
+  // fresh mapping and its page faults on every run).
+  static constexpr size_t kBlockRows = 32;
+  std::unique_ptr<double[]> rows_;
+  long flushed_ = 0;  // rows already in ts_ (rows_ holds rows flushed_ .. next_ - 1)
+  std::vector<double> row_;  // one row (thin: take()'s rows; repeatLastUntilDone's source)
   const std::vector<double>* marks_ = nullptr;
   std::vector<Pending> pending_;      // thin: the states of the rows recorded so far
   long repeat_first_ = 0, repeat_count_ = 0;  // thin: repeatLastUntilDone's rows (grid index, count)

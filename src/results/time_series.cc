@@ -38,6 +38,18 @@ void TimeSeries::appendRepeated(const std::vector<double>& row, size_t count, in
   }
 }
 
+void TimeSeries::appendRowMajor(const double* data, size_t rows) {
+  const size_t width = names_.size();
+  for (size_t c = 0; c < width; ++c) {
+    std::vector<double>& col = data_[c];
+    const size_t old = col.size();
+    col.resize(old + rows);
+    double* out = col.data() + old;
+    const double* in = data + c;
+    for (size_t i = 0; i < rows; ++i, in += width) out[i] = *in;
+  }
+}
+
 void TimeSeries::reserveRows(size_t rows) {
   for (auto& col : data_) col.reserve(rows);
 }

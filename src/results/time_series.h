@@ -20,6 +20,8 @@ class TimeSeries {
   // Appends `count` copies of `row` (row.size() == numColumns()), except that column grid_col of
   // copy i holds (first + i) * step: a grid column (the time) that goes on while the rest stays.
   void appendRepeated(const std::vector<double>& row, size_t count, int grid_col, long first, double step);
+  // Appends `rows` rows stored one after another in data (row-major, numColumns() values each).
+  void appendRowMajor(const double* data, size_t rows);
   void reserveRows(size_t rows);                   // capacity for `rows` rows (no reallocation while appending)
   const std::vector<std::string>& names() const { return names_; }
   size_t numColumns() const { return names_.size(); }
