@@ -280,6 +280,34 @@ TEST(TimeSeriesRows, AppendRepeatedEqualsAppendingEachRow) {
   EXPECT_THROW(b.appendRepeated(row, 3, 3, 0, dt), std::logic_error);
 }
 
+// The analytic recorder writes rows row-major in blocks and moves them into the columns with
+// appendRowMajor: the same table as appending each row, in blocks of any size (0 included).
+TEST(TimeSeriesRows, AppendRowMajorEqualsAppendingEachRow) {
+  TimeSeries a, b;
+  for (const char* c : {"t_s", "x_m", "phi_deg", "rot_state"}) {
+    a.addColumn(c);
+    b.addColumn(c);
+  }
+  std::vector<double> block;
+  std::size_t in_block = 0, rows = 0;
+  for (std::size_t block_rows : {0u, 1u, 5u, 32u, 3u}) {
+    for (std::size_t i = 0; i < block_rows; ++i, ++rows) {
+      const double k = static_cast<double>(rows);
+      const std::vector<double> row = {k * 1e-3, 0.5 * k, -k * k, std::fmod(k, 2.0)};
+      a.appendRow(row);
+      block.insert(block.end(), row.begin(), row.end());
+      ++in_block;
+    }
+    b.appendRowMajor(block.data(), in_block);
+    block.clear();
+    in_block = 0;
+  }
+  ASSERT_EQ(a.numRows(), 41u);
+  ASSERT_EQ(b.numRows(), 41u);
+  for (int c = 0; c < 4; ++c)
+    for (std::size_t i = 0; i < a.numRows(); ++i) ASSERT_EQ(a.at(i, c), b.at(i, c)) << c << " " << i;
+}
+
 // With time_series none (and no video) the analytic and per-foot runs record two rows, t = 0 and
 // the end, instead of one per sample_dt_s: nothing reads the others. Every summary field of every
 // run is the same as with the full series, bit for bit (wall times aside): the summaries come
