@@ -16,6 +16,7 @@
 #include "analytic_model/analytic_model.h"
 #include "analytic_model/analytic_recorder.h"
 #include "analytic_model/foot_loads.h"
+#include "analytic_model/step_control.h"
 #include "analytic_model/support_check.h"
 #include "results/work_limits.h"
 
@@ -79,68 +80,7 @@ bool allFinite(const State& y) {
   return true;
 }
 
-// Step-size control of Hairer, Norsett & Wanner's DOPRI5 (Solving ODEs I, Sec. II.4, with Lund
-// stabilization, beta = 0.04), in odeint's StepAdjuster shape. odeint's default shrinks a rejected
-// step by err^(-1/3) and grows an accepted one by err^(-1/5) only below err = 0.5: where the local
-// error rises faster than h^5 (a sliding translation slowing to a stop, whose direction turns ever
-// faster), it overshrinks, regrows and is rejected again, one rejection every step. This one
-// grows and shrinks by err^-(0.2 - 0.75 beta) with the previous accepted error damping the growth, and never
-// grows the step right after a rejection: the same accuracy with far fewer rejected trials
-// (docs/scale.md "Hot path"). Where the error grows from step to step (a slide slowing to a stop,
-// its direction turning ever faster) that still proposes a step the next error test rejects, one
-// rejection every other step; Gustafsson's predictive controller (Hairer & Wanner, Solving ODEs II,
-// Sec. IV.8, Eq. 8.21, as RADAU5 uses it) extrapolates the error's trend from the last two
-// accepted steps, h_new = h (h / h_acc) (err_acc / err^2)^(1/5) safety, and the smaller of the
-// two proposals is taken.
-class StabilizedStepAdjuster {
- public:
-  using time_type = double;
-  using value_type = double;
-  explicit StabilizedStepAdjuster(double max_dt = 0.0, long* rejections = nullptr)
-      : max_dt_(max_dt), rejections_(rejections) {}
-
-  // Rejected (err > 1): shrink by at most 5.
-  double decrease_step(double dt, double err, int /*error_order*/) const {
-    rejected_ = true;
-    if (rejections_) ++*rejections_;
-    return clampMax(dt / std::min(kMaxShrink, std::pow(err, kExpo1) / kSafety));
-  }
-  // Accepted (err <= 1): grow by at most 10, damped by the previous accepted error.
-  double increase_step(double dt, double err, int /*stepper_order*/) const {
-    if (!(err >= 0.0)) return clampMax(dt / kMaxShrink);  // NaN error (odeint accepts it): shrink
-    // err^kExpo1 / err_old^kBeta as one exp (err = 0: exp(-inf) = 0, the largest growth).
-    const double log_err = std::log(err);
-    double fac = std::clamp(std::exp(kExpo1 * log_err - kBeta * log_err_old_) / kSafety, 1.0 / kMaxGrow, kMaxShrink);
-    const double log_err_floor = std::max(kLogMinErr, log_err);
-    if (h_acc_ > 0.0) {  // predictive: (h_acc / h) (err^2 / err_acc)^(1/5) / safety, as a divisor of h
-      const double fac_pred = h_acc_ / dt * std::exp(0.2 * (2.0 * log_err_floor - log_err_old_)) / kSafety;
-      fac = std::max(fac, std::clamp(fac_pred, 1.0 / kMaxGrow, kMaxShrink));
-    }
-    h_acc_ = dt;
-    log_err_old_ = log_err_floor;
-    double h = dt / fac;
-    if (rejected_) h = std::min(h, dt);
-    rejected_ = false;
-    return clampMax(h);
-  }
-  bool check_step_size_limit(double dt) const { return max_dt_ == 0.0 || std::abs(dt) <= max_dt_; }
-  double get_max_dt() const { return max_dt_; }
-
- private:
-  static constexpr double kBeta = 0.04, kExpo1 = 0.2 - kBeta * 0.75, kSafety = 0.9, kMaxShrink = 5.0, kMaxGrow = 10.0;
-  double clampMax(double dt) const { return max_dt_ > 0.0 ? std::min(dt, max_dt_) : dt; }
-  double max_dt_;
-  long* rejections_;  // counts rejected trial steps (may be null)
-  static inline const double kLogMinErr = std::log(1e-4);
-  mutable double log_err_old_ = kLogMinErr;  // log of the previous accepted error, at least 1e-4
-  mutable bool rejected_ = false;
-  mutable double h_acc_ = 0.0;  // the last accepted step (0: none yet)
-};
-
-using Dopri5 = odeint::runge_kutta_dopri5<State>;
-using DenseDopri5 = odeint::dense_output_runge_kutta<odeint::controlled_runge_kutta<
-    Dopri5, odeint::default_error_checker<double, Dopri5::algebra_type, Dopri5::operations_type>,
-    StabilizedStepAdjuster, odeint::initially_resizer, odeint::explicit_error_stepper_fsal_tag>>;
+using DenseDopri5 = StabilizedDenseDopri5<State>;
 
 // What a run needs to know before it starts: its end, its rows, its step sizes.
 struct RunPlan {
@@ -374,9 +314,7 @@ void adaptiveSegment(Run& run, double seg_end) {
     ++run.rhs;
     derivative(m, run.ws, tt, x, run.modes, dx);
   };
-  DenseDopri5 stepper(DenseDopri5::controlled_stepper_type(
-      odeint::default_error_checker<double, Dopri5::algebra_type, Dopri5::operations_type>(s.abs_tol, s.rel_tol),
-      StabilizedStepAdjuster(max_dt, &run.rejected)));
+  DenseDopri5 stepper = makeStabilizedDopri5<State>(s.abs_tol, s.rel_tol, max_dt, &run.rejected);
   // After a switch the dynamics change: start small. After a tail breakpoint they continue with
   // a jump in the tail acceleration only: go on with the step size the solver had reached.
   double dt0 = std::min(max_dt, run.dt_resume > 0 ? run.dt_resume : 1e-4);

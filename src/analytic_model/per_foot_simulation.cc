@@ -11,6 +11,7 @@
 
 #include "analytic_model/analytic_simulation.h"
 #include "analytic_model/per_foot_model.h"
+#include "analytic_model/step_control.h"
 #include "analytic_model/stick_slip.h"
 #include "analytic_model/support_check.h"
 #include "robot/friction_law.h"
@@ -517,14 +518,18 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
         if (b > tt + 1e-14) return std::min(b, t_end);
       return t_end;
     };
-    auto rhs = [&](const State& x, State& dx, double tt) { model.derivative(tt, x, dx); };
+    long rhs_count = 0, rejected = 0;  // right-hand sides evaluated, trial steps rejected
+    auto rhs = [&](const State& x, State& dx, double tt) {
+      ++rhs_count;
+      model.derivative(tt, x, dx);
+    };
     struct {
       bool have = false;  // end holds the scan of the stuck chunk that ended at t_end
       double t_end = 0;
       ScanEnd end;
     } chunk;
     double dt_resume = 0.0;  // the step to go on with after a tail breakpoint (0: start small)
-    using Stepper = decltype(odeint::make_dense_output(1.0, 1.0, 1.0, odeint::runge_kutta_dopri5<State>()));
+    using Stepper = StabilizedDenseDopri5<State>;
     struct {
       bool have = false;  // the last sliding step (scanned for the support margin) ended at t_end
       double t_end = 0;
@@ -574,8 +579,9 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       }
       chunk.have = false;
       const double max_dt = t < tail_end ? h_max : t_end - t;
-      auto stepper = odeint::make_dense_output(settings.abs_tol, settings.rel_tol, max_dt,
-                                               odeint::runge_kutta_dopri5<State>());
+      // The analytic model's step control (step_control.h): odeint's default rejected every other
+      // step where a slide slows to a stop.
+      Stepper stepper = makeStabilizedDopri5<State>(settings.abs_tol, settings.rel_tol, max_dt, &rejected);
       // As in the analytic model (analytic_simulation.cc): after a switch start small, after a
       // breakpoint go on with the reached step; a step never crosses a breakpoint (the tail
       // acceleration jumps there and the error estimate fails), it ends on it.
@@ -638,6 +644,8 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     sum.extra["final_phidot_dps"] = y[kW] * 180.0 / M_PI;
     sum.extra["final_speed_mps"] = speed;
     sum.extra["breakaways"] = breakaways;
+    sum.extra["rhs_evaluations"] = static_cast<double>(rhs_count);
+    sum.extra["rejected_steps"] = static_cast<double>(rejected);
     if (model.stiction()) sum.extra["max_load_factor_stuck"] = max_load_factor;
     sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
     if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
