@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "analytic_model/per_foot_model.h"
 #include "analytic_test_util.h"
 #include "random_cases.h"
 #include "experiments/experiment_loader.h"
@@ -418,4 +419,32 @@ TEST(TimeSeriesOutput, ThinRowsEvaluatedLazilyEqualThinningTheFullSeries) {
     if (HasFatalFailure()) return;
   }
   EXPECT_GT(repeated, 50);
+  // The per-foot model's recorder does the same (both normal-load models).
+  {
+    const RobotParams r = paperRobot(1);
+    const TailTrajectory tr = sameMove(1, 0, -90, 0.25, 0.25);
+    same(simulatePerFoot(r, tr, {}, {}, {}), simulatePerFoot(r, tr, {}, {}, thin), tr.breakpoints(), "per-foot fig7");
+  }
+  RandomCases pf_gen(4343);
+  int pf_repeated = 0, pf_compared = 0;
+  for (int k = 0; k < 120; ++k) {
+    const RandomCase c = pf_gen.next();
+    PerFootSettings s;
+    if (k % 2) s.normal_loads = NormalLoadModel::kLoadTransfer;
+    const RunResult full = simulatePerFoot(c.robot, c.trajectory, s, c.effects, {});
+    if (!full.summary.ok) continue;
+    const size_t n = full.series.numRows();
+    bool copies = n > 2;
+    for (size_t col = 1; copies && col < full.series.numColumns(); ++col) {
+      const double a = full.series.at(n - 1, static_cast<int>(col)), b = full.series.at(n - 2, static_cast<int>(col));
+      copies = a == b || (std::isnan(a) && std::isnan(b));
+    }
+    pf_repeated += copies;
+    ++pf_compared;
+    same(full, simulatePerFoot(c.robot, c.trajectory, s, c.effects, thin), c.trajectory.breakpoints(),
+         "per-foot random case " + std::to_string(k) + ": " + describe(c));
+    if (HasFatalFailure()) return;
+  }
+  EXPECT_GT(pf_compared, 100);
+  EXPECT_GT(pf_repeated, 10);
 }

@@ -14,6 +14,7 @@
 #include "analytic_model/step_control.h"
 #include "analytic_model/stick_slip.h"
 #include "analytic_model/support_check.h"
+#include "results/thin_series.h"
 #include "robot/friction_law.h"
 
 namespace tailsim {
@@ -371,7 +372,69 @@ class Recorder {
   double nextTime() const { return next_ < n_samples_ ? next_ * dt_ : std::numeric_limits<double>::infinity(); }
   bool done() const { return next_ >= n_samples_; }
 
+  // thin_marks (output.time_series: thin): the rows are kept as states and evaluated in take(),
+  // only those thinRowIndices keeps, as the analytic model's recorder does: the rule reads t, phi
+  // and the stick/slip states, which the state gives. The same rows, bit for bit, as thinning the
+  // full series (test TimeSeriesOutput.ThinRowsEvaluatedLazilyEqualThinningTheFullSeries).
+  void setThinMarks(const std::vector<double>* marks) {
+    marks_ = marks;
+    if (marks_) pending_.reserve(static_cast<size_t>(n_samples_));
+  }
+  bool thinned() const { return marks_ != nullptr; }
+
   void record(double t, const State& y, bool stuck) {
+    if (marks_) pending_.push_back({t, y, stuck});
+    else {
+      fillRow(t, y, stuck);
+      ts_.appendRow(row_);
+    }
+    ++next_;
+  }
+  void repeatLastUntilDone() {
+    if (marks_) {
+      if (pending_.empty() || done()) return;
+      repeat_first_ = next_;
+      repeat_count_ = n_samples_ - next_;
+      next_ = n_samples_;
+      return;
+    }
+    if (ts_.numRows() == 0) return;
+    while (!done()) {
+      row_[0] = nextTime();
+      ts_.appendRow(row_);
+      ++next_;
+    }
+  }
+  TimeSeries take() {
+    if (!marks_) return std::move(ts_);
+    const double d = 180.0 / M_PI;
+    TimeSeries light;  // the columns the thinning rule reads, as fillRow writes them
+    for (const char* c : {"t_s", "phi_deg", "rot_state", "trans_state"}) light.addColumn(c);
+    const size_t n_pending = pending_.size();
+    light.reserveRows(n_pending + static_cast<size_t>(repeat_count_));
+    std::vector<double> r(4);
+    auto lightRow = [&](double t, const Pending& p) {
+      const double state = model_.stiction() ? (p.stuck ? 0.0 : 1.0) : kNaN;
+      r = {t, p.y[kPhi] * d, state, model_.translation() ? state : kNaN};
+      light.appendRow(r);
+    };
+    for (const Pending& p : pending_) lightRow(p.t, p);
+    for (long i = 0; i < repeat_count_; ++i) lightRow(static_cast<double>(repeat_first_ + i) * dt_, pending_.back());
+    const std::vector<size_t> keep = thinRowIndices(light, *marks_);
+    ts_.reserveRows(keep.size());
+    for (size_t k : keep) {
+      const Pending& p = pending_[std::min(k, n_pending - 1)];
+      fillRow(p.t, p.y, p.stuck);
+      if (k >= n_pending) row_[0] = static_cast<double>(repeat_first_ + static_cast<long>(k - n_pending)) * dt_;
+      ts_.appendRow(row_);
+    }
+    std::vector<Pending>().swap(pending_);
+    return std::move(ts_);
+  }
+
+ private:
+  // row_ = the row of (t, y, stuck).
+  void fillRow(double t, const State& y, bool stuck) {
     const bool decomp = model_.effects().load_decomposition;
     const Eval ev = model_.evaluate(t, y, stuck, decomp);
     model_.joints(t, js_);
@@ -391,26 +454,21 @@ class Recorder {
     for (int i = 0; i < 4; ++i) row_.insert(row_.end(), {ev.Ff[i].x(), ev.Ff[i].y()});
     for (int i = 0; i < 4; ++i) row_.push_back(ev.N[i]);
     row_.push_back(stuck ? ev.load_factor : kNaN);
-    ts_.appendRow(row_);
-    ++next_;
   }
-  void repeatLastUntilDone() {
-    if (ts_.numRows() == 0) return;
-    while (!done()) {
-      row_[0] = nextTime();
-      ts_.appendRow(row_);
-      ++next_;
-    }
-  }
-  TimeSeries take() { return std::move(ts_); }
-
- private:
+  struct Pending {
+    double t;
+    State y;
+    bool stuck;
+  };
   const Model& model_;
   double dt_;
   long n_samples_ = 0, next_ = 0;
   TimeSeries ts_;
   std::vector<double> row_;
   std::vector<JointState> js_;
+  const std::vector<double>* marks_ = nullptr;
+  std::vector<Pending> pending_;               // thin: the states of the rows recorded so far
+  long repeat_first_ = 0, repeat_count_ = 0;   // thin: repeatLastUntilDone's rows (grid index, count)
 };
 
 std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) {
@@ -470,6 +528,8 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads, t_end);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
+    const std::vector<double> thin_marks = trajectory.breakpoints();
+    if (output.time_series == TimeSeriesOutput::kThin) rec.setThinMarks(&thin_marks);
     const double v_stop = settings.v_stop_mps;
     State y{};
     y[kVx] = settings.initial_velocity[0];
@@ -634,6 +694,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     recordUpTo(t_end, [&](double, State& ys) { ys = y; });
 
     result.series = rec.take();
+    result.series_thinned = rec.thinned();
     sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
     sum.t_stop_s = stuck ? t_stop : t_end;
     sum.stick_slip_events = switches;

@@ -29,7 +29,7 @@ RunResult failedRun(const std::string& model, const std::string& why) {
 // (support_check.h); the per-foot load transfer's shifted centre of pressure, which depends on the
 // state, is scanned along the solution with the stick/slip events (per_foot_simulation.cc).
 //
-// With thin and no video, the analytic model evaluates only the rows thinning keeps (it returns
+// With thin and no video, the analytic and per-foot models evaluate only the rows thinning keeps (they return
 // them with RunResult::series_thinned); a video needs every row, so with one it records them all
 // and the runner thins the CSV's copy.
 OutputSettings recordedOutput(const ExperimentCase& c) {
