@@ -3,6 +3,7 @@
 // checked before the run, and the verdict must not depend on the rows the run records.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -164,4 +165,73 @@ TEST(PerFootTipping, AgreesWithADenseScanOfTheSolution) {
   std::printf("%d runs tipped (0.1 us before the exit at most %.2e m inside), %d stood\n", tipped, worst, stood);
   EXPECT_GE(tipped, 8);
   EXPECT_GE(stood, 8);
+}
+
+
+// An exit while the body slides (every other test's exits happen while it is held). The body
+// starts sliding forward at 0.6 m/s (PerFootSettings::initial_velocity) under a one-link stroke;
+// sliding friction at every foot shifts the centre of pressure by up to h mu_d, and as the body
+// slows and turns the shift swings onto the side edge at about t = 0.34 s, after the tail has
+// stopped (0.3 s), while the body still slides and turns. The critical height (bisection on two-row
+// runs, about 0.5285 m) splits runs that stand from runs that tip; just beyond it the full and the
+// two-row runs fail at the same time, the state just before is sliding, and rows every 20 us up
+// to the exit stay inside, the margin falling linearly onto the edge.
+TEST(PerFootTipping, AnExitWhileSlidingIsLocatedWhateverTheRunRecords) {
+  RobotParams robot = paperRobot(1);
+  const TailTrajectory tr = sameMove(1, 60, -120, 0.3, 0.25);
+  PerFootSettings s;
+  s.normal_loads = NormalLoadModel::kLoadTransfer;
+  s.initial_velocity = {0.6, 0.0, 0.0};
+  OutputSettings none;
+  none.sample_dt_s = tr.endTime() + none.settle_s;  // what time_series: none records
+  auto run = [&](double h, const OutputSettings& o) {
+    robot.quadruped.com_height_m = h;
+    return simulatePerFoot(robot, tr, s, {}, o);
+  };
+  auto tipsByCop = [](const RunResult& r) { return r.summary.error.find("centre of pressure") != std::string::npos; };
+  // Above about 0.53 m the load transfer's fixed point no longer converges (the run fails saying so).
+  double lo = 0.5, hi = 0.529;
+  ASSERT_TRUE(run(lo, none).summary.ok) << run(lo, none).summary.error;
+  ASSERT_TRUE(tipsByCop(run(hi, none))) << run(hi, none).summary.error;
+  for (int it = 0; it < 30; ++it) {
+    const double h = 0.5 * (lo + hi);
+    const RunResult r = run(h, none);
+    ASSERT_TRUE(r.summary.ok || tipsByCop(r)) << h << ": " << r.summary.error;
+    (r.summary.ok ? lo : hi) = h;
+  }
+  const double h_c = 0.5 * (lo + hi);
+  EXPECT_NEAR(h_c, 0.5285, 1e-3);
+  for (const OutputSettings& o : {none, OutputSettings{}}) EXPECT_TRUE(run(h_c * (1 - 1e-4), o).summary.ok);
+  const double h = h_c * (1 + 1e-4);
+  const RunResult a = run(h, none), full = run(h, OutputSettings{});
+  ASSERT_TRUE(tipsByCop(a)) << a.summary.error;
+  ASSERT_TRUE(tipsByCop(full)) << full.summary.error;
+  const double t_A = exitTime(a);
+  EXPECT_NEAR(t_A, 0.344, 0.01) << a.summary.error;
+  EXPECT_GT(t_A, tr.endTime());
+  EXPECT_NEAR(exitTime(full), t_A, 1e-9) << full.summary.error;
+  // Rows every 20 us up to just before the exit: all inside, the body sliding and turning there.
+  OutputSettings dense = none;
+  dense.sample_dt_s = 2e-5;
+  dense.duration_s = t_A - 2e-5;
+  const RunResult b = run(h, dense);
+  ASSERT_TRUE(b.summary.ok) << b.summary.error;
+  EXPECT_EQ(b.series.values("trans_state").back(), 1.0);
+  EXPECT_EQ(b.series.values("rot_state").back(), 1.0);
+  EXPECT_GT(b.summary.extra.at("final_speed_mps"), 1e-3);
+  const std::vector<double> m = rowMargins(robot, b);
+  EXPECT_GT(*std::min_element(m.begin(), m.end()), 0.0);
+  double g[2];
+  for (int j = 0; j < 2; ++j) {
+    OutputSettings o = none;
+    o.duration_s = t_A - (j == 0 ? 1e-6 : 1e-7);
+    o.sample_dt_s = o.duration_s / 4;
+    const RunResult r = run(h, o);
+    ASSERT_TRUE(r.summary.ok) << r.summary.error;
+    g[j] = rowMargins(robot, r).back();
+  }
+  EXPECT_GT(g[1], 0.0);
+  EXPECT_LT(g[1], 0.2 * g[0]);  // linear onto the edge: 0.1 g[0]
+  std::printf("h_c %.6f m, exit at t = %.6f s while sliding; margin 1 us / 0.1 us before: %.3g / %.3g m\n", h_c, t_A,
+              g[0], g[1]);
 }
