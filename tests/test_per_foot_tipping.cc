@@ -189,7 +189,10 @@ TEST(PerFootTipping, AnExitWhileSlidingIsLocatedWhateverTheRunRecords) {
     return simulatePerFoot(robot, tr, s, {}, o);
   };
   auto tipsByCop = [](const RunResult& r) { return r.summary.error.find("centre of pressure") != std::string::npos; };
-  // Above about 0.53 m the load transfer's fixed point no longer converges (the run fails saying so).
+  // Above about 0.53 m the load transfer's fixed point no longer converges: the run fails saying so.
+  const RunResult high = run(0.54, none);
+  EXPECT_FALSE(high.summary.ok);
+  EXPECT_NE(high.summary.error.find("fixed point does not converge at t = "), std::string::npos) << high.summary.error;
   double lo = 0.5, hi = 0.529;
   ASSERT_TRUE(run(lo, none).summary.ok) << run(lo, none).summary.error;
   ASSERT_TRUE(tipsByCop(run(hi, none))) << run(hi, none).summary.error;

@@ -172,7 +172,11 @@ class Model {
         double change = 0.0;
         for (int i = 0; i < 4; ++i) change = std::max(change, std::abs(ev.N[i] - N_old[i]));
         if (change <= 1e-13 * weight_) break;
-        if (it > 200) throw std::runtime_error("the load-transfer fixed point does not converge");
+        if (it > 200)
+          throw std::runtime_error("the load-transfer fixed point does not converge at t = " + std::to_string(t) +
+                                   " s while sliding: with com_height_m " + std::to_string(robot_.quadruped.com_height_m) +
+                                   " m the feet's normal loads and friction have no stable solution near the support's "
+                                   "edge (docs/per-foot-model.md \"Normal loads\"); a lower COM or less friction runs");
       }
     }
     for (int i = 0; i < 4; ++i) {
