@@ -9,16 +9,18 @@ void systemMassProperties(const RobotParams& robot, const TailKinematics& kin, S
   const Vec2 p_QB(-q.d_Q2B_m, 0.0);
   Vec2 sum = Vec2::Zero();
   double tail_mass = 0.0;  // robot.tailMass(), summed in the same order
-  for (size_t i = 0; i < kin.p_L.size(); ++i) {
-    sum += robot.tail[i].mass_kg * (p_QB - kin.p_L[i]);
-    tail_mass += robot.tail[i].mass_kg;
+  const size_t n = kin.p_L.size();
+  const TailLink* links = robot.tail.data();
+  const Vec2* p_L = kin.p_L.data();
+  for (size_t i = 0; i < n; ++i) {
+    sum += links[i].mass_kg * (p_QB - p_L[i]);
+    tail_mass += links[i].mass_kg;
   }
   s.mass_kg = q.mass_kg + tail_mass;  // Eq. (10), robot.systemMass()
   s.p_QC = sum / s.mass_kg;  // Eq. (10), quadruped COM at the origin of Q; R_Z(180 deg) v = -v
   s.p_QB = p_QB;
   double I = q.izz_kgm2 + q.mass_kg * s.p_QC.squaredNorm();  // Eqs. (11)-(12)
-  for (size_t i = 0; i < kin.p_L.size(); ++i)
-    I += robot.tail[i].izz_kgm2 + robot.tail[i].mass_kg * (p_QB - kin.p_L[i] - s.p_QC).squaredNorm();
+  for (size_t i = 0; i < n; ++i) I += links[i].izz_kgm2 + links[i].mass_kg * (p_QB - p_L[i] - s.p_QC).squaredNorm();
   s.Izz_kgm2 = I;
 }
 

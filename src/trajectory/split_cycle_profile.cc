@@ -128,8 +128,12 @@ JointState JointProfile::at(double t) const {
 }
 
 void TailTrajectory::evaluate(double t, std::vector<JointState>& out) const {
-  if (out.size() != joints.size()) out.resize(joints.size());
-  for (size_t i = 0; i < joints.size(); ++i) out[i] = joints[i].at(t);
+  // Sizes and pointers read once: at() is out of line, so the loop would reload them per joint.
+  const size_t n = joints.size();
+  if (out.size() != n) out.resize(n);
+  JointState* o = out.data();
+  const JointProfile* j = joints.data();
+  for (size_t i = 0; i < n; ++i) o[i] = j[i].at(t);
 }
 
 bool TailTrajectory::finished(double t) const {
