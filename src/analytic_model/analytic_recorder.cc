@@ -20,7 +20,7 @@ AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples, const
                         col::kLF, col::kFTx, col::kFTy, col::kFFx, col::kFFy, col::kRotState, col::kTransState})
     ts_.addColumn(c);
   // Bounded by limits::kMaxRowsPerRun (planRun).
-  if (thin_marks) pending_.reserve(static_cast<size_t>(n_samples));
+  if (thin_marks) thin_.reserve(static_cast<size_t>(n_samples));
   else {
     ts_.reserveRows(static_cast<size_t>(n_samples));
     rows_.reset(new double[kBlockRows * ts_.numColumns()]);  // written before read
@@ -31,7 +31,7 @@ AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples, const
 void AnalyticRecorder::record(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
                               const Modes& modes) {
   if (next_ >= n_samples_) throw std::logic_error("analytic recorder: more rows than the run's grid");
-  if (marks_) pending_.push_back({t, y, modes});
+  if (marks_) thin_.push({t, y, modes});
   else {
     if (next_ - flushed_ == static_cast<long>(kBlockRows)) flushRows();
     fillRow(m, w, t, y, modes, rows_.get() + static_cast<size_t>(next_ - flushed_) * ts_.numColumns());
@@ -71,9 +71,8 @@ void AnalyticRecorder::fillRow(const AnalyticModel& m, AnalyticWorkspace& w, dou
 
 void AnalyticRecorder::repeatLastUntilDone() {
   if (marks_) {
-    if (pending_.empty() || done()) return;
-    repeat_first_ = next_;
-    repeat_count_ = n_samples_ - next_;
+    if (thin_.empty() || done()) return;
+    thin_.repeatLast(next_, n_samples_ - next_);
     next_ = n_samples_;
     return;
   }
@@ -95,40 +94,17 @@ TimeSeries AnalyticRecorder::take(const AnalyticModel& m, AnalyticWorkspace& w) 
   }
   // The columns the thinning rule reads, as fillRow writes them.
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  const double d = 180.0 / M_PI;
   const bool stiction = m.stiction(), trans = stiction && m.translation();
-  TimeSeries light;
-  for (const char* c : {col::kT, col::kPhi, col::kRotState, col::kTransState}) light.addColumn(c);
-  const size_t n_pending = pending_.size();
-  light.reserveRows(n_pending + static_cast<size_t>(repeat_count_));
-  std::vector<double> r(4);
-  auto lightRow = [&](double t, const Pending& p) {
-    r = {t, p.y[kPhi] * d, stiction ? (p.modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
-         trans ? (p.modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN};
-    light.appendRow(r);
+  auto light = [&](const Pending& p) {
+    return std::array<double, 3>{p.y[kPhi] * (180.0 / M_PI), stiction ? (p.modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
+                                 trans ? (p.modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN};
   };
-  for (const Pending& p : pending_) lightRow(p.t, p);
-  for (long i = 0; i < repeat_count_; ++i)  // TimeSeries::appendRepeated's times
-    lightRow(static_cast<double>(repeat_first_ + i) * dt_, pending_.back());
-  const std::vector<size_t> keep = thinRowIndices(light, *marks_);
-  ts_.reserveRows(keep.size());
-  bool row_is_last = false;  // row_ holds the last pending row (the repeated rows' source)
-  for (size_t k : keep) {
-    if (k < n_pending) {
-      const Pending& p = pending_[k];
-      fillRow(m, w, p.t, p.y, p.modes, row_.data());
-      ts_.appendRow(row_);
-      row_is_last = k + 1 == n_pending;
-      continue;
-    }
-    if (!row_is_last) {
-      const Pending& p = pending_.back();
-      fillRow(m, w, p.t, p.y, p.modes, row_.data());
-      row_is_last = true;
-    }
-    ts_.appendRepeated(row_, 1, 0, repeat_first_ + static_cast<long>(k - n_pending), dt_);
-  }
-  std::vector<Pending>().swap(pending_);
+  auto emit = [&](const Pending& p, double t, bool same) {
+    if (!same) fillRow(m, w, p.t, p.y, p.modes, row_.data());
+    row_[0] = t;  // a repeated row: its grid time
+    ts_.appendRow(row_);
+  };
+  thin_.take(*marks_, dt_, light, emit);
   return std::move(ts_);
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "analytic_model/analytic_model.h"
+#include "results/thin_series.h"
 #include "results/time_series.h"
 
 namespace tailsim {
@@ -58,8 +59,7 @@ class AnalyticRecorder {
   long flushed_ = 0;  // rows already in ts_ (rows_ holds rows flushed_ .. next_ - 1)
   std::vector<double> row_;  // one row (thin: take()'s rows; repeatLastUntilDone's source)
   const std::vector<double>* marks_ = nullptr;
-  std::vector<Pending> pending_;      // thin: the states of the rows recorded so far
-  long repeat_first_ = 0, repeat_count_ = 0;  // thin: repeatLastUntilDone's rows (grid index, count)
+  LazyThinRows<Pending> thin_;  // thin: the states of the rows recorded so far
 };
 
 }  // namespace tailsim

@@ -382,12 +382,12 @@ class Recorder {
   // full series (test TimeSeriesOutput.ThinRowsEvaluatedLazilyEqualThinningTheFullSeries).
   void setThinMarks(const std::vector<double>* marks) {
     marks_ = marks;
-    if (marks_) pending_.reserve(static_cast<size_t>(n_samples_));
+    if (marks_) thin_.reserve(static_cast<size_t>(n_samples_));
   }
   bool thinned() const { return marks_ != nullptr; }
 
   void record(double t, const State& y, bool stuck) {
-    if (marks_) pending_.push_back({t, y, stuck});
+    if (marks_) thin_.push({t, y, stuck});
     else {
       fillRow(t, y, stuck);
       ts_.appendRow(row_);
@@ -396,9 +396,8 @@ class Recorder {
   }
   void repeatLastUntilDone() {
     if (marks_) {
-      if (pending_.empty() || done()) return;
-      repeat_first_ = next_;
-      repeat_count_ = n_samples_ - next_;
+      if (thin_.empty() || done()) return;
+      thin_.repeatLast(next_, n_samples_ - next_);
       next_ = n_samples_;
       return;
     }
@@ -411,28 +410,16 @@ class Recorder {
   }
   TimeSeries take() {
     if (!marks_) return std::move(ts_);
-    const double d = 180.0 / M_PI;
-    TimeSeries light;  // the columns the thinning rule reads, as fillRow writes them
-    for (const char* c : {"t_s", "phi_deg", "rot_state", "trans_state"}) light.addColumn(c);
-    const size_t n_pending = pending_.size();
-    light.reserveRows(n_pending + static_cast<size_t>(repeat_count_));
-    std::vector<double> r(4);
-    auto lightRow = [&](double t, const Pending& p) {
+    auto light = [&](const Pending& p) {  // as fillRow writes them
       const double state = model_.stiction() ? (p.stuck ? 0.0 : 1.0) : kNaN;
-      r = {t, p.y[kPhi] * d, state, model_.translation() ? state : kNaN};
-      light.appendRow(r);
+      return std::array<double, 3>{p.y[kPhi] * (180.0 / M_PI), state, model_.translation() ? state : kNaN};
     };
-    for (const Pending& p : pending_) lightRow(p.t, p);
-    for (long i = 0; i < repeat_count_; ++i) lightRow(static_cast<double>(repeat_first_ + i) * dt_, pending_.back());
-    const std::vector<size_t> keep = thinRowIndices(light, *marks_);
-    ts_.reserveRows(keep.size());
-    for (size_t k : keep) {
-      const Pending& p = pending_[std::min(k, n_pending - 1)];
-      fillRow(p.t, p.y, p.stuck);
-      if (k >= n_pending) row_[0] = static_cast<double>(repeat_first_ + static_cast<long>(k - n_pending)) * dt_;
+    auto emit = [&](const Pending& p, double t, bool same) {
+      if (!same) fillRow(p.t, p.y, p.stuck);
+      row_[0] = t;  // a repeated row: its grid time
       ts_.appendRow(row_);
-    }
-    std::vector<Pending>().swap(pending_);
+    };
+    thin_.take(*marks_, dt_, light, emit);
     return std::move(ts_);
   }
 
@@ -471,8 +458,7 @@ class Recorder {
   std::vector<double> row_;
   std::vector<JointState> js_;
   const std::vector<double>* marks_ = nullptr;
-  std::vector<Pending> pending_;               // thin: the states of the rows recorded so far
-  long repeat_first_ = 0, repeat_count_ = 0;   // thin: repeatLastUntilDone's rows (grid index, count)
+  LazyThinRows<Pending> thin_;  // thin: the states of the rows recorded so far
 };
 
 std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) {

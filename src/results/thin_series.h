@@ -3,6 +3,8 @@
 // everything the full series shows at its corners.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -27,5 +29,53 @@ std::vector<size_t> thinRowIndices(const TimeSeries& ts, const std::vector<doubl
 
 // The series with only those rows (same columns, same order).
 TimeSeries thinRows(const TimeSeries& ts, const std::vector<double>& marks, size_t grid = kThinGrid);
+
+// The rows of a run with `time_series: thin`, kept as states until the run ends, so that only the
+// rows thinRowIndices keeps are evaluated (the analytic and per-foot recorders). The rule reads t,
+// phi and the stick/slip states, which a state gives without evaluating the model. P: a row's
+// state, with its time in P::t. The same rows, bit for bit, as thinning the full series.
+template <class P>
+class LazyThinRows {
+ public:
+  void reserve(size_t rows) { pending_.reserve(rows); }
+  void push(const P& p) { pending_.push_back(p); }
+  bool empty() const { return pending_.empty(); }
+  // The grid rows first .. first + count - 1 repeat the last state (a run at rest for good), each
+  // at its own time (first + i) * dt, as TimeSeries::appendRepeated writes it.
+  void repeatLast(long first, long count) {
+    repeat_first_ = first;
+    repeat_count_ = count;
+  }
+  // light(p) -> {phi_deg, rot_state, trans_state} of state p, as the full row would hold them.
+  // emit(p, t, same) for every kept row in order: its state and time; `same`: p is the state of
+  // the row emitted just before (a repeated row: only the time differs). Frees the states.
+  template <class Light, class Emit>
+  void take(const std::vector<double>& marks, double dt, const Light& light, const Emit& emit) {
+    TimeSeries ts;
+    for (const char* c : {"t_s", "phi_deg", "rot_state", "trans_state"}) ts.addColumn(c);
+    const size_t n = pending_.size();
+    ts.reserveRows(n + static_cast<size_t>(repeat_count_));
+    std::vector<double> r(4);
+    auto row = [&](double t, const P& p) {
+      const std::array<double, 3> l = light(p);
+      r = {t, l[0], l[1], l[2]};
+      ts.appendRow(r);
+    };
+    for (const P& p : pending_) row(p.t, p);
+    for (long i = 0; i < repeat_count_; ++i) row(gridTime(i, dt), pending_.back());
+    const P* last = nullptr;
+    for (size_t k : thinRowIndices(ts, marks)) {
+      const P& p = pending_[std::min(k, n - 1)];
+      emit(p, k < n ? p.t : gridTime(static_cast<long>(k - n), dt), last == &p);
+      last = &p;
+    }
+    std::vector<P>().swap(pending_);
+  }
+
+ private:
+  double gridTime(long i, double dt) const { return static_cast<double>(repeat_first_ + i) * dt; }
+  std::vector<P> pending_;
+  long repeat_first_ = 0, repeat_count_ = 0;
+};
 
 }  // namespace tailsim
