@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -41,6 +42,26 @@ double exitTime(const RunResult& r) {
   const std::string key = "tips over at t = ";
   const size_t k = r.summary.error.find(key);
   return k == std::string::npos ? std::nan("") : std::stod(r.summary.error.substr(k + key.size()));
+}
+
+// The support margin just before an exit at t_A: the last rows of runs that end 1 us and 0.1 us
+// before it (the rows do not change the solution). runTo(o) runs the case with output o; a run
+// that fails is a test failure (margins NaN).
+template <class RunTo>
+std::array<double, 2> marginsBefore(const RobotParams& robot, const RunTo& runTo, const OutputSettings& base, double t_A) {
+  std::array<double, 2> g{std::nan(""), std::nan("")};
+  for (int j = 0; j < 2; ++j) {
+    OutputSettings o = base;
+    o.duration_s = t_A - (j == 0 ? 1e-6 : 1e-7);
+    o.sample_dt_s = o.duration_s / 4;
+    const RunResult r = runTo(o);
+    if (!r.summary.ok) {
+      ADD_FAILURE() << "the run to " << o.duration_s << " s failed: " << r.summary.error;
+      return g;
+    }
+    g[j] = rowMargins(robot, r).back();
+  }
+  return g;
 }
 
 // Two links, stiction (mu 1.5: the body is held through the stroke), COM h high: the held
@@ -146,17 +167,9 @@ TEST(PerFootTipping, AgreesWithADenseScanOfTheSolution) {
         continue;
       }
       ++tipped;
-      // Just before t_A the centre of pressure is inside and reaching the edge: runs that end 1 us and
-      // 0.1 us before it (their last rows; the rows do not change the solution).
-      double g[2];
-      for (int j = 0; j < 2; ++j) {
-        OutputSettings o = none;
-        o.duration_s = t_A - (j == 0 ? 1e-6 : 1e-7);
-        o.sample_dt_s = o.duration_s / 4;
-        const RunResult r = run(h, o);
-        ASSERT_TRUE(r.summary.ok) << k << " " << describe(c) << " h " << h << ": " << r.summary.error;
-        g[j] = rowMargins(c.robot, r).back();
-      }
+      // Just before t_A the centre of pressure is inside and reaching the edge.
+      const std::array<double, 2> g = marginsBefore(c.robot, [&](const OutputSettings& o) { return run(h, o); }, none, t_A);
+      ASSERT_FALSE(HasFailure()) << k << " " << describe(c) << " h " << h;
       EXPECT_GT(g[1], 0.0) << k << " " << describe(c) << " h " << h;
       EXPECT_LT(g[1], 0.2 * g[0]) << k << " " << describe(c) << " h " << h;  // linear: 0.1 g[0]
       worst = std::max(worst, g[1]);
@@ -224,15 +237,8 @@ TEST(PerFootTipping, AnExitWhileSlidingIsLocatedWhateverTheRunRecords) {
   EXPECT_GT(b.summary.extra.at("final_speed_mps"), 1e-3);
   const std::vector<double> m = rowMargins(robot, b);
   EXPECT_GT(*std::min_element(m.begin(), m.end()), 0.0);
-  double g[2];
-  for (int j = 0; j < 2; ++j) {
-    OutputSettings o = none;
-    o.duration_s = t_A - (j == 0 ? 1e-6 : 1e-7);
-    o.sample_dt_s = o.duration_s / 4;
-    const RunResult r = run(h, o);
-    ASSERT_TRUE(r.summary.ok) << r.summary.error;
-    g[j] = rowMargins(robot, r).back();
-  }
+  const std::array<double, 2> g = marginsBefore(robot, [&](const OutputSettings& o) { return run(h, o); }, none, t_A);
+  ASSERT_FALSE(HasFailure());
   EXPECT_GT(g[1], 0.0);
   EXPECT_LT(g[1], 0.2 * g[0]);  // linear onto the edge: 0.1 g[0]
   std::printf("h_c %.6f m, exit at t = %.6f s while sliding; margin 1 us / 0.1 us before: %.3g / %.3g m\n", h_c, t_A,
