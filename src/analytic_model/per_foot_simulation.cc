@@ -518,8 +518,8 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads, t_end);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
-    const std::vector<double> thin_marks = trajectory.breakpoints();
-    if (output.time_series == TimeSeriesOutput::kThin) rec.setThinMarks(&thin_marks);
+    const std::vector<double> bps = trajectory.breakpoints();  // (also thinning's marks)
+    if (output.time_series == TimeSeriesOutput::kThin) rec.setThinMarks(&bps);
     const double v_stop = settings.v_stop_mps;
     State y{};
     y[kVx] = settings.initial_velocity[0];
@@ -562,7 +562,6 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
         rec.record(ts, ys, stuck);
       }
     };
-    const std::vector<double> bps = trajectory.breakpoints();
     auto nextBreak = [&](double tt) {
       for (double b : bps)
         if (b > tt + 1e-14) return std::min(b, t_end);
