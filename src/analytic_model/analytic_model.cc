@@ -162,7 +162,7 @@ void exactCoupling(const AnalyticModel& m, AnalyticWorkspace& w, double phi, dou
   ev.F_break = m.mu_break * m.weight;
   // Friction loads of the DOFs that slide (known); stuck DOFs get theirs from the solve.
   const SlidingFriction f = m.needsArm() ? slidingFriction(m.effects.friction, m.robot.friction, m.weight, c.L_F,
-                                                           modes.rot_dir, y[kPhiDot], Vec2(y[kVx], y[kVy]), m.v_reg)
+                                                           modes.rot_dir, y[kPhiDot], y[kVx], y[kVy], m.v_reg)
                                          : SlidingFriction{};
   solveMotion(m, w, y, modes, f, c.loads, ev);
 }

@@ -34,9 +34,9 @@ namespace {
 [[gnu::always_inline]] inline double footLoadsCore(const QuadrupedParams& q, const Vec2& p_QC, std::array<double, 4>& f,
                                                    bool& clipped, std::array<Vec2, 4>* p_F) {
   const double l = q.l_F_m, w = q.w_F_m;
-  const Vec2 p_CC = comFromFootCentroid(q, p_QC);  // foot centroid -> system COM (Eq. A2)
-  const double xe = p_CC.x(), ye = p_CC.y();       // Eq. (A3)
-  if (supportMargin(q, p_CC) < 0) throwTipping(q, xe, ye);
+  // Eq. (A2), comFromFootCentroid in scalars; Eq. (A3).
+  const double xe = p_QC.x() - q.d_Q2C_m, ye = p_QC.y() - 0.0;
+  if (supportMargin(q, xe, ye) < 0) throwTipping(q, xe, ye);
   // Eq. (A3) solved (paper-notes point 5): ellipse with a/b = l_F/w_F,
   //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).
   // Eqs. (A4)-(A5), f_i = 1/4 + B sin(xi + C_i) with B = b sqrt(2) / (2 w_F), expanded with
@@ -57,14 +57,16 @@ namespace {
     f[0] += lambda; f[1] -= lambda; f[2] += lambda; f[3] -= lambda;
     for (double& v : f) v = std::max(v, 0.0);  // round-off at exactly zero
   }
-  // Eq. (17): foot positions relative to the system COM, in Q; Eq. (19): L_F.
+  // Eq. (17): foot positions relative to the system COM, in Q; Eq. (19): L_F. In scalars, in
+  // Eigen's order ((centroid + corner) - p_QC, then x^2 + y^2): Vec2 temporaries here went through
+  // the stack as two 8-byte stores read back as one 16-byte load, a store-forwarding stall each.
   static const double kX[4] = {0.5, 0.5, -0.5, -0.5}, kY[4] = {0.5, -0.5, -0.5, 0.5};
-  const Vec2 p_Q2Centroid(q.d_Q2C_m, 0.0);
+  const double cx = q.d_Q2C_m, cy = 0.0, qx = p_QC.x(), qy = p_QC.y();
   double L_F = 0;
   for (int i = 0; i < 4; ++i) {
-    const Vec2 p = p_Q2Centroid + Vec2(kX[i] * l, kY[i] * w) - p_QC;
-    if (p_F) (*p_F)[i] = p;
-    L_F += f[i] * p.norm();
+    const double px = (cx + kX[i] * l) - qx, py = (cy + kY[i] * w) - qy;
+    if (p_F) (*p_F)[i] = Vec2(px, py);
+    L_F += f[i] * std::sqrt(px * px + py * py);
   }
   return L_F;
 }

@@ -35,10 +35,11 @@ inline Vec2 comFromFootCentroid(const QuadrupedParams& q, const Vec2& p_QC) { re
 
 // How far a point p_CC (relative to the foot centroid, in Q) is inside the support rectangle that
 // footLoads accepts (2 kSupportSlack (l_F + w_F) beyond the edges): >= 0 standing, < 0 tipping.
-inline double supportMargin(const QuadrupedParams& q, const Vec2& p_CC) {
+inline double supportMargin(const QuadrupedParams& q, double x_CC, double y_CC) {
   const double slack = 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m);  // an edge up to round-off still stands
-  return std::min(0.5 * q.l_F_m + slack - std::abs(p_CC.x()), 0.5 * q.w_F_m + slack - std::abs(p_CC.y()));
+  return std::min(0.5 * q.l_F_m + slack - std::abs(x_CC), 0.5 * q.w_F_m + slack - std::abs(y_CC));
 }
+inline double supportMargin(const QuadrupedParams& q, const Vec2& p_CC) { return supportMargin(q, p_CC.x(), p_CC.y()); }
 
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
 // support rectangle (beyond 2 kSupportSlack (l_F + w_F)).

@@ -41,9 +41,15 @@ struct SlidingFriction {
 // right-hand side jump); Eq. (15) sliding, F = -mu_d W v / max(|v|, v_reg) (regularized inside
 // |v| < v_reg so a creeping body does not chatter in direction; v_reg = 0: plain Coulomb).
 // law kContinuous: the ADAMS law, mu from the slip speed, direction from the sign of the rate.
-// law kNone, or no arm: no friction.  W: weight [N]; phi_dot [rad/s]; v: body velocity [m/s].
+// law kNone, or no arm: no friction.  W: weight [N]; phi_dot [rad/s]; (vx, vy): body velocity [m/s].
+// (The velocity as two doubles: the state's vx, vy are stored one by one, and a Vec2 of them read
+// back as one 16-byte load stalled on store forwarding.)
 SlidingFriction slidingFriction(FrictionLaw law, const FrictionParams& fp, double weight, double L_F,
-                                double rot_dir, double phi_dot, const Vec2& v, double v_reg);
+                                double rot_dir, double phi_dot, double vx, double vy, double v_reg);
+inline SlidingFriction slidingFriction(FrictionLaw law, const FrictionParams& fp, double weight, double L_F,
+                                       double rot_dir, double phi_dot, const Vec2& v, double v_reg) {
+  return slidingFriction(law, fp, weight, L_F, rot_dir, phi_dot, v.x(), v.y(), v_reg);
+}
 
 // The DOF to switch for margins g (or -1 for none): a stuck DOF at or below zero breaks away
 // first (translation before rotation when both), then a sliding translation below zero sticks,

@@ -5,22 +5,32 @@
 namespace tailsim {
 
 void systemMassProperties(const RobotParams& robot, const TailKinematics& kin, SystemLoads& s) {
+  // In scalars, in Eigen's order (element-wise, then x^2 + y^2): Vec2 temporaries went through the
+  // stack as two 8-byte stores read back as one 16-byte load (a store-forwarding stall each).
   const QuadrupedParams& q = robot.quadruped;
-  const Vec2 p_QB(-q.d_Q2B_m, 0.0);
-  Vec2 sum = Vec2::Zero();
+  const double bx = -q.d_Q2B_m, by = 0.0;  // p_QB
+  double sx = 0.0, sy = 0.0;
   double tail_mass = 0.0;  // robot.tailMass(), summed in the same order
   const size_t n = kin.p_L.size();
   const TailLink* links = robot.tail.data();
   const Vec2* p_L = kin.p_L.data();
   for (size_t i = 0; i < n; ++i) {
-    sum += links[i].mass_kg * (p_QB - p_L[i]);
-    tail_mass += links[i].mass_kg;
+    const double m = links[i].mass_kg;
+    sx += m * (bx - p_L[i].x());
+    sy += m * (by - p_L[i].y());
+    tail_mass += m;
   }
-  s.mass_kg = q.mass_kg + tail_mass;  // Eq. (10), robot.systemMass()
-  s.p_QC = sum / s.mass_kg;  // Eq. (10), quadruped COM at the origin of Q; R_Z(180 deg) v = -v
-  s.p_QB = p_QB;
-  double I = q.izz_kgm2 + q.mass_kg * s.p_QC.squaredNorm();  // Eqs. (11)-(12)
-  for (size_t i = 0; i < n; ++i) I += links[i].izz_kgm2 + links[i].mass_kg * (p_QB - p_L[i] - s.p_QC).squaredNorm();
+  const double mass = q.mass_kg + tail_mass;  // Eq. (10), robot.systemMass()
+  // Eq. (10), quadruped COM at the origin of Q; R_Z(180 deg) v = -v
+  const double cx = sx / mass, cy = sy / mass;
+  double I = q.izz_kgm2 + q.mass_kg * (cx * cx + cy * cy);  // Eqs. (11)-(12)
+  for (size_t i = 0; i < n; ++i) {
+    const double dx = (bx - p_L[i].x()) - cx, dy = (by - p_L[i].y()) - cy;
+    I += links[i].izz_kgm2 + links[i].mass_kg * (dx * dx + dy * dy);
+  }
+  s.mass_kg = mass;
+  s.p_QC = Vec2(cx, cy);
+  s.p_QB = Vec2(bx, by);
   s.Izz_kgm2 = I;
 }
 
