@@ -55,7 +55,9 @@ void systemLoads(const RobotParams& robot, const std::vector<JointState>& joints
   TailKinematics& kin = scratch.kin;
   tailKinematics(robot.tail, joints, kin, decompose);
   systemMassProperties(robot, kin, s);
-  const Vec2 p_CB = s.p_QB - s.p_QC;  // p_B - p_COM
+  // p_B - p_COM, from scalar reads: systemMassProperties stored p_QB and p_QC one double at a time,
+  // and a packed read of them stalled on store forwarding.
+  const Vec2 p_CB(s.p_QB.x() - s.p_QC.x(), s.p_QB.y() - s.p_QC.y());
   netTailLoad(tailBaseLoad(robot.tail, kin), p_CB, s.F_T_Q, s.MzT);
   if (decompose) {
     Vec2 F_acc, F_speed;
