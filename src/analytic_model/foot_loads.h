@@ -35,8 +35,10 @@ inline Vec2 comFromFootCentroid(const QuadrupedParams& q, const Vec2& p_QC) { re
 
 // How far a point p_CC (relative to the foot centroid, in Q) is inside the support rectangle that
 // footLoads accepts (2 kSupportSlack (l_F + w_F) beyond the edges): >= 0 standing, < 0 tipping.
+// How far beyond each edge footLoads still accepts a COM: an edge up to round-off still stands.
+inline double supportSlack(const QuadrupedParams& q) { return 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m); }
 inline double supportMargin(const QuadrupedParams& q, double x_CC, double y_CC) {
-  const double slack = 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m);  // an edge up to round-off still stands
+  const double slack = supportSlack(q);
   return std::min(0.5 * q.l_F_m + slack - std::abs(x_CC), 0.5 * q.w_F_m + slack - std::abs(y_CC));
 }
 inline double supportMargin(const QuadrupedParams& q, const Vec2& p_CC) { return supportMargin(q, p_CC.x(), p_CC.y()); }

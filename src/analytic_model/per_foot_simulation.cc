@@ -86,6 +86,7 @@ class Model {
   const Effects& effects() const { return e_; }
   // Whether the load transfer's support margin must be scanned (see the constructor), and the
   // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
+  long newtonSolves() const { return newton_solves_; }
   bool scansSupport() const { return scan_support_; }
   double shiftMax() const { return shift_max_; }
   void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
@@ -164,20 +165,17 @@ class Model {
     Vec2 F = Vec2::Zero();
     normalLoads(ev, t, phi, F);
     if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction() && !prescribed_) {
-      for (int it = 0;; ++it) {
+      bool converged = false;
+      for (int it = 0; it <= 200 && !converged; ++it) {
         F.setZero();
         for (int i = 0; i < 4; ++i) F += ev.N[i] * dir[i];
         const std::array<double, 4> N_old = ev.N;
         normalLoads(ev, t, phi, F);
         double change = 0.0;
         for (int i = 0; i < 4; ++i) change = std::max(change, std::abs(ev.N[i] - N_old[i]));
-        if (change <= 1e-13 * weight_) break;
-        if (it > 200)
-          throw std::runtime_error("the load-transfer fixed point does not converge at t = " + std::to_string(t) +
-                                   " s while sliding: with com_height_m " + std::to_string(robot_.quadruped.com_height_m) +
-                                   " m the feet's normal loads and friction have no stable solution near the support's "
-                                   "edge (docs/per-foot-model.md \"Normal loads\"); a lower COM or less friction runs");
+        converged = change <= 1e-13 * weight_;
       }
+      if (!converged) loadTransferNewton(ev, t, phi, dir, F);
     }
     for (int i = 0; i < 4; ++i) {
       ev.discs.c[i] = (e_.friction == FrictionLaw::kStiction ? fp.mu_d : 0.0) * ev.N[i];
@@ -248,13 +246,76 @@ class Model {
         const Vec2 c = comFromFootCentroid(q, p);
         ev.cop_CC = c;
         ev.support = supportMargin(q, c);  // footLoads' own test
-        if (ev.support < 0)
-          p = Vec2(std::clamp(c.x(), -0.5 * q.l_F_m, 0.5 * q.l_F_m), std::clamp(c.y(), -0.5 * q.w_F_m, 0.5 * q.w_F_m)) +
-              Vec2(q.d_Q2C_m, 0.0);
+        // The nearest point of the rectangle footLoads accepts (its edges plus supportSlack): the
+        // loads stay continuous across ev.support = 0. Clamped to the bare edges they jumped there
+        // by ~1e-10 m of the centre of pressure, and the load-transfer fixed point, whose solution
+        // sat on an edge, cycled across the jump without converging.
+        if (ev.support < 0) {
+          const double hx = 0.5 * q.l_F_m + supportSlack(q), hy = 0.5 * q.w_F_m + supportSlack(q);
+          p = Vec2(std::clamp(c.x(), -hx, hx), std::clamp(c.y(), -hy, hy)) + Vec2(q.d_Q2C_m, 0.0);
+        }
       }
       f = footLoads(q, p).f_C;
     }
     for (int i = 0; i < 4; ++i) ev.N[i] = weight_ * f[i];
+  }
+
+  // The load transfer's loads where the fixed-point iteration does not converge: a contraction
+  // too slow for its 200 iterations (factor near 1), or an expansive map (a high COM: the
+  // iterates jump between the support's corners). A solution always exists: the centre of
+  // pressure p_C - h sum_i f_i(p) dir_i stays in a bounded convex set and the f_i are continuous
+  // in it (Brouwer). The map is piecewise affine, so Newton's method on G(F) = sum_i N_i(F) dir_i
+  // - F, with its Jacobian by differences inside the current piece and a backtracking line search
+  // on |G|, ends in a piece's exact solution. Where the map is expansive the solution need not be
+  // unique; this is the one Newton's method reaches from the iteration's last state, and the run
+  // counts such solves (extra.load_transfer_newton_solves). Throws if |G| does not fall to
+  // 1e-12 W.
+  void loadTransferNewton(Eval& ev, double t, double phi, const std::array<Vec2, 4>& dir, const Vec2& F_last) const {
+    ++newton_solves_;
+    auto G = [&](const Vec2& f) {
+      normalLoads(ev, t, phi, f);
+      Vec2 g = -f;
+      for (int i = 0; i < 4; ++i) g += ev.N[i] * dir[i];
+      return g;
+    };
+    const double tol = 1e-10 * weight_;
+    // Starts: the iteration's last state, then no friction and all the weight on each foot in turn
+    // (a start can end in a kink's local minimum of |G|; the solution is then found from another).
+    const Vec2 starts[6] = {F_last, Vec2::Zero(), weight_ * dir[0], weight_ * dir[1], weight_ * dir[2], weight_ * dir[3]};
+    double best = std::numeric_limits<double>::infinity();
+    for (const Vec2& F0 : starts) {
+      Vec2 F = F0, g = G(F);
+      for (int it = 0; it < 60 && !(g.norm() <= tol); ++it) {
+        const double d = 1e-7 * std::max(F.norm(), 1e-3 * weight_);
+        Eigen::Matrix2d J;
+        J.col(0) = (G(F + Vec2(d, 0.0)) - g) / d;
+        J.col(1) = (G(F + Vec2(0.0, d)) - g) / d;
+        Vec2 step = -J.fullPivLu().solve(g);
+        if (!step.allFinite()) step = g;  // singular piece: the plain iteration's step
+        double a = 1.0;
+        Vec2 F_new = F + step, g_new = G(F_new);
+        while (!(g_new.norm() < (1.0 - 1e-4 * a) * g.norm()) && a > 1e-10) {
+          a *= 0.5;
+          F_new = F + a * step;
+          g_new = G(F_new);
+        }
+        if (!(g_new.norm() < g.norm())) break;  // no descent: a kink's local minimum
+        F = F_new;
+        g = g_new;
+      }
+      if (g.norm() <= tol) {
+        normalLoads(ev, t, phi, F);  // ev's loads (and support margin) at the solution
+        return;
+      }
+      best = std::min(best, g.norm());
+    }
+    std::ostringstream os;
+    os.precision(3);
+    os << "the load-transfer loads were not found at t = " << t << " s while sliding (fixed-point iteration, "
+       << "then Newton's method from 6 starts; smallest residual " << best << " N): with com_height_m "
+       << robot_.quadruped.com_height_m << " m the normal loads and the friction that shifts them are hard to "
+       << "solve near the support's edge (docs/per-foot-model.md \"Normal loads\"); a lower COM or less friction runs";
+    throw std::runtime_error(os.str());
   }
 
   // The planar multibody with the base moving (paper-notes point 3, as analytic.coupling: exact):
@@ -297,6 +358,7 @@ class Model {
   mutable std::vector<JointState> js_;
   mutable LoadScratch scratch_;
   mutable TailKinematics kin_;
+  mutable long newton_solves_ = 0;  // loadTransferNewton calls (summary extra)
 };
 
 // Event margin: > 0 no switch. Stuck: 1 - s (the discs hold the required wrench while s < 1).
@@ -696,6 +758,8 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     sum.extra["breakaways"] = breakaways;
     sum.extra["rhs_evaluations"] = static_cast<double>(rhs_count);
     sum.extra["rejected_steps"] = static_cast<double>(rejected);
+    if (settings.normal_loads == NormalLoadModel::kLoadTransfer)
+      sum.extra["load_transfer_newton_solves"] = static_cast<double>(model.newtonSolves());
     if (model.stiction()) sum.extra["max_load_factor_stuck"] = max_load_factor;
     sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
     if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
