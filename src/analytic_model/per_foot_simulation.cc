@@ -267,9 +267,8 @@ class Model {
   // in it (Brouwer). The map is piecewise affine, so Newton's method on G(F) = sum_i N_i(F) dir_i
   // - F, with its Jacobian by differences inside the current piece and a backtracking line search
   // on |G|, ends in a piece's exact solution. Where the map is expansive the solution need not be
-  // unique; this is the one Newton's method reaches from the iteration's last state, and the run
-  // counts such solves (extra.load_transfer_newton_solves). Throws if |G| does not fall to
-  // 1e-12 W.
+  // unique; this is the one Newton's method reaches first (starts below), and the run counts such
+  // solves (extra.load_transfer_newton_solves). Throws if |G| falls to 1e-10 W from no start.
   void loadTransferNewton(Eval& ev, double t, double phi, const std::array<Vec2, 4>& dir, const Vec2& F_last) const {
     ++newton_solves_;
     auto G = [&](const Vec2& f) {
