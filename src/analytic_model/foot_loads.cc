@@ -28,14 +28,11 @@ namespace {
 }  // namespace
 
 namespace {
-// Eqs. (A1)-(A5), (17) and (19): the loads f (clipped: a negative one was zeroed) and L_F, the
-// returned value; the foot positions into p_F unless it is null. footLoads() and frictionArm()
-// share it (frictionArm, the analytic model's hot path, needs L_F alone).
-[[gnu::always_inline]] inline double footLoadsCore(const QuadrupedParams& q, const Vec2& p_QC, std::array<double, 4>& f,
-                                                   bool& clipped, std::array<Vec2, 4>* p_F) {
+// Eqs. (A3)-(A5) at (xe, ye), the system COM relative to the foot centroid: the loads f (clipped:
+// a negative one was zeroed). Throws TippingError outside the accepted rectangle.
+[[gnu::always_inline]] inline void fractionsAt(const QuadrupedParams& q, double xe, double ye, std::array<double, 4>& f,
+                                               bool& clipped) {
   const double l = q.l_F_m, w = q.w_F_m;
-  // Eq. (A2), comFromFootCentroid in scalars; Eq. (A3).
-  const double xe = p_QC.x() - q.d_Q2C_m, ye = p_QC.y() - 0.0;
   if (supportMargin(q, xe, ye) < 0) throwTipping(q, xe, ye);
   // Eq. (A3) solved (paper-notes point 5): ellipse with a/b = l_F/w_F,
   //   xi = atan2(y_e, x_e w_F / l_F), b = hypot(x_e w_F / l_F, y_e).
@@ -57,6 +54,26 @@ namespace {
     f[0] += lambda; f[1] -= lambda; f[2] += lambda; f[3] -= lambda;
     for (double& v : f) v = std::max(v, 0.0);  // round-off at exactly zero
   }
+}
+}  // namespace
+
+std::array<double, 4> footLoadFractions(const QuadrupedParams& q, double x_CC, double y_CC) {
+  std::array<double, 4> f;
+  bool clipped;
+  fractionsAt(q, x_CC, y_CC, f, clipped);
+  return f;
+}
+
+namespace {
+// Eqs. (A1)-(A5), (17) and (19): the loads f (clipped: a negative one was zeroed) and L_F, the
+// returned value; the foot positions into p_F unless it is null. footLoads() and frictionArm()
+// share it (frictionArm, the analytic model's hot path, needs L_F alone).
+[[gnu::always_inline]] inline double footLoadsCore(const QuadrupedParams& q, const Vec2& p_QC, std::array<double, 4>& f,
+                                                   bool& clipped, std::array<Vec2, 4>* p_F) {
+  const double l = q.l_F_m, w = q.w_F_m;
+  // Eq. (A2), comFromFootCentroid in scalars; Eqs. (A3)-(A5).
+  const double xe = p_QC.x() - q.d_Q2C_m, ye = p_QC.y() - 0.0;
+  fractionsAt(q, xe, ye, f, clipped);
   // Eq. (17): foot positions relative to the system COM, in Q; Eq. (19): L_F. In scalars, in
   // Eigen's order ((centroid + corner) - p_QC, then x^2 + y^2): Vec2 temporaries here went through
   // the stack as two 8-byte stores read back as one 16-byte load, a store-forwarding stall each.

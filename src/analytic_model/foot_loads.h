@@ -33,10 +33,11 @@ constexpr double kSupportSlack = 1e-10;
 // body-fixed, so it is subtracted in Q). p_QC: system COM relative to the quadruped COM, in Q.
 inline Vec2 comFromFootCentroid(const QuadrupedParams& q, const Vec2& p_QC) { return p_QC - Vec2(q.d_Q2C_m, 0.0); }
 
-// How far a point p_CC (relative to the foot centroid, in Q) is inside the support rectangle that
-// footLoads accepts (2 kSupportSlack (l_F + w_F) beyond the edges): >= 0 standing, < 0 tipping.
 // How far beyond each edge footLoads still accepts a COM: an edge up to round-off still stands.
 inline double supportSlack(const QuadrupedParams& q) { return 2.0 * kSupportSlack * (q.l_F_m + q.w_F_m); }
+
+// How far a point p_CC (relative to the foot centroid, in Q) is inside the support rectangle that
+// footLoads accepts (supportSlack beyond the edges): >= 0 standing, < 0 tipping.
 inline double supportMargin(const QuadrupedParams& q, double x_CC, double y_CC) {
   const double slack = supportSlack(q);
   return std::min(0.5 * q.l_F_m + slack - std::abs(x_CC), 0.5 * q.w_F_m + slack - std::abs(y_CC));
@@ -46,6 +47,10 @@ inline double supportMargin(const QuadrupedParams& q, const Vec2& p_CC) { return
 // p_QC: system COM relative to the quadruped COM, in Q.  Throws TippingError outside the
 // support rectangle (beyond 2 kSupportSlack (l_F + w_F)).
 FootLoads footLoads(const QuadrupedParams& q, const Vec2& p_QC);
+// footLoads(q, p_QC).f_C for the point (x_CC, y_CC) relative to the foot centroid (in Q), given
+// directly: a point clamped onto the accepted rectangle stays on it (no round trip through p_QC,
+// whose rounding can put it 1 ulp outside). Throws TippingError outside.
+std::array<double, 4> footLoadFractions(const QuadrupedParams& q, double x_CC, double y_CC);
 // footLoads(q, p_QC).L_F alone (the same arithmetic, bit for bit, and the same TippingError).
 double frictionArm(const QuadrupedParams& q, const Vec2& p_QC);
 

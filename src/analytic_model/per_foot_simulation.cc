@@ -86,7 +86,8 @@ class Model {
   const Effects& effects() const { return e_; }
   // Whether the load transfer's support margin must be scanned (see the constructor), and the
   // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
-  long newtonSolves() const { return newton_solves_; }
+  // loadTransferNewton calls are counted into *counter (it outlives the Model: a failed run reports it too).
+  void countNewtonSolvesInto(long* counter) const { newton_counter_ = counter; }
   bool scansSupport() const { return scan_support_; }
   double shiftMax() const { return shift_max_; }
   void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
@@ -166,7 +167,7 @@ class Model {
     normalLoads(ev, t, phi, F);
     if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction() && !prescribed_) {
       bool converged = false;
-      for (int it = 0; it <= 200 && !converged; ++it) {
+      for (int it = 0; it <= 201 && !converged; ++it) {  // (the 202 iterations it always had)
         F.setZero();
         for (int i = 0; i < 4; ++i) F += ev.N[i] * dir[i];
         const std::array<double, 4> N_old = ev.N;
@@ -243,34 +244,37 @@ class Model {
       Vec2 p = ev.loads.p_QC;
       if (s_.normal_loads == NormalLoadModel::kLoadTransfer) p += rotate(-phi, Vec2(-q.com_height_m * F_W / weight_));
       if (scan_support_) {  // (otherwise ruled out before the run: never outside)
-        const Vec2 c = comFromFootCentroid(q, p);
+        Vec2 c = comFromFootCentroid(q, p);
         ev.cop_CC = c;
         ev.support = supportMargin(q, c);  // footLoads' own test
-        // The nearest point of the rectangle footLoads accepts (its edges plus supportSlack): the
-        // loads stay continuous across ev.support = 0. Clamped to the bare edges they jumped there
-        // by ~1e-10 m of the centre of pressure, and the load-transfer fixed point, whose solution
-        // sat on an edge, cycled across the jump without converging.
+        // Outside: the nearest point of the rectangle footLoads accepts (its edges plus
+        // supportSlack), so the loads stay continuous across ev.support = 0. (Clamped to the bare
+        // edges they jumped there by ~1e-10 m of the centre of pressure, and a load-transfer fixed
+        // point on an edge cycled across the jump.) The loads are taken at c itself: turning it
+        // back into p and subtracting d_Q2C again could land 1 ulp outside and throw.
         if (ev.support < 0) {
           const double hx = 0.5 * q.l_F_m + supportSlack(q), hy = 0.5 * q.w_F_m + supportSlack(q);
-          p = Vec2(std::clamp(c.x(), -hx, hx), std::clamp(c.y(), -hy, hy)) + Vec2(q.d_Q2C_m, 0.0);
+          c = Vec2(std::clamp(c.x(), -hx, hx), std::clamp(c.y(), -hy, hy));
         }
+        f = footLoadFractions(q, c.x(), c.y());
+      } else {
+        f = footLoads(q, p).f_C;
       }
-      f = footLoads(q, p).f_C;
     }
     for (int i = 0; i < 4; ++i) ev.N[i] = weight_ * f[i];
   }
 
-  // The load transfer's loads where the fixed-point iteration does not converge: a contraction
-  // too slow for its 200 iterations (factor near 1), or an expansive map (a high COM: the
-  // iterates jump between the support's corners). A solution always exists: the centre of
-  // pressure p_C - h sum_i f_i(p) dir_i stays in a bounded convex set and the f_i are continuous
-  // in it (Brouwer). The map is piecewise affine, so Newton's method on G(F) = sum_i N_i(F) dir_i
-  // - F, with its Jacobian by differences inside the current piece and a backtracking line search
-  // on |G|, ends in a piece's exact solution. Where the map is expansive the solution need not be
-  // unique; this is the one Newton's method reaches first (starts below), and the run counts such
-  // solves (extra.load_transfer_newton_solves). Throws if |G| falls to 1e-10 W from no start.
+  // The load transfer's loads where the fixed-point iteration does not converge (its map is
+  // expansive, or contracts too slowly for its iterations). A solution always exists: the centre
+  // of pressure p_C - h sum_i f_i(p) dir_i stays in a bounded convex set and the f_i are
+  // continuous in it (Brouwer). The map is piecewise affine, so Newton's method on G(F) =
+  // sum_i N_i(F) dir_i - F (dir_i: foot i's friction per unit normal load), with its Jacobian by
+  // differences inside the current piece and a backtracking line search on |G|, reaches a
+  // solution; it polishes while |G| still falls. Where the map is expansive the solution need not
+  // be unique: this is the one reached first (starts below). The run counts these calls
+  // (extra.load_transfer_newton_solves). Throws if no start brings |G| to 1e-10 W (W = m g).
   void loadTransferNewton(Eval& ev, double t, double phi, const std::array<Vec2, 4>& dir, const Vec2& F_last) const {
-    ++newton_solves_;
+    if (newton_counter_) ++*newton_counter_;
     auto G = [&](const Vec2& f) {
       normalLoads(ev, t, phi, f);
       Vec2 g = -f;
@@ -284,13 +288,18 @@ class Model {
     double best = std::numeric_limits<double>::infinity();
     for (const Vec2& F0 : starts) {
       Vec2 F = F0, g = G(F);
-      for (int it = 0; it < 60 && !(g.norm() <= tol); ++it) {
+      // Newton steps until |G| <= tol, then on while they still reduce |G| (at most 3 more): the
+      // solution of the current affine piece to round-off, not just to the tolerance.
+      int polish = 0;
+      for (int it = 0; it < 60 && polish < 3; ++it) {
+        if (g.norm() <= tol) ++polish;
         const double d = 1e-7 * std::max(F.norm(), 1e-3 * weight_);
         Eigen::Matrix2d J;
         J.col(0) = (G(F + Vec2(d, 0.0)) - g) / d;
         J.col(1) = (G(F + Vec2(0.0, d)) - g) / d;
-        Vec2 step = -J.fullPivLu().solve(g);
-        if (!step.allFinite()) step = g;  // singular piece: the plain iteration's step
+        const Eigen::FullPivLU<Eigen::Matrix2d> lu(J);
+        // A singular piece: the plain iteration's step (solve() would give a finite, useless one).
+        const Vec2 step = lu.isInvertible() ? Vec2(-lu.solve(g)) : g;
         double a = 1.0;
         Vec2 F_new = F + step, g_new = G(F_new);
         while (!(g_new.norm() < (1.0 - 1e-4 * a) * g.norm()) && a > 1e-10) {
@@ -298,7 +307,7 @@ class Model {
           F_new = F + a * step;
           g_new = G(F_new);
         }
-        if (!(g_new.norm() < g.norm())) break;  // no descent: a kink's local minimum
+        if (!(g_new.norm() < g.norm())) break;  // no descent: a kink's local minimum, or round-off
         F = F_new;
         g = g_new;
       }
@@ -357,7 +366,7 @@ class Model {
   mutable std::vector<JointState> js_;
   mutable LoadScratch scratch_;
   mutable TailKinematics kin_;
-  mutable long newton_solves_ = 0;  // loadTransferNewton calls (summary extra)
+  mutable long* newton_counter_ = nullptr;  // loadTransferNewton calls (summary extra), or null
 };
 
 // Event margin: > 0 no switch. Stuck: 1 - s (the discs hold the required wrench while s < 1).
@@ -569,6 +578,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   const double h_scan = shortest / 32.0;
   const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
 
+  long newton_solves = 0;
   try {
     // Every evaluation with friction takes the paper's arm L_F at the system COM, which fails outside
     // the support rectangle: checked along the whole trajectory first (support_check.h). The load
@@ -578,6 +588,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     if (effects.friction != FrictionLaw::kNone && effects.gravity && robot.systemMass() * robot.gravity_mps2 > 0.0)
       requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads, t_end);
+    model.countNewtonSolvesInto(&newton_solves);
     Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
     const std::vector<double> bps = trajectory.breakpoints();  // (also thinning's marks)
     if (output.time_series == TimeSeriesOutput::kThin) rec.setThinMarks(&bps);
@@ -757,8 +768,6 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     sum.extra["breakaways"] = breakaways;
     sum.extra["rhs_evaluations"] = static_cast<double>(rhs_count);
     sum.extra["rejected_steps"] = static_cast<double>(rejected);
-    if (settings.normal_loads == NormalLoadModel::kLoadTransfer)
-      sum.extra["load_transfer_newton_solves"] = static_cast<double>(model.newtonSolves());
     if (model.stiction()) sum.extra["max_load_factor_stuck"] = max_load_factor;
     sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
     if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
@@ -769,6 +778,8 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     sum.ok = false;
     sum.error = std::string("perfoot model failed: ") + e.what();
   }
+  if (settings.normal_loads == NormalLoadModel::kLoadTransfer)
+    sum.extra["load_transfer_newton_solves"] = static_cast<double>(newton_solves);
   sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
 }
