@@ -84,10 +84,10 @@ class Model {
   bool translation() const { return e_.translation; }
   double weight() const { return weight_; }
   const Effects& effects() const { return e_; }
-  // Whether the load transfer's support margin must be scanned (see the constructor), and the
-  // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
   // loadTransferNewton calls are counted into *counter (it outlives the Model: a failed run reports it too).
   void countNewtonSolvesInto(long* counter) const { newton_counter_ = counter; }
+  // Whether the load transfer's support margin must be scanned (see the constructor), and the
+  // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
   bool scansSupport() const { return scan_support_; }
   double shiftMax() const { return shift_max_; }
   void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
