@@ -50,7 +50,9 @@ constexpr const char* kExitCodes =
     "  2    usage error: unknown subcommand or option, missing or bad argument\n"
     "  3    run: some model runs failed (the rest is saved; see summary.json); optimize: a limit violated on the re-run;\n"
     "       maneuver: a run failed or the closed loop missed the heading\n"
-    "  130  run: interrupted by Ctrl-C (finished cases are saved; run again to resume)";
+    "  130  run: interrupted by Ctrl-C (SIGINT; finished cases are saved; run again to resume)\n"
+    "  143  run: stopped by SIGTERM (a batch system's time limit), likewise\n"
+    "  129  run: stopped by SIGHUP (the terminal closed), likewise";
 
 std::string versionString() {
   std::string v = std::string("tailsim ") + kVersion;
@@ -339,7 +341,8 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         std::fprintf(stderr, "interrupted: %d of %d cases saved in %s; run the same command again to resume\n",
                      s.ran + s.resumed, s.total, out_dir.c_str());
-        return kExitInterrupted;
+        // 128 + the signal, as a shell reports a process it ended (SIGINT 130, SIGTERM 143, SIGHUP 129).
+        return s.stop_signal > 0 ? 128 + s.stop_signal : kExitInterrupted;
       }
       if (shard_text.empty()) printCases(suite, out_dir, suite.size() > 1);  // a shard's table is mostly "not run"
       if (plots) {

@@ -6,6 +6,7 @@
 #include <sys/eventfd.h>
 #include <sys/file.h>
 #include <sys/signalfd.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -198,8 +200,15 @@ class CaseJournal {
   void append(const std::string& line) {
     std::lock_guard<std::mutex> lock(mu_);
     if (fd_ < 0) {
-      fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+      // A regular file of the folder only: never through a symlink, never a FIFO or device.
+      fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
       if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + path_.string());
+      struct stat st {};
+      if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+        ::close(fd_);
+        fd_ = -1;
+        throw std::runtime_error(path_.string() + " is not a regular file: not written");
+      }
     }
     size_t done = 0;
     while (done < line.size()) {
@@ -225,11 +234,9 @@ class CaseJournal {
 // newline (torn by a kill or a full disk) is cut off the file, so the next append starts a line.
 std::map<std::string, std::string> readJournal(const fs::path& p, bool repair) {
   std::map<std::string, std::string> out;
-  std::ifstream in(p, std::ios::binary);
-  if (!in) return out;
-  std::ostringstream os;
-  os << in.rdbuf();
-  const std::string text = os.str();
+  const std::optional<std::string> read = readResultFile(p.string());
+  if (!read) return out;
+  const std::string& text = *read;
   const size_t end = text.rfind('\n');
   const size_t whole = end == std::string::npos ? 0 : end + 1;  // bytes of complete lines
   size_t at = 0;
@@ -264,8 +271,18 @@ struct Job {
   int total = 0, resumed = 0;
   std::unique_ptr<CaseJournal> journal;     // DIR/cases.jsonl (cases without a folder)
   std::vector<std::string> other_lines;     // per case: its journal line when not run now (else empty)
-  std::unique_ptr<TimeSeriesH5Writer> h5;   // DIR/time_series.h5 (cases with time_series_file: hdf5)
+  // Cases with time_series_file: hdf5. Each finished case's groups are a file of their own,
+  // DIR/time_series.h5.d/<dir>.h5, published (fsync, rename) before its journal line is appended,
+  // so it survives any stop; writeSummary joins them with the published DIR/time_series.h5.
+  bool any_h5 = false;
+  std::unique_ptr<TimeSeriesH5Reader> published;  // DIR/time_series.h5 as found (may be !ok())
+  std::vector<char> h5_from;                      // per case: kH5None, kH5Published or kH5Part
 };
+
+constexpr char kH5None = 0, kH5Published = 1, kH5Part = 2;
+const char* const kH5Parts = "time_series.h5.d";
+
+fs::path h5PartPath(const Job& job, size_t i) { return job.root / kH5Parts / (job.dirs[i] + ".h5"); }
 
 bool keepsSeries(const ExperimentCase& c) { return c.output.time_series != TimeSeriesOutput::kNone; }
 bool inH5(const ExperimentCase& c) { return keepsSeries(c) && c.output.time_series_file == TimeSeriesFile::kHdf5; }
@@ -278,7 +295,7 @@ class RunLock {
   explicit RunLock(const fs::path& dir) {
     fs::create_directories(dir);
     const fs::path p = dir / ".tailsim.lock";
-    fd_ = ::open(p.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    fd_ = ::open(p.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
     if (fd_ < 0) throw std::runtime_error("cannot open " + p.string() + ": " + std::strerror(errno));
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       const int err = errno;
@@ -303,9 +320,30 @@ class RunLock {
   int fd_ = -1;
 };
 
+// A JSON file of the folder (discarded, not an exception, when absent or not JSON; an error when
+// it is not a regular file or too large: readResultFile).
 json readJsonFile(const fs::path& p) {
-  std::ifstream in(p);
-  return json::parse(in, nullptr, false);  // discarded (not an exception) when unreadable
+  const std::optional<std::string> text = readResultFile(p.string());
+  return text ? json::parse(*text, nullptr, false) : json(json::value_t::discarded);
+}
+
+// Whether p is a regular file itself (a symlink to one is not).
+bool isRegularFile(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_regular_file(fs::symlink_status(p, ec));
+}
+
+// Whether a finished case's entry holds a result for every model the case runs (a journal line
+// edited or torn to `"runs": {}` is not finished).
+bool entryComplete(const json& j, const ExperimentCase& c) {
+  const auto runs = j.find("runs");
+  if (runs == j.end() || !runs->is_object() || runs->empty()) return false;
+  for (const auto& [model, run] : runs->items())
+    if (!run.is_object() || !run.contains("ok") || !run["ok"].is_boolean()) return false;
+  if (c.kind != CaseKind::kSimulate) return true;
+  for (const std::string& m : c.models)
+    if (!runs->contains(m)) return false;
+  return runs->size() == c.models.size();
 }
 
 // Which experiment's results a folder holds: {name, source}, from summary.json or, after an
@@ -328,13 +366,10 @@ std::pair<std::string, std::string> resultOwner(const fs::path& root) {
       const auto o = owner(readJsonFile(d.path() / "result.json"), "experiment");
       if (!o.first.empty()) return o;
     }
-  if (fs::exists(root / "cases.jsonl", ec)) {  // cases without a folder
-    std::ifstream in(root / "cases.jsonl");
-    std::string line;
-    if (std::getline(in, line)) {
-      const auto o = owner(json::parse(line, nullptr, false), "experiment");
-      if (!o.first.empty()) return o;
-    }
+  if (const std::optional<std::string> text = readResultFile((root / "cases.jsonl").string())) {  // cases without a folder
+    const std::string line = text->substr(0, text->find('\n'));
+    const auto o = owner(json::parse(line, nullptr, false), "experiment");
+    if (!o.first.empty()) return o;
   }
   return {};
 }
@@ -349,7 +384,7 @@ bool holdsResults(const fs::path& root) {
 void clearResultFolder(const fs::path& root) {
   for (const char* entry :
        {"summary.json", "results.csv", "experiment.yaml", "robot.yaml", "mjcf", "report.md", "cases", "cases.jsonl",
-        "time_series.h5", "renders", "plots"})
+        "time_series.h5", kH5Parts, "renders", "plots"})
     fs::remove_all(root / entry);
   std::error_code ec;
   for (const auto& f : fs::directory_iterator(root, ec)) {  // a swept robot's copies: robot-<k>.yaml
@@ -454,6 +489,7 @@ int removeStaleTemps(const fs::path& root) {
     }
   };
   clean(root);
+  clean(root / kH5Parts);
   clean(root / "renders");
   clean(root / "plots");
   if (fs::is_directory(root / "cases", ec))
@@ -494,62 +530,73 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
   job.entries.resize(e.cases.size());
   // Cases without a folder are finished when DIR/cases.jsonl has them; with their time series in
-  // DIR/time_series.h5, only when the published file also has their group with the same key
-  // (else they run again: a killed run never published its temporary file).
+  // HDF5, only when their group is whole with the same key in their own file
+  // (DIR/time_series.h5.d/<dir>.h5, written before the journal line) or in the published
+  // DIR/time_series.h5 (else they run again).
   const bool any_journal =
       std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return !e.cases[i].output.caseFolder(); });
-  const bool any_h5 = std::any_of(e.cases.begin(), e.cases.end(), [](const ExperimentCase& c) { return inH5(c); });
+  job.any_h5 = std::any_of(e.cases.begin(), e.cases.end(), [](const ExperimentCase& c) { return inH5(c); });
   std::map<std::string, std::string> journal = readJournal(root / "cases.jsonl", true);
+  const bool had_journal = !journal.empty() || isRegularFile(root / "cases.jsonl");
+  job.h5_from.assign(e.cases.size(), kH5None);
+  if (job.any_h5) job.published = std::make_unique<TimeSeriesH5Reader>((root / "time_series.h5").string());
+  // Where case i's whole group is: its own file, else the published file, else nowhere.
+  const auto findH5 = [&](size_t i, const std::vector<std::string>& models) -> char {
+    const fs::path part = h5PartPath(job, i);
+    if (isRegularFile(part) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], job.keys[i], models))
+      return kH5Part;
+    return job.published->hasCase(job.dirs[i], job.keys[i], models) ? kH5Published : kH5None;
+  };
   {  // the lines of cases not run now (--case, another shard's) are kept when the journal is rewritten
     std::vector<char> now(e.cases.size(), 0);
     for (size_t i : todo_all) now[i] = 1;
     job.other_lines.resize(e.cases.size());
     for (size_t i = 0; i < e.cases.size(); ++i)
       if (!now[i])
-        if (auto it = journal.find(e.cases[i].name); it != journal.end()) job.other_lines[i] = it->second;
+        if (auto it = journal.find(e.cases[i].name); it != journal.end()) {
+          job.other_lines[i] = it->second;
+          if (inH5(e.cases[i])) job.h5_from[i] = findH5(i, {});  // its group stays too
+        }
   }
-  std::unique_ptr<TimeSeriesH5Reader> published;
-  if (any_h5) published = std::make_unique<TimeSeriesH5Reader>((root / "time_series.h5").string());
-  std::vector<size_t> copy_h5;  // resumed cases whose group is copied from the published file
   for (size_t i : todo_all) {  // finished cases of an earlier, interrupted run
     const ExperimentCase& c = e.cases[i];
     json j;
     if (!opt.resume) {
     } else if (c.output.caseFolder()) {
-      const fs::path rj = root / "cases" / job.dirs[i] / "result.json";
-      if (fs::exists(rj)) j = readJsonFile(rj);
+      j = readJsonFile(root / "cases" / job.dirs[i] / "result.json");
     } else if (auto it = journal.find(c.name); it != journal.end()) {
       j = json::parse(it->second);
       std::string().swap(it->second);
     }
-    // A case is reused only when everything its results depend on is unchanged (caseKey).
-    bool reuse = j.is_object() && j.value("key", std::string()) == job.keys[i] && j.value("name", std::string()) == c.name;
+    // A case is reused only when everything its results depend on is unchanged (caseKey), and
+    // its entry is whole (a result for every model it runs).
+    bool reuse = j.is_object() && j.value("key", std::string()) == job.keys[i] && j.value("name", std::string()) == c.name &&
+                 entryComplete(j, c);
     if (reuse && inH5(c)) {
       std::vector<std::string> models;
-      if (j.contains("runs") && j["runs"].is_object())
-        for (const auto& run : j["runs"].items()) models.push_back(run.key());
-      reuse = published && published->hasCase(job.dirs[i], job.keys[i], models);
-      if (reuse) copy_h5.push_back(i);
+      for (const auto& run : j["runs"].items()) models.push_back(run.key());
+      job.h5_from[i] = findH5(i, models);
+      reuse = job.h5_from[i] != kH5None;
     }
     if (reuse) {
       job.entries[i] = j.dump();
       ++job.resumed;
       continue;
     }
+    job.h5_from[i] = kH5None;
     if (opt.merge_only)
       throw std::runtime_error("merge: case '" + e.cases[i].name + "' of experiment " + e.name +
                                " is finished in none of the shard folders (run its shard, or the shard again)");
     job.todo.push_back(i);
   }
-  if (any_journal || !journal.empty()) job.journal = std::make_unique<CaseJournal>(root / "cases.jsonl");
-  if (any_h5) {
-    job.h5 = std::make_unique<TimeSeriesH5Writer>((root / "time_series.h5").string());
-    for (size_t i : copy_h5) job.h5->copyCase(*published, job.dirs[i]);
-    for (size_t i = 0; i < e.cases.size(); ++i)  // cases not run now keep their group
-      if (!job.other_lines[i].empty() && inH5(e.cases[i]) &&
-          published->hasCase(job.dirs[i], job.keys[i], {}))
-        job.h5->copyCase(*published, job.dirs[i]);
+  if (had_journal) {  // compacted: one line per finished case, whatever earlier runs appended
+    std::string lines;
+    for (size_t i = 0; i < e.cases.size(); ++i)
+      if (!job.entries[i].empty() && !e.cases[i].output.caseFolder()) lines += job.entries[i] + "\n";
+      else if (!job.other_lines[i].empty()) lines += job.other_lines[i] + "\n";
+    writeFileAtomic((root / "cases.jsonl").string(), lines);
   }
+  if (any_journal || had_journal) job.journal = std::make_unique<CaseJournal>(root / "cases.jsonl");
   return job;
 }
 
@@ -583,14 +630,19 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
   j["runs"] = json::object();
   const bool thin = c.output.time_series == TimeSeriesOutput::kThin;
   const std::vector<double> marks = thin && c.kind == CaseKind::kSimulate ? c.trajectory().breakpoints() : std::vector<double>{};
+  std::unique_ptr<TimeSeriesH5Writer> part;  // this case's DIR/time_series.h5.d/<dir>.h5
+  if (inH5(c)) {
+    fs::create_directories(job.root / kH5Parts);
+    part = std::make_unique<TimeSeriesH5Writer>(h5PartPath(job, i).string(), H5Storage::kMemory);
+  }
   for (const RunResult& r : runs) {
     // Every model's CSV in the one column order (docs/ARCHITECTURE.md "Time-series columns").
     if (keepsSeries(c)) {
       TimeSeries ordered = col::inColumnOrder(r.series, modelColumnOrder(col::links(r.series)));
       if (thin && !r.series_thinned) ordered = thinRows(ordered, marks);
       if (folder) writeCsvAtomic((dir / (r.summary.model + ".csv")).string(), ordered);
-      else job.h5->write(job.dirs[i], c.name, job.keys[i], c.sweep_values, r.summary.model,
-                         settings::nameOf(timeSeriesOutputNames(), c.output.time_series), ordered);
+      else part->write(job.dirs[i], c.name, job.keys[i], c.sweep_values, r.summary.model,
+                       settings::nameOf(timeSeriesOutputNames(), c.output.time_series), ordered);
     }
     j["runs"][r.summary.model] = summaryJson(r.summary);
     if (!r.summary.ok) ++failed_runs;
@@ -611,6 +663,7 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
+  if (part) part->publish();  // on disk before the journal says the case is finished
   std::string line = j.dump();
   if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
   else job.journal->append(line + "\n");  // one line, one write(): the case is finished
@@ -631,6 +684,40 @@ ResultsCsvInput tableInput(const Job& job) {
           &job.extra_names};
 }
 
+// DIR/time_series.h5 from the published file's groups and the finished cases' files of their own
+// (DIR/time_series.h5.d), which are then removed. When the published file already holds exactly
+// the finished cases it is left as it is (a resume that ran nothing copies nothing).
+void publishTimeSeriesH5(Job& job) {
+  std::vector<size_t> from_published, from_parts;
+  for (size_t i = 0; i < job.h5_from.size(); ++i) {
+    if (job.h5_from[i] == kH5Published) from_published.push_back(i);
+    if (job.h5_from[i] == kH5Part) from_parts.push_back(i);
+  }
+  const fs::path parts = job.root / kH5Parts;
+  std::error_code ec;
+  if (from_parts.empty() && job.published && job.published->ok() &&
+      job.published->caseDirs().size() == from_published.size()) {
+    fs::remove_all(parts, ec);
+    return;
+  }
+  {
+    // Space for every group copied, reserved before libhdf5 writes (it must never meet a full disk).
+    long long bytes = 0;
+    if (!from_published.empty()) bytes += static_cast<long long>(fs::file_size(job.published->path(), ec));
+    for (size_t i : from_parts) bytes += static_cast<long long>(fs::file_size(h5PartPath(job, i), ec));
+    TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes + bytes / 2 + (64 << 10));
+    for (size_t i : from_published) out.copyCase(*job.published, job.dirs[i]);
+    for (size_t i : from_parts) {
+      const TimeSeriesH5Reader part(h5PartPath(job, i).string());
+      if (!part.ok()) throw std::runtime_error("cannot read " + h5PartPath(job, i).string());
+      out.copyCase(part, job.dirs[i]);
+    }
+    job.published.reset();  // (closed before the rename replaces it)
+    out.publish();
+  }
+  fs::remove_all(parts, ec);
+}
+
 // Writes DIR/summary.json and DIR/results.csv (from the same entries: every finished case,
 // resumed ones included). summary.json is s.dump(1) of {header..., "cases": [entries...]}, written
 // from the entries' text one at a time instead of from one JSON tree of all of them (a sweep of
@@ -645,7 +732,7 @@ void writeSummary(Job& job) {
       else if (!job.other_lines[i].empty()) lines += job.other_lines[i] + "\n";
     writeFileAtomic((job.root / "cases.jsonl").string(), lines);
   }
-  if (job.h5) job.h5->publish();
+  if (job.any_h5) publishTimeSeriesH5(job);
   json s;
   s["experiment"] = e.name;
   s["tailsim_version"] = kVersion;
@@ -725,17 +812,19 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
     return heavy(a) && !heavy(b);
   });
 
-  // Ctrl-C (opt.stop_on_sigint): SIGINT is blocked in this thread before the workers start (they
-  // inherit the mask, and so do ffmpeg/gnuplot children), and read here from a signalfd: no
-  // handler, no global flag. The first stops new cases, the in-flight ones finish and are saved; a
-  // second terminates the process at once (finished cases stay saved: each is written whole).
+  // Ctrl-C, SIGTERM (a batch system's time limit) and SIGHUP (a closed terminal), with
+  // opt.stop_on_sigint: blocked in this thread before the workers start (they inherit the mask,
+  // and so do ffmpeg/gnuplot children), and read here from a signalfd: no handler, no global flag.
+  // The first stops new cases, the in-flight ones finish and are saved; a second terminates the
+  // process at once by that signal (finished cases stay saved: each is on disk whole, its HDF5
+  // groups in a file of its own, before its journal line).
   // The main thread sleeps in poll() on that signalfd and on an eventfd each worker writes when it
   // exits, so it wakes the moment the last case is done (a fixed sleep cost every run up to 100 ms),
   // and otherwise once per progress period (a wake-up after every case doubled the system time of
   // a sweep of short cases: docs/scale.md "Work no result needed").
   sigset_t int_set, old_mask;
   sigemptyset(&int_set);
-  sigaddset(&int_set, SIGINT);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&int_set, sig);
   if (opt.stop_on_sigint) pthread_sigmask(SIG_BLOCK, &int_set, &old_mask);
   const PollFd sig_fd(opt.stop_on_sigint ? ::signalfd(-1, &int_set, SFD_CLOEXEC | SFD_NONBLOCK) : -1);
   const PollFd wake_fd(::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
@@ -752,6 +841,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   std::atomic<size_t> next{0};
   std::atomic<int> done{0}, failed{0}, running{0};
   std::atomic<bool> stop{false};
+  int stop_signal = 0;  // the signal that stopped the run (main thread only)
   std::mutex mu;
   std::string first_error;
   RunContext ctx;  // shared by the workers: the MuJoCo pre-roll once per distinct model
@@ -766,6 +856,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
         std::string entry = runAndWrite(*t.job, t.i, f, ctx);
         failed += f;
         t.job->entries[t.i] = std::move(entry);  // distinct element per task: no lock needed
+        if (inH5(t.job->e->cases[t.i])) t.job->h5_from[t.i] = kH5Part;
       } catch (const std::exception& ex) {
         // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);
@@ -836,29 +927,24 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
     }
     if (opt.stop_on_sigint && (fds[1].revents & POLLIN)) {
       signalfd_siginfo info{};
-      if (::read(sig_fd.fd, &info, sizeof info) == static_cast<ssize_t>(sizeof info) && info.ssi_signo == SIGINT) {
+      if (::read(sig_fd.fd, &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
+        const int sig = static_cast<int>(info.ssi_signo);
+        const std::string sig_name = sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "Ctrl-C";
+        const std::string by = sig == SIGINT ? "" : " by " + sig_name;
         if (line_open) std::fprintf(stderr, "\n");
         line_open = false;
         if (!stop.exchange(true)) {
+          stop_signal = sig;
           const int in_flight = static_cast<int>(std::min(next.load(), tasks.size())) - done.load();
-          std::fprintf(stderr, "interrupted: finishing %d running case%s (Ctrl-C again to abandon %s)\n", in_flight,
-                       in_flight == 1 ? "" : "s", in_flight == 1 ? "it" : "them");
+          std::fprintf(stderr, "interrupted%s: finishing %d running case%s (%s again to abandon %s)\n", by.c_str(),
+                       in_flight, in_flight == 1 ? "" : "s", sig_name.c_str(), in_flight == 1 ? "it" : "them");
         } else {
-          // Finished cases stay resumable: their result.json / cases.jsonl line is on disk; their
-          // HDF5 groups are in the unpublished temporary file, so publish it now (a case still being
-          // written is incomplete there, and a resume runs it again: hasCase needs every model).
-          for (Job& job : jobs) {
-            if (!job.h5) continue;
-            try {
-              job.h5->publish();
-            } catch (const std::exception&) {  // nothing more to save; the signal still ends the run
-            }
-          }
-          std::fprintf(stderr, "interrupted again: abandoning the running cases; %d cases saved\n",
-                       done.load() + stats.resumed);
-          std::signal(SIGINT, SIG_DFL);
+          // Finished cases stay resumable: their result.json / cases.jsonl line is on disk, their
+          // HDF5 groups in DIR/time_series.h5.d; a case still being written runs again.
+          std::fprintf(stderr, "interrupted again: abandoning the running cases; %d cases saved\n", done.load() + stats.resumed);
+          std::signal(sig, SIG_DFL);
           pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
-          std::raise(SIGINT);  // terminates: the shell sees "killed by SIGINT"
+          std::raise(sig);  // terminates: the shell sees "killed by <signal>"
         }
       }
     }
@@ -869,6 +955,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   if (show) printProgress(true);
   else if (line_open) std::fprintf(stderr, "\n");
   stats.interrupted = stop.load();
+  stats.stop_signal = stop_signal;
   try {
     std::vector<ResultsCsvInput> tables;
     for (Job& job : jobs) {

@@ -26,7 +26,7 @@ struct RunOptions {
                                  // results of another experiment in out_dir are deleted, not refused
   std::string only_case;         // run just this case ("" = all)
   long max_new_cases = -1;       // stop after this many newly run cases (tests of resuming)
-  bool stop_on_sigint = false;   // Ctrl-C: start no new case, let running ones finish and save them
+  bool stop_on_sigint = false;   // Ctrl-C, SIGTERM, SIGHUP: start no new case, let running ones finish and save them
                                  // (RunStats::interrupted); a second Ctrl-C terminates the process
   int shard_index = 1;           // --shard K/N: run only the cases assigned to shard K (sharding.h)
   int shard_count = 1;
@@ -39,7 +39,8 @@ struct RunStats {
   int resumed = 0;   // cases found finished and skipped
   int failed = 0;    // model runs with ok == false
   double wall_time_s = 0;
-  bool interrupted = false;  // stopped early by SIGINT; resumed + ran cases are saved
+  bool interrupted = false;  // stopped early (a signal, a full disk); resumed + ran cases are saved
+  int stop_signal = 0;       // the signal that stopped it: SIGINT, SIGTERM or SIGHUP (0: none)
 };
 
 // Keeps only the models named in `only` in every case (none given: all). Throws ConfigError naming

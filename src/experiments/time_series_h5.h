@@ -6,8 +6,11 @@
 //   /<case dir>/<model>/         one group per model run; attribute "time_series" (full | thin)
 //   /<case dir>/<model>/<column> one 1-D float64 dataset per CSV column, named as the CSV column,
 //                                attribute "units" ("s", "deg", "deg/s", "N m", ...; "1" for states)
-// Written to a temporary file beside the target (<file>.tmp.<pid>.h5) and renamed over it when the
-// run ends, so a killed run never leaves a torn published file. The C API's handles are wrapped
+//   /<case dir>/<model>          attribute "columns": the number of datasets (written last: a
+//                                group is whole only with it)
+// Written to a temporary file beside the target (<file>.tmp.<pid>.h5) and renamed over it (after
+// fsync), so a killed run never leaves a torn published file. The runner writes each finished case
+// to a file of its own this way (DIR/time_series.h5.d/<case dir>.h5) and joins them at the run's end. The C API's handles are wrapped
 // (H5Handle); Debian's libhdf5 is built thread-safe, and each writer also serializes its own calls.
 #pragma once
 
@@ -15,6 +18,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "results/time_series.h"
 
@@ -36,39 +40,58 @@ class TimeSeriesH5Reader {
   TimeSeriesH5Reader(const TimeSeriesH5Reader&) = delete;
   TimeSeriesH5Reader& operator=(const TimeSeriesH5Reader&) = delete;
   bool ok() const;
-  // Whether /<case_dir> exists with attribute "key" == key and a group per model.
+  // Whether /<case_dir> exists with attribute "key" == key and a whole group per model: every
+  // column it was written with, of one length, at least one row, t_s finite in every row.
   bool hasCase(const std::string& case_dir, const std::string& key, const std::vector<std::string>& models) const;
   // The columns of /<case_dir>/<model> in the order they were written; throws std::runtime_error.
   TimeSeries read(const std::string& case_dir, const std::string& model) const;
+  // The case groups at the file's root.
+  std::vector<std::string> caseDirs() const;
   long long handle() const;  // the file's hid_t (for TimeSeriesH5Writer::copyCase)
+  const std::string& path() const { return path_; }
 
  private:
   long long file_ = -1;
   std::string path_;
 };
 
+// Where a writer builds its file: beside the target on disk, or in memory (the core driver) and
+// written out whole by publish(), so a full disk fails in tailsim's own write(), never inside
+// libhdf5 (whose H5Ocopy crashed on ENOSPC).
+enum class H5Storage { kDisk, kMemory };
+
 class TimeSeriesH5Writer {
  public:
-  // Creates the temporary file beside `final_path`; throws std::runtime_error.
-  explicit TimeSeriesH5Writer(const std::string& final_path);
+  // Creates the temporary file beside `final_path` (kDisk) or in memory; throws std::runtime_error.
+  // reserve_bytes (kDisk): disk space allocated for it first (fallocate beyond its end, given back
+  // by publish), so the writes cannot meet a full disk; std::system_error(ENOSPC) when it is not
+  // there.
+  explicit TimeSeriesH5Writer(const std::string& final_path, H5Storage storage = H5Storage::kDisk,
+                              long long reserve_bytes = 0);
   // Not published: the temporary file is closed and removed.
   ~TimeSeriesH5Writer();
   TimeSeriesH5Writer(const TimeSeriesH5Writer&) = delete;
   TimeSeriesH5Writer& operator=(const TimeSeriesH5Writer&) = delete;
 
-  // /<case_dir>: created on first use with its attributes.
+  // /<case_dir>: created on first use with its attributes. A failed write throws
+  // std::system_error(ENOSPC) when the disk is full, else std::runtime_error.
   void write(const std::string& case_dir, const std::string& case_name, const std::string& key,
              const std::map<std::string, std::string>& sweep, const std::string& model, const std::string& mode,
              const TimeSeries& ts);
   // Copies /<case_dir> (all its models) from a published file (H5Ocopy).
   void copyCase(const TimeSeriesH5Reader& from, const std::string& case_dir);
-  // Closes the file and renames it over final_path.
+  // Closes the file, flushes it to disk and renames it over final_path (the rename is flushed too).
   void publish();
 
  private:
+  void writeLocked(const std::string& case_dir, const std::string& case_name, const std::string& key,
+                   const std::map<std::string, std::string>& sweep, const std::string& model, const std::string& mode,
+                   const TimeSeries& ts);
   std::mutex mu_;
   long long file_ = -1;
   std::string final_path_, temp_path_;
+  H5Storage storage_ = H5Storage::kDisk;
+  int reserve_fd_ = -1;
   bool published_ = false;
 };
 

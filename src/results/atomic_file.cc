@@ -47,6 +47,38 @@ void writeFileAtomic(const std::string& path, const std::string& contents) {
   }
 }
 
+std::optional<std::string> readResultFile(const std::string& path, long long max_bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    const int err = errno;
+    if (err == ENOENT) return std::nullopt;
+    if (err == ELOOP) throw std::runtime_error(path + " is a symbolic link: tailsim reads and writes only regular files in a result folder (remove it)");
+    throw std::runtime_error("cannot open " + path + ": " + std::strerror(err));
+  }
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw std::runtime_error("cannot stat " + path + ": " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode))
+    throw std::runtime_error(path + " is not a regular file: tailsim reads and writes only regular files in a result folder (remove it)");
+  if (st.st_size > max_bytes)
+    throw std::runtime_error(path + " is " + std::to_string(st.st_size) + " bytes, more than tailsim ever writes there (" +
+                             std::to_string(max_bytes) + "): not read");
+  std::string out(static_cast<size_t>(st.st_size), '\0');
+  size_t got = 0;
+  while (got < out.size()) {
+    const ssize_t n = ::read(fd, out.data() + got, out.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw std::runtime_error("cannot read " + path + ": " + std::strerror(errno));
+    if (n == 0) break;  // shrunk meanwhile
+    got += static_cast<size_t>(n);
+  }
+  out.resize(got);
+  return out;
+}
+
 namespace {
 
 // The descriptor a path names directly ("-", /dev/stdout, /dev/fd/N, ...), or -1.

@@ -2,6 +2,7 @@
 // flush, then rename over it (rename is atomic within one filesystem).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "results/time_series.h"
@@ -22,6 +23,13 @@ void writeFileAtomic(const std::string& path, const std::string& contents);
 // Returns true when the contents went to a stream (descriptor, device, FIFO, socket) rather than
 // to a file, so callers can keep their messages off stdout. Throws std::runtime_error naming PATH.
 bool writeUserFile(const std::string& path, const std::string& contents);
+
+// Reads a file tailsim wrote into a result folder (cases.jsonl, result.json, summary.json, ...)
+// only if it is what it should be: std::nullopt when absent; std::runtime_error naming the path
+// when it is a symbolic link (never followed out of the folder), not a regular file (a FIFO never
+// blocks, a device is never read) or larger than max_bytes (never read into memory unbounded).
+constexpr long long kMaxResultFileBytes = 1LL << 30;
+std::optional<std::string> readResultFile(const std::string& path, long long max_bytes = kMaxResultFileBytes);
 
 // CSV with a header row of column names; numbers with 12 significant digits.
 std::string toCsv(const TimeSeries& ts);
