@@ -199,6 +199,9 @@ int main(int argc, char** argv) {
   run->add_option("--case", case_name, "run only this case");
   run->add_flag("--no-render", no_render, "skip the render section");
   run->add_flag("--fresh", fresh, "start from an empty result folder (deletes tailsim's results in --out, also another experiment's)");
+  bool allow_other_build = false;
+  run->add_flag("--allow-other-build", allow_other_build,
+                "resume cases computed by another tailsim version or commit (warned, recorded in summary.json) instead of refusing them");
   run->add_flag("--quiet", quiet, "no progress line");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
   std::string shard_text;
@@ -210,6 +213,8 @@ int main(int argc, char** argv) {
   merge->add_option("shards", merge_dirs, "the shards' result folders")->required()->check(CLI::ExistingDirectory);
   merge->add_option("--out", merge_out, "the merged result folder (new or empty)")->required();
   merge->add_option("--threads", threads, "worker threads (default 0: all cores)")->check(CLI::NonNegativeNumber);
+  merge->add_flag("--allow-other-build", allow_other_build,
+                  "keep cases computed by another tailsim version or commit (warned, recorded in summary.json) instead of refusing them");
   std::vector<std::string> only_models;
   run->add_option("--models", only_models, "run only these models (analytic, perfoot, mujoco) of each case")
       ->check(CLI::IsMember(modelNames()));
@@ -328,6 +333,7 @@ int main(int argc, char** argv) {
       o.progress = !quiet;
       o.only_case = case_name;
       o.stop_on_sigint = true;
+      o.allow_other_build = allow_other_build;
       if (!shard_text.empty()) {
         o.shard_index = shard.index;
         o.shard_count = shard.count;
@@ -352,7 +358,7 @@ int main(int argc, char** argv) {
       return s.failed ? kExitRunsFailed : kExitOk;
     }
     if (*merge) {
-      const MergeStats m = mergeShards(merge_dirs, merge_out, threads);
+      const MergeStats m = mergeShards(merge_dirs, merge_out, threads, allow_other_build);
       std::printf("merged %d shards: %d cases, %d files into %s\n", m.shards, m.cases, m.files_copied, merge_out.c_str());
       return kExitOk;
     }

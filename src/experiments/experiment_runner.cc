@@ -268,6 +268,7 @@ struct Job {
   std::set<std::string> extra_names;  // writeSummary: every run's extra figures (results.csv columns)
   std::vector<size_t> todo;       // case indices to run now
   std::string source;             // recordedSource(*e), as found before the folder is written
+  std::map<std::string, int> other_builds;  // "version commit" -> finished cases of that build reused
   int total = 0, resumed = 0;
   std::unique_ptr<CaseJournal> journal;     // DIR/cases.jsonl (cases without a folder)
   std::vector<std::string> other_lines;     // per case: its journal line when not run now (else empty)
@@ -541,11 +542,11 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   job.h5_from.assign(e.cases.size(), kH5None);
   if (job.any_h5) job.published = std::make_unique<TimeSeriesH5Reader>((root / "time_series.h5").string());
   // Where case i's whole group is: its own file, else the published file, else nowhere.
-  const auto findH5 = [&](size_t i, const std::vector<std::string>& models) -> char {
+  const auto findH5 = [&](size_t i, const std::vector<std::string>& models, const std::string& key) -> char {
     const fs::path part = h5PartPath(job, i);
-    if (isRegularFile(part) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], job.keys[i], models))
+    if (isRegularFile(part) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
       return kH5Part;
-    return job.published->hasCase(job.dirs[i], job.keys[i], models) ? kH5Published : kH5None;
+    return job.published->hasCase(job.dirs[i], key, models) ? kH5Published : kH5None;
   };
   {  // the lines of cases not run now (--case, another shard's) are kept when the journal is rewritten
     std::vector<char> now(e.cases.size(), 0);
@@ -555,7 +556,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       if (!now[i])
         if (auto it = journal.find(e.cases[i].name); it != journal.end()) {
           job.other_lines[i] = it->second;
-          if (inH5(e.cases[i])) job.h5_from[i] = findH5(i, {});  // its group stays too
+          if (inH5(e.cases[i])) job.h5_from[i] = findH5(i, {}, job.keys[i]);  // its group stays too
         }
   }
   for (size_t i : todo_all) {  // finished cases of an earlier, interrupted run
@@ -572,10 +573,20 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     // its entry is whole (a result for every model it runs).
     bool reuse = j.is_object() && j.value("key", std::string()) == job.keys[i] && j.value("name", std::string()) == c.name &&
                  entryComplete(j, c);
+    if (!reuse && j.is_object() && j.value("name", std::string()) == c.name && entryComplete(j, c)) {
+      // A finished case of another build, for the same inputs: refused unless allowed.
+      const BuildId theirs{j.value("tailsim_version", std::string()), j.value("tailsim_git_commit", std::string())};
+      if (theirs != thisBuild() && j.value("key", std::string()) == sha256Hex(caseKeyText(c, job.render, theirs))) {
+        const std::string build = "tailsim " + theirs.version + " (commit " +
+                                  (theirs.git_commit.empty() ? "unknown" : theirs.git_commit) + ")";
+        ++job.other_builds[build];
+        reuse = opt.allow_other_build;
+      }
+    }
     if (reuse && inH5(c)) {
       std::vector<std::string> models;
       for (const auto& run : j["runs"].items()) models.push_back(run.key());
-      job.h5_from[i] = findH5(i, models);
+      job.h5_from[i] = findH5(i, models, j.value("key", std::string()));
       reuse = job.h5_from[i] != kH5None;
     }
     if (reuse) {
@@ -588,6 +599,23 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       throw std::runtime_error("merge: case '" + e.cases[i].name + "' of experiment " + e.name +
                                " is finished in none of the shard folders (run its shard, or the shard again)");
     job.todo.push_back(i);
+  }
+  if (!job.other_builds.empty()) {
+    std::string list;
+    int n = 0;
+    for (const auto& [build, count] : job.other_builds) {
+      list += (list.empty() ? "" : ", ") + std::to_string(count) + " by " + build;
+      n += count;
+    }
+    const std::string self = "tailsim " + std::string(kVersion) + " (commit " + (*kGitCommit ? kGitCommit : "unknown") + ")";
+    if (!opt.allow_other_build)
+      throw std::runtime_error(root.string() + " holds finished cases computed by another tailsim build (" + list +
+                               "; this is " + self + "): " +
+                               (opt.merge_only ? "merge shards of one build, or add --allow-other-build to keep them"
+                                               : "add --fresh to recompute them, or --allow-other-build to keep them") +
+                               " (recorded in summary.json)");
+    std::fprintf(stderr, "warning: %s: %d finished case%s of another tailsim build kept (%s; this is %s)\n",
+                 root.string().c_str(), n, n == 1 ? "" : "s", list.c_str(), self.c_str());
   }
   if (had_journal) {  // compacted: one line per finished case, whatever earlier runs appended
     std::string lines;
@@ -741,6 +769,7 @@ void writeSummary(Job& job) {
   s["source"] = job.source;
   s["kind"] = e.cases.empty() ? "simulate" : name(e.cases.front().kind);
   s["swept_keys"] = e.swept_keys;
+  if (!job.other_builds.empty()) s["other_builds"] = job.other_builds;  // --allow-other-build: cases reused from them
   s["cases"] = json::array();
   // "cases" is the first key (sorted), so its empty array is the first match; JSON strings cannot
   // hold an unescaped quote, so no string value matches.
@@ -754,8 +783,11 @@ void writeSummary(Job& job) {
     json entry = json::parse(entry_text);  // the one parse of this entry
     entry.erase("experiment");  // said once, in the header
     entry.erase("source");
-    entry.erase("tailsim_version");
-    entry.erase("tailsim_git_commit");
+    if (entry.value("tailsim_version", std::string()) == kVersion &&
+        entry.value("tailsim_git_commit", std::string()) == kGitCommit) {  // said once, in the header
+      entry.erase("tailsim_version");
+      entry.erase("tailsim_git_commit");
+    }
     // An element of an array at depth 1 of an indent-1 dump: every line two spaces further in.
     std::string d = entry.dump(1);
     std::string nested;

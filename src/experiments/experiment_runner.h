@@ -31,6 +31,8 @@ struct RunOptions {
   int shard_index = 1;           // --shard K/N: run only the cases assigned to shard K (sharding.h)
   int shard_count = 1;
   bool merge_only = false;       // run nothing: every case must be finished in out_dir (tailsim merge)
+  bool allow_other_build = false;  // finished cases of another tailsim build (version/commit) are reused
+                                   // with a warning and recorded in summary.json ("other_builds"), not refused
 };
 
 struct RunStats {

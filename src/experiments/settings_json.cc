@@ -157,14 +157,18 @@ ExperimentCase caseFromResolved(const json& j) {
   return c;
 }
 
-std::string caseKeyText(const ExperimentCase& c, bool render) {
+BuildId thisBuild() { return {kVersion, kGitCommit}; }
+
+std::string caseKeyText(const ExperimentCase& c, bool render) { return caseKeyText(c, render, thisBuild()); }
+
+std::string caseKeyText(const ExperimentCase& c, bool render, const BuildId& b) {
   json k = resolvedJson(c);
   k.erase("source_file");  // where the values came from does not change the results
   k.erase("robot_file");
   if (!render) k.erase("render");  // --no-render: a later run with rendering renders the case
   k["rendered"] = render;
-  k["tailsim_version"] = kVersion;
-  k["tailsim_git_commit"] = kGitCommit;
+  k["tailsim_version"] = b.version;
+  k["tailsim_git_commit"] = b.git_commit;
   return k.dump();  // keys sorted (std::map), numbers in shortest round-trip form
 }
 

@@ -23,4 +23,14 @@ ExperimentCase caseFromResolved(const nlohmann::json& j);
 // settings only then), the tailsim version and git commit; sorted keys, round-trippable numbers.
 std::string caseKeyText(const ExperimentCase& c, bool render);
 
+// A tailsim build: its version and git commit (as in summary.json, result.json, cases.jsonl lines).
+struct BuildId {
+  std::string version, git_commit;
+  bool operator==(const BuildId& o) const { return version == o.version && git_commit == o.git_commit; }
+  bool operator!=(const BuildId& o) const { return !(*this == o); }
+};
+BuildId thisBuild();
+// The key text as the build `b` computes it (resume and merge recognise another build's results).
+std::string caseKeyText(const ExperimentCase& c, bool render, const BuildId& b);
+
 }  // namespace tailsim

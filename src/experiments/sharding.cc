@@ -12,6 +12,10 @@
 #include <unistd.h>
 
 #include "experiments/experiment_runner.h"
+#include "results/atomic_file.h"
+
+#include <map>
+#include <nlohmann/json.hpp>
 
 namespace tailsim {
 
@@ -94,6 +98,25 @@ bool rebuiltOrTransient(const fs::path& rel) {
   return false;
 }
 
+// A finished case's entry (result.json, a cases.jsonl line) as compared between shards: its JSON
+// without the measured wall times (two runs of one case differ in nothing else).
+std::string comparable(const std::string& text) {
+  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  if (!j.is_object()) return text;
+  if (auto runs = j.find("runs"); runs != j.end() && runs->is_object())
+    for (auto& [model, run] : runs->items())
+      if (run.is_object()) run.erase("wall_time_s");
+  return j.dump();
+}
+
+// The same case finished in two shards must have the same result (identical duplicates are fine).
+void requireSameResult(const std::string& a_text, const std::string& b_text, const std::string& case_name,
+                       const std::string& a_dir, const std::string& b_dir) {
+  if (comparable(a_text) != comparable(b_text))
+    throw std::runtime_error("merge: case '" + case_name + "' has different results in " + a_dir + " and " + b_dir +
+                             " (not shards of one run; merge one of them)");
+}
+
 // Per-case outputs (cases/<dir>/..., renders/<dir>.*): the first shard that has the case wins.
 bool perCase(const fs::path& rel) {
   for (const auto& part : rel)
@@ -114,7 +137,8 @@ fs::path caseFolderOf(const fs::path& rel) {
 }
 }  // namespace
 
-MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads) {
+MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
+                       bool allow_other_build) {
   if (shard_dirs.empty()) throw std::runtime_error("merge: no shard folders given");
   MergeStats st;
   st.shards = static_cast<int>(shard_dirs.size());
@@ -140,6 +164,8 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
   try {
     fs::create_directories(stage);
     std::vector<fs::path> taken_cases;
+    std::map<fs::path, std::string> taken_by;  // case folder -> the shard folder it was taken from
+    std::map<std::string, std::pair<std::string, std::string>> journal_lines;  // name -> {line, shard}
     for (const std::string& d : shard_dirs) {
       const fs::path root(d);
       std::vector<fs::path> this_shard_cases;
@@ -149,8 +175,17 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
         if (rebuiltOrTransient(rel)) continue;
         const fs::path dst = stage / rel;
         if (rel.filename() == "cases.jsonl") {  // finished cases without a folder: every shard's lines
+          const std::string text = readResultFile(it->path().string()).value_or(std::string());
+          std::istringstream lines(text);
+          for (std::string line; std::getline(lines, line);) {
+            const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+            if (!j.is_object() || !j.contains("name") || !j["name"].is_string()) continue;
+            const std::string name = (rel.parent_path() / j["name"].get<std::string>()).string();
+            const auto [at, first] = journal_lines.emplace(name, std::make_pair(line, d));
+            if (!first) requireSameResult(at->second.first, line, j["name"].get<std::string>(), at->second.second, d);
+          }
           fs::create_directories(dst.parent_path());
-          std::ofstream(dst, std::ios::binary | std::ios::app) << readAll(it->path());
+          std::ofstream(dst, std::ios::binary | std::ios::app) << text;
           continue;
         }
         if (rel.filename() == "time_series.h5") {  // every shard's case groups (the first shard's win)
@@ -160,7 +195,13 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
         }
         if (perCase(rel)) {
           const fs::path cf = caseFolderOf(rel);
-          if (std::find(taken_cases.begin(), taken_cases.end(), cf) != taken_cases.end()) continue;  // earlier shard's
+          if (std::find(taken_cases.begin(), taken_cases.end(), cf) != taken_cases.end()) {  // earlier shard's
+            if (rel.filename() == "result.json" && fs::exists(stage / rel, ec))
+              requireSameResult(readResultFile((stage / rel).string()).value_or(""),
+                                readResultFile(it->path().string()).value_or(""), cf.filename().string(), taken_by[cf], d);
+            continue;
+          }
+          taken_by.emplace(cf, d);
           if (std::find(this_shard_cases.begin(), this_shard_cases.end(), cf) == this_shard_cases.end())
             this_shard_cases.push_back(cf);
         } else if (fs::exists(dst, ec)) {  // inputs and MJCF copies: the same in every shard
@@ -183,6 +224,7 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
     o.progress = false;
     o.render = true;
     o.merge_only = true;
+    o.allow_other_build = allow_other_build;
     const RunStats rs = runSuite(suite, o);
     st.cases = rs.total;
     fs::remove(stage / ".tailsim.lock", ec);

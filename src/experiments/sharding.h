@@ -40,6 +40,7 @@ std::vector<std::vector<char>> shardMembership(const std::vector<Experiment>& su
 struct MergeStats {
   int shards = 0, cases = 0, files_copied = 0;
 };
-MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads);
+MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
+                       bool allow_other_build = false);
 
 }  // namespace tailsim
