@@ -587,7 +587,7 @@ TEST(FigureTitles, LongTitlesAreWrappedAtSpacesOutsideGroups) {
   }
   EXPECT_EQ(wrapGpText("a M_{z, T} b", 3), "a\nM_{z, T}\nb");  // never inside a {group}
   // the quoted title is one gnuplot string expression
-  EXPECT_EQ(gpQuote("a\nb's"), "'a'.\"\\n\".'b''s'");
+  EXPECT_EQ(gpQuote("a\nb's"), "'a'.\"\\n\".'b'.\"'\".'s'");
   EXPECT_EQ(gpTitle("short", 1000), "'short'");
   EXPECT_GT(titleChars(1000, 15), 80u);
   EXPECT_LT(titleChars(1000, 15), 100u);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "experiments/experiment_loader.h"
+#include "experiments/yaml_file.h"
 
 namespace tailsim {
 namespace design_yaml {
@@ -139,11 +140,7 @@ inline YAML::Node loadYaml(const std::string& abs) {
   const auto size = fs::file_size(abs, ec);
   if (ec) throw ConfigError(abs + ": cannot read: " + ec.message());
   if (size > kMaxFileBytes) throw ConfigError(abs + ": file is larger than 1 MiB");
-  try {
-    return YAML::LoadFile(abs);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(abs + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
-  }
+  return loadBoundedYaml(abs);  // the experiment loader's bounds and messages
 }
 
 
@@ -157,7 +154,7 @@ inline const Val& need(const Reader& r, const Map& m, const Val& parent, const c
 }
 
 // The keys every design file (kind optimize, kind maneuver) starts with: name (one safe path
-// component), description, kind (must be `kind`) and base (an experiment file, relative to this one).
+// component, experimentNameProblem), description, kind (must be `kind`) and base (an experiment file, relative to this one).
 struct DesignHead {
   std::string name, description, base_file;
 };
@@ -165,10 +162,7 @@ inline DesignHead readDesignHead(const Reader& r, const Val& root, const Map& to
                                  const char* kind) {
   DesignHead h;
   h.name = r.text(need(r, top, root, "name"));
-  if (h.name.empty() || h.name.size() > 100 || h.name.find_first_of("/\\") != std::string::npos || h.name == "." ||
-      h.name == ".." || h.name[0] == '-')
-    r.fail(need(r, top, root, "name"),
-           "must be one safe path component (no / or \\, not . or .., no leading -, 1..100 characters)");
+  if (const std::string why = experimentNameProblem(h.name); !why.empty()) r.fail(need(r, top, root, "name"), why);
   if (const Val* d = Reader::get(top, "description")) h.description = r.text(*d);
   r.choice(need(r, top, root, "kind"), {kind});
   const Val& base = need(r, top, root, "base");

@@ -469,14 +469,16 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     GnuplotFigure fig;
     fig.stem = "heading";
     std::ostringstream b;
+    std::ostringstream title;
+    title << "Maneuver " << spec.name << ": heading to " << s.heading_deg << " deg";
     b << "set datafile separator ','\nset key bottom right\nset grid\n"
-      << "set title 'Maneuver " << spec.name << ": heading to " << s.heading_deg << " deg' noenhanced\n"
+      << "set title " << gpQuote(title.str()) << " noenhanced\n"
       << "set xlabel 't [s]'\nset ylabel 'heading change [deg]'\n"
       << "plot " << s.heading_deg << " with lines dt 2 lc rgb '#000000' title 'target'";
     const char* colours[] = {"#0072B2", "#E69F00", "#009E73"};
     for (std::size_t i = 0; i < rep.runs.size(); ++i)
-      b << ", '../maneuver.csv' every ::1 using 1:" << i + 2 << " with lines lw 2 lc rgb '" << colours[i % 3] << "' title '"
-        << rep.runs[i].label << "' noenhanced";
+      b << ", '../maneuver.csv' every ::1 using 1:" << i + 2 << " with lines lw 2 lc rgb " << gpQuote(colours[i % 3])
+        << " title " << gpQuote(rep.runs[i].label) << " noenhanced";
     b << "\n";
     fig.body = b.str();
     renderFigure((fs::path(out_dir) / "plots").string(), fig);

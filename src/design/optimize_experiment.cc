@@ -251,12 +251,13 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
     fig.stem = "history";
     std::ostringstream b;
     b << "set datafile separator ','\nset key bottom right\nset grid\n"
-      << "set title 'Convergence of " << spec.name << " (" << familyName(prob.space.family) << ")' noenhanced\n"
-      << "set xlabel 'analytic model runs'\nset ylabel '" << objectiveName(prob.objective)
-      << (prob.objective == StrokeObjective::kPhiNet ? " [rad]" : "") << "' noenhanced\nplot ";
+      << "set title " << gpQuote("Convergence of " + spec.name + " (" + familyName(prob.space.family) + ")")
+      << " noenhanced\nset xlabel 'analytic model runs'\nset ylabel "
+      << gpQuote(std::string(objectiveName(prob.objective)) + (prob.objective == StrokeObjective::kPhiNet ? " [rad]" : ""))
+      << " noenhanced\nplot ";
     for (std::size_t i = 0; i < spec.seeds.size(); ++i)
       b << (i ? ", " : "") << "'../history.csv' every ::1 using ($1==" << spec.seeds[i]
-        << " ? $4 : 1/0):6 with steps lw 2 title 'seed " << spec.seeds[i] << "'";
+        << " ? $4 : 1/0):6 with steps lw 2 title " << gpQuote("seed " + std::to_string(spec.seeds[i]));
     b << "\n";
     fig.body = b.str();
     renderFigure((fs::path(out_dir) / "plots").string(), fig);
@@ -290,8 +291,8 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
     rep.files.push_back("pareto.csv");
     GnuplotFigure fig;
     fig.stem = "pareto";
-    fig.body = "set datafile separator ','\nset grid\nset key off\nset title 'Net yaw vs peak joint torque (" +
-               spec.name + ")' noenhanced\nset xlabel 'peak joint torque [N m]'\nset ylabel '|{/Symbol f}_{net}| [deg]'\n"
+    fig.body = "set datafile separator ','\nset grid\nset key off\nset title " +
+               gpQuote("Net yaw vs peak joint torque (" + spec.name + ")") + " noenhanced\nset xlabel 'peak joint torque [N m]'\nset ylabel '|{/Symbol f}_{net}| [deg]'\n"
                "plot '../pareto.csv' every ::1 using 2:(abs($3)) with linespoints lw 2 pt 7\n";
     renderFigure((fs::path(out_dir) / "plots").string(), fig);
     rep.files.push_back("plots/pareto.png");

@@ -6,6 +6,7 @@
 // Every case is built before anything is returned, so a bad value anywhere in the grid is
 // reported before any work starts. Each error names file:line:col and the dotted key.
 #include "experiments/experiment_loader.h"
+#include "experiments/yaml_file.h"
 
 #include <dlfcn.h>
 #include <fcntl.h>
@@ -1120,14 +1121,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   const Item& name = r.need(top, "name");
   c.experiment = r.string(name);
   // The name becomes a folder (a suite's OUT/<name>/, render's OUT/<name>/): one safe path component.
-  const std::string& nm = c.experiment;
-  const bool control = std::any_of(nm.begin(), nm.end(), [](char ch) {
-    return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
-  });
-  if (nm.empty() || nm.size() > 100 || nm == "." || nm == ".." || nm[0] == '-' || control ||
-      nm.find_first_of("/\\") != std::string::npos)
-    r.fail(name, "must be a folder name: 1 to 100 characters, no '/', '\\' or control characters, "
-                 "not '.' or '..', not starting with '-'");
+  if (const std::string why = experimentNameProblem(c.experiment); !why.empty()) r.fail(name, why);
   if (const Item* d = top.get("description")) r.string(*d);
 
   // Robot file, then the experiment's overrides.
@@ -1319,6 +1313,19 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
 }
 
 }  // namespace
+
+YAML::Node loadBoundedYaml(const std::string& path) { return parseYaml(&path); }
+
+std::string experimentNameProblem(const std::string& nm) {
+  const bool control = std::any_of(nm.begin(), nm.end(), [](char ch) {
+    return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+  });
+  if (nm.empty() || nm.size() > 100 || nm == "." || nm == ".." || nm[0] == '-' || control ||
+      nm.find_first_of("/\\") != std::string::npos)
+    return "must be a folder name: 1 to 100 characters, no '/', '\\' or control characters, "
+           "not '.' or '..', not starting with '-'";
+  return "";
+}
 
 Experiment loadExperiment(const std::string& path) {
   Loader L;

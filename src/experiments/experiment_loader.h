@@ -47,6 +47,12 @@ RobotFileData loadRobotFile(const std::string& name_or_path);
 // be suites themselves). A normal experiment file yields a one-element vector. Throws ConfigError.
 std::vector<Experiment> loadExperimentSuite(const std::string& path);
 
+// The `name` of an experiment or design file (optimize, maneuver) becomes a folder and appears in
+// plot titles: one safe path component of 1 to 100 bytes, no '/', '\\' or control characters
+// (NUL and line breaks included), not '.' or '..', not starting with '-'. Returns "" when `name` is
+// fine, else what is wrong (for the caller's ConfigError at the key).
+std::string experimentNameProblem(const std::string& name);
+
 // At most this many values per sweep/range and this many cases per experiment.
 constexpr std::size_t kMaxSweepValues = 10000;
 constexpr std::size_t kMaxCases = 100000;

@@ -25,9 +25,11 @@ namespace fs = std::filesystem;
 
 std::string gpQuote(const std::string& s) {
   std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "''";
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\'') out += "'.\"'\".'";  // not '': gnuplot 5.4 reads '''x' as '' 'x', 'a''''b' as a'
     else if (c == '\n') out += "'.\"\\n\".'";
+    else if (u < 0x20 || u == 0x7f) out += ' ';  // NUL, CR, tab, ESC: a space, never script syntax
     else out += c;
   }
   return out + "'";
@@ -104,7 +106,10 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
   fs::create_directories(plots_dir);
   const fs::path user_dir(plots_dir);              // paths as the user gave them, for messages
   const fs::path dir = fs::absolute(plots_dir);  // gnuplot's working directory: any cwd works
-  const std::string script = "# " + fig.stem + ": written by tailsim plot; rerun with `gnuplot " + fig.stem +
+  std::string comment_stem = fig.stem;  // a line break in the comment would start a command
+  for (char& c : comment_stem)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == '\\') c = '_';
+  const std::string script = "# " + comment_stem + ": written by tailsim plot; rerun with `gnuplot " + comment_stem +
                              ".gp` in this folder\nset encoding utf8\nset datafile missing 'NaN'\n" +
                              terminalBlock(fig, true) + terminalBlock(fig, false);
   writeFileAtomic((dir / (fig.stem + ".gp")).string(), script);

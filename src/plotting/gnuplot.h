@@ -25,8 +25,13 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
 void writeDataFile(const std::string& path, const std::vector<std::string>& header,
                    const std::vector<std::vector<double>>& rows);
 
-// Quotes a string for a gnuplot single-quoted literal; a line break becomes '."\n".' (a string
-// expression: `set title`, `set multiplot title`, `plot ... title` all take one).
+// Quotes a string for gnuplot as a string expression of single-quoted literals: a quote becomes
+// '."'".' and a line break '."\n".' (`set title`, `set output`, `plot 'file'`, `title`, `lc rgb`
+// all take a string expression). The only way text that is not tailsim's own (names, labels,
+// paths) enters a gnuplot script: inside single quotes gnuplot expands no backquotes, macros (@)
+// or backslash escapes; a doubled quote is not used (gnuplot 5.4 misreads '' next to another
+// quote or at the start); other control characters (NUL, CR, tab) become spaces. Every script
+// tailsim writes quotes its text with it.
 std::string gpQuote(const std::string& s);
 
 }  // namespace tailsim

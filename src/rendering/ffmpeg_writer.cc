@@ -99,6 +99,10 @@ int makeLogFile() {
   return fd;
 }
 
+// A path as ffmpeg's file: protocol URL: a path is never read as an option (a leading '-') or as
+// another protocol ("http:", "concat:", "pipe:"), whatever the folder or case names hold.
+std::string fileUrl(const std::string& path) { return "file:" + path; }
+
 std::string rawLog(int fd) {
   std::string s;
   char buf[4096];
@@ -171,7 +175,7 @@ std::string ffprobeFor(const std::string& ffmpeg_exe) {
 long countVideoFrames(const std::string& ffprobe_exe, const std::string& path) {
   std::string out;
   const int rc = runCapture({ffprobe_exe, "-v", "error", "-select_streams", "v:0", "-count_packets", "-show_entries",
-                             "stream=nb_read_packets", "-of", "csv=p=0", path},
+                             "stream=nb_read_packets", "-of", "csv=p=0", fileUrl(path)},
                             out);
   if (rc != 0) return -1;
   char* end = nullptr;
@@ -232,7 +236,7 @@ FfmpegSink::FfmpegSink(const std::string& ffmpeg_exe, int width, int height, con
       add({"-vf", "select=eq(n\\," + std::to_string(outputs[i].png_frame) + ")", "-fps_mode", "passthrough",
            "-frames:v", "1", "-update", "1", "-c:v", "png", "-f", "image2"});
     }
-    args.push_back(tmp_paths_[i]);
+    args.push_back(fileUrl(tmp_paths_[i]));
   }
 
   int fds[2];

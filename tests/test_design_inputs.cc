@@ -1,0 +1,189 @@
+// Hostile text in design files (kind optimize, kind maneuver) and in every gnuplot script tailsim
+// writes: a name is data, never a command; the design files accept exactly the names an experiment
+// file accepts.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "design/maneuver.h"
+#include "design/optimize_config.h"
+#include "design/optimize_experiment.h"
+#include "experiments/experiment_loader.h"
+#include "plotting/gnuplot.h"
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kSourceDir = TAILSIM_SOURCE_DIR;
+
+class DesignInputs : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string tmpl = (fs::temp_directory_path() / "tailsim_design_inputs_XXXXXX").string();
+    ASSERT_NE(mkdtemp(tmpl.data()), nullptr);
+    dir_ = tmpl;
+    std::ofstream(dir_ / "base.yaml") << "name: b\nrobot: " << kSourceDir
+                                       << "/configs/robots/paper_quadruped.yaml\ntail: {links: 1}\n"
+                                          "trajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\nmodels: [analytic]\n";
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string write(const std::string& rel, const std::string& text) {
+    const fs::path p = dir_ / rel;
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  // A YAML double-quoted scalar holding `s` (every byte outside printable ASCII as \xHH or \uHHHH).
+  static std::string yamlQuoted(const std::string& s) {
+    std::string out = "\"";
+    char buf[8];
+    for (const char c : s) {
+      const auto u = static_cast<unsigned char>(c);
+      if (c == '"' || c == '\\') {
+        out += '\\';
+        out += c;
+      } else if (u < 0x20 || u == 0x7f) {
+        std::snprintf(buf, sizeof buf, "\\x%02x", u);
+        out += buf;
+      } else {
+        out += c;
+      }
+    }
+    return out + "\"";
+  }
+  std::string optimizeFile(const std::string& name, const std::string& extra = "") {
+    return write("opt.yaml", "name: " + yamlQuoted(name) +
+                                 "\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n"
+                                 "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                 "  islands: 1\n  population: 6\n  generations: 2\n  polish: none\n  seeds: [1]\n  pareto_points: 2\n"
+                                 "  mujoco_check: false\n" + extra);
+  }
+  std::string maneuverFile(const std::string& name, const std::string& extra = "  mujoco: false\n") {
+    return write("m.yaml", "name: " + yamlQuoted(name) + "\nkind: maneuver\nbase: base.yaml\nmaneuver:\n  heading_deg: 20\n" +
+                               extra);
+  }
+  template <class Load>
+  static std::string errorOf(const Load& load) {
+    try {
+      load();
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  // Every file named PWNED under dir_ (where gnuplot's working directory and the folders above it are).
+  std::vector<std::string> pwned() const {
+    std::vector<std::string> found;
+    for (const auto& e : fs::recursive_directory_iterator(dir_))
+      if (e.path().filename().string().find("PWNED") != std::string::npos) found.push_back(e.path().string());
+    return found;
+  }
+  fs::path dir_;
+};
+
+using NoInputTextReachesAnInterpreterUnescaped = DesignInputs;
+
+// Names that would run a command, start a new gnuplot line or end the string early if pasted into
+// a script between quotes.
+std::vector<std::string> hostileTexts() {
+  return {"Rone's stroke",
+          "x' . system('touch PWNED1') . '",
+          "x\" . system(\"touch PWNED2\") . \"",
+          "`touch PWNED3`",
+          "$(touch PWNED4)",
+          "@PWNED5",
+          "a\\",
+          "back\\slash\\' . system('touch PWNED6') . '",
+          "line\nsystem('touch PWNED7')",
+          "cr\rsystem('touch PWNED8')",
+          std::string("nul\0' . system('touch PWNED9') . '", 35),
+          "tab\there ~{/Symbol f}_{net}^2 & more # not a comment",
+          "UTF-8: φ_net Δθ 転回 \xF0\x9F\x90\x88",
+          std::string(10000, '\'') + "system('touch PWNED10')",
+          std::string(10240, 'x')};
+}
+
+// gpQuote is what every script quotes text with: gnuplot reads back exactly the text (control
+// characters other than a line break as spaces) and runs nothing of it.
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, GpQuoteRoundTripsHostileText) {
+  std::string body = "set print 'echo.txt'\n";
+  std::string want;
+  for (const std::string& s : hostileTexts()) {
+    body += "print " + gpQuote(s) + "\n";
+    std::string shown = s;
+    for (char& c : shown)
+      if ((static_cast<unsigned char>(c) < 0x20 && c != '\n') || c == 0x7f) c = ' ';
+    want += shown + "\n";
+  }
+  body += "unset print\nset title " + gpQuote(hostileTexts()[1]) + " noenhanced\nplot x title " +
+          gpQuote(hostileTexts()[8]) + "\n";
+  GnuplotFigure fig;
+  fig.stem = "hostile";
+  fig.body = body;
+  ASSERT_NO_THROW(renderFigure((dir_ / "plots").string(), fig));
+  std::ifstream in(dir_ / "plots/echo.txt", std::ios::binary);
+  std::stringstream got;
+  got << in.rdbuf();
+  EXPECT_EQ(got.str(), want);
+  EXPECT_EQ(pwned(), std::vector<std::string>());
+}
+
+// A design file's name is checked by the experiment loader's rule: what an experiment refuses
+// (a line break, NUL, a slash) a design file refuses at the key, and the rest loads.
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, DesignFilesTakeTheExperimentNameRule) {
+  for (const std::string& s : hostileTexts()) {
+    const bool ok = experimentNameProblem(s).empty();
+    std::string opt_err, man_err;
+    try {
+      loadOptimizeSpec(optimizeFile(s));
+    } catch (const ConfigError& e) {
+      opt_err = e.what();
+    }
+    try {
+      loadManeuverSpec(maneuverFile(s));
+    } catch (const ConfigError& e) {
+      man_err = e.what();
+    }
+    if (ok) {
+      EXPECT_EQ(opt_err, "") << s;
+      EXPECT_EQ(man_err, "") << s;
+    } else {
+      EXPECT_NE(opt_err.find("opt.yaml:1:7: name: must be a folder name"), std::string::npos) << opt_err;
+      EXPECT_NE(man_err.find("m.yaml:1:7: name: must be a folder name"), std::string::npos) << man_err;
+    }
+  }
+  EXPECT_FALSE(experimentNameProblem("Rone's stroke") != "");
+  EXPECT_NE(experimentNameProblem("line\nbreak"), "");
+  EXPECT_NE(experimentNameProblem(std::string("nul\0x", 5)), "");
+}
+
+// optimize and maneuver with names made to escape their plot scripts finish, write their plots and
+// summary.json, and run no command.
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, DesignPlotsRunNoCommand) {
+  const std::vector<std::string> names = {"Rone's stroke", "x' . system('touch PWNED1') . '",
+                                          "''`touch PWNED3` $(touch PWNED4) @PWNED5 ''''"};
+  int k = 0;
+  for (const std::string& n : names) {
+    const std::string out = (dir_ / ("o" + std::to_string(k++))).string();
+    ASSERT_NO_THROW(runOptimize(loadOptimizeSpec(optimizeFile(n)), out, false)) << n;
+    EXPECT_TRUE(fs::is_regular_file(out + "/summary.json")) << n;
+    EXPECT_TRUE(fs::is_regular_file(out + "/plots/history.png")) << n;
+    const std::string mout = (dir_ / ("m" + std::to_string(k++))).string();
+    ASSERT_NO_THROW(runManeuver(loadManeuverSpec(maneuverFile(n)), mout, false, false)) << n;
+    EXPECT_TRUE(fs::is_regular_file(mout + "/summary.json")) << n;
+    EXPECT_TRUE(fs::is_regular_file(mout + "/plots/heading.png")) << n;
+  }
+  EXPECT_EQ(pwned(), std::vector<std::string>());
+}
+
+}  // namespace
+}  // namespace tailsim
