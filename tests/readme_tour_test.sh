@@ -60,7 +60,8 @@ check() {
         local n; n=$(find "$dir" -path '*/plots/*.png' -size +1k | wc -l)
         [ "$n" -ge 1 ] || fail "run --plot: no plots under $dir"
         [ -s "$dir/figures.html" ] || fail "run --plot: no $dir/figures.html"
-        ok "run --plot: report.md, figures.html and $n PNG plots"
+        [ -s "$dir/index.html" ] && [ -s "$dir/page/data.js" ] || fail "run --plot: no result page $dir/index.html"
+        ok "run --plot: report.md, figures.html, index.html and $n PNG plots"
       fi
       ;;
     plot)
@@ -68,6 +69,10 @@ check() {
       while read -r f; do
         [ -n "$f" ] || continue
         [ "$f" = "$pos/figures.html" ] && continue
+        if [ "$f" = "$pos/index.html" ]; then
+          grep -q 'src="page/data.js"' "$f" || fail "plot: $f (printed) is not the result page"
+          continue
+        fi
         is_png "$f" || fail "plot: $f (printed) is not a PNG"
         grep -qF "<img src=\"${f#"$pos"/}\"" "$pos/figures.html" || fail "plot: $pos/figures.html does not show $f"
         n=$((n + 1))

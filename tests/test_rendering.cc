@@ -228,6 +228,55 @@ TEST(Replay, TailPhaseFollowsSplitCycleBreakpoints) {
   EXPECT_EQ(tailPhase(tr, 0.3001), TailPhase::kAtRest);
 }
 
+// The tail phases belong to split-cycle strokes (Eq. 20): a spline has no t1 or t2, so the video
+// says nothing about accelerating for it, nor for a tail without strokes.
+TEST(Replay, TailPhaseOnlyForSplitCycleStrokes) {
+  TailTrajectory split;
+  split.joints.emplace_back(SplitCycleParams{});
+  EXPECT_TRUE(splitCycleStrokes(split));
+  SplineParams sp;
+  sp.knots_rad = {0.0, -0.5, -1.0};
+  TailTrajectory mixed = split;
+  mixed.joints.emplace_back(sp);
+  EXPECT_FALSE(splitCycleStrokes(mixed));
+  TailTrajectory spline;
+  spline.joints.emplace_back(sp);
+  EXPECT_FALSE(splitCycleStrokes(spline));
+  EXPECT_FALSE(splitCycleStrokes(TailTrajectory{}));
+}
+
+// The phi(t) inset's ticks: its range runs from round tick to round tick (1, 2, 2.5, 5 x 10^k),
+// one grid line per tick, labels printed with the digits the step needs.
+TEST(RenderOverlay, InsetTicksAtRoundNumbers) {
+  const RoundTicks t = roundTicks(0.0, 0.75, 4);  // the Fig. 6a video: 0 .. 0.75 s
+  EXPECT_DOUBLE_EQ(t.step, 0.2);
+  EXPECT_DOUBLE_EQ(t.lo, 0.0);
+  EXPECT_NEAR(t.hi, 0.8, 1e-12);
+  EXPECT_EQ(t.count, 5);
+  EXPECT_EQ(t.decimals, 1);
+  const RoundTicks y = roundTicks(-1.0, 12.0, 3);  // phi -1 .. 12 deg
+  EXPECT_DOUBLE_EQ(y.step, 5.0);
+  EXPECT_DOUBLE_EQ(y.lo, -5.0);
+  EXPECT_DOUBLE_EQ(y.hi, 15.0);
+  EXPECT_EQ(y.count, 5);
+  EXPECT_EQ(y.decimals, 0);
+  const RoundTicks q = roundTicks(0.0, 1.0, 4);  // a range that ends on a tick keeps it
+  EXPECT_DOUBLE_EQ(q.step, 0.25);
+  EXPECT_DOUBLE_EQ(q.hi, 1.0);
+  EXPECT_EQ(q.count, 5);
+  EXPECT_EQ(q.decimals, 2);
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{{0.013, 0.377}, {-7.1, 0.2}, {3, 1234}}) {
+    const RoundTicks r = roundTicks(lo, hi, 4);
+    EXPECT_LE(r.lo, lo);
+    EXPECT_GE(r.hi, hi);
+    const double k = r.step / std::pow(10.0, std::floor(std::log10(r.step)));
+    EXPECT_TRUE(std::abs(k - 1) < 1e-9 || std::abs(k - 2) < 1e-9 || std::abs(k - 2.5) < 1e-9 || std::abs(k - 5) < 1e-9) << r.step;
+    EXPECT_NEAR(r.lo / r.step, std::round(r.lo / r.step), 1e-9);
+    EXPECT_NEAR(r.hi / r.step, std::round(r.hi / r.step), 1e-9);
+    EXPECT_LE(r.count, 9);
+  }
+}
+
 // ---------------------------------------------------------------- videos
 
 struct Probe {

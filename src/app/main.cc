@@ -33,6 +33,7 @@
 #include "plotting/figure_sheet.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"
+#include "plotting/result_page.h"
 #include "results/atomic_file.h"
 #include "results/sha256.h"
 #include "tailsim_version.h"
@@ -354,6 +355,7 @@ int main(int argc, char** argv) {
       if (plots) {
         printSeriesNotes(out_dir);
         std::printf("report: %s\n", writeReport(out_dir).c_str());
+        std::printf("page: %s\n", writeResultPage(out_dir).c_str());
       }
       return s.failed ? kExitRunsFailed : kExitOk;
     }
@@ -453,6 +455,7 @@ int main(int argc, char** argv) {
       printSeriesNotes(result_dir);
       const auto files = plotResults(result_dir);
       for (const auto& f : files) std::printf("%s\n", f.png.c_str());
+      std::printf("%s\n", writeResultPage(result_dir).c_str());
       std::printf("%s\n", figureSheetPath(result_dir).c_str());
       return kExitOk;
     }

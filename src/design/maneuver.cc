@@ -500,7 +500,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     c.joints.clear();
     if (!rep.plan.empty())
       for (const auto& jp : cycleStrokes(s, n, rep.plan.front(), 0.0).fast.joints) c.joints.push_back(jp.params());
-    renderCase(c, runs, (fs::path(out_dir) / "renders").string());
+    renderCase(c, runs, (fs::path(out_dir) / "renders").string(), "open-loop plan (analytic)");
     rep.files.push_back("renders/" + spec.name + ".mp4");
   }
   rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();

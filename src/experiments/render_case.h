@@ -11,6 +11,9 @@ namespace tailsim {
 
 // Renders <out_dir>/<case dir>.mp4 and .png from the case's runs (MuJoCo poses the model, the
 // analytic run the ghost; without a MuJoCo run the analytic run poses the model, no ghost).
-RenderStats renderCase(const ExperimentCase& c, const std::vector<RunResult>& runs, const std::string& out_dir);
+// outline_label names the ghost in the colour key when its series is not the analytic model's own
+// run (a maneuver's "open-loop plan").
+RenderStats renderCase(const ExperimentCase& c, const std::vector<RunResult>& runs, const std::string& out_dir,
+                       const std::string& outline_label = "");
 
 }  // namespace tailsim

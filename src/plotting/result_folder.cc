@@ -104,6 +104,9 @@ CaseRecord parseCase(const json& c) {
       run.wall_time_s = numberOr(j, "wall_time_s", NAN);
       run.stick_slip_events = static_cast<int>(numberOr(j, "stick_slip_events", 0));
       if (j.contains("error") && j["error"].is_string()) run.error = j["error"].get<std::string>();
+      if (j.contains("warnings") && j["warnings"].is_array())
+        for (const auto& w : j["warnings"])
+          if (w.is_string()) run.warnings.push_back(w.get<std::string>());
       r.runs[it.key()] = run;
     }
   }

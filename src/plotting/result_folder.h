@@ -24,6 +24,7 @@ struct RunRecord {
   double wall_time_s = NAN;
   int stick_slip_events = 0;
   std::string error;
+  std::vector<std::string> warnings;  // "warnings" (result computed but doubtful)
 };
 
 struct CaseRecord {

@@ -86,6 +86,13 @@ TailPhase tailPhase(const TailTrajectory& traj, double t) {
   return decel ? TailPhase::kDecelerating : TailPhase::kAtRest;
 }
 
+bool splitCycleStrokes(const TailTrajectory& traj) {
+  if (traj.joints.empty()) return false;
+  for (const SplitCycleProfile& j : traj.joints)
+    if (j.isSpline()) return false;
+  return true;
+}
+
 const char* tailPhaseName(TailPhase p) {
   switch (p) {
     case TailPhase::kAccelerating: return "accelerating";

@@ -52,6 +52,8 @@ PlanarTailPose planarTailPose(const RobotParams& robot, const PlanarState& s);
 // decelerating while some joint is in (t1, t2], else at rest (Eq. 20's pieces).
 enum class TailPhase { kAtRest, kAccelerating, kDecelerating };
 TailPhase tailPhase(const TailTrajectory& traj, double t);
+// True when every joint moves by a split-cycle stroke (no spline): only then has the tail phases.
+bool splitCycleStrokes(const TailTrajectory& traj);
 const char* tailPhaseName(TailPhase p);
 
 // Where the planar state goes in a MuJoCo model's qpos, found by joint name (mj_name2id with the

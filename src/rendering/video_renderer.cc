@@ -193,6 +193,24 @@ void addGhost(mjvScene& scn, const GhostShape& g, const RobotParams& robot, cons
   }
 }
 
+// The heading: a grey line along the body's heading at the start (phi0) and a dark line along its
+// heading now, both from the quadruped COM, `length` long, at height z (just above the body's top,
+// so the top camera sees them): a turn of a few degrees shows as the angle between them (the tip
+// moves length * dphi: 7 deg over 0.2 m is 2.4 cm, some 15 px at the default size).
+void addHeading(mjvScene& scn, const PlanarState& s, double phi0, double length, double z, double r) {
+  const auto add = [&](int type, const float rgba[4], double yaw, double radius) {
+    if (scn.ngeom >= scn.maxgeom) return;
+    mjvGeom* geom = scn.geoms + scn.ngeom;
+    mjv_initGeom(geom, type, nullptr, nullptr, nullptr, rgba);
+    mjv_makeConnector(geom, type, radius, s.x, s.y, z, s.x + length * std::cos(yaw), s.y + length * std::sin(yaw), z);
+    geom->category = mjCAT_DECOR;
+    ++scn.ngeom;
+  };
+  static constexpr float kStart[4] = {0.55f, 0.55f, 0.55f, 1.0f}, kNow[4] = {0.08f, 0.08f, 0.08f, 1.0f};
+  add(mjGEOM_CAPSULE, kStart, phi0, r);
+  add(mjGEOM_CAPSULE, kNow, s.phi, r);
+}
+
 // ---------------------------------------------------------------- scene
 
 // Visual-only changes to the renderer's own compiled copy of the model (physics untouched):
@@ -250,16 +268,17 @@ int textWidth(const mjrContext& con, const std::string& s) {
   return w;
 }
 
-FrameLayout frameLayout(int W, int H, const mjrContext& con) {
+FrameLayout frameLayout(int W, int H, const mjrContext& con, const std::vector<std::string>& labels) {
   FrameLayout L;
   const int ch = con.charHeight, pad = std::max(4, ch / 3);
-  const int need = textWidth(con, "analytic (outline)  +000.00 deg") + 2 * pad;
+  int need = textWidth(con, "heading change +000.0 deg") + 2 * pad;
+  for (const std::string& l : labels) need = std::max(need, textWidth(con, l + "  +000.00 deg") + 2 * pad);
   const int pw = std::min(W / 2, std::max(static_cast<int>(std::lround(0.3 * W)), need));
   const int title_h = ch + 2 * pad;
   L.scene = {0, 0, W - pw, H - title_h};
   L.title = {0, H - title_h, W - pw, title_h};
   L.panel = {W - pw, 0, pw, H};
-  const int text_h = 2 * ch + 3 * pad;  // two lines of text at the top of the panel
+  const int text_h = 3 * ch + 4 * pad;  // three lines of text at the top of the panel
   const int lab_h = ch + 2 * pad;
   L.key[0] = {W - pw + pad, H - text_h - lab_h, pw - 2 * pad, lab_h};
   L.key[1] = {W - pw + pad, L.key[0].bottom - pad - lab_h, pw - 2 * pad, lab_h};
@@ -281,6 +300,9 @@ struct RenderRig {
   double look_z = 0.1;
   double look_offset[2] = {0, 0};  // camera target minus the quadruped COM (world x, y)
   double line_r = 0.002;           // ghost outline radius [m] (~1.3 px)
+  double phi0 = 0.0;               // heading at the first frame [rad]
+  double heading_length = 0.2;     // heading line and arrow [m]
+  double heading_z = 0.2;          // their height [m]
   FrameLayout layout2d;
   std::unique_ptr<mjvFigure> figure;  // the phi(t) inset (mjvFigure is ~1 MB: on the heap)
   std::vector<uint8_t> pixels;
@@ -320,6 +342,30 @@ Extent robotExtent(const RenderRig& r, const RobotParams& robot, double t0, doub
   }
   return e;
 }
+
+}  // namespace
+
+RoundTicks roundTicks(double lo, double hi, int intervals) {
+  RoundTicks t;
+  const double raw = (hi - lo) / std::max(1, intervals);
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10.0 * p;
+  for (double m : {1.0, 2.0, 2.5, 5.0})
+    if (m * p >= raw * (1.0 - 1e-9)) {
+      step = m * p;
+      break;
+    }
+  // Snap to the step's grid, allowing for the last bits of a range that ends on a tick.
+  t.lo = std::floor(lo / step + 1e-9) * step;
+  t.hi = std::ceil(hi / step - 1e-9) * step;
+  t.count = static_cast<int>(std::lround((t.hi - t.lo) / step)) + 1;
+  t.step = step;
+  t.decimals = std::max(0, static_cast<int>(std::ceil(-std::log10(step) - 1e-9)));
+  if (std::abs(step * std::pow(10.0, t.decimals) - std::round(step * std::pow(10.0, t.decimals))) > 1e-6) ++t.decimals;  // 2.5
+  return t;
+}
+
+namespace {
 
 // The phi(t) inset: both models' phi over the shown time, the time cursor (the figure's
 // selection line) set per frame.
@@ -362,11 +408,16 @@ void setupFigure(RenderRig& r, double t0, double t1, int height) {
     f.linergb[line][0] = rgb.r, f.linergb[line][1] = rgb.g, f.linergb[line][2] = rgb.b;
     ++line;
   }
-  const double margin = 0.08 * std::max(hi - lo, 1.0);
-  f.range[0][0] = static_cast<float>(t0);
-  f.range[0][1] = static_cast<float>(std::max(t1, t0 + 1e-6));
-  f.range[1][0] = static_cast<float>(lo - margin);
-  f.range[1][1] = static_cast<float>(hi + margin);
+  // Ranges from round tick to round tick, one grid line per tick: labels at round numbers.
+  const RoundTicks tx = roundTicks(t0, std::max(t1, t0 + 1e-6), 4), ty = roundTicks(lo, std::max(hi, lo + 1.0), 3);
+  f.range[0][0] = static_cast<float>(tx.lo);
+  f.range[0][1] = static_cast<float>(tx.hi);
+  f.range[1][0] = static_cast<float>(ty.lo);
+  f.range[1][1] = static_cast<float>(ty.hi);
+  f.gridsize[0] = tx.count;
+  f.gridsize[1] = ty.count;
+  std::snprintf(f.xformat, sizeof f.xformat, "%%.%df", tx.decimals);
+  std::snprintf(f.yformat, sizeof f.yformat, "%%.%df", ty.decimals);
 }
 
 void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
@@ -398,13 +449,15 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
 
   // Tracking camera: it follows the quadruped COM (set per frame) with a fixed offset; the
   // offset and distance frame the box that every point of both models' outlines stays in over
-  // the video (relative to the COM), with a 6 % margin, in the scene part of the frame.
-  r.layout2d = frameLayout(s.width, s.height, r.gl->context());
+  // the video (relative to the COM), with a 10 % margin, in the scene part of the frame.
+  r.layout2d = frameLayout(s.width, s.height, r.gl->context(),
+                           {in.solid_label + " (solid)", in.outline_label + " (outline)"});
   const double aspect = static_cast<double>(r.layout2d.scene.width) / r.layout2d.scene.height;
   const Extent e = robotExtent(r, *in.robot, t0, t1);
   r.look_offset[0] = 0.5 * (e.lo[0] + e.hi[0]);
   r.look_offset[1] = 0.5 * (e.lo[1] + e.hi[1]);
-  const double half_w = 0.5 * (e.hi[0] - e.lo[0]) * 1.06 + 0.01, half_h = 0.5 * (e.hi[1] - e.lo[1]) * 1.06 + 0.01;
+  // 10 % margin: the robot keeps clear of the title strip and the frame's edges.
+  const double half_w = 0.5 * (e.hi[0] - e.lo[0]) * 1.1 + 0.01, half_h = 0.5 * (e.hi[1] - e.lo[1]) * 1.1 + 0.01;
   const double tan_half = std::tan(0.5 * m->vis.global.fovy * M_PI / 180.0);
   mjv_defaultFreeCamera(m, &r.cam);
   r.cam.type = mjCAMERA_FREE;
@@ -420,7 +473,9 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
     // box's circumscribed circle fits the smaller field of view.
     r.cam.elevation = -35.0;
     r.cam.azimuth = 45.0;
-    r.cam.distance = 1.05 * std::hypot(half_w, half_h) / (tan_half * std::min(1.0, aspect));
+    // The body's top counts too: seen at an angle it rises above its footprint.
+    const double top = r.ghost.body_z + r.ghost.body_half[2];
+    r.cam.distance = 1.05 * std::sqrt(half_w * half_w + half_h * half_h + top * top) / (tan_half * std::min(1.0, aspect));
   }
   // Scale at the robot: metres per pixel. The ghost's lines are ~1.3 px in radius, the model's
   // tail at least 4 px (visual only: the renderer's own copy of the model).
@@ -435,6 +490,9 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
     r.model->geom_rbound[i] = std::max(r.model->geom_rbound[i], tail_r + r.model->geom_size[3 * i + 1]);
   }
   r.ghost.tail_radius = tail_r;
+  r.phi0 = r.mujoco->at(t0).phi;
+  r.heading_length = 0.9 * r.ghost.body_half[0];
+  r.heading_z = r.ghost.body_z + r.ghost.body_half[2] + 0.01;
   setupFigure(r, t0, t1, s.height);
   r.pixels.resize(static_cast<size_t>(s.width) * s.height * 3);
 }
@@ -454,21 +512,25 @@ void drawPanel(RenderRig& r, const RenderInputs& in, const RenderSettings& s, do
   const mjrContext& con = r.gl->context();
   constexpr double kRad2Deg = 180.0 / M_PI;
   char buf[256];
-  mjr_rectangle(L.title, 0.10f, 0.10f, 0.12f, 1.0f);
   mjr_rectangle(L.panel, 0.10f, 0.10f, 0.12f, 1.0f);
+  mjr_rectangle(L.title, 0.10f, 0.10f, 0.12f, 1.0f);
   std::snprintf(buf, sizeof buf, "%gx slow motion", s.slowmo);
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.title, in.title.c_str(), nullptr, &con);
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, L.title, buf, nullptr, &con);
   std::string text = "t = ";
   std::snprintf(buf, sizeof buf, "%.3f s", t);
   text += buf;
-  if (in.trajectory) text += std::string("\ntail ") + tailPhaseName(tailPhase(*in.trajectory, t));
+  // The phases of Eq. 20 exist only for split-cycle strokes (a spline has no t1 or t2).
+  if (in.trajectory && splitCycleStrokes(*in.trajectory))
+    text += std::string("\ntail ") + tailPhaseName(tailPhase(*in.trajectory, t));
+  std::snprintf(buf, sizeof buf, "\nheading change %+.1f deg", (st.phi - r.phi0) * kRad2Deg);
+  text += buf;
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.panel, text.c_str(), nullptr, &con);
   // Colour key: one label per model in its colour, with its phi now.
-  std::snprintf(buf, sizeof buf, "MuJoCo (solid)  %+.2f deg", st.phi * kRad2Deg);
+  std::snprintf(buf, sizeof buf, "%s (solid)  %+.2f deg", in.solid_label.c_str(), st.phi * kRad2Deg);
   mjr_label(L.key[0], mjFONT_NORMAL, buf, kMujocoRgb.r, kMujocoRgb.g, kMujocoRgb.b, 1.0f, 1, 1, 1, &con);
   if (ghost) {
-    std::snprintf(buf, sizeof buf, "analytic (outline)  %+.2f deg", ghost->phi * kRad2Deg);
+    std::snprintf(buf, sizeof buf, "%s (outline)  %+.2f deg", in.outline_label.c_str(), ghost->phi * kRad2Deg);
     mjr_label(L.key[1], mjFONT_NORMAL, buf, kAnalyticRgb.r, kAnalyticRgb.g, kAnalyticRgb.b, 1.0f, 1, 1, 1, &con);
   }
   r.figure->selection = static_cast<float>(t);
@@ -491,6 +553,7 @@ void renderFrame(RenderRig& r, const RenderInputs& in, const RenderSettings& s, 
   r.cam.lookat[2] = r.look_z;
   mjvScene& scn = r.gl->scene();
   mjv_updateScene(m, d, &r.opt, nullptr, &r.cam, mjCAT_ALL, &scn);
+  addHeading(scn, st, r.phi0, r.heading_length, r.heading_z, r.line_r * 1.5);
   std::optional<PlanarState> ghost;
   if (r.analytic) {
     ghost = r.analytic->at(t);

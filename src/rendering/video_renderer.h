@@ -18,6 +18,15 @@ namespace tailsim {
 // with a message saying what is wrong and how to fix it.
 void checkRenderPrerequisites(const RenderSettings& settings, const std::string& out_dir);
 
+// Ticks at round numbers (1, 2, 2.5 or 5 times a power of ten) covering [lo, hi] in about
+// `intervals` steps: the inset plot's range runs from tick lo to tick hi with count grid lines.
+struct RoundTicks {
+  double lo = 0.0, hi = 1.0, step = 1.0;
+  int count = 2;
+  int decimals = 0;  // digits after the point that print every tick exactly
+};
+RoundTicks roundTicks(double lo, double hi, int intervals);
+
 struct RenderInputs {
   const RobotParams* robot = nullptr;
   const TailTrajectory* trajectory = nullptr;  // for the tail-phase text
@@ -25,6 +34,10 @@ struct RenderInputs {
   const TimeSeries* analytic = nullptr;        // poses the translucent ghost (nullable)
   std::string mjcf_xml;                        // the case's model (generateMjcf)
   std::string title;                           // optional first overlay line (case name)
+  // The colour key's names of the solid model and of the outline (what each series is: "MuJoCo",
+  // "analytic model", "open-loop plan (analytic model)", ...).
+  std::string solid_label = "MuJoCo";
+  std::string outline_label = "analytic model";
 };
 
 struct RenderStats {
