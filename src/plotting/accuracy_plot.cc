@@ -28,9 +28,9 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
     std::ostringstream body;
     body << "set logscale xy\nset grid\nset format y '10^{%L}'\nset xlabel 'wall time per run [ms]'\n"
          << "set ylabel '|φ_{net} − reference| [deg]'\nset title "
-         << gpTitle("Work-precision: error of φ_{net} against wall time, case " + gpText(st.case_name),
-                    1000)  // 1300 px less the key outside
-         << "\nset key outside right top\n";
+         << gpTitle("Work-precision: error of φ_{net} against wall time, case " + gpText(st.case_name), 1300)
+         // the legend below the plot, in columns: the plot keeps the figure's full width
+         << "\nset key outside below center horizontal maxcols 3 box\n";
     std::vector<std::string> parts;
     int k = 0;
     for (const auto& [name, rows] : curves) {
@@ -58,7 +58,7 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
     fig.stem = stem;
     fig.body = body.str();
     fig.width_px = 1300;
-    fig.height_px = 750;
+    fig.height_px = 750 + 30 * static_cast<int>((parts.size() + 2) / 3);  // room for the legend's rows
     pngs.push_back(renderFigure(dir, fig));
   }
   return pngs;

@@ -65,8 +65,11 @@ std::string gpPanelTitle(const std::string& model, const std::vector<SweepAxis>&
 
 namespace {
 // Series colours leave out the two model colours (blue, vermillion): a case curve never looks
-// like a model curve.
-const char* const kSeries[] = {oi::kOrange, oi::kSkyBlue, oi::kGreen, oi::kPurple, oi::kBlack};
+// like a model curve. The five Okabe-Ito line colours first, then five darker or greyer ones
+// (brown, grey, dark purple, olive, dark teal) apart from them and from each other in hue or
+// lightness, so that up to ten curves of a figure never share a colour.
+const char* const kSeries[] = {oi::kOrange, oi::kSkyBlue, oi::kGreen, oi::kPurple, oi::kBlack,
+                               "#8C510A",   "#999999",    "#5E3C99",  "#9A9A00",  "#01665E"};
 constexpr size_t kNumSeries = sizeof kSeries / sizeof kSeries[0];
 }  // namespace
 
@@ -94,8 +97,9 @@ std::string divergingPalette() {
          oi::kVermillion + "')\n";
 }
 
-std::string sequentialPalette() {
+std::string sequentialPalette(bool dark_at_low) {
   // white - orange - dark orange: neither model's colour
+  if (dark_at_low) return std::string("set palette defined (0 '#7A4A00', 1 '") + oi::kOrange + "', 2 '#FFFDF7')\n";
   return std::string("set palette defined (0 '#FFFDF7', 1 '") + oi::kOrange + "', 2 '#7A4A00')\n";
 }
 
