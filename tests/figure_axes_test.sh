@@ -3,8 +3,9 @@
 # index (tests/check_axes.sh): random sweeps of 1 to 4 keys (numeric and categorical, 2-4 values
 # each) on a robot that is not the paper's (tests/data/figure_robot.yaml), analytic and per-foot
 # models, run with `tailsim run --quiet` and drawn with `tailsim plot`. Seed 36 unless
-# TAILSIM_FIGURE_SEED says another (printed, to replay a failure). Also checks what the 3+-key figures are: one small-multiples
-# figure per model, and that --quiet prints one line.
+# TAILSIM_FIGURE_SEED says another (printed, to replay a failure). Also checks what the 3+-key
+# figures are (one small-multiples figure per model), that --quiet prints one line, and
+# `plot --no-titles --size W,H --font-scale F`.
 #   tests/figure_axes_test.sh SRC BUILD
 set -euo pipefail
 src=$1
@@ -70,4 +71,14 @@ for run in 1 2 3 4; do
     done
   fi
 done
+
+# For a paper or slides: no figure title in the image (the caption keeps it), one size, bigger fonts.
+"$tailsim" plot "$work/out1" --no-titles --size 800,600 --font-scale 1.5 >/dev/null
+for gp in "$work"/out1/plots/*.gp; do
+  first=$(grep -oE "^set (title|multiplot .* title) '([^']|'')*'" "$gp" | head -n1)
+  [[ "$first" == *"title ''" ]] || fail "$gp: --no-titles, but the figure's title is: $first"
+  grep -q "^set terminal pngcairo enhanced size 800,600 font 'Sans,15' fontscale 1.5 " "$gp" ||
+    fail "$gp: --size 800,600 --font-scale 1.5 not in the terminal line"
+done
+grep -q '<figcaption>' "$work/out1/figures.html" || fail "figures.html lost its captions"
 echo "figure_axes: ok"
