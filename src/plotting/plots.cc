@@ -332,7 +332,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   };
   const Txt mom_title = ctx.title(W("moments about the system COM") + ctx.tail);
   std::ostringstream mb;
-  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << ctx.figTitle(mom_title, 1000, 17) << " font 'Sans,17'\n"
+  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << ctx.figTitle(mom_title, 1200, 17) << " font 'Sans,17'\n"
      << range("x", 0, t_end) << phaseObjects(phases, t_end);
   for (const std::string& m : mm) {
     const TimeSeries& s = ts[m];
@@ -350,7 +350,8 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     writeDataFile(ctx.data(stem), names, rows);
     std::string panel = gpText(modelTitle(m));
     if (m == "mujoco") panel += ": impulse-averaged over each output interval";
-    mb << "set grid\nset key bottom right box opaque\nset title " << gpTitle(panel, 1000)
+    // the legend beside the panel: inside, it hid curves wherever it was put
+    mb << "set grid\nset key outside right top vertical box\nset title " << gpTitle(panel, 1000)
        << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
     int n = 0;
     for (size_t j = 0; j < cols.size(); ++j) {
@@ -368,7 +369,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     cap += " MuJoCo's moments are impulse averages: the contact and joint impulses of the MuJoCo steps in each "
            "output interval (t ± Δt/2) summed and divided by the interval's length, not single samples of the "
            "chattering contact forces.";
-  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1000,
+  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1200,
              60 + 430 * static_cast<int>(mm.size()));
 }
 
