@@ -455,6 +455,11 @@ TEST(FigureWords, KeysValuesAndFigureNames) {
   EXPECT_EQ(gpValueLabel("analytic.coupling", "exact"), "exact coupling");
   EXPECT_EQ(gpValueLabel("tail.links", "3"), "3 links");
   EXPECT_EQ(gpAxisLabel("quadruped.d_Q2B_m"), "d_{Q2B} [mm]");
+  // keys without a symbol of their own: words, with what they belong to; symbol-like names stay
+  EXPECT_EQ(gpAxisLabel("mujoco.foot_shape"), "MuJoCo foot shape");
+  EXPECT_EQ(gpAxisLabel("quadruped.mass_kg"), "body mass [kg]");
+  EXPECT_EQ(gpAxisLabel("mujoco.body_height_m"), "MuJoCo body height [m]");
+  EXPECT_EQ(gpValueLabel("mujoco.foot_shape", "box"), "MuJoCo foot shape = box");
   EXPECT_EQ(gpText("case d_Q2B_m=0.1"), "case d\\_Q2B\\_m=0.1");
   EXPECT_EQ(gpSymbols("phi_net over theta0 and M_zT"), "φ_{net} over θ_0 and M_{z,T}");
   EXPECT_EQ(figureName("Fig. 6(a): phi(t), analytic vs MuJoCo", "fig06a"), "Fig. 6a");

@@ -852,9 +852,15 @@ void plotManyKeys(Ctx& ctx) {
     }
     if (all.empty()) continue;
     const auto [ylo, yhi] = span(all, 0.08);
+    // keys this model does not read ("mujoco.foot_shape" for the analytic model): said in the title
+    std::string unused;
+    for (const SweepAxis& a : r.axes)
+      if (!modelReads(m, a.key)) unused += (unused.empty() ? "" : ", ") + keyDisplay(a.key).plain;
+    Txt who{gpText(modelTitle(m)), modelTitle(m)};
+    if (!unused.empty()) who = who + Txt{gpText(" (" + unused + " not used)"), " (" + unused + " not used)"};
     const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(as.key) +
-                                W(", one panel per ") + Txt{"", ""} + W(facet_words) + ctx.tail + W(": ") +
-                                Txt{gpText(modelTitle(m)), modelTitle(m)});
+                                Txt{", one panel per " + gpText(facet_words), ", one panel per " + facet_words} +
+                                ctx.tail + W(": ") + who);
     const std::string stem = r.name + "_phi_net_facets_" + m;
     std::ostringstream b;
     // Panels leave room on the right for one legend beside the top-right panel.

@@ -283,6 +283,25 @@ KeyDisplay keyDisplay(const std::string& key) {
         d.unit = unit;
         break;
       }
+    // A name of words ("foot_shape", "body_height", "mass": every part at least 3 letters) is
+    // shown as words, with what it belongs to: "MuJoCo foot shape", "body mass"; a symbol-like
+    // name ("l_F", "d_Q2C") stays a symbol.
+    bool words = true;
+    for (size_t a = 0, b; a <= d.plain.size(); a = b + 1) {
+      b = d.plain.find('_', a);
+      if (b == std::string::npos) b = d.plain.size();
+      words = words && b - a >= 3;
+    }
+    if (words) {
+      std::string w = d.plain;
+      std::replace(w.begin(), w.end(), '_', ' ');
+      const std::string section = key.substr(0, key.find('.'));
+      static const std::map<std::string, std::string> owner = {
+          {"quadruped", "body "}, {"mujoco", "MuJoCo "}, {"perfoot", "per-foot "}, {"analytic", "analytic "}, {"tail", "tail "}};
+      if (const auto it = owner.find(section); it != owner.end() && key.find('.') != std::string::npos) w = it->second + w;
+      d.plain = w;
+      d.symbol = gpText(w);
+    }
   }
   if (!joint.empty()) {
     d.symbol += " (joint " + joint + ")";
