@@ -6,7 +6,8 @@ cd "$(dirname "$0")/.."
 # without it CMake generation fails.
 # libhdf5-dev: output.time_series_file: hdf5; hdf5-tools (h5dump, h5ls) and python3-h5py: its tests.
 # pybind11-dev, python3-dev, python3-numpy: the Python module (docs/python.md); python3-matplotlib: the
-# optional plot of examples/sweep.py.
+# optional plot of examples/sweep.py; python3-pandas: reading results.csv in the docs' analysis example
+# (docs/python.md, test docs_python_examples).
 # clang, libclang-rt-14-dev: the libFuzzer target of the experiment loader (scripts/fuzz.sh, CI).
 # libjs-three: three.js r111 (and its OrbitControls), copied into each result folder's page/ by the
 # result page DIR/index.html (docs/result-page.md). chromium, chromium-driver, python3-selenium: the
@@ -16,7 +17,7 @@ PKGS="build-essential cmake libmujoco-dev libmujoco-samples libeigen3-dev libyam
   gnuplot-nox libtinyxml2-dev nlohmann-json3-dev
   libqhull-dev clang libclang-rt-14-dev python3-jsonschema python3-yaml libpagmo-dev libnlopt-cxx-dev
   parallel slurm-wlm munge libhdf5-dev hdf5-tools python3-h5py pybind11-dev python3-dev python3-numpy
-  python3-matplotlib libjs-three chromium chromium-driver python3-selenium"
+  python3-matplotlib python3-pandas libjs-three chromium chromium-driver python3-selenium"
 missing=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

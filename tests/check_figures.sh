@@ -5,7 +5,8 @@
 #     PNG signature, > 8 KB, width/height in the IHDR chunk as its .gp script's pngcairo size;
 #   - no title is a file or experiment name (titles read from the .gp scripts: no folder name,
 #     plot stem or .dat/.csv/.png file in them; every figure's title starts with "Fig.");
-#   - DIR/figures.html shows every PNG under DIR/*/plots/ exactly once, with a caption.
+#   - DIR/figures.html shows every PNG under DIR/*/plots/ exactly once, with a caption;
+#   - no axis is a case index (tests/check_axes.sh).
 #   tests/check_figures.sh DIR          (called by readme_tour_test.sh on results/paper)
 set -euo pipefail
 dir=$1
@@ -33,10 +34,8 @@ expected=(
   fig14_tail_dof/plots/fig14_tail_dof_phi_t
   mu_swapped/plots/mu_swapped_phi
   mu_swapped/plots/mu_swapped_moments
-  model_bridge_n1/plots/model_bridge_n1_phi_net_map
-  model_bridge_n1/plots/model_bridge_n1_phi_net_lines
-  model_bridge_n6/plots/model_bridge_n6_phi_net_map
-  model_bridge_n6/plots/model_bridge_n6_phi_net_lines
+  model_bridge_n1/plots/model_bridge_n1_phi_net_bars
+  model_bridge_n6/plots/model_bridge_n6_phi_net_bars
 )
 for e in "${expected[@]}"; do
   [ -f "$dir/$e.png" ] || fail "missing figure $dir/$e.png"
@@ -78,3 +77,4 @@ actual=$(cd "$dir" && find . -path '*/plots/*.png' | sed 's|^\./||' | sort)
 [ "$listed" = "$actual" ] || fail "figures.html lists:\n$listed\nbut the PNGs are:\n$actual"
 [ "$(grep -c '<figcaption>' "$sheet")" = "$(wc -l <<<"$actual")" ] || fail "figures.html: a figure without caption"
 echo "  ok: $n figures under $dir: non-blank, sized as scripted, titled in words; figures.html lists all"
+bash "$(dirname "$0")/check_axes.sh" "$dir"

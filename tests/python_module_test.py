@@ -160,6 +160,16 @@ class PythonModule(unittest.TestCase):
                 "assert a == [f(-60), f(-90)] * 2, a\n")
         subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
 
+    def test_import_without_numpy_says_so(self):
+        # A fresh interpreter where numpy cannot be imported: `import tailsim` is an ImportError
+        # that names the missing package and how to install it.
+        code = ("import sys; sys.modules['numpy'] = None\n"  # import numpy -> ImportError
+                "try:\n    import tailsim\nexcept ImportError as e:\n    print(e)\nelse:\n    print('imported')\n")
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("numpy is missing", p.stdout)
+        self.assertIn("python3-numpy", p.stdout)
+
     def test_example_without_matplotlib(self):
         out = os.path.join(self.tmp.name, "example")
         code = ("import sys; sys.modules['matplotlib'] = None\n"  # import matplotlib -> ImportError

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -21,6 +22,7 @@
 #include "plotting/plots.h"
 #include "plotting/report.h"
 #include "plotting/style.h"
+#include "plotting/sweep_summary.h"
 #include "results/atomic_file.h"
 #include "trajectory/split_cycle_profile.h"
 
@@ -453,6 +455,11 @@ TEST(FigureWords, KeysValuesAndFigureNames) {
   EXPECT_EQ(gpValueLabel("analytic.coupling", "exact"), "exact coupling");
   EXPECT_EQ(gpValueLabel("tail.links", "3"), "3 links");
   EXPECT_EQ(gpAxisLabel("quadruped.d_Q2B_m"), "d_{Q2B} [mm]");
+  // keys without a symbol of their own: words, with what they belong to; symbol-like names stay
+  EXPECT_EQ(gpAxisLabel("mujoco.foot_shape"), "MuJoCo foot shape");
+  EXPECT_EQ(gpAxisLabel("quadruped.mass_kg"), "body mass [kg]");
+  EXPECT_EQ(gpAxisLabel("mujoco.body_height_m"), "MuJoCo body height [m]");
+  EXPECT_EQ(gpValueLabel("mujoco.foot_shape", "box"), "MuJoCo foot shape = box");
   EXPECT_EQ(gpText("case d_Q2B_m=0.1"), "case d\\_Q2B\\_m=0.1");
   EXPECT_EQ(gpSymbols("phi_net over theta0 and M_zT"), "φ_{net} over θ_0 and M_{z,T}");
   EXPECT_EQ(figureName("Fig. 6(a): phi(t), analytic vs MuJoCo", "fig06a"), "Fig. 6a");
@@ -559,6 +566,8 @@ TEST(FigureStyle, SeriesStylesAreDistinctAndNeverAModelColour) {
   }
   EXPECT_EQ(first.size(), numSeriesColors());
   EXPECT_NE(seriesDash(numSeriesColors()), 1);
+  // Fig. 14 (six tails) and a six-case ladder: no colour twice among the curves of one figure.
+  EXPECT_GE(numSeriesColors(), 10u);
 }
 
 TEST(FigureTitles, VisibleWidthIgnoresMarkup) {
@@ -675,6 +684,146 @@ TEST(HeatMap, LargeSweepsGetTheirMap) {
     }
     EXPECT_EQ(rows, nx * ny);
   }
+  fs::remove_all(root);
+}
+
+// A figure's script draws it twice (PNG, then SVG): the PNG's commands.
+std::string pngCommands(const std::string& gp) { return gp.substr(0, gp.find("set terminal svg")); }
+
+// A synthetic sweep of every combination of `axes` (key -> values), phi_net of each model from f.
+void writeGridExperiment(const fs::path& dir, const std::string& name,
+                         const std::vector<std::pair<std::string, std::vector<json>>>& axes,
+                         const std::vector<std::string>& models,
+                         const std::function<double(const std::string&, const std::vector<double>&)>& f) {
+  std::vector<SynthCase> cs;
+  std::vector<size_t> idx(axes.size(), 0);
+  while (true) {
+    SynthCase c;
+    std::vector<double> x;
+    for (size_t k = 0; k < axes.size(); ++k) {
+      const json& v = axes[k].second[idx[k]];
+      c.sweep[axes[k].first] = v;
+      x.push_back(v.is_number() ? v.get<double>() : static_cast<double>(idx[k]));
+    }
+    for (const std::string& m : models) c.phi[m] = f(m, x);
+    cs.push_back(c);
+    size_t k = axes.size();
+    while (k > 0 && ++idx[k - 1] == axes[k - 1].second.size()) idx[--k] = 0;
+    if (k == 0) break;
+  }
+  std::vector<std::string> keys;
+  for (const auto& a : axes) keys.push_back(a.first);
+  writeExperiment(dir, name, keys, cs, "name: " + name + "\n");
+}
+
+// Colour by meaning: a phi_net map whose values all have one sign is drawn with the sequential
+// map over their range, not the diverging one (Fig. 12 used half of a blue-orange scale); values of
+// both signs get the diverging map centred on zero; two models get a difference panel, diverging.
+TEST(HeatMap, SequentialForOneSignDivergingForBothAndForTheDifference) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_colours_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const std::vector<std::pair<std::string, std::vector<json>>> axes = {
+      {"trajectory.dtheta_deg", {-60, -120, -180}}, {"trajectory.dT_s", {0.2, 0.4, 0.6}}};
+  writeGridExperiment(root / "positive", "positive", axes, {"analytic", "mujoco"},
+                      [](const std::string& m, const std::vector<double>& x) {
+                        return 1.0 + x[1] - 0.01 * x[0] + (m == "mujoco" ? 0.5 : 0.0);
+                      });
+  writeGridExperiment(root / "both", "both", axes, {"analytic"},
+                      [](const std::string&, const std::vector<double>& x) { return x[1] - 0.4; });
+  plotExperiment(loadResults((root / "positive").string()));
+  plotExperiment(loadResults((root / "both").string()));
+  const std::string pos = pngCommands(readText(root / "positive" / "plots" / "positive_phi_net_map.gp"));
+  const std::string both = pngCommands(readText(root / "both" / "plots" / "both_phi_net_map.gp"));
+  const std::string seq = sequentialPalette(), div = divergingPalette();
+  // positive: two model panels on the sequential map, then the difference on the diverging one
+  ASSERT_NE(pos.find(seq), std::string::npos) << pos;
+  const size_t first_div = pos.find(div);
+  ASSERT_NE(first_div, std::string::npos) << "no difference panel:\n" << pos;
+  EXPECT_GT(first_div, pos.rfind(seq));
+  EXPECT_NE(pos.find("positive_phi_net_map_difference.dat"), std::string::npos);
+  EXPECT_TRUE(fs::exists(root / "positive" / "plots" / "positive_phi_net_map_difference.dat"));
+  // the models' colour range is the values' range, not +-max centred on zero
+  EXPECT_EQ(pos.find("set cbrange [-"), pos.rfind("set cbrange [-")) << "only the difference is centred on zero";
+  EXPECT_NE(both.find(div), std::string::npos);
+  EXPECT_EQ(both.find(seq), std::string::npos);
+  fs::remove_all(root);
+}
+
+// Three or more swept keys: small multiples per model with the keys on the axes, in panel titles
+// and in the legend, never a case index (the 198-case sweep drew phi_net over "case index").
+TEST(Facets, ThreeAndFourKeysAreDrawnAsSmallMultiples) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_facets_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const std::vector<std::pair<std::string, std::vector<json>>> three = {
+      {"trajectory.dtheta_deg", {-60, -120, -180}},
+      {"trajectory.dT_s", {0.15, 0.2, 0.25, 0.3, 0.35, 0.4}},
+      {"trajectory.w_ss", {0.1, 0.25, 0.5}}};
+  auto f = [](const std::string& m, const std::vector<double>& x) {
+    return -0.05 * x[0] * x[1] + x[2] + (m == "mujoco" ? 1.0 : 0.0);
+  };
+  writeGridExperiment(root / "three", "three", three, {"analytic", "mujoco"}, f);
+  auto four = three;
+  four.push_back({"effects.friction", {"stiction", "continuous"}});
+  writeGridExperiment(root / "four", "four", four, {"analytic"}, f);
+
+  const FacetKeys fk = facetKeys(loadResults((root / "three").string()).axes);
+  const ExperimentResults r3 = loadResults((root / "three").string());
+  EXPECT_EQ(r3.axes[fk.x].key, "trajectory.dT_s");  // the numeric key with the most values
+  ASSERT_EQ(fk.facets.size(), 1u);
+  for (const char* exp : {"three", "four"}) {
+    const ExperimentResults r = loadResults((root / exp).string());
+    const std::vector<PlotFile> plots = plotExperiment(r);
+    ASSERT_EQ(plots.size(), r.models.size()) << exp << ": one figure per model";
+    for (const std::string& m : r.models) {
+      const fs::path gp = root / exp / "plots" / (std::string(exp) + "_phi_net_facets_" + m + ".gp");
+      ASSERT_TRUE(fs::exists(gp)) << gp;
+      const std::string text = readText(gp);
+      EXPECT_EQ(text.find("case"), std::string::npos) << text;
+      EXPECT_NE(text.find("set xlabel 'ΔT [s]'"), std::string::npos) << text;
+      EXPECT_NE(text.find("set ylabel 'φ_{net} [deg]'"), std::string::npos);
+    }
+  }
+  // three keys: curves per Δθ (the first key with the fewest values), panels per w_ss
+  const std::string three_gp = readText(root / "three" / "plots" / "three_phi_net_facets_mujoco.gp");
+  EXPECT_NE(three_gp.find("title 'Δθ'"), std::string::npos) << "the legend names the series key";
+  EXPECT_NE(three_gp.find("set title 'w_{ss} = 0.25'"), std::string::npos) << three_gp;
+  // four keys: curves per friction law (2 values), panels Δθ x w_ss, 3 x 3
+  const std::string four_gp = pngCommands(readText(root / "four" / "plots" / "four_phi_net_facets_analytic.gp"));
+  size_t panels = 0;
+  for (size_t p = four_gp.find("\nplot "); p != std::string::npos; p = four_gp.find("\nplot ", p + 1)) ++panels;
+  EXPECT_EQ(panels, 9u);
+  EXPECT_NE(four_gp.find("title 'friction law'"), std::string::npos) << four_gp;
+  EXPECT_NE(four_gp.find("title 'continuous'"), std::string::npos) << four_gp;
+  fs::remove_all(root);
+}
+
+// What any experiment's results say (figures.html, report.md), and no paper claims for an
+// experiment that is not a paper figure.
+TEST(SweepSummary, BestTrendsDifferencesAndWarningsForAnyExperiment) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_summary_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  writeGridExperiment(root / "mine", "mine",
+                      {{"trajectory.dT_s", {0.2, 0.4, 0.6}}, {"trajectory.w_ss", {0.25, 0.5}}},
+                      {"analytic", "mujoco"}, [](const std::string& m, const std::vector<double>& x) {
+                        return 10 * x[0] + (m == "mujoco" ? 2.0 * x[1] : 0.0);
+                      });
+  ExperimentResults r = loadResults((root / "mine").string());
+  EXPECT_FALSE(isPaperFigure(r));
+  const SweepSummary s = summarizeSweep(r);
+  ASSERT_EQ(s.best.size(), 2u);
+  EXPECT_NE(s.best[0].find("largest φ_net +6.00° at ΔT = 0.6 s, w_ss = 0.25"), std::string::npos) << s.best[0];
+  bool rises = false;
+  for (const std::string& t : s.trends) rises = rises || t.find("rises with ΔT, from +2.") != std::string::npos;
+  EXPECT_TRUE(rises) << s.trends[0];
+  ASSERT_EQ(s.disagree.size(), 1u);
+  EXPECT_NE(s.disagree[0].find("largest difference +1.00°"), std::string::npos) << s.disagree[0];
+  const std::string md = reportMarkdown({r}, computeFindings({r}), {}, root.string());
+  EXPECT_EQ(md.find("Paper claims"), std::string::npos);
+  EXPECT_EQ(md.find("Rone"), std::string::npos);
+  EXPECT_NE(md.find("Trend along each swept key"), std::string::npos);
+  const std::string html = figureSheetHtml(root.string(), {r}, {});
+  EXPECT_EQ(html.find("Rone"), std::string::npos);
+  EXPECT_NE(html.find("Where the models differ"), std::string::npos);
   fs::remove_all(root);
 }
 

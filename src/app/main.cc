@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "experiments/accuracy_study.h"
@@ -63,9 +64,38 @@ std::string versionString() {
 
 // `--case NAME` must name a case of the suite: an error listing the available ones otherwise.
 
+// The quantity of a pose case (kind: pose has no motion, so no phi_net): the tail moment M_zT, its
+// tangential and centripetal parts over I_zz when the CSV has them, and the friction moment arm
+// L_F, from the first row of the model's CSV. Empty if the CSV cannot be read.
+std::string poseQuantity(const ExperimentResults* r, const std::string& case_name, const std::string& model) {
+  if (!r) return {};
+  for (const CaseRecord& c : r->cases) {
+    if (c.name != case_name) continue;
+    try {
+      const TimeSeries s = r->series(c, model);
+      if (s.numRows() == 0) return {};
+      auto at = [&](const char* col) { return s.has(col) ? s.values(col)[0] : std::nan(""); };
+      char b[200];
+      std::string out;
+      if (s.has("MzT_Nm")) std::snprintf(b, sizeof b, "M_zT %+.4f N m", at("MzT_Nm")), out += b;
+      if (s.has("MzT_tan_over_Izz_radps2") && s.has("MzT_cen_over_Izz_radps2"))
+        std::snprintf(b, sizeof b, " (tan/I_zz %+.3f, cen/I_zz %+.3f rad/s^2)", at("MzT_tan_over_Izz_radps2"),
+                      at("MzT_cen_over_Izz_radps2")),
+            out += b;
+      if (s.has("LF_m")) std::snprintf(b, sizeof b, "%sL_F %.1f mm", out.empty() ? "" : ", ", 1e3 * at("LF_m")), out += b;
+      return out;
+    } catch (const std::exception&) {
+      return {};
+    }
+  }
+  return {};
+}
+
 void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite) {
-  // A short table of phi_net per case and model, read back from the result folder's summary.json
-  // (its entries name each case's folder: "dir").
+  // A short table per case and model, read back from the result folder's summary.json (its
+  // entries name each case's folder: "dir"): phi_net of a simulation, the pose's own quantity of
+  // a pose study. A warning that differs between runs only in its numbers is printed once, with
+  // the number of runs (each run keeps its own in results.csv and summary.json).
   for (const Experiment& e : suite) {
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
     std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
@@ -75,7 +105,33 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
     if (!s.is_discarded() && s.contains("cases") && s["cases"].is_array())
       for (const nlohmann::json& c : s["cases"])
         if (c.is_object() && c.contains("name") && c["name"].is_string()) by_name[c["name"].get<std::string>()] = &c;
-    if (e.cases.size() > 60) {  // a longer table scrolls away; summary.json has them all
+    const bool pose = !s.is_discarded() && s.value("kind", std::string()) == "pose";
+    std::optional<ExperimentResults> pose_results;
+    if (pose) try {
+        pose_results = loadResults(dir.string());
+      } catch (const std::exception&) {
+      }
+    struct Shared {
+      std::string model, text, first_case;
+      int runs = 0;
+    };
+    std::vector<Shared> warnings;  // in order of first appearance
+    std::map<std::pair<std::string, std::string>, size_t> by_shape;
+    for (const ExperimentCase& c : e.cases) {
+      const auto it = by_name.find(c.name);
+      if (it == by_name.end() || !it->second->contains("runs") || !(*it->second)["runs"].is_object()) continue;
+      for (const auto& [model, r] : (*it->second)["runs"].items())
+        if (r.contains("warnings") && r["warnings"].is_array())
+          for (const auto& w : r["warnings"]) {
+            if (!w.is_string()) continue;
+            const auto key = std::make_pair(model, warningShape(w.get<std::string>()));
+            const auto [slot, added] = by_shape.emplace(key, warnings.size());
+            if (added) warnings.push_back({model, w.get<std::string>(), c.name});
+            ++warnings[slot->second].runs;
+          }
+    }
+    const bool table = e.cases.size() <= 60;  // a longer table scrolls away; summary.json has them all
+    if (!table) {
       int warned = 0;  // runs whose result carries warnings (e.g. still moving at the end)
       for (const auto& [name, j] : by_name)
         if (j->contains("runs") && (*j)["runs"].is_object())
@@ -84,9 +140,9 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
       std::printf("  %zu cases (see %s/summary.json)", e.cases.size(), dir.c_str());
       if (warned > 0) std::printf(", %d model runs with warnings", warned);
       std::printf("\n");
-      continue;
     }
     for (const ExperimentCase& c : e.cases) {
+      if (!table) break;
       std::printf("  %-40s", c.name.c_str());
       const auto it = by_name.find(c.name);
       if (it == by_name.end()) { std::printf(" (not run)\n"); continue; }
@@ -94,7 +150,10 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
       if (!j.contains("runs") || !j["runs"].is_object()) { std::printf(" (unreadable)\n"); continue; }
       for (const auto& [model, r] : j["runs"].items()) {
         if (!r.value("ok", false)) std::printf(" %s: FAILED (%s)", model.c_str(), r.value("error", std::string()).c_str());
-        else if (r["phi_net_deg"].is_number())
+        else if (pose) {
+          const std::string q = poseQuantity(pose_results ? &*pose_results : nullptr, c.name, model);
+          std::printf(" %s: %s", model.c_str(), q.empty() ? "ok" : q.c_str());
+        } else if (r["phi_net_deg"].is_number())
           std::printf(" %s: phi_net %+.3f deg (%.2f ms)", model.c_str(), r["phi_net_deg"].get<double>(),
                       1e3 * r.value("wall_time_s", 0.0));
         else std::printf(" %s: ok", model.c_str());
@@ -103,8 +162,13 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
       for (const auto& [model, r] : j["runs"].items())
         if (r.contains("warnings") && r["warnings"].is_array())
           for (const auto& w : r["warnings"])
-            if (w.is_string()) std::printf("    warning (%s): %s\n", model.c_str(), w.get<std::string>().c_str());
+            if (w.is_string() && warnings[by_shape.at({model, warningShape(w.get<std::string>())})].runs == 1)
+              std::printf("    warning (%s): %s\n", model.c_str(), w.get<std::string>().c_str());
     }
+    for (const Shared& w : warnings)
+      if (w.runs > 1 || !table)
+        std::printf("  warning (%s), %d run%s (first: %s; each run's numbers in results.csv): %s\n", w.model.c_str(),
+                    w.runs, w.runs == 1 ? "" : "s", w.first_case.c_str(), w.text.c_str());
   }
 }
 
@@ -203,7 +267,7 @@ int main(int argc, char** argv) {
   bool allow_other_build = false;
   run->add_flag("--allow-other-build", allow_other_build,
                 "resume cases computed by another tailsim version or commit (warned, recorded in summary.json) instead of refusing them");
-  run->add_flag("--quiet", quiet, "no progress line");
+    run->add_flag("--quiet", quiet, "print only errors and the final line (cases run, resumed, failed)");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
   std::string shard_text;
   run->add_option("--shard", shard_text,
@@ -243,6 +307,13 @@ int main(int argc, char** argv) {
   std::string result_dir;
   auto* plot = app.add_subcommand("plot", "redraw the figures of a result folder (no simulation)");
   plot->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
+  PlotOptions plot_opt;
+  bool no_titles = false;
+  std::string plot_size;
+  plot->add_flag("--no-titles", no_titles, "no title drawn in the figures (figures.html's captions keep them)");
+  plot->add_option("--size", plot_size, "W,H: every figure W x H pixels (PNG; the SVG in points)");
+  plot->add_option("--font-scale", plot_opt.font_scale, "every font scaled by this factor (default 1)")
+      ->check(CLI::PositiveNumber);
   auto* report = app.add_subcommand("report", "write DIR/report.md: plots and the paper's findings checked");
   report->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
   auto* ladder = app.add_subcommand("ladder", "write DIR/ladder.md: the gap ladder of a configs/ladder/ result folder");
@@ -351,11 +422,14 @@ int main(int argc, char** argv) {
         // 128 + the signal, as a shell reports a process it ended (SIGINT 130, SIGTERM 143, SIGHUP 129).
         return s.stop_signal > 0 ? 128 + s.stop_signal : kExitInterrupted;
       }
-      if (shard_text.empty()) printCases(suite, out_dir, suite.size() > 1);  // a shard's table is mostly "not run"
+      // --quiet: errors and the line above only
+      if (shard_text.empty() && !quiet) printCases(suite, out_dir, suite.size() > 1);  // a shard's table is mostly "not run"
       if (plots) {
-        printSeriesNotes(out_dir);
-        std::printf("report: %s\n", writeReport(out_dir).c_str());
-        std::printf("page: %s\n", writeResultPage(out_dir).c_str());
+        if (!quiet) printSeriesNotes(out_dir);
+        const std::string report_path = writeReport(out_dir);
+        if (!quiet) std::printf("report: %s\n", report_path.c_str());
+        const std::string page_path = writeResultPage(out_dir);
+        if (!quiet) std::printf("page: %s\n", page_path.c_str());
       }
       return s.failed ? kExitRunsFailed : kExitOk;
     }
@@ -452,8 +526,20 @@ int main(int argc, char** argv) {
       return rc == 0 ? kExitOk : kExitRunsFailed;
     }
     if (*plot) {
+      plot_opt.titles = !no_titles;
+      if (!plot_size.empty()) {
+        int w = 0, h = 0;
+        char extra = 0;
+        if (std::sscanf(plot_size.c_str(), "%d,%d%c", &w, &h, &extra) != 2 || w < 100 || h < 100 || w > 30000 ||
+            h > 30000) {
+          std::fprintf(stderr, "error: --size %s: expected W,H in pixels, each 100..30000 (e.g. --size 1600,1000)\n",
+                       plot_size.c_str());
+          return kExitUsage;
+        }
+        plot_opt.width_px = w, plot_opt.height_px = h;
+      }
       printSeriesNotes(result_dir);
-      const auto files = plotResults(result_dir);
+      const auto files = plotResults(result_dir, plot_opt);
       for (const auto& f : files) std::printf("%s\n", f.png.c_str());
       std::printf("%s\n", writeResultPage(result_dir).c_str());
       std::printf("%s\n", figureSheetPath(result_dir).c_str());

@@ -473,12 +473,25 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     title << "Maneuver " << spec.name << ": heading to " << s.heading_deg << " deg";
     b << "set datafile separator ','\nset key bottom right\nset grid\n"
       << "set title " << gpQuote(title.str()) << " noenhanced\n"
-      << "set xlabel 't [s]'\nset ylabel 'heading change [deg]'\n"
-      << "plot " << s.heading_deg << " with lines dt 2 lc rgb '#000000' title 'target'";
+      << "set xlabel 't [s]'\nset ylabel 'heading change [deg]'\n";
+    // The time axis ends 15 % after the last action: the last stroke's return and rest, or the
+    // closed loop settling within tolerance (the runs idle afterwards).
+    double t_action = 0;
+    for (const ManeuverRun& r : rep.runs) {
+      if (!r.strokes.empty()) {
+        const StrokeRecord& x = r.strokes.back();
+        t_action = std::max(t_action, x.t_start_s + x.command.scale * s.stroke_dT_s + s.return_dT_s + s.rest_s);
+      }
+      t_action = std::max(t_action, r.t_within_s);
+    }
+    if (t_action > 0) b << "set xrange [0:" << g17(1.15 * t_action) << "]\n";
+    b << "plot " << s.heading_deg << " with lines dt 2 lc rgb '#000000' title 'target'";
+    // Runs that follow the same heading stay visible: wide solid under narrower dashed lines.
     const char* colours[] = {"#0072B2", "#E69F00", "#009E73"};
+    const char* lines[] = {"lw 5 dt 1", "lw 2.5 dt 2", "lw 2 dt 4"};
     for (std::size_t i = 0; i < rep.runs.size(); ++i)
-      b << ", '../maneuver.csv' every ::1 using 1:" << i + 2 << " with lines lw 2 lc rgb " << gpQuote(colours[i % 3])
-        << " title " << gpQuote(rep.runs[i].label) << " noenhanced";
+      b << ", '../maneuver.csv' every ::1 using 1:" << i + 2 << " with lines " << lines[i % 3] << " lc rgb "
+        << gpQuote(colours[i % 3]) << " title " << gpQuote(rep.runs[i].label) << " noenhanced";
     b << "\n";
     fig.body = b.str();
     renderFigure((fs::path(out_dir) / "plots").string(), fig);

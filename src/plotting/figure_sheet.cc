@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "plotting/style.h"
+#include "plotting/sweep_summary.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {
@@ -64,15 +65,22 @@ std::string figureSheetHtml(const std::string& dir, const std::vector<Experiment
   });
   std::ostringstream o;
   const std::string where = fs::absolute(dir).lexically_normal().filename().string();
+  const bool paper = std::any_of(results.begin(), results.end(), [](const ExperimentResults& r) { return isPaperFigure(r); });
+  std::string heading = "tailsim figures: " + where;
+  if (paper) heading = "tailsim figures: Rone &amp; Ben-Tzvi 2016 reproduction";
+  else if (results.size() == 1) heading = "tailsim figures: " + html(results[0].name);
   o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
     << "<title>tailsim figures: " << html(where) << "</title>\n"
     << "<style>\nbody{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}\n"
     << "figure{margin:1.5em 0 2.5em 0}img{max-width:100%;height:auto;border:1px solid #ddd}\n"
     << "figcaption{margin-top:.4em;line-height:1.4}figcaption a{color:#0072B2}\n"
     << "h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:2em}nav li{margin:.15em 0}\n</style>\n"
-    << "</head>\n<body>\n<h1>tailsim figures: Rone &amp; Ben-Tzvi 2016 reproduction</h1>\n"
+    << "</head>\n<body>\n<h1>" << heading << "</h1>\n"
     << "<p>Every figure drawn by <code>tailsim plot</code> from the result folder <code>" << html(where)
-    << "</code>, in paper order. Analytic = the paper's model (stiction friction), MuJoCo = the contact model. "
+    << "</code>" << (paper ? ", in paper order" : "")
+    << ". Analytic = the paper's model (stiction friction), MuJoCo = the contact model. "
+    << "Under each experiment: what its results say (the largest φ<sub>net</sub> per model, its trend along "
+       "each swept key, where the models differ, every run's warnings once), then its figures. "
     << "Each figure's SVG, gnuplot script and data files are beside its PNG.</p>\n<nav><ul>\n";
   int section = 0;
   for (const ExperimentResults* r : order) {
@@ -88,6 +96,17 @@ std::string figureSheetHtml(const std::string& dir, const std::vector<Experiment
     ++section;
     o << "<h2 id=\"s" << section << "\">" << html(figureName(r->description, r->name)) << "</h2>\n";
     if (!r->description.empty()) o << "<p>" << html(plainSymbols(r->description)) << "</p>\n";
+    const SweepSummary sum = summarizeSweep(*r);
+    auto list = [&](const char* what, const std::vector<std::string>& lines) {
+      if (lines.empty()) return;
+      o << "<p><b>" << what << "</b></p>\n<ul>\n";
+      for (const std::string& l : lines) o << "<li>" << html(l) << "</li>\n";
+      o << "</ul>\n";
+    };
+    list("Largest φ<sub>net</sub> per model", sum.best);
+    list("Trend along each swept key", sum.trends);
+    list("Where the models differ", sum.disagree);
+    list("Warnings (each once, with the number of runs)", sum.warnings);
     int mine = 0;
     for (const PlotFile& p : plots) {
       if (!under(p.png, r->dir)) continue;

@@ -67,13 +67,15 @@ int runGnuplot(const fs::path& dir, const std::string& script, const fs::path& l
 
 std::string terminalBlock(const GnuplotFigure& f, bool png) {
   std::ostringstream o;
+  char scale[48] = "";
+  if (f.font_scale > 0 && f.font_scale != 1.0) std::snprintf(scale, sizeof scale, " fontscale %.3g", f.font_scale);
   if (png)
     o << "set terminal pngcairo enhanced size " << f.width_px << "," << f.height_px
-      << " font 'Sans,15' linewidth 2\n"
+      << " font 'Sans,15'" << scale << " linewidth 2\n"
       << "set output " << gpQuote(f.stem + ".png") << "\n";
   else
     o << "set terminal svg enhanced size " << f.width_px << "," << f.height_px
-      << " font 'Sans,15' linewidth 2 background rgb 'white'\n"
+      << " font 'Sans,15'" << scale << " linewidth 2 background rgb 'white'\n"
       << "set output " << gpQuote(f.stem + ".svg") << "\n";
   o << f.body << "\nunset output\n";
   return o.str();

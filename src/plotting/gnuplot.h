@@ -13,6 +13,7 @@ struct GnuplotFigure {
   std::string body;        // plot commands (no terminal/output); starts from a `reset` state
   int width_px = 1000;     // PNG size; the SVG gets the same size in points
   int height_px = 700;
+  double font_scale = 1.0;  // every font of the figure scaled (the terminals' fontscale)
 };
 
 // Writes <plots_dir>/<stem>.gp, runs gnuplot in plots_dir (posix_spawn, no shell; plots_dir may be

@@ -166,37 +166,43 @@ std::string plotFigure(const std::string& plots, const std::string& exp, const s
        << "set ylabel 'φ_{net} [deg]'\nset grid\nset key outside right top box\n";
   std::vector<std::vector<double>> rows;
   std::vector<std::string> header;
-  if (cs.size() <= 6) {  // x: the rungs, one line a case
-    header = {"rung"};
-    for (size_t k = 0; k < cs.size(); ++k) header.push_back("case" + std::to_string(k + 1));
-    for (size_t i = 0; i < rungs().size(); ++i) {
-      std::vector<double> row{static_cast<double>(i + 1)};
-      for (const LadderCase& c : cs) row.push_back(c.*rungs()[i].value);
-      rows.push_back(row);
+  // x: the rungs; each line joins one case's phi_net from rung to rung. Up to 10 cases: one colour
+  // each, in the legend; more: every case a thin grey line and their median in black.
+  const bool few = cs.size() <= numSeriesColors();
+  header = {"rung"};
+  for (size_t k = 0; k < cs.size(); ++k) header.push_back("case" + std::to_string(k + 1));
+  if (!few) header.push_back("median");
+  for (size_t i = 0; i < rungs().size(); ++i) {
+    std::vector<double> row{static_cast<double>(i + 1)};
+    std::vector<double> finite;
+    for (const LadderCase& c : cs) {
+      row.push_back(c.*rungs()[i].value);
+      if (std::isfinite(row.back())) finite.push_back(row.back());
     }
-    body << "set xtics (";
-    for (size_t i = 0; i < rungs().size(); ++i)
-      body << (i ? ", " : "") << gpQuote(gpText(rungs()[i].title)) << " " << i + 1;
-    body << ") rotate by -25\nset xrange [0.5:" << rungs().size() + 0.5 << "]\nplot ";
+    if (!few) {
+      std::sort(finite.begin(), finite.end());
+      const size_t n = finite.size();
+      row.push_back(n == 0 ? NAN : n % 2 ? finite[n / 2] : 0.5 * (finite[n / 2 - 1] + finite[n / 2]));
+    }
+    rows.push_back(row);
+  }
+  body << "set xtics (";
+  for (size_t i = 0; i < rungs().size(); ++i)
+    body << (i ? ", " : "") << gpQuote(gpText(rungs()[i].title)) << " " << i + 1;
+  body << ") rotate by -25\nset xrange [0.5:" << rungs().size() + 0.5 << "]\nset xlabel 'rung of the ladder'\nplot ";
+  if (few) {
     for (size_t k = 0; k < cs.size(); ++k)
       body << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << k + 2
            << " with linespoints lw 2 pt " << seriesPoint(k) << " dt " << seriesDash(k) << " lc rgb "
            << gpQuote(seriesColor(k)) << " title "
            << gpQuote(gpText(cs[k].name));
-  } else {  // x: the cases, one line a rung
-    header = {"case"};
-    for (const Rung& g : rungs()) header.push_back(g.key);
-    for (size_t k = 0; k < cs.size(); ++k) {
-      std::vector<double> row{static_cast<double>(k + 1)};
-      for (const Rung& g : rungs()) row.push_back(cs[k].*g.value);
-      rows.push_back(row);
-    }
-    body << "set xlabel 'case (ladder.csv order)'\nplot ";
-    for (size_t i = 0; i < rungs().size(); ++i)
-      body << (i ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << i + 2
-           << " with linespoints lw 1.5 pt " << seriesPoint(i) << " ps 0.6 dt " << seriesDash(i) << " lc rgb "
-           << gpQuote(seriesColor(i)) << " title "
-           << gpQuote(gpText(rungs()[i].title));
+  } else {
+    for (size_t k = 0; k < cs.size(); ++k)
+      body << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << k + 2
+           << " with lines lw 0.8 lc rgb '#B0B0B0' " << (k ? "notitle" : "title " + gpQuote(
+                  gpText(std::to_string(cs.size()) + " cases, one line each")));
+    body << ", \\\n     " << gpQuote(stem + ".dat") << " using 1:" << cs.size() + 2
+         << " with linespoints lw 3 pt 7 lc rgb '#000000' title 'median'";
   }
   body << "\n";
   writeDataFile((std::filesystem::path(plots) / (stem + ".dat")).string(), header, rows);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -12,6 +13,7 @@
 #include "results/columns.h"
 #include "plotting/gnuplot.h"
 #include "plotting/style.h"
+#include "experiments/model_registry.h"
 
 namespace tailsim {
 
@@ -46,6 +48,22 @@ Txt V(const std::string& key, const std::string& value) {
   return {gpValueLabel(key, value), plainValueLabel(key, value)};
 }
 
+// A model's name without its parenthesis ("MuJoCo", "analytic"): for panels that compare models
+// over a swept key the parenthesis may name ("analytic (stiction)" when the friction law is swept).
+std::string shortModel(const std::string& m) {
+  const std::string t = modelTitle(m);
+  const size_t open = t.find(" (");
+  return open == std::string::npos ? t : t.substr(0, open);
+}
+
+// Whether a model reads a key: "analytic.coupling" is read by the analytic model only (a section
+// named after another model); every other section by every model.
+bool modelReads(const std::string& model, const std::string& key) {
+  const std::string section = key.substr(0, key.find('.'));
+  const std::vector<std::string> models = modelNames();
+  return section == model || std::find(models.begin(), models.end(), section) == models.end();
+}
+
 // A tic label: the value in the axis's unit (d_Q2B in mm), words for non-numeric values.
 std::string ticLabel(const std::string& key, const std::string& value) {
   const auto v = parseNumber(value);
@@ -59,25 +77,33 @@ struct Ctx {
   Txt fig;            // "Fig. 6a"
   Txt tail;           // ", 1-link tail" when the experiment has one tail
   std::vector<PlotFile> out;
+  PlotOptions opt;
 
   Txt title(const Txt& what) const { return fig + Txt{" — ", " — "} + what; }
+  // The figure's own title for `set title` / `set multiplot ... title`: empty with --no-titles
+  // (the caption keeps it). Panel titles (which model, which facet) stay.
+  std::string figTitle(const Txt& t, int width_px, double font_pt = 15) const {
+    return opt.titles ? gpTitle(t.gp, width_px, font_pt) : std::string("''");
+  }
   std::string data(const std::string& stem) const { return (fs::path(plots) / (stem + ".dat")).string(); }
   void render(const std::string& stem, const std::string& body, const Txt& title, const std::string& caption,
               int w = 1000, int h = 700) {
     GnuplotFigure f;
     f.stem = stem;
     f.body = body;
-    f.width_px = w;
-    f.height_px = h;
+    f.width_px = opt.width_px > 0 ? opt.width_px : w;
+    f.height_px = opt.height_px > 0 ? opt.height_px : h;
+    f.font_scale = opt.font_scale;
     out.push_back({renderFigure(plots, f), caption, title.plain});
   }
 };
 
 // width_px: the figure's width, so that a long title is wrapped to fit it.
-std::string header(const Txt& title, const std::string& xlabel, const std::string& ylabel, int width_px = 1000) {
+std::string header(const Ctx& ctx, const Txt& title, const std::string& xlabel, const std::string& ylabel,
+                   int width_px = 1000) {
   std::ostringstream o;
   o << "reset\nset grid\nset key top left box opaque\n";
-  o << "set title " << gpTitle(title.gp, width_px) << "\n";
+  o << "set title " << ctx.figTitle(title, width_px) << "\n";
   o << "set xlabel " << gpQuote(xlabel) << "\nset ylabel " << gpQuote(ylabel) << "\n";
   return o.str();
 }
@@ -196,7 +222,9 @@ std::string phaseObjects(const Phases& p, double t_end) {
   if (!p.ok) return {};
   std::ostringstream o;
   const double b[] = {p.t_start, p.t1, p.t_rev, p.t_stuck, std::max(t_end, p.t_stuck)};
-  const char* shade[] = {"#E8E8E8", "#F6F6F6", "#E8E8E8", "#F6F6F6"};
+  // Grey levels 0.80 and 0.91 (about 20 and 9 % below white): distinct from each other and from
+  // the white plot area in print and on a projector, light enough for every curve colour on top.
+  const char* shade[] = {"#CCCCCC", "#E8E8E8", "#CCCCCC", "#E8E8E8"};
   const char* letter[] = {"A", "B", "C", "D"};
   for (int i = 0; i < 4; ++i) {
     o << "set object " << 10 + i << " rect from " << fmt("%.6g", b[i]) << ", graph 0 to " << fmt("%.6g", b[i + 1])
@@ -257,7 +285,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   // phi(t), all models overlaid (Figs. 6, 7a).
   const Txt phi_title = ctx.title(W("body yaw phi(t)") + ctx.tail + vs);
   std::ostringstream body;
-  body << header(phi_title, "t [s]", "φ [deg]") << range("x", 0, t_end) << phaseObjects(phases, t_end);
+  body << header(ctx, phi_title, "t [s]", "φ [deg]") << range("x", 0, t_end) << phaseObjects(phases, t_end);
   body << "set key bottom right box opaque\nplot ";  // phi rises from 0 and settles: bottom right is free
   for (size_t i = 0; i < models.size(); ++i) {
     const std::string& m = models[i];
@@ -291,23 +319,25 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
         break;
       }
   if (mm.empty()) return;
-  // The y range: every panel's values with a margin, nothing clipped (MuJoCo's loads are impulse
-  // averages over each output interval, docs/mujoco-model.md "Force and moment columns").
-  std::vector<double> yv;
-  for (const std::string& m : mm) {
-    const TimeSeries& s = ts[m];
+  // Each panel its own y range (its values up to t_end with a margin, nothing clipped): one
+  // model's spikes (MuJoCo's impulse averages, docs/mujoco-model.md "Force and moment columns")
+  // never squash another model's curves.
+  auto panelRange = [&](const TimeSeries& s) {
+    std::vector<double> yv;
     for (const auto& [col, label] : cols)
       if (s.has(col))
         for (size_t k = 0; k < s.numRows(); ++k)
           if (s.values(col::kT)[k] <= t_end) yv.push_back(s.values(col)[k]);
-  }
-  const auto [ylo, yhi] = span(yv, 0.12);
+    return span(yv, 0.12);
+  };
   const Txt mom_title = ctx.title(W("moments about the system COM") + ctx.tail);
   std::ostringstream mb;
-  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << gpTitle(mom_title.gp, 1000, 17) << " font 'Sans,17'\n"
-     << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string()) << phaseObjects(phases, t_end);
+  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << ctx.figTitle(mom_title, 1200, 17) << " font 'Sans,17'\n"
+     << range("x", 0, t_end) << phaseObjects(phases, t_end);
   for (const std::string& m : mm) {
     const TimeSeries& s = ts[m];
+    const auto [ylo, yhi] = panelRange(s);
+    mb << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string("set autoscale y\n"));
     const std::string stem = stem_prefix + "_moments_" + m;
     std::vector<std::string> names = {col::kT};
     for (const auto& [col, label] : cols) names.push_back(col);
@@ -320,7 +350,8 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     writeDataFile(ctx.data(stem), names, rows);
     std::string panel = gpText(modelTitle(m));
     if (m == "mujoco") panel += ": impulse-averaged over each output interval";
-    mb << "set grid\nset key bottom right box opaque\nset title " << gpTitle(panel, 1000)
+    // the legend beside the panel: inside, it hid curves wherever it was put
+    mb << "set grid\nset key outside right top vertical box\nset title " << gpTitle(panel, 1000)
        << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
     int n = 0;
     for (size_t j = 0; j < cols.size(); ++j) {
@@ -333,18 +364,40 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   mb << "unset multiplot\n";
   std::string cap = mom_title.plain +
                     ". Tail moment M_z,T (Eq. 13), friction moment M_z,F and inertial moment I_zz φ̈ over time, one "
-                    "panel per model, same scales.";
+                    "panel per model, one time scale; each panel has its own moment scale (read the y tics).";
   if (ts.count("mujoco") && std::find(mm.begin(), mm.end(), "mujoco") != mm.end())
     cap += " MuJoCo's moments are impulse averages: the contact and joint impulses of the MuJoCo steps in each "
            "output interval (t ± Δt/2) summed and divided by the interval's length, not single samples of the "
-           "chattering contact forces; the y range holds every value of both panels.";
-  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1000,
+           "chattering contact forces.";
+  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1200,
              60 + 430 * static_cast<int>(mm.size()));
 }
 
 // ---- heat maps ------------------------------------------------------------------------------
 
 }  // namespace
+
+FacetKeys facetKeys(const std::vector<SweepAxis>& axes) {
+  FacetKeys f;
+  if (axes.size() < 2) return f;
+  // x: the numeric key with the most values (the first such), else the key with the most values.
+  size_t x = axes.size();
+  for (size_t i = 0; i < axes.size(); ++i)
+    if (axes[i].numeric && (x == axes.size() || axes[i].values.size() > axes[x].values.size())) x = i;
+  if (x == axes.size()) {
+    x = 0;
+    for (size_t i = 1; i < axes.size(); ++i)
+      if (axes[i].values.size() > axes[x].values.size()) x = i;
+  }
+  // series: the remaining key with the fewest values (the first such).
+  size_t s = axes.size();
+  for (size_t i = 0; i < axes.size(); ++i)
+    if (i != x && (s == axes.size() || axes[i].values.size() < axes[s].values.size())) s = i;
+  f.x = x, f.series = s;
+  for (size_t i = 0; i < axes.size(); ++i)
+    if (i != x && i != s) f.facets.push_back(i);
+  return f;
+}
 
 HeatMapLayout heatMapLayout(size_t nx, size_t ny) {
   HeatMapLayout l;
@@ -361,22 +414,59 @@ HeatMapLayout heatMapLayout(size_t nx, size_t ny) {
 
 namespace {
 
-// values[model][iy][ix]; x = axes[1], y = axes[0]. A signed quantity (or any map with both signs)
-// gets a diverging colour map centred on zero; cell text is white on dark cells, a value that rounds to zero prints unsigned.
+// values[model][iy][ix]; x = axes[1], y = axes[0]. The models share one colour scale: sequential
+// (white to dark) when every value has one sign, dark at the largest magnitude; diverging centred on
+// zero only when the values have both signs. with_difference and two models: a third panel, the
+// second model minus the first, on its own diverging scale centred on zero. Cell text is white on
+// dark cells; a value that rounds to zero prints unsigned.
 void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::string& cblabel, const SweepAxis& ax,
              const SweepAxis& ay, const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& values,
-             const std::string& caption_more, bool signed_quantity) {
+             const std::string& caption_more, bool with_difference) {
+  struct Panel {
+    std::string dstem, title, cblabel;
+    std::vector<std::vector<double>> grid;
+    bool diverging = false;
+    bool negative = false;  // sequential with every value <= 0: dark at the most negative
+    double cblo = 0, cbhi = 1;
+  };
+  auto scale = [](Panel& p, double lo, double hi, bool force_diverging) {
+    p.diverging = force_diverging || (lo < 0 && hi > 0);
+    p.negative = !p.diverging && hi <= 0 && lo < 0;
+    p.cblo = lo, p.cbhi = hi;
+    if (p.diverging) p.cbhi = std::max(std::fabs(lo), std::fabs(hi)), p.cblo = -p.cbhi;
+    if (p.cbhi <= p.cblo) p.cbhi = p.cblo + 1.0;
+  };
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const auto& [m, grid] : values)
     for (const auto& row : grid)
       for (double v : row)
         if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
   if (!std::isfinite(lo)) return;
-  // A signed quantity (phi_net) is centred on zero even when this sweep has one sign only.
-  const bool is_signed = signed_quantity || (lo < 0 && hi > 0);
-  double cblo = lo, cbhi = hi;
-  if (is_signed) cbhi = std::max(std::fabs(lo), std::fabs(hi)), cblo = -cbhi;
-  if (cbhi <= cblo) cbhi = cblo + 1.0;
+  std::vector<Panel> panels;
+  for (const auto& [m, grid] : values) {
+    Panel p{stem + "_" + m, gpPanelTitle(m, {ax, ay}), cblabel, grid};
+    scale(p, lo, hi, false);
+    panels.push_back(p);
+  }
+  std::string diff_caption;
+  if (with_difference && values.size() == 2) {
+    const auto& [m0, g0] = values[0];
+    const auto& [m1, g1] = values[1];
+    Panel d{stem + "_difference", gpText(shortModel(m1)) + " − " + gpText(shortModel(m0)), "difference " + cblabel, g0};
+    double dlo = std::numeric_limits<double>::infinity(), dhi = -dlo;
+    for (size_t iy = 0; iy < g0.size(); ++iy)
+      for (size_t ix = 0; ix < g0[iy].size(); ++ix) {
+        d.grid[iy][ix] = g1[iy][ix] - g0[iy][ix];
+        if (std::isfinite(d.grid[iy][ix])) dlo = std::min(dlo, d.grid[iy][ix]), dhi = std::max(dhi, d.grid[iy][ix]);
+      }
+    if (std::isfinite(dlo)) {
+      scale(d, dlo, dhi, true);
+      panels.push_back(d);
+      diff_caption = " The last panel is " + shortModel(m1) + " minus " + shortModel(m0) +
+                     " on its own scale (diverging, centred on zero: blue where " + shortModel(m1) +
+                     " is lower, vermillion where it is higher).";
+    }
+  }
   const HeatMapLayout lay = heatMapLayout(ax.values.size(), ay.values.size());
   auto tics = [](const SweepAxis& a, const char* axis, size_t every) {
     std::ostringstream o;
@@ -386,37 +476,38 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
     o << ")\n";
     return o.str();
   };
-  // Dark cells: |value| beyond 60 % of the scale (diverging) or the top 40 % (sequential).
-  const std::string dark = is_signed ? "(abs($3) > " + fmt("%.6g", 0.6 * cbhi) + ")"
-                                     : "($3 > " + fmt("%.6g", cblo + 0.6 * (cbhi - cblo)) + ")";
   const std::string text = "(abs($3) < 0.05 ? '0.0' : sprintf('%.1f', $3))";
-  const bool stacked = ax.values.size() > ay.values.size() && values.size() > 1;
+  const bool stacked = ax.values.size() > ay.values.size() && panels.size() > 1;
   const int pw = lay.panel_w, ph = lay.panel_h;
-  const int n = static_cast<int>(values.size());
+  const int n = static_cast<int>(panels.size());
   const int w = stacked ? pw : pw * n, h = (stacked ? ph * n : ph) + 40;
   const Txt title = ctx.title(what + ctx.tail);
   std::ostringstream b;
-  b << "reset\nset multiplot layout " << (stacked ? values.size() : 1) << "," << (stacked ? 1 : values.size())
-    << " title " << gpTitle(title.gp, w, 17) << " font 'Sans,17'\n";
-  for (const auto& [m, grid] : values) {
-    const std::string dstem = stem + "_" + m;
+  b << "reset\nset multiplot layout " << (stacked ? panels.size() : 1) << "," << (stacked ? 1 : panels.size())
+    << " title " << ctx.figTitle(title, w, 17) << " font 'Sans,17'\n";
+  for (const Panel& p : panels) {
     std::vector<std::vector<double>> rows;
-    for (size_t iy = 0; iy < grid.size(); ++iy)
-      for (size_t ix = 0; ix < grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), grid[iy][ix]});
-    writeDataFile(ctx.data(dstem), {"ix", "iy", "value"}, rows);
-    b << "set title " << gpTitle(gpPanelTitle(m, {ax, ay}), pw - 120) << "\n"
+    for (size_t iy = 0; iy < p.grid.size(); ++iy)
+      for (size_t ix = 0; ix < p.grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), p.grid[iy][ix]});
+    writeDataFile(ctx.data(p.dstem), {"ix", "iy", "value"}, rows);
+    // Dark cells: |value| beyond 60 % of the scale (diverging), the darkest 40 % (sequential).
+    const std::string dark =
+        p.diverging ? "(abs($3) > " + fmt("%.6g", 0.6 * p.cbhi) + ")"
+        : p.negative ? "($3 < " + fmt("%.6g", p.cbhi - 0.6 * (p.cbhi - p.cblo)) + ")"
+                     : "($3 > " + fmt("%.6g", p.cblo + 0.6 * (p.cbhi - p.cblo)) + ")";
+    b << "set title " << gpTitle(p.title, pw - 120) << "\n"
       << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel " << gpQuote(gpAxisLabel(ay.key)) << "\n"
       << "set xrange [-0.5:" << ax.values.size() - 0.5 << "]\nset yrange [-0.5:" << ay.values.size() - 0.5 << "]\n"
-      << tics(ax, "x", lay.xtic_every) << tics(ay, "y", lay.ytic_every) << range("cb", cblo, cbhi)
-      << "set cblabel " << gpQuote(cblabel) << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
-      << (is_signed ? divergingPalette() : sequentialPalette());
+      << tics(ax, "x", lay.xtic_every) << tics(ay, "y", lay.ytic_every) << range("cb", p.cblo, p.cbhi)
+      << "set cblabel " << gpQuote(p.cblabel) << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
+      << (p.diverging ? divergingPalette() : sequentialPalette(p.negative));
     if (lay.values_in_cells)
-      b << "plot " << gpQuote(dstem + ".dat")
+      b << "plot " << gpQuote(p.dstem + ".dat")
         << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
         << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
         << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
     else  // one pixel block per cell (the rows are a full grid, ix fastest); NaN cells stay empty
-      b << "set xtics rotate by -45\nplot " << gpQuote(dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
+      b << "set xtics rotate by -45\nplot " << gpQuote(p.dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
   }
   b << "unset multiplot\n";
   std::string cap = title.plain + ". " + caption_more;
@@ -424,7 +515,10 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
     cap += " (" + std::to_string(ax.values.size()) + " × " + std::to_string(ay.values.size()) +
            " cells: too many to print the values, they are in the .dat files).";
   cap += " One panel per model, one colour scale";
-  cap += is_signed ? " (diverging, centred on zero: blue negative, vermillion positive)." : ".";
+  cap += panels.front().diverging ? " (diverging, centred on zero: the values have both signs; blue negative, vermillion positive)."
+         : panels.front().negative ? " (sequential: every value is negative, darker is more negative)."
+                                   : " (sequential: every value has one sign, darker is larger).";
+  cap += diff_caption;
   ctx.render(stem, b.str(), title, cap, w, h);
 }
 
@@ -448,7 +542,7 @@ void plotOneKey(Ctx& ctx) {
 
   const Txt title = ctx.title(W("net body rotation phi_net over ") + K(a.key) + ctx.tail);
   std::ostringstream b;
-  b << header(title, gpAxisLabel(a.key), "φ_{net} [deg]");
+  b << header(ctx, title, gpAxisLabel(a.key), "φ_{net} [deg]");
   const bool bars = leafKey(a.key) == "links" || !a.numeric;
   if (bars) {
     b << "set style data histogram\nset style histogram cluster gap 1\nset style fill solid 0.85 border -1\n"
@@ -509,7 +603,7 @@ void plotOneKey(Ctx& ctx) {
   const auto [ylo, yhi] = span(phis, 0.06);
   const Txt ttitle = ctx.title(W("body yaw phi(t) for each ") + K(a.key) + ctx.tail);
   std::ostringstream t;
-  t << "reset\nset multiplot layout " << panels.size() << ",1 title " << gpTitle(ttitle.gp, 1150, 17) << " font 'Sans,17'\n"
+  t << "reset\nset multiplot layout " << panels.size() << ",1 title " << ctx.figTitle(ttitle, 1150, 17) << " font 'Sans,17'\n"
     << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
   for (const auto& [m, curves] : panels) {
     t << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {a}), 900)
@@ -527,8 +621,105 @@ void plotOneKey(Ctx& ctx) {
              1150, 60 + 430 * static_cast<int>(panels.size()));
 }
 
+// Two swept keys of which one or both are categorical (friction law, coupling, foot shape):
+// grouped bars. One group per value of the cluster key (a key every model reads, categorical
+// first), in each group one bar per model and value of the other key; a model that does not read
+// the other key ("analytic.coupling" for MuJoCo) has one bar per group, not copies. Colour = model;
+// the other key's values are fill shades (solid, light, hatched, ...), named in the legend.
+void plotGroupedBars(Ctx& ctx) {
+  const ExperimentResults& r = ctx.r;
+  auto readByAll = [&](const SweepAxis& a) {
+    for (const std::string& m : r.models)
+      if (!modelReads(m, a.key)) return false;
+    return true;
+  };
+  size_t ic = 0;  // the cluster key
+  int best = -1;
+  for (size_t i = 0; i < 2; ++i) {
+    const int score = (readByAll(r.axes[i]) ? 2 : 0) + (r.axes[i].numeric ? 0 : 1);
+    if (score > best) best = score, ic = i;
+  }
+  const SweepAxis& ac = r.axes[ic];
+  const SweepAxis& ab = r.axes[1 - ic];
+  const auto cells = caseGrid(r, ac, ab);  // [cluster value][bar value]
+  struct Series {
+    std::string model;
+    int ib;  // value of ab, -1: the model does not read ab (its first case per cluster)
+  };
+  std::vector<Series> series;
+  for (const std::string& m : r.models) {
+    if (!modelReads(m, ab.key)) series.push_back({m, -1});
+    else
+      for (size_t j = 0; j < ab.values.size(); ++j) series.push_back({m, static_cast<int>(j)});
+  }
+  const std::string stem = r.name + "_phi_net_bars";
+  std::vector<std::vector<double>> rows;
+  for (size_t i = 0; i < ac.values.size(); ++i) {
+    std::vector<double> row = {double(i)};
+    for (const Series& sr : series) {
+      const CaseRecord* c = nullptr;
+      if (sr.ib >= 0) c = cells[i][sr.ib];
+      else
+        for (size_t j = 0; j < ab.values.size() && !c; ++j) c = cells[i][j];
+      row.push_back(c ? r.phiNet(*c, sr.model) : kNaN);
+    }
+    rows.push_back(row);
+  }
+  std::vector<std::string> names = {leafKey(ac.key)};
+  for (const Series& sr : series)
+    names.push_back(sr.model + (sr.ib >= 0 ? "_" + leafKey(ab.key) + "=" + ab.values[sr.ib] : std::string()));
+  writeDataFile(ctx.data(stem), names, rows);
+
+  const Txt title = ctx.title(W("net body rotation phi_net over ") + K(ac.key) + W(" and ") + K(ab.key) + ctx.tail);
+  const int w = std::max(1000, 260 + static_cast<int>(ac.values.size() * (series.size() + 1)) * 70);
+  // Bars start at zero: the y range holds zero and every value, with room for the value labels.
+  double lo = 0, hi = 0;
+  for (const auto& row : rows)
+    for (size_t k = 1; k < row.size(); ++k)
+      if (std::isfinite(row[k])) lo = std::min(lo, row[k]), hi = std::max(hi, row[k]);
+  const double pad = 0.12 * std::max(hi - lo, 1e-3);
+  const size_t nb = series.size();
+  std::ostringstream b;
+  b << header(ctx, title, gpAxisLabel(ac.key), "φ_{net} [deg]", w)
+    << "set style data histogram\nset style histogram cluster gap 1\nset boxwidth 0.9\n"
+    << range("y", lo < 0 ? lo - pad : 0.0, hi > 0 ? hi + pad : 0.0)
+    << "set xrange [-0.6:" << ac.values.size() - 0.4 << "]\n"
+    << "set xzeroaxis lt -1\nset grid noxtics\nset key outside right top box\n"
+    << "set xtics (";
+  for (size_t i = 0; i < ac.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ac.key, ac.values[i])) << " " << i;
+  b << ")\nplot ";
+  // shades of the other key's values: solid, light, hatched two ways, then open
+  static const char* const fills[] = {"fs solid 1.0 border -1", "fs solid 0.4 border -1", "fs pattern 4 border -1",
+                                      "fs pattern 5 border -1", "fs empty border -1"};
+  for (size_t k = 0; k < series.size(); ++k) {
+    const Series& sr = series[k];
+    std::string t = gpText(shortModel(sr.model));
+    if (sr.ib >= 0) t += ", " + gpValueLabel(ab.key, ab.values[sr.ib]);
+    else t += " (" + keyDisplay(ab.key).symbol + " not used)";
+    b << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using " << k + 2 << " "
+      << fills[sr.ib < 0 ? 0 : sr.ib % 5] << " lc rgb " << gpQuote(modelColor(sr.model)) << " title " << gpQuote(t);
+  }
+  // Each bar's value above it (below a negative bar): bar k of a cluster of nb (gap 1) is centred
+  // at cluster + (k + 0.5 - nb / 2) / (nb + 1).
+  for (size_t k = 0; k < nb; ++k)
+    b << ", \\\n     " << gpQuote(stem + ".dat") << " using ($1 + " << fmt("%.6g", (k + 0.5 - 0.5 * nb) / (nb + 1.0))
+      << "):($" << k + 2 << " + ($" << k + 2 << " < 0 ? -1 : 1) * " << fmt("%.6g", 0.35 * pad) << "):(sprintf('%.2f', $"
+      << k + 2 << ")) with labels font 'Sans,12' notitle";
+  b << "\n";
+  std::string cap = title.plain + ". φ_net of each case as bars, grouped by " + K(ac.key).plain +
+                    "; colour = model, fill = " + K(ab.key).plain + " (solid, light, hatched, in the legend's order).";
+  for (const std::string& m : r.models)
+    if (!modelReads(m, ab.key))
+      cap += " " + shortModel(m) + " does not read " + K(ab.key).plain + ": one bar per group.";
+  ctx.render(stem, b.str(), title, cap, w + 360, 700);
+}
+
 void plotTwoKeys(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
+  if (!r.axes[0].numeric || !r.axes[1].numeric) {
+    plotGroupedBars(ctx);
+    return;
+  }
   const SweepAxis& ay = r.axes[0];  // slowest-varying key (first in the file)
   const SweepAxis& ax = r.axes[1];
   std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
@@ -553,7 +744,7 @@ void plotTwoKeys(Ctx& ctx) {
   const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(ay.key) + ctx.tail);
   std::ostringstream b;
   const int panel_w = 1100, fig_w = panel_w * static_cast<int>(grids.size());
-  b << "reset\nset multiplot layout 1," << grids.size() << " title " << gpTitle(title.gp, fig_w, 17) << " font 'Sans,17'\n"
+  b << "reset\nset multiplot layout 1," << grids.size() << " title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n"
     << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
   if (!ax.numeric) {
     b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
@@ -585,24 +776,139 @@ void plotTwoKeys(Ctx& ctx) {
              fig_w, 720);
 }
 
+// Small multiples for 3 or more swept keys (facetKeys): one figure per model, one panel per
+// combination of the facet keys' values (a grid: rows and columns are the two facet keys when
+// there are two), in each panel phi_net over the x key with one curve per value of the series key.
+// Every panel of a figure has the same axes, so panels compare by eye.
 void plotManyKeys(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
-  const std::string stem = r.name + "_phi_net_cases";
-  std::vector<std::vector<double>> rows;
-  for (size_t i = 0; i < r.cases.size(); ++i) {
-    std::vector<double> row = {double(i)};
-    for (const std::string& m : r.models) row.push_back(r.phiNet(r.cases[i], m));
-    rows.push_back(row);
+  const FacetKeys fk = facetKeys(r.axes);
+  const SweepAxis& ax = r.axes[fk.x];
+  const SweepAxis& as = r.axes[fk.series];
+  const KeyDisplay kx = keyDisplay(ax.key);
+  // The cases by their values of every axis, in axes order.
+  std::map<std::vector<std::string>, const CaseRecord*> index;
+  for (const CaseRecord& c : r.cases) {
+    std::vector<std::string> k;
+    for (const SweepAxis& a : r.axes) {
+      const auto it = c.sweep.find(a.key);
+      k.push_back(it == c.sweep.end() ? std::string() : it->second);
+    }
+    index.emplace(k, &c);
   }
-  writeDataFile(ctx.data(stem), {"case"}, rows);
-  const Txt title = ctx.title(W("net body rotation phi_net per case") + ctx.tail);
-  std::ostringstream b;
-  b << header(title, "case index (order of summary.json)", "φ_{net} [deg]") << "plot ";
-  for (size_t j = 0; j < r.models.size(); ++j)
-    b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2 << " with linespoints pt 7 lc rgb "
-      << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(modelTitle(r.models[j])));
-  b << "\n";
-  ctx.render(stem, b.str(), title, title.plain + ". φ_net of every case in the order of summary.json.");
+  // Every combination of the facet keys' values, the last facet key fastest.
+  std::vector<std::vector<size_t>> combos(1);
+  for (size_t f : fk.facets) {
+    std::vector<std::vector<size_t>> next;
+    for (const auto& c : combos)
+      for (size_t i = 0; i < r.axes[f].values.size(); ++i) {
+        next.push_back(c);
+        next.back().push_back(i);
+      }
+    combos = std::move(next);
+  }
+  const size_t np = combos.size();
+  size_t cols = 1, rows = 1;
+  if (fk.facets.size() == 2) {
+    rows = r.axes[fk.facets[0]].values.size();
+    cols = r.axes[fk.facets[1]].values.size();
+  } else {
+    cols = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(np))));
+    rows = (np + cols - 1) / cols;
+  }
+  // Panel size shrinks with their number, the whole figure within about 3000 x 2400 px.
+  const int panel_w = std::clamp(3000 / static_cast<int>(cols), 380, 620);
+  const int panel_h = std::clamp(2400 / static_cast<int>(rows), 300, 440);
+  const int legend_w = 260;
+  const int fig_w = panel_w * static_cast<int>(cols) + legend_w, fig_h = panel_h * static_cast<int>(rows) + 90;
+  std::string facet_words;
+  for (size_t f = 0; f < fk.facets.size(); ++f)
+    facet_words += std::string(f ? " and " : "") + keyDisplay(r.axes[fk.facets[f]].key).plain;
+
+  for (const std::string& m : r.models) {
+    std::vector<double> all;
+    std::vector<std::string> dats;
+    for (size_t p = 0; p < np; ++p) {
+      std::vector<std::vector<double>> rowsd;
+      for (size_t ix = 0; ix < ax.values.size(); ++ix) {
+        std::vector<double> row = {ax.numeric ? ax.number(ix) * kx.scale : double(ix)};
+        for (size_t is = 0; is < as.values.size(); ++is) {
+          std::vector<std::string> k(r.axes.size());
+          k[fk.x] = ax.values[ix];
+          k[fk.series] = as.values[is];
+          for (size_t f = 0; f < fk.facets.size(); ++f) k[fk.facets[f]] = r.axes[fk.facets[f]].values[combos[p][f]];
+          const auto it = index.find(k);
+          const double v = it == index.end() ? kNaN : r.phiNet(*it->second, m);
+          row.push_back(v);
+          if (std::isfinite(v)) all.push_back(v);
+        }
+        rowsd.push_back(row);
+      }
+      const std::string dstem = r.name + "_phi_net_facets_" + m + "_" + std::to_string(p);
+      std::vector<std::string> names = {leafKey(ax.key)};
+      for (const std::string& v : as.values) names.push_back(leafKey(as.key) + "=" + v);
+      writeDataFile(ctx.data(dstem), names, rowsd);
+      dats.push_back(dstem + ".dat");
+    }
+    if (all.empty()) continue;
+    const auto [ylo, yhi] = span(all, 0.08);
+    // keys this model does not read ("mujoco.foot_shape" for the analytic model): said in the title
+    std::string unused;
+    for (const SweepAxis& a : r.axes)
+      if (!modelReads(m, a.key)) unused += (unused.empty() ? "" : ", ") + keyDisplay(a.key).plain;
+    Txt who{gpText(modelTitle(m)), modelTitle(m)};
+    if (!unused.empty()) who = who + Txt{gpText(" (" + unused + " not used)"), " (" + unused + " not used)"};
+    const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(as.key) +
+                                Txt{", one panel per " + gpText(facet_words), ", one panel per " + facet_words} +
+                                ctx.tail + W(": ") + who);
+    const std::string stem = r.name + "_phi_net_facets_" + m;
+    std::ostringstream b;
+    // Panels leave room on the right for one legend beside the top-right panel.
+    const double right = 1.0 - static_cast<double>(legend_w) / fig_w;
+    const double top = 1.0 - 70.0 / fig_h;
+    b << "reset\nset multiplot title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n"
+      << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string()) << "set grid\nset xzeroaxis lt -1\n"
+      << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel 'φ_{net} [deg]'\n";
+    if (!ax.numeric) {
+      b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
+      for (size_t i = 0; i < ax.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ax.key, ax.values[i])) << " " << i;
+      b << ")\n";
+    } else {  // the swept values and a 3 % margin, not gnuplot's rounded tics
+      std::vector<double> xs;
+      for (size_t i = 0; i < ax.values.size(); ++i) xs.push_back(ax.number(i) * kx.scale);
+      const auto [xlo, xhi] = span(xs, 0.03);
+      if (std::isfinite(xlo)) b << range("x", xlo, xhi);
+    }
+    for (size_t p = 0; p < np; ++p) {
+      const size_t row = p / cols, col = p % cols;
+      const double w = right / cols, h = top / rows;
+      std::string ptitle;
+      for (size_t f = 0; f < fk.facets.size(); ++f) {
+        const SweepAxis& fa = r.axes[fk.facets[f]];
+        ptitle += (f ? ", " : "") + gpValueLabel(fa.key, fa.values[combos[p][f]]);
+      }
+      b << "set origin " << fmt("%.5f", col * w) << "," << fmt("%.5f", top - (row + 1) * h) << "\nset size "
+        << fmt("%.5f", w) << "," << fmt("%.5f", h) << "\nset title " << gpQuote(ptitle) << "\n";
+      if (p == 0) {
+        b << "set key at screen " << fmt("%.5f", right + 0.01) << ", screen " << fmt("%.5f", top)
+          << " left top box opaque title " << gpQuote(keyDisplay(as.key).symbol) << "\n";
+      } else if (p == 1) {
+        b << "unset key\n";
+      }
+      b << "plot ";
+      for (size_t is = 0; is < as.values.size(); ++is)
+        b << (is ? ", \\\n     " : "") << gpQuote(dats[p]) << " using 1:" << is + 2 << " with linespoints lw 2 pt "
+          << seriesPoint(is) << " ps 1.1 dt " << seriesDash(is) << " lc rgb " << gpQuote(seriesColor(is))
+          << " title " << gpQuote(gpValueLabel(as.key, as.values[is], false));
+      b << "\n";
+    }
+    b << "unset multiplot\n";
+    ctx.render(stem, b.str(), title,
+               title.plain + ". φ_net of " + modelTitle(m) + " over " + K(ax.key).plain + ", one curve per value of " +
+                   K(as.key).plain + ", one panel per value of " + facet_words +
+                   "; every panel has the same axes. A missing point is a case that was not run or failed.",
+               fig_w, fig_h);
+  }
 }
 
 // ---- pose -----------------------------------------------------------------------------------
@@ -662,7 +968,7 @@ void plotPoseOneKey(Ctx& ctx) {
     const std::string ylabel = perIzz ? "contribution to φ̈ [rad/s^2]" : "moment [N m]";
     const Txt title = ctx.title(Txt{"tail moment contributions over ", "tail moment contributions over "} + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << "reset\nset multiplot layout 1,2 title " << gpTitle(title.gp, 1600, 17) << " font 'Sans,17'\n";
+    b << "reset\nset multiplot layout 1,2 title " << ctx.figTitle(title, 1600, 17) << " font 'Sans,17'\n";
     for (int j = 0; j < 2; ++j)
       b << "set grid\nunset key\nset xzeroaxis lt -1\nset title " << gpTitle(parts[j].gp, 800) << "\nset xlabel "
         << gpQuote(gpAxisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpQuote(stem + ".dat")
@@ -681,7 +987,7 @@ void plotPoseOneKey(Ctx& ctx) {
     writeDataFile(ctx.data(stem), {leafKey(a.key), "LF_mm"}, rows);
     const Txt title = ctx.title(W("friction moment arm L_F over ") + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << header(title, gpAxisLabel(a.key), "L_F [mm]") << "unset key\nplot " << gpQuote(stem + ".dat")
+    b << header(ctx, title, gpAxisLabel(a.key), "L_F [mm]") << "unset key\nplot " << gpQuote(stem + ".dat")
       << " using 1:2 with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
     ctx.render(stem, b.str(), title, title.plain + " (Eqs. 17-19, " + modelTitle(model) + ").");
   }
@@ -710,8 +1016,8 @@ void plotPoseTwoKeys(Ctx& ctx) {
 
 }  // namespace
 
-std::vector<PlotFile> plotExperiment(const ExperimentResults& r) {
-  Ctx ctx{r, (fs::path(r.dir) / "plots").string(), {}, {}, {}};
+std::vector<PlotFile> plotExperiment(const ExperimentResults& r, const PlotOptions& opt) {
+  Ctx ctx{r, (fs::path(r.dir) / "plots").string(), {}, {}, {}, opt};
   const std::string name = figureName(r.description, r.name);
   ctx.fig = {gpFigureName(r.description, r.name), name};
   if (r.links > 0) {
@@ -736,11 +1042,11 @@ std::vector<PlotFile> plotExperiment(const ExperimentResults& r) {
   return ctx.out;
 }
 
-std::vector<PlotFile> plotResults(const std::string& dir) {
+std::vector<PlotFile> plotResults(const std::string& dir, const PlotOptions& opt) {
   std::vector<PlotFile> all;
   const std::vector<ExperimentResults> results = loadResultTree(dir);
   for (const ExperimentResults& r : results) {
-    std::vector<PlotFile> p = plotExperiment(r);
+    std::vector<PlotFile> p = plotExperiment(r, opt);
     all.insert(all.end(), p.begin(), p.end());
   }
   writeFigureSheet(dir, results, all);

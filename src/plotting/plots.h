@@ -9,7 +9,11 @@
 //                              smaller cells, no values; heatMapLayout), one per model
 //                              side by side; phi_net over the faster key, one curve per value of
 //                              the slower one                                        (Figs. 9, 12)
-//   simulate, 3+ swept keys -> phi_net over the case index
+//                              plus, with two models, the difference of the second from the
+//                              first (diverging colours centred on zero)
+//   simulate, 3+ swept keys -> small multiples, one figure per model: phi_net over the numeric key
+//                              with the most values, one curve per value of the key with the
+//                              fewest, one panel per combination of the other keys (facetKeys)
 //   pose, 1 swept key       -> M_zT,tan/I_zz and M_zT,cen/I_zz (else the acceleration-/speed-driven
 //                              parts) over the key; L_F over the key                      (Fig. 8)
 //   pose, 2 swept keys      -> heat map of L_F                                           (Fig. 10)
@@ -45,12 +49,31 @@ struct HeatMapLayout {
 };
 HeatMapLayout heatMapLayout(size_t nx, size_t ny);
 
+// How the figures are drawn for a paper or slides (`tailsim plot --no-titles --size W,H
+// --font-scale F`): without the figure's own title (the caption keeps it; panel titles stay),
+// every figure at W x H pixels (0: each figure's own size), fonts scaled by F.
+struct PlotOptions {
+  bool titles = true;
+  int width_px = 0, height_px = 0;
+  double font_scale = 1.0;
+};
+
+// The roles of the swept keys in a figure of 3 or more keys (indices into axes): x is the numeric
+// key with the most values (the first key with the most values when none is numeric), series the
+// remaining key with the fewest values (one curve each), facets the others in file order (one
+// panel per combination of their values).
+struct FacetKeys {
+  size_t x = 0, series = 1;
+  std::vector<size_t> facets;
+};
+FacetKeys facetKeys(const std::vector<SweepAxis>& axes);
+
 // Draws the figures of one experiment into r.dir/plots/. Throws std::runtime_error if gnuplot
 // fails; a model whose CSV is missing is left out of the figures that need it.
-std::vector<PlotFile> plotExperiment(const ExperimentResults& r);
+std::vector<PlotFile> plotExperiment(const ExperimentResults& r, const PlotOptions& opt = {});
 
 // DIR is one result folder or a suite folder (one result folder per experiment under it).
 // Returns every figure written, and writes DIR/figures.html (figure_sheet.h) listing them.
-std::vector<PlotFile> plotResults(const std::string& dir);
+std::vector<PlotFile> plotResults(const std::string& dir, const PlotOptions& opt = {});
 
 }  // namespace tailsim

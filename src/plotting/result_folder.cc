@@ -104,9 +104,9 @@ CaseRecord parseCase(const json& c) {
       run.wall_time_s = numberOr(j, "wall_time_s", NAN);
       run.stick_slip_events = static_cast<int>(numberOr(j, "stick_slip_events", 0));
       if (j.contains("error") && j["error"].is_string()) run.error = j["error"].get<std::string>();
-      if (j.contains("warnings") && j["warnings"].is_array())
-        for (const auto& w : j["warnings"])
-          if (w.is_string()) run.warnings.push_back(w.get<std::string>());
+      if (auto w = j.find("warnings"); w != j.end() && w->is_array())
+        for (const json& x : *w)
+          if (x.is_string()) run.warnings.push_back(x.get<std::string>());
       r.runs[it.key()] = run;
     }
   }
@@ -301,6 +301,20 @@ std::vector<ExperimentResults> loadResultTree(const std::string& dir) {
   std::vector<ExperimentResults> out;
   for (const fs::path& p : subs) out.push_back(loadResults(p.string()));
   return out;
+}
+
+std::string warningShape(const std::string& w) {
+  auto digit = [&](size_t i) { return i < w.size() && w[i] >= '0' && w[i] <= '9'; };
+  std::string s;
+  for (size_t i = 0; i < w.size();) {
+    if (!digit(i)) {
+      s += w[i++];
+      continue;
+    }
+    s += '#';  // one number: digits with an optional fraction ("23", "21.2", "1e-3" -> "#e-#")
+    while (digit(i) || (w[i] == '.' && digit(i + 1))) ++i;
+  }
+  return s;
 }
 
 }  // namespace tailsim

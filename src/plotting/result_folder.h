@@ -24,7 +24,7 @@ struct RunRecord {
   double wall_time_s = NAN;
   int stick_slip_events = 0;
   std::string error;
-  std::vector<std::string> warnings;  // "warnings" (result computed but doubtful)
+  std::vector<std::string> warnings;  // the run's warnings, as summary.json lists them
 };
 
 struct CaseRecord {
@@ -88,6 +88,11 @@ ExperimentResults loadResults(const std::string& dir);
 
 // DIR itself if it holds summary.json, else every direct subfolder that does (sorted by name).
 std::vector<ExperimentResults> loadResultTree(const std::string& dir);
+
+// A warning with each number masked ("all four feet carry no load in 22.3 % ..." and "... in 23 %
+// ..." -> "... in # % ..."): runs whose warnings differ only in their numbers say the same thing, shown once with
+// their count (the console table, figures.html, report.md).
+std::string warningShape(const std::string& warning);
 
 // "trajectory.theta0_deg" -> "theta0_deg"; "trajectory.dtheta_deg[2]" -> "dtheta_deg[2]".
 std::string leafKey(const std::string& key);

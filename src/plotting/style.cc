@@ -65,8 +65,11 @@ std::string gpPanelTitle(const std::string& model, const std::vector<SweepAxis>&
 
 namespace {
 // Series colours leave out the two model colours (blue, vermillion): a case curve never looks
-// like a model curve.
-const char* const kSeries[] = {oi::kOrange, oi::kSkyBlue, oi::kGreen, oi::kPurple, oi::kBlack};
+// like a model curve. The five Okabe-Ito line colours first, then five darker or greyer ones
+// (brown, grey, dark purple, olive, dark teal) apart from them and from each other in hue or
+// lightness, so that up to ten curves of a figure never share a colour.
+const char* const kSeries[] = {oi::kOrange, oi::kSkyBlue, oi::kGreen, oi::kPurple, oi::kBlack,
+                               "#8C510A",   "#999999",    "#5E3C99",  "#9A9A00",  "#01665E"};
 constexpr size_t kNumSeries = sizeof kSeries / sizeof kSeries[0];
 }  // namespace
 
@@ -94,8 +97,9 @@ std::string divergingPalette() {
          oi::kVermillion + "')\n";
 }
 
-std::string sequentialPalette() {
+std::string sequentialPalette(bool dark_at_low) {
   // white - orange - dark orange: neither model's colour
+  if (dark_at_low) return std::string("set palette defined (0 '#7A4A00', 1 '") + oi::kOrange + "', 2 '#FFFDF7')\n";
   return std::string("set palette defined (0 '#FFFDF7', 1 '") + oi::kOrange + "', 2 '#7A4A00')\n";
 }
 
@@ -279,6 +283,25 @@ KeyDisplay keyDisplay(const std::string& key) {
         d.unit = unit;
         break;
       }
+    // A name of words ("foot_shape", "body_height", "mass": every part at least 3 letters) is
+    // shown as words, with what it belongs to: "MuJoCo foot shape", "body mass"; a symbol-like
+    // name ("l_F", "d_Q2C") stays a symbol.
+    bool words = true;
+    for (size_t a = 0, b; a <= d.plain.size(); a = b + 1) {
+      b = d.plain.find('_', a);
+      if (b == std::string::npos) b = d.plain.size();
+      words = words && b - a >= 3;
+    }
+    if (words) {
+      std::string w = d.plain;
+      std::replace(w.begin(), w.end(), '_', ' ');
+      const std::string section = key.substr(0, key.find('.'));
+      static const std::map<std::string, std::string> owner = {
+          {"quadruped", "body "}, {"mujoco", "MuJoCo "}, {"perfoot", "per-foot "}, {"analytic", "analytic "}, {"tail", "tail "}};
+      if (const auto it = owner.find(section); it != owner.end() && key.find('.') != std::string::npos) w = it->second + w;
+      d.plain = w;
+      d.symbol = gpText(w);
+    }
   }
   if (!joint.empty()) {
     d.symbol += " (joint " + joint + ")";

@@ -29,23 +29,25 @@ std::string modelTitle(const std::string& model);
 std::string gpPanelTitle(const std::string& model, const std::vector<SweepAxis>& axes);
 // Curves that are not models (one per case or per value of a key), in every figure the same way:
 // the five Okabe-Ito line colours that are not a model's (orange, sky blue, bluish green, reddish
-// purple, black) in that order, solid with filled points for the first five, then the same colours
-// dashed with open points, then dotted, ...: (colour, dash, point) differs for every i < 20, so no
-// two curves of a figure look alike (Fig. 9: seven values of d_Q2B).
+// purple, black) in that order, then five darker or greyer ones (brown, grey, dark purple, olive,
+// dark teal): no colour twice among the first ten curves (Fig. 9: seven values of d_Q2B; Fig. 14:
+// six tails). All solid for the first ten, then the same colours dashed, then dotted, ...; the
+// points differ too: (colour, dash, point) differs for every i < 40.
 std::string seriesColor(size_t i);
-int seriesDash(size_t i);   // gnuplot dashtype: 1 solid for the first 5, then 2, 3, 4, 1, ...
+int seriesDash(size_t i);   // gnuplot dashtype: 1 solid for the first 10, then 2, 3, 4, 1, ...
 int seriesPoint(size_t i);  // gnuplot pointtype (pngcairo/svg): 13 distinct, filled then open
-size_t numSeriesColors();   // 5
+size_t numSeriesColors();   // 10
 // Every Okabe-Ito line colour (yellow left out), for plots whose series are neither models nor
 // cases (the accuracy study's integrator families): 7 distinct colours.
 std::string categoricalColor(size_t i);
 // The three moments of Figs. 6-7 (tail, friction, inertial), never a model's colour.
 std::string quantityColor(size_t i);
 
-// gnuplot `set palette defined (...)` for a signed quantity on a range centred on zero
-// (blue - white - vermillion) and for a one-signed quantity (white - orange - dark orange).
+// gnuplot `set palette defined (...)` for values of both signs and differences, on a range
+// centred on zero (blue - white - vermillion), and for one-signed values (white - orange - dark
+// orange; dark_at_low: dark orange - orange - white, for values that are all negative).
 std::string divergingPalette();
-std::string sequentialPalette();
+std::string sequentialPalette(bool dark_at_low = false);
 
 // ---- words -----------------------------------------------------------------------------------
 // Escapes gnuplot enhanced-text control characters (_ ^ @ & ~ { } \) in free text.

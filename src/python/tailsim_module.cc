@@ -203,7 +203,15 @@ PYBIND11_MODULE(tailsim, m) {
   // pybind11 sets up numpy's C API in a function-local static on the first array made. Made first by
   // two pool threads at once, one waits in the static's guard holding nothing while the other imports
   // numpy and waits for the GIL: a deadlock. Do it here, once, while importing the module.
-  py::module_::import("numpy");
+  try {
+    py::module_::import("numpy");
+  } catch (py::error_already_set& e) {
+    if (!e.matches(PyExc_ImportError)) throw;
+    throw py::import_error(
+        "tailsim: numpy is missing (tailsim returns time series as numpy arrays): install it, e.g. "
+        "apt-get install python3-numpy (scripts/setup.sh installs it); import error: " +
+        std::string(e.what()));
+  }
   (void)py::array_t<double>(0);
 
   py::class_<Simulation>(m, "Simulation", "The result of tailsim.simulate(): one model run of one case")
