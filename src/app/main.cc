@@ -267,7 +267,7 @@ int main(int argc, char** argv) {
   bool allow_other_build = false;
   run->add_flag("--allow-other-build", allow_other_build,
                 "resume cases computed by another tailsim version or commit (warned, recorded in summary.json) instead of refusing them");
-    run->add_flag("--quiet", quiet, "print only errors and the final line (cases run, resumed, failed)");
+  run->add_flag("--quiet", quiet, "print only errors and the final line (cases run, resumed, failed)");
   run->add_flag("--plot", plots, "draw the plots and the report afterwards");
   std::string shard_text;
   run->add_option("--shard", shard_text,
