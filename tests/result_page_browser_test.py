@@ -194,6 +194,22 @@ def main():
                 assert s["force_arrows"]["normal"] == loaded == 4, (s["force_arrows"], loaded)
                 sliding = sum(math.hypot(float(row["F%dx_N" % k]), float(row["F%dy_N" % k])) > 1e-3 for k in range(1, 5))
                 assert s["force_arrows"]["friction"] == sliding, (s["force_arrows"], sliding)
+        # Play moves the time on; the scrub bar sets it; sorting and filtering the table.
+        driver.execute_script("tailsim.seek(0); tailsim.play()")
+        time.sleep(0.4)
+        st = driver.execute_script("tailsim.pause(); return tailsim.state()")
+        assert 0.05 < st["t"] and not st["playing"], st["t"]
+        t_end = driver.execute_script(
+            "const s = document.getElementById('scrub'); s.value = 1000; s.dispatchEvent(new Event('input')); return tailsim.state().t")
+        t_last = max(float(r["t_s"]) for r in read_csv(os.path.join(out, SWEEP_NAME, "cases", case_dir, "perfoot.csv")))
+        assert abs(t_end - t_last) < 1e-9, (t_end, t_last)
+        first = "return document.querySelector('.row').firstChild.textContent"
+        driver.execute_script("document.querySelectorAll('#thead .cell')[3].click()")  # analytic phi_net, ascending
+        assert "dtheta_deg=-30,dT_s=0.3" in driver.execute_script(first)
+        driver.execute_script("document.querySelectorAll('#thead .cell')[3].click()")  # descending
+        assert "dtheta_deg=-60,dT_s=0.2" in driver.execute_script(first)
+        driver.execute_script("const f = document.getElementById('filter'); f.value = 'dT_s=0.2'; f.dispatchEvent(new Event('input'))")
+        assert driver.execute_script("return document.getElementById('count').textContent") == "2 of 4 cases"
         if SHOTS:
             driver.execute_script("document.getElementById('replaysec').scrollIntoView()")
             driver.save_screenshot(os.path.join(SHOTS, "result-page-replay.png"))
