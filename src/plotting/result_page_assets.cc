@@ -78,6 +78,7 @@ const char* const kResultPageJs = R"JS('use strict';
     document.title = 'tailsim: ' + d.folder;
     $('title').textContent = 'tailsim results: ' + d.folder;
     $('figlink').hidden = !d.figures_html;
+    if (d.note) $('title').appendChild(el('small', { class: 'note' }, ' (' + d.note + ')'));
     const sel = $('expsel');
     d.experiments.forEach((e, i) => sel.appendChild(el('option', { value: i }, e.name)));
     sel.parentNode.hidden = d.experiments.length < 2;
@@ -472,7 +473,7 @@ const char* const kResultPageJs = R"JS('use strict';
   function setupScene(c) {
     const box = $('view3d');
     if (view.three) { box.removeChild(view.three.renderer.domElement); view.three.renderer.dispose(); view.three = null; }
-    if (!c.geometry || !window.THREE) return;
+    if (!c.geometry || !window.THREE || !THREE.OrbitControls) return;
     let renderer;
     try {
       renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
