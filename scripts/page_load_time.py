@@ -5,6 +5,7 @@ took until the results table was drawn, the page's size on disk and its rows in 
 usage: scripts/page_load_time.py DIR [REPEATS]   (needs chromium, chromium-driver, python3-selenium)
 """
 import os
+import shutil
 import sys
 import tempfile
 import time
@@ -49,6 +50,7 @@ def main():
             print("load %.2f s (page clock %.0f ms), sort %.2f s; %s, %d rows in the DOM" % (t1 - t0, nav, t3 - t2, count, rows))
     finally:
         driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
     print("size: data.js %.1f MB, page/ %.1f MB (three.js %.2f MB), index.html %d B" % (
         size(os.path.join(folder, "page", "data.js")) / 1e6, size(os.path.join(folder, "page")) / 1e6,
         size(os.path.join(folder, "page", "three.min.js")) / 1e6, size(os.path.join(folder, "index.html"))))

@@ -35,7 +35,9 @@ TAILSIM = os.path.join(BUILD, "tailsim")
 # 10 kB of it.
 HOSTILE = "</script><script>window.pwned=1</script> \"quoted\" 'single' & <b>bold</b> \u2028 line \u2029 end " + "x" * 10000
 
-SWEEP = """name: sweep2
+# An experiment name may hold markup characters, quotes and U+2028 (not '/' or control characters).
+SWEEP_NAME = "sweep2 <img src=x onerror=window.pwned=1> \"q\" 'a' &amp; \u2028 end"
+SWEEP = """name: %s
 description: %s
 robot: paper
 tail: {links: 2}
@@ -108,7 +110,7 @@ def main():
     t_start = time.time()
     tmp = tempfile.mkdtemp(prefix="tailsim-page-")
     with open(os.path.join(tmp, "sweep2.yaml"), "w") as f:
-        f.write(SWEEP % yaml_string(HOSTILE))
+        f.write(SWEEP % (yaml_string(SWEEP_NAME), yaml_string(HOSTILE)))
     with open(os.path.join(tmp, "mujoco1.yaml"), "w") as f:
         f.write(MUJOCO)
     with open(os.path.join(tmp, "suite.yaml"), "w") as f:
@@ -138,15 +140,18 @@ def main():
         t_loaded = time.time()
 
         names = driver.execute_script("return tailsim.experiments()")
-        assert sorted(names) == ["mujoco1", "sweep2"], names
-        sweep, mj = names.index("sweep2"), names.index("mujoco1")
+        assert sorted(names) == ["mujoco1", SWEEP_NAME], names
+        sweep, mj = names.index(SWEEP_NAME), names.index("mujoco1")
         driver.execute_script("tailsim.selectExperiment(arguments[0])", sweep)
 
         # Text from the inputs is shown as text, nothing of it runs.
-        assert driver.execute_script("return window.pwned === undefined"), "the description ran as script"
+        assert driver.execute_script("return window.pwned === undefined"), "text from the inputs ran as script"
         desc = driver.execute_script("return document.getElementById('expdesc').textContent")
         assert desc == HOSTILE, "description not shown verbatim: %r..." % desc[:80]
         assert driver.execute_script("return document.querySelectorAll('#expdesc *').length") == 0
+        assert driver.execute_script("return document.getElementById('exptitle').textContent") == SWEEP_NAME
+        assert driver.execute_script("return document.getElementById('expsel').selectedOptions[0].textContent") == SWEEP_NAME
+        assert driver.execute_script("return document.querySelectorAll('img[src=x]').length") == 0
 
         # The table: 4 cases, rows only for what is visible.
         assert driver.execute_script("return document.getElementById('count').textContent") == "4 of 4 cases"
@@ -171,9 +176,9 @@ def main():
         assert st["webgl"], "no WebGL: the 3D view was not drawn"
 
         # The replay at a CSV row's time mid-stroke shows that row.
-        case_dir = [d for d in os.listdir(os.path.join(out, "sweep2", "cases")) if "dtheta_deg=-60" in d and "dT_s=0.3" in d][0]
+        case_dir = [d for d in os.listdir(os.path.join(out, SWEEP_NAME, "cases")) if "dtheta_deg=-60" in d and "dT_s=0.3" in d][0]
         for model in ("analytic", "perfoot"):
-            rows = read_csv(os.path.join(out, "sweep2", "cases", case_dir, model + ".csv"))
+            rows = read_csv(os.path.join(out, SWEEP_NAME, "cases", case_dir, model + ".csv"))
             row = min(rows, key=lambda r: abs(float(r["t_s"]) - 0.15))  # mid-stroke (0..0.3 s)
             t = float(row["t_s"])
             driver.execute_script("tailsim.seek(arguments[0])", t)
@@ -189,6 +194,22 @@ def main():
                 assert s["force_arrows"]["normal"] == loaded == 4, (s["force_arrows"], loaded)
                 sliding = sum(math.hypot(float(row["F%dx_N" % k]), float(row["F%dy_N" % k])) > 1e-3 for k in range(1, 5))
                 assert s["force_arrows"]["friction"] == sliding, (s["force_arrows"], sliding)
+        # Play moves the time on; the scrub bar sets it; sorting and filtering the table.
+        driver.execute_script("tailsim.seek(0); tailsim.play()")
+        time.sleep(0.4)
+        st = driver.execute_script("tailsim.pause(); return tailsim.state()")
+        assert 0.05 < st["t"] and not st["playing"], st["t"]
+        t_end = driver.execute_script(
+            "const s = document.getElementById('scrub'); s.value = 1000; s.dispatchEvent(new Event('input')); return tailsim.state().t")
+        t_last = max(float(r["t_s"]) for r in read_csv(os.path.join(out, SWEEP_NAME, "cases", case_dir, "perfoot.csv")))
+        assert abs(t_end - t_last) < 1e-9, (t_end, t_last)
+        first = "return document.querySelector('.row').firstChild.textContent"
+        driver.execute_script("document.querySelectorAll('#thead .cell')[3].click()")  # analytic phi_net, ascending
+        assert "dtheta_deg=-30,dT_s=0.3" in driver.execute_script(first)
+        driver.execute_script("document.querySelectorAll('#thead .cell')[3].click()")  # descending
+        assert "dtheta_deg=-60,dT_s=0.2" in driver.execute_script(first)
+        driver.execute_script("const f = document.getElementById('filter'); f.value = 'dT_s=0.2'; f.dispatchEvent(new Event('input'))")
+        assert driver.execute_script("return document.getElementById('count').textContent") == "2 of 4 cases"
         if SHOTS:
             driver.execute_script("document.getElementById('replaysec').scrollIntoView()")
             driver.save_screenshot(os.path.join(SHOTS, "result-page-replay.png"))

@@ -242,12 +242,13 @@ std::string seriesJson(const TimeSeries& ts) {
 
 // ---------------------------------------------------------------- the page
 
-std::string indexHtml() {
+std::string indexHtml(bool three) {
   std::ostringstream o;
   o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n" << kGeneratorMeta << "\n"
     << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
     << "<title>tailsim results</title>\n<style>\n" << kResultPageCss << "</style>\n</head>\n<body>\n"
-    << kResultPageBody << "<script src=\"page/three.min.js\"></script>\n<script src=\"page/OrbitControls.js\"></script>\n"
+    << kResultPageBody
+    << (three ? "<script src=\"page/three.min.js\"></script>\n<script src=\"page/OrbitControls.js\"></script>\n" : "")
     << "<script src=\"page/tailsim.js\"></script>\n<script src=\"page/data.js\"></script>\n</body>\n</html>\n";
   return o.str();
 }
@@ -425,9 +426,17 @@ std::string writeResultPage(const std::string& dir) {
     if (!fs::is_regular_file(fs::symlink_status(index, ec)) || readFile(index).find(kGeneratorMeta) == std::string::npos)
       throw std::runtime_error(index + " exists and was not written by tailsim: not replaced (move it away to get the result page)");
   }
-  const std::string three = readFile(std::string(kThreeDir) + "/three.min.js");
-  const std::string orbit = readFile(std::string(kThreeDir) + "/examples/js/controls/OrbitControls.js");
-  const std::string licence = readFile(kThreeCopyright);
+  // three.js, its orbit control and licence; without them (libjs-three not installed) the page has
+  // its tables and plots and says why the 3D view is missing.
+  std::string three, orbit, licence, three_note;
+  try {
+    three = readFile(std::string(kThreeDir) + "/three.min.js");
+    orbit = readFile(std::string(kThreeDir) + "/examples/js/controls/OrbitControls.js");
+    licence = readFile(kThreeCopyright);
+  } catch (const std::exception& e) {
+    three.clear();
+    three_note = std::string("no 3D view: ") + e.what() + " (Debian package libjs-three; apt install libjs-three, then tailsim plot again)";
+  }
   const std::vector<ExperimentResults> tree = loadResultTree(dir);
   const fs::path page = root / "page";
   fs::create_directories(page / "cases");
@@ -436,15 +445,18 @@ std::string writeResultPage(const std::string& dir) {
   for (size_t i = 0; i < tree.size(); ++i) experiments.push_back(experimentJson(tree[i], static_cast<int>(i), root, geometry));
   const bool figures_html = fs::exists(root / "figures.html", ec);
   const std::string folder = fs::absolute(root).lexically_normal().filename().string();
-  const std::string data = "tailsim.dataLoaded({\"folder\":" + jsString(folder) +
+  const std::string data = "tailsim.dataLoaded({\"folder\":" + jsString(folder) + ",\"note\":" + jsString(three_note) +
                            ",\"figures_html\":" + (figures_html ? "true" : "false") + ",\"experiments\":[" +
                            joined(experiments, ",\n") + "]});\n";
-  writeFileAtomic((page / "three.min.js").string(), three);
-  writeFileAtomic((page / "OrbitControls.js").string(), orbit);
-  writeFileAtomic((page / "three-LICENSE").string(), licence);
+  if (!three.empty()) {
+    writeFileAtomic((page / "three.min.js").string(), three);
+    writeFileAtomic((page / "OrbitControls.js").string(), orbit);
+    writeFileAtomic((page / "three-LICENSE").string(), licence);
+  }
   writeFileAtomic((page / "tailsim.js").string(), kResultPageJs);
   writeFileAtomic((page / "data.js").string(), data);
-  writeFileAtomic(index, indexHtml());
+  writeFileAtomic(index, indexHtml(!three.empty()));
+  if (!three_note.empty()) std::fprintf(stderr, "note: %s: %s\n", index.c_str(), three_note.c_str());
   return index;
 }
 

@@ -31,7 +31,8 @@ std::string resultPagePath(const std::string& dir);
 // Writes DIR/index.html and DIR/page/ (each file whole or not at all) for the result folder or
 // suite folder DIR and returns the index's path. Throws std::runtime_error if DIR is no result
 // folder, or if DIR/index.html exists and was not written by tailsim (a user's file is never
-// replaced), or if Debian's three.js (libjs-three) is not installed.
+// replaced). Without Debian's three.js (libjs-three) the page has no 3D view and says so (a note
+// on stderr too).
 std::string writeResultPage(const std::string& dir);
 
 }  // namespace tailsim

@@ -78,6 +78,7 @@ const char* const kResultPageJs = R"JS('use strict';
     document.title = 'tailsim: ' + d.folder;
     $('title').textContent = 'tailsim results: ' + d.folder;
     $('figlink').hidden = !d.figures_html;
+    if (d.note) $('title').appendChild(el('small', { class: 'note' }, ' (' + d.note + ')'));
     const sel = $('expsel');
     d.experiments.forEach((e, i) => sel.appendChild(el('option', { value: i }, e.name)));
     sel.parentNode.hidden = d.experiments.length < 2;
@@ -226,6 +227,15 @@ const char* const kResultPageJs = R"JS('use strict';
   }
   function axisTicks(g, a, p0, p1, horizontal) {
     g.font = '11px sans-serif';
+    if (a.values && a.numeric && a.values.length > 12) {
+      // many numeric values (a range): ticks at round numbers, placed between the cell centres
+      const n = a.values.length, lo = Math.min.apply(null, a.numbers), hi = Math.max.apply(null, a.numbers);
+      niceTicks(lo, hi, 6).forEach((v) => {
+        const p = p0 + ((v - lo) / (hi - lo) * (n - 1) + 0.5) / n * (p1 - p0), s = String(+v.toPrecision(6));
+        if (horizontal) g.fillText(s, p - 8, MAP.y1 + 16); else g.fillText(s, 24, p + 4);
+      });
+      return;
+    }
     if (a.values) {
       const n = a.values.length, every = Math.ceil(n / 8);
       for (let i = 0; i < n; i += every) {
@@ -463,7 +473,7 @@ const char* const kResultPageJs = R"JS('use strict';
   function setupScene(c) {
     const box = $('view3d');
     if (view.three) { box.removeChild(view.three.renderer.domElement); view.three.renderer.dispose(); view.three = null; }
-    if (!c.geometry || !window.THREE) return;
+    if (!c.geometry || !window.THREE || !THREE.OrbitControls) return;
     let renderer;
     try {
       renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
