@@ -8,8 +8,8 @@
 # `plot --no-titles --size W,H --font-scale F`.
 #   tests/figure_axes_test.sh SRC BUILD
 set -euo pipefail
-src=$1
-build=$2
+src=$(cd "$1" && pwd)
+build=$(cd "$2" && pwd)
 tailsim=$build/tailsim
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -749,6 +749,36 @@ TEST(HeatMap, SequentialForOneSignDivergingForBothAndForTheDifference) {
   fs::remove_all(root);
 }
 
+// A model whose values span far more than another's (MuJoCo's spikes) does not squash the other's
+// curves: the phi_net curves get one y range per panel when the ranges differ more than threefold,
+// one shared range otherwise.
+TEST(Lines, ModelPanelsShareAScaleUnlessTheirRangesAreFarApart) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_lines_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const std::vector<std::pair<std::string, std::vector<json>>> axes = {
+      {"trajectory.dtheta_deg", {-60, -120, -180}}, {"trajectory.dT_s", {0.2, 0.4, 0.6}}};
+  writeGridExperiment(root / "apart", "apart", axes, {"analytic", "mujoco"},
+                      [](const std::string& m, const std::vector<double>& x) {
+                        return (m == "mujoco" ? -250.0 : 1.0) * x[1] - 0.01 * x[0];
+                      });
+  writeGridExperiment(root / "close", "close", axes, {"analytic", "mujoco"},
+                      [](const std::string& m, const std::vector<double>& x) {
+                        return (m == "mujoco" ? 1.5 : 1.0) * x[1] - 0.01 * x[0];
+                      });
+  for (const char* exp : {"apart", "close"}) plotExperiment(loadResults((root / exp).string()));
+  auto yranges = [&](const char* exp) {
+    const std::string gp = pngCommands(readText(root / exp / "plots" / (std::string(exp) + "_phi_net_lines.gp")));
+    std::set<std::string> out;
+    std::smatch m;
+    for (auto it = gp.cbegin(); std::regex_search(it, gp.cend(), m, std::regex(R"(set yrange \[[^\]]*\])")); it = m.suffix().first)
+      out.insert(m.str());
+    return out;
+  };
+  EXPECT_EQ(yranges("apart").size(), 2u) << "one y range per model panel";
+  EXPECT_EQ(yranges("close").size(), 1u) << "one shared y range";
+  fs::remove_all(root);
+}
+
 // Three or more swept keys: small multiples per model with the keys on the axes, in panel titles
 // and in the legend, never a case index (the 198-case sweep drew phi_net over "case index").
 TEST(Facets, ThreeAndFourKeysAreDrawnAsSmallMultiples) {

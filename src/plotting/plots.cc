@@ -123,6 +123,26 @@ std::pair<double, double> span(const std::vector<double>& v, double margin) {
   return {lo - margin * d, hi + margin * d};
 }
 
+// The y ranges of panels that compare models: one shared range, unless one panel's values span
+// more than three times another's (a model's spikes or blow-up would squash the others' curves);
+// then each panel its own. Returns one range per panel and whether they are shared.
+std::pair<std::vector<std::pair<double, double>>, bool> panelRanges(const std::vector<std::vector<double>>& panels,
+                                                                    double margin) {
+  std::vector<std::pair<double, double>> own;
+  std::vector<double> all;
+  double widest = 0, narrowest = std::numeric_limits<double>::infinity();
+  for (const auto& v : panels) {
+    own.push_back(span(v, margin));
+    all.insert(all.end(), v.begin(), v.end());
+    if (std::isfinite(own.back().first)) {
+      const double w = own.back().second - own.back().first;
+      widest = std::max(widest, w), narrowest = std::min(narrowest, w);
+    }
+  }
+  if (widest > 3 * narrowest) return {own, false};
+  return {std::vector<std::pair<double, double>>(panels.size(), span(all, margin)), true};
+}
+
 // ---- time axes and phases -------------------------------------------------------------------
 
 std::vector<std::string> jointSpeedColumns(const TimeSeries& s) {
@@ -571,10 +591,12 @@ void plotOneKey(Ctx& ctx) {
   };
   std::vector<std::pair<std::string, std::vector<Curve>>> panels;
   std::vector<TimeSeries> loaded;
-  std::vector<double> stops, phis;
+  std::vector<double> stops;
+  std::vector<std::vector<double>> phis;  // per panel
   loaded.reserve(r.cases.size() * r.models.size());
   for (const std::string& m : r.models) {
     std::vector<Curve> curves;
+    std::vector<double> mine;
     for (size_t i = 0; i < a.values.size(); ++i) {
       const CaseRecord* c = r.find({{a.key, a.values[i]}});
       if (!c) continue;
@@ -589,23 +611,25 @@ void plotOneKey(Ctx& ctx) {
       std::vector<std::vector<double>> rr;
       for (size_t k = 0; k < s.numRows(); ++k) rr.push_back({s.values(col::kT)[k], s.values(col::kPhi)[k]});
       writeDataFile(ctx.data(dstem), {col::kT, col::kPhi}, rr);
-      for (double v : s.values(col::kPhi)) phis.push_back(v);
+      for (double v : s.values(col::kPhi)) mine.push_back(v);
       if (auto it = c->runs.find(m); it != c->runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
       loaded.push_back(std::move(s));
       curves.push_back({dstem + ".dat", i});
     }
-    if (!curves.empty()) panels.emplace_back(m, curves);
+    if (!curves.empty()) panels.emplace_back(m, curves), phis.push_back(mine);
   }
   if (panels.empty()) return;
   std::vector<const TimeSeries*> all;
   for (const TimeSeries& s : loaded) all.push_back(&s);
   const double t_end = timeAxisEnd(all, stops);
-  const auto [ylo, yhi] = span(phis, 0.06);
+  const auto [yr, shared] = panelRanges(phis, 0.06);
   const Txt ttitle = ctx.title(W("body yaw phi(t) for each ") + K(a.key) + ctx.tail);
   std::ostringstream t;
   t << "reset\nset multiplot layout " << panels.size() << ",1 title " << ctx.figTitle(ttitle, 1150, 17) << " font 'Sans,17'\n"
-    << range("x", 0, t_end) << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
-  for (const auto& [m, curves] : panels) {
+    << range("x", 0, t_end);
+  for (size_t p = 0; p < panels.size(); ++p) {
+    const auto& [m, curves] = panels[p];
+    t << (std::isfinite(yr[p].first) ? range("y", yr[p].first, yr[p].second) : std::string("set autoscale y\n"));
     t << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {a}), 900)
       << "\nset xlabel 't [s]'\nset ylabel 'φ [deg]'\nplot ";
     for (size_t n = 0; n < curves.size(); ++n)
@@ -617,7 +641,9 @@ void plotOneKey(Ctx& ctx) {
   t << "unset multiplot\n";
   ctx.render(r.name + "_phi_t", t.str(), ttitle,
              ttitle.plain + ". Body yaw over time, one curve per value of " + K(a.key).plain +
-                 ", one panel per model, same scales.",
+                 ", one panel per model, one time scale; " +
+                 (shared ? std::string("one angle scale.")
+                         : std::string("each panel its own angle scale (the models' ranges differ more than threefold).")),
              1150, 60 + 430 * static_cast<int>(panels.size()));
 }
 
@@ -723,35 +749,38 @@ void plotTwoKeys(Ctx& ctx) {
   const SweepAxis& ay = r.axes[0];  // slowest-varying key (first in the file)
   const SweepAxis& ax = r.axes[1];
   std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
-  std::vector<double> all;
   const auto cells = caseGrid(r, ay, ax);
   for (const std::string& m : r.models) {
     std::vector<std::vector<double>> g(ay.values.size(), std::vector<double>(ax.values.size(), kNaN));
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
       for (size_t ix = 0; ix < ax.values.size(); ++ix)
-        if (const CaseRecord* c = cells[iy][ix]) {
-          g[iy][ix] = r.phiNet(*c, m);
-          all.push_back(g[iy][ix]);
-        }
+        if (const CaseRecord* c = cells[iy][ix]) g[iy][ix] = r.phiNet(*c, m);
     grids.emplace_back(m, g);
   }
   heatMap(ctx, r.name + "_phi_net_map", W("net body rotation phi_net over ") + K(ax.key) + W(" and ") + K(ay.key),
           "φ_{net} [deg]", ax, ay, grids, "Cells: φ_net in degrees for each case.", true);
 
-  // Curves over the x key, one per y value, one panel per model, one y scale.
+  // Curves over the x key, one per y value, one panel per model; one y scale unless the models'
+  // ranges differ more than threefold (panelRanges).
   const KeyDisplay kx = keyDisplay(ax.key);
-  const auto [ylo, yhi] = span(all, 0.08);
+  std::vector<std::vector<double>> per_model;
+  for (const auto& [m, g] : grids) {
+    per_model.emplace_back();
+    for (const auto& row : g) per_model.back().insert(per_model.back().end(), row.begin(), row.end());
+  }
+  const auto [yr, shared] = panelRanges(per_model, 0.08);
   const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(ay.key) + ctx.tail);
   std::ostringstream b;
   const int panel_w = 1100, fig_w = panel_w * static_cast<int>(grids.size());
-  b << "reset\nset multiplot layout 1," << grids.size() << " title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n"
-    << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string());
+  b << "reset\nset multiplot layout 1," << grids.size() << " title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n";
   if (!ax.numeric) {
     b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
     for (size_t i = 0; i < ax.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ax.key, ax.values[i])) << " " << i;
     b << ")\n";
   }
-  for (const auto& [m, g] : grids) {
+  for (size_t p = 0; p < grids.size(); ++p) {
+    const auto& [m, g] = grids[p];
+    b << (std::isfinite(yr[p].first) ? range("y", yr[p].first, yr[p].second) : std::string("set autoscale y\n"));
     const std::string dstem = r.name + "_phi_net_lines_" + m;
     std::vector<std::vector<double>> rows;
     for (size_t ix = 0; ix < ax.values.size(); ++ix) {
@@ -772,7 +801,9 @@ void plotTwoKeys(Ctx& ctx) {
   b << "unset multiplot\n";
   ctx.render(r.name + "_phi_net_lines", b.str(), title,
              title.plain + ". φ_net over " + K(ax.key).plain + ", one curve per value of " + K(ay.key).plain +
-                 ", one panel per model, same y scale.",
+                 ", one panel per model, " +
+                 (shared ? std::string("same y scale.")
+                         : std::string("each panel its own y scale (the models' ranges differ more than threefold).")),
              fig_w, 720);
 }
 
