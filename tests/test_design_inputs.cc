@@ -226,6 +226,23 @@ TEST_F(UnboundedWorkRefusedAtLoad, ManeuverRunsAreEstimatedAndBounded) {
   EXPECT_EQ(errorOf([&] { loadManeuverSpec(maneuverFile("m", "  mujoco: true\n")); }), "(no error)");
 }
 
+// Limits no stroke can keep are refused at load (they ran the whole search and exited 3,
+// "limits VIOLATED"); the shipped limits load (ShippedConfigs.OptimizeFilesLoad).
+TEST_F(UnboundedWorkRefusedAtLoad, ImpossibleOptimizeLimitsAreRefused) {
+  auto file = [&](const std::string& limits) {
+    return write("lim.yaml", "name: l\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n  limits: " + limits +
+                                 "\n  seeds: [1]\n");
+  };
+  std::string e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 1e-9}")); });
+  EXPECT_NE(e.find("lim.yaml:6:11: optimize.limits: no stroke keeps these limits"), std::string::npos) << e;
+  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 1, dT_s: [0.05, 0.1]}")); });
+  EXPECT_NE(e.find("peaks at 20 deg/s (limit 1)"), std::string::npos) << e;
+  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [10, 10.5], thetadot_max_dps: 600}")); });
+  EXPECT_NE(e.find("needs a range of 1 deg (have 0.5)"), std::string::npos) << e;
+  EXPECT_EQ(errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 1}")); }),
+            "(no error)");
+}
+
 // (b) A maneuver's strokes are checked as the experiment loader checks a trajectory, at the key.
 TEST_F(Smaller, ManeuverValuesAreCheckedAtLoadWithLocation) {
   std::string e = errorOf([&] { loadManeuverSpec(maneuverFile("m", "  min_scale: 0.000001\n  mujoco: false\n")); });

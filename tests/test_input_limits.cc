@@ -181,5 +181,17 @@ TEST_F(Smaller, EmptyFilesAndEmptyOutAreRefusedInTailsimsWords) {
   }
 }
 
+// (c) A render at the documented maximum: msaa above 4 was accepted and rendered with 4 (llvmpipe's
+// GL_MAX_SAMPLES) or failed late with a GL status code; refused at load with the key.
+TEST_F(Smaller, RenderMsaaIsBoundedToWhatTheGlSupports) {
+  const std::string f = write("r.yaml", "name: r\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n"
+                                        "models: [mujoco]\nrender: {width: 8192, height: 8192, msaa: 16}\n");
+  const std::string e = errorOf(f);
+  EXPECT_EQ(e.rfind(f + ":5:43: render.msaa: must be in 0..4", 0), 0u) << e;
+  const std::string g = write("g.yaml", "name: g\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n"
+                                        "models: [mujoco]\nrender: {width: 8192, height: 8192, msaa: 4}\n");
+  EXPECT_EQ(errorOf(g), "(no error)");
+}
+
 }  // namespace
 }  // namespace tailsim

@@ -192,6 +192,28 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");
   }
+  // Limits that leave no stroke to search (the search used to run to its end and report "limits
+  // VIOLATED"): a 1 deg split-cycle stroke of every joint over the longest duration must keep them.
+  {
+    const double amp = 1.0 * kRadPerDeg;
+    SplitCycleParams p;
+    p.theta0_rad = std::max(L.theta_min_rad, std::min(0.0, L.theta_max_rad - amp));
+    p.dtheta_rad = amp;
+    p.dT_s = L.dT_max_s;
+    p.w_ss = std::max(L.w_ss_min, std::min(0.5, L.w_ss_max));
+    TailTrajectory probe;
+    for (int i = 0; i < sp.n_links; ++i) probe.joints.emplace_back(p);
+    StrokeLimits at_rest = L;  // a stroke that must end where it started is a spline's: not this probe
+    at_rest.end = StrokeEnd::kAtRest;
+    const StrokeFigures f = strokeFigures(s.base.robot.tail, probe);
+    if (L.theta_max_rad - L.theta_min_rad < amp || limitViolation(f, at_rest) > 0.0)
+      r.fail(lv, "no stroke keeps these limits: 1 deg of every joint over the longest duration (dT_s " +
+                     fmtG(L.dT_max_s) + " s) needs a range of 1 deg (have " +
+                     fmtG((L.theta_max_rad - L.theta_min_rad) / kRadPerDeg) + "), peaks at " +
+                     fmtG(f.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
+                     fmtG(L.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(f.peak_torque_Nm) + " N m (limit " +
+                     (L.torque_max_Nm > 0 ? fmtG(L.torque_max_Nm) : std::string("none")) + "): widen them");
+  }
   s.problem.base = s.base;
   return s;
 }
