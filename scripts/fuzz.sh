@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Fuzzes the experiment loader (tests/fuzz_experiment_loader.cc) with libFuzzer, ASan and UBSan:
+# Fuzzes the loaders of every input file and the Python keyword path (tests/fuzz_experiment_loader.cc)
+# with libFuzzer, ASan and UBSan:
 # builds it with clang in build-fuzz/ (CMake option TAILSIM_FUZZ) and runs the CTest test
 # fuzz_experiment_loader, which starts from the seed corpus configs/ and keeps what it finds in
 # build-fuzz/fuzz-corpus/ (so each run continues the last). Crashing inputs: build-fuzz/fuzz-artifacts/.

@@ -57,7 +57,9 @@ while IFS= read -r gp; do
   [ "$(be32 "$png" 16)" = "$w" ] && [ "$(be32 "$png" 20)" = "$h" ] ||
     fail "$png is $(be32 "$png" 16)x$(be32 "$png" 20), its script says ${w}x$h"
   # Titles: `set title '...'` and `set multiplot ... title '...'`; the figure's own title is the first.
-  titles=$(grep -oE "^set (title|multiplot .* title) '([^']|'')*'" "$gp" | sed -E "s/^set (title|multiplot .* title) '//; s/'\$//")
+  # (gpQuote writes a quote inside the text as '."'".': read back as ')
+  titles=$(grep -oE "^set (title|multiplot .* title) '([^']|'\.\"'\"\.')*'" "$gp" |
+           sed -E "s/^set (title|multiplot .* title) '//; s/'\$//; s/'\.\"'\"\.'/'/g")
   [ -n "$titles" ] || fail "$gp has no title"
   first=$(head -n1 <<<"$titles")
   [[ "$first" == Fig.* ]] || fail "$gp: title '$first' does not name the paper's figure"

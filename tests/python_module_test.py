@@ -7,9 +7,11 @@ import concurrent.futures
 import csv
 import json
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 
 SRC, BUILD = (os.path.abspath(a) for a in sys.argv[1:3])
@@ -184,6 +186,80 @@ class PythonModule(unittest.TestCase):
         self.assertEqual([float(r["dtheta_deg"]) for r in rows], [-10, -50, -90, -130, -170])
         row = rows[2]  # dtheta = -90: the Fig. 7 case
         self.assertEqual(float(row["phi_net_deg"]), self.cli_phi)
+
+
+class PythonInputs(unittest.TestCase):
+    """CTest python_inputs: hostile or unbounded inputs through the module (issue 32, classes 7 and 9)."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory(prefix="tailsim-py-inputs-")
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def sweep(self, swings, offsets):
+        """A perfoot sweep of swings x offsets cases, no time series."""
+        path = os.path.join(self.tmp.name, "sweep.yaml")
+        with open(path, "w") as f:
+            f.write("name: sweep\nrobot: paper\nmodels: [perfoot]\noutput: {time_series: none}\n"
+                    f"trajectory: {{dtheta_deg: {{range: [-90, -10, {80 / (swings - 1)!r}]}}, dT_s: 0.25}}\n"
+                    f"quadruped: {{d_Q2B_m: {{range: [0.1, 0.2, {0.1 / (offsets - 1)!r}]}}}}\n")
+        return path
+
+    def test_crashes_instead_of_errors_threads_bounded(self):
+        with self.assertRaisesRegex(ValueError, r"threads must lie in 0\.\.1024"):
+            tailsim.run(FIG7, out=os.path.join(self.tmp.name, "t"), threads=100000)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp.name, "t")))
+
+    def test_crashes_instead_of_errors_thread_creation_fails(self):
+        # An interpreter with little address space left: starting 64 workers fails part-way; the run
+        # goes on with fewer or raises, and the interpreter lives (it was aborted: SIGABRT).
+        code = ("import resource, tailsim\n"
+                "pages = int(open('/proc/self/statm').read().split()[0])\n"
+                "lim = pages * resource.getpagesize() + (40 << 20)\n"
+                "resource.setrlimit(resource.RLIMIT_AS, (lim, lim))\n"
+                "try:\n"
+                f"    tailsim.run({self.sweep(8, 8)!r}, out={os.path.join(self.tmp.name, 'o')!r}, threads=64)\n"
+                "except RuntimeError as e:\n"
+                "    assert 'cannot start a worker thread' in str(e), e\n"
+                "print('alive')\n")
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("alive", p.stdout)
+
+    def test_smaller_nul_in_path(self):
+        out = os.path.join(self.tmp.name, "nul")
+        with self.assertRaisesRegex(ValueError, "experiment: embedded null character"):
+            tailsim.run(FIG7 + "\0.ignored", out=out)
+        with self.assertRaisesRegex(ValueError, "out: embedded null character"):
+            tailsim.run(FIG7, out=out + "\0/elsewhere")
+        with self.assertRaisesRegex(ValueError, "name_or_path: embedded null character"):
+            tailsim.robot("paper\0x")
+        with self.assertRaisesRegex(ValueError, "robot: embedded null character"):
+            tailsim.simulate(**dict(FIG7_ARGS, robot="paper\0x"))
+        with self.assertRaisesRegex(ValueError, "out: the result folder is empty"):
+            tailsim.run(FIG7, out="")
+        self.assertFalse(os.path.exists(out))
+
+    def test_smaller_ctrl_c_stops_a_sweep(self):
+        # SIGINT 3 s into a sweep of 16,261 cases (54 s to the end): KeyboardInterrupt within seconds, the
+        # finished cases saved (the run waited for the whole sweep before).
+        code = ("import time, tailsim\n"
+                "t0 = time.monotonic()\n"
+                "try:\n"
+                f"    tailsim.run({self.sweep(161, 101)!r}, out={os.path.join(self.tmp.name, 'c')!r}, threads=1)\n"
+                "    print('finished', time.monotonic() - t0)\n"
+                "except KeyboardInterrupt:\n"
+                "    print('interrupted', time.monotonic() - t0)\n")
+        p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(3)
+        p.send_signal(signal.SIGINT)
+        t = time.monotonic()
+        out, err = p.communicate(timeout=600)
+        self.assertLess(time.monotonic() - t, 10, out + err)
+        self.assertTrue(out.startswith("interrupted"), out + err)
+        with open(os.path.join(self.tmp.name, "c", "cases.jsonl")) as f:
+            self.assertGreater(len(f.readlines()), 0)
 
 
 if __name__ == "__main__":

@@ -91,6 +91,8 @@ class DesignInputs : public ::testing::Test {
 };
 
 using NoInputTextReachesAnInterpreterUnescaped = DesignInputs;
+using UnboundedWorkRefusedAtLoad = DesignInputs;
+using Smaller = DesignInputs;
 
 // Names that would run a command, start a new gnuplot line or end the string early if pasted into
 // a script between quotes.
@@ -183,6 +185,99 @@ TEST_F(NoInputTextReachesAnInterpreterUnescaped, DesignPlotsRunNoCommand) {
     EXPECT_TRUE(fs::is_regular_file(mout + "/plots/heading.png")) << n;
   }
   EXPECT_EQ(pwned(), std::vector<std::string>());
+}
+
+// directions: enumerate searches 2^n patterns: a tail of more than 12 links is refused at the key
+// (n = 13 took minutes and n = 20 2.9 GB; n = 32 shifted 1 << 32 and searched one pattern).
+TEST_F(UnboundedWorkRefusedAtLoad, EnumeratedDirectionsAreBounded) {
+  for (const int n : {13, 20, 32}) {
+    std::string links;
+    for (int i = 0; i < n; ++i) links += (i ? ", " : "") + std::string("{mass_kg: 0.1, izz_kgm2: 0.0001, length_m: 0.05}");
+    std::ofstream(dir_ / "base.yaml") << "name: b\nrobot: paper\ntail: {custom: [" << links
+                                       << "]}\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\nmodels: [analytic]\n";
+    const std::string e = errorOf([&] { loadOptimizeSpec(optimizeFile("o", "  directions: enumerate\n")); });
+    EXPECT_NE(e.find("opt.yaml:14:15: optimize.directions: enumerate would search 2^" + std::to_string(n)), std::string::npos)
+        << e;
+    EXPECT_NE(e.find("more than 2^12 = 4096"), std::string::npos) << e;
+  }
+}
+
+// The analytic runs of a whole optimize file are estimated at load; the documented maxima (about
+// 1e11 runs) are refused with the estimate, a small file loads.
+TEST_F(UnboundedWorkRefusedAtLoad, OptimizeRunsAreEstimatedAndBounded) {
+  const std::string big = write("big.yaml", "name: big\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n"
+                                            "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                            "  islands: 64\n  population: 1000\n  generations: 10000\n");
+  const std::string e = errorOf([&] { loadOptimizeSpec(big); });
+  EXPECT_NE(e.find("big.yaml:5:3: optimize: the search would run the analytic model about 640064202 times"), std::string::npos) << e;
+  EXPECT_NE(e.find("more than the limit 100000000 ("), std::string::npos) << e;
+  const OptimizeSpec ok = loadOptimizeSpec(optimizeFile("o"));
+  // 2 (start) + 1 island x 6 x (2 generations + 1): 20 runs per search, x (1 seed + 2 Pareto points).
+  EXPECT_EQ(optimizeRunEstimate(ok), 60.0);
+}
+
+// The longest MuJoCo run of a maneuver (the closed loop, max_strokes cycles) is estimated at load.
+TEST_F(UnboundedWorkRefusedAtLoad, ManeuverRunsAreEstimatedAndBounded) {
+  const std::string e = errorOf([&] {
+    loadManeuverSpec(maneuverFile("m", "  max_strokes: 1000\n  return_dT_s: 10\n  rest_s: 10\n  mujoco: true\n"));
+  });
+  EXPECT_NE(e.find("m.yaml:6:16: maneuver.max_strokes: the MuJoCo closed loop may run"), std::string::npos) << e;
+  EXPECT_NE(e.find("= 30400.5 s: "), std::string::npos) << e;
+  EXPECT_EQ(errorOf([&] { loadManeuverSpec(maneuverFile("m", "  mujoco: true\n")); }), "(no error)");
+}
+
+// Limits no stroke can keep are refused at load (they ran the whole search and exited 3,
+// "limits VIOLATED"); the shipped limits load (ShippedConfigs.OptimizeFilesLoad).
+TEST_F(UnboundedWorkRefusedAtLoad, ImpossibleOptimizeLimitsAreRefused) {
+  auto file = [&](const std::string& limits) {
+    return write("lim.yaml", "name: l\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n  limits: " + limits +
+                                 "\n  seeds: [1]\n");
+  };
+  std::string e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 1e-9}")); });
+  EXPECT_NE(e.find("lim.yaml:6:11: optimize.limits: no stroke keeps these limits"), std::string::npos) << e;
+  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 1, dT_s: [0.05, 0.1]}")); });
+  EXPECT_NE(e.find("peaks at 20 deg/s (limit 1)"), std::string::npos) << e;
+  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [10, 10.5], thetadot_max_dps: 600}")); });
+  EXPECT_NE(e.find("needs a range of 1 deg (have 0.5)"), std::string::npos) << e;
+  EXPECT_EQ(errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 1}")); }),
+            "(no error)");
+}
+
+// (b) A maneuver's strokes are checked as the experiment loader checks a trajectory, at the key.
+TEST_F(Smaller, ManeuverValuesAreCheckedAtLoadWithLocation) {
+  std::string e = errorOf([&] { loadManeuverSpec(maneuverFile("m", "  min_scale: 0.000001\n  mujoco: false\n")); });
+  EXPECT_NE(e.find("m.yaml:6:14: maneuver.min_scale: the shortest stroke"), std::string::npos) << e;
+  e = errorOf([&] { loadManeuverSpec(maneuverFile("m", "  stroke_w_ss: 0.001\n")); });
+  EXPECT_NE(e.find("m.yaml:6:16: maneuver.stroke_w_ss: must lie in [0.01, 0.99]"), std::string::npos) << e;
+  e = errorOf([&] { loadManeuverSpec(maneuverFile("m", "  return_dT_s: 0.0000001\n")); });
+  EXPECT_NE(e.find("m.yaml:6:16: maneuver.return_dT_s: must be at least 0.001 s"), std::string::npos) << e;
+}
+
+// (d) A write error in optimize (here best_perfoot.csv cannot replace a folder of that name) ends
+// the command with the error; it is not reported as a failure of the per-foot model.
+TEST_F(Smaller, OptimizeWriteErrorIsNotAModelFailure) {
+  const fs::path out = dir_ / "res";
+  fs::create_directories(out / "best_perfoot.csv");
+  std::ofstream(out / "best_perfoot.csv" / "keep") << "x";
+  try {
+    runOptimize(loadOptimizeSpec(optimizeFile("o")), out.string(), false);
+    ADD_FAILURE() << "optimize finished without the write error";
+  } catch (const ConfigError& e) {
+    ADD_FAILURE() << e.what();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("best_perfoot.csv"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+}
+
+// (f) Empty and comment-only design files: an error at line 1 in tailsim's words.
+TEST_F(Smaller, EmptyDesignFilesAreRefusedWithLocation) {
+  for (const std::string& text : {std::string(""), std::string("# only a comment\n\n")}) {
+    const std::string f = write("empty.yaml", text);
+    for (const std::string& e : {errorOf([&] { loadOptimizeSpec(f); }), errorOf([&] { loadManeuverSpec(f); }),
+                                 errorOf([&] { loadExperiment(f); })})
+      EXPECT_EQ(e.rfind(f + ":1:1: the file holds no YAML value (it is empty or only comments)", 0), 0u) << e;
+  }
 }
 
 }  // namespace

@@ -166,13 +166,14 @@ TEST_F(HostileInput, Finding10_RenderLimitsAreCheckedAtLoad) {
   expectAt(errorOf(exp("render: {width: 641}\n")), 5, "render.width: must be even");
   expectAt(errorOf(exp("render: {height: 481}\n")), 5, "render.height: must be even");
   expectAt(errorOf(exp("render: {fps: 500}\n")), 5, "render.fps: must be in 1..240");
-  expectAt(errorOf(exp("render: {msaa: 32}\n")), 5, "render.msaa: must be in 0..16");
+  expectAt(errorOf(exp("render: {msaa: 32}\n")), 5, "render.msaa: must be in 0..4");
+  expectAt(errorOf(exp("render: {msaa: 8}\n")), 5, "render.msaa: must be in 0..4");
   expectAt(errorOf(exp("render: {slowmo: 1e300}\n")), 5, "render.slowmo: must lie in [0.001, 1000]");
   expectAt(errorOf(exp("render: {slowmo: 1e-300}\n")), 5, "render.slowmo: must lie in");
   // A long run at high slow motion: too many frames, said before anything runs.
   expectAt(errorOf(exp("output: {duration_s: 200}\nrender: {fps: 240, slowmo: 1000}\n")), 6, "frames");
   // The limits themselves load.
-  const Experiment e = loadExperiment(write("ok.yaml", exp("render: {width: 8192, height: 16, fps: 240, msaa: 16, "
+  const Experiment e = loadExperiment(write("ok.yaml", exp("render: {width: 8192, height: 16, fps: 240, msaa: 4, "
                                                           "slowmo: 0.001}\n")));
   EXPECT_EQ(e.cases[0].render.width, kRenderMaxSize);
   EXPECT_EQ(e.cases[0].render.fps, kRenderMaxFps);

@@ -37,6 +37,7 @@
 #include "plotting/result_page.h"
 #include "results/atomic_file.h"
 #include "results/sha256.h"
+#include "results/work_limits.h"
 #include "tailsim_version.h"
 
 using namespace tailsim;
@@ -248,6 +249,12 @@ int writeExperimentMjcf(const std::string& exp_path, const std::string& only_cas
 
 }  // namespace
 
+// --out and --menagerie: a folder or file name, never empty (an empty path would mean "here"
+// to some calls and an error to others).
+const CLI::Validator kNonEmptyPath(
+    [](std::string& v) { return v.empty() ? std::string("is empty: give a folder or file name") : std::string(); },
+    "PATH");
+
 int main(int argc, char** argv) {
   CLI::App app{"tailsim: quadruped yaw turning with a planar robotic tail (Rone & Ben-Tzvi 2016)"};
   app.require_subcommand(1);
@@ -259,8 +266,9 @@ int main(int argc, char** argv) {
   bool no_render = false, fresh = false, quiet = false, plots = false;
   auto* run = app.add_subcommand("run", "run an experiment (or a suite such as configs/paper/all.yaml)");
   run->add_option("experiment", exp_path, "experiment YAML")->required()->check(CLI::ExistingFile);
-  run->add_option("--out", out_dir, "result folder")->required();
-  run->add_option("--threads", threads, "worker threads (default 0: all cores)")->check(CLI::NonNegativeNumber);
+  run->add_option("--out", out_dir, "result folder")->required()->check(kNonEmptyPath);
+  run->add_option("--threads", threads, "worker threads (default 0: all cores; at most 1024)")
+      ->check(CLI::Range(0, limits::kMaxThreads));
   run->add_option("--case", case_name, "run only this case");
   run->add_flag("--no-render", no_render, "skip the render section");
   run->add_flag("--fresh", fresh, "start from an empty result folder (deletes tailsim's results in --out, also another experiment's)");
@@ -276,8 +284,9 @@ int main(int argc, char** argv) {
   std::string merge_out;
   auto* merge = app.add_subcommand("merge", "join the result folders of `run --shard K/N` into one folder");
   merge->add_option("shards", merge_dirs, "the shards' result folders")->required()->check(CLI::ExistingDirectory);
-  merge->add_option("--out", merge_out, "the merged result folder (new or empty)")->required();
-  merge->add_option("--threads", threads, "worker threads (default 0: all cores)")->check(CLI::NonNegativeNumber);
+  merge->add_option("--out", merge_out, "the merged result folder (new or empty)")->required()->check(kNonEmptyPath);
+  merge->add_option("--threads", threads, "worker threads (default 0: all cores; at most 1024)")
+      ->check(CLI::Range(0, limits::kMaxThreads));
   merge->add_flag("--allow-other-build", allow_other_build,
                   "keep cases computed by another tailsim version or commit (warned, recorded in summary.json) instead of refusing them");
   std::vector<std::string> only_models;
@@ -293,16 +302,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 6))
       ->excludes(mjcf_exp_opt);
   mjcf->add_option("--case", mjcf_case, "only this case's model")->needs(mjcf_exp_opt);
-  auto* mjcf_out_opt = mjcf->add_option("--out", mjcf_out, "one self-contained .xml, the model tailsim simulates (- = stdout)");
+  auto* mjcf_out_opt = mjcf->add_option("--out", mjcf_out, "one self-contained .xml, the model tailsim simulates (- = stdout)")
+                            ->check(kNonEmptyPath);
   mjcf->add_option("--menagerie", mjcf_menagerie,
                    "folder for the Menagerie form: tailsim_<name>.xml (robot) + scene_<name>.xml (mjcf/README.md)")
-      ->excludes(mjcf_out_opt);
+      ->excludes(mjcf_out_opt)
+      ->check(kNonEmptyPath);
 
   std::string render_out = "renders";
   auto* render = app.add_subcommand("render", "render each case of an experiment to MP4 + PNG (headless)");
   render->add_option("experiment", exp_path, "experiment YAML")->required()->check(CLI::ExistingFile);
   render->add_option("--case", case_name, "render only this case");
-  render->add_option("--out", render_out, "output folder (default: renders/)");
+  render->add_option("--out", render_out, "output folder (default: renders/)")->check(kNonEmptyPath);
 
   std::string result_dir;
   auto* plot = app.add_subcommand("plot", "redraw the figures of a result folder (no simulation)");
@@ -325,7 +336,7 @@ int main(int argc, char** argv) {
   auto* accuracy = app.add_subcommand("accuracy", "work-precision study of both models' solver settings");
   accuracy->add_option("experiment", exp_path, "experiment YAML (every simulate case is studied)")
       ->required()->check(CLI::ExistingFile);
-  accuracy->add_option("--out", acc_out, "output folder")->required();
+  accuracy->add_option("--out", acc_out, "output folder")->required()->check(kNonEmptyPath);
   accuracy->add_option("--repeats", acc_repeats, "runs per setting; wall time is their median")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -340,13 +351,13 @@ int main(int argc, char** argv) {
   bool opt_quiet = false;
   auto* optimize = app.add_subcommand("optimize", "optimise a tail stroke (kind: optimize experiment)");
   optimize->add_option("experiment", exp_path, "optimize experiment YAML")->required()->check(CLI::ExistingFile);
-  optimize->add_option("--out", opt_out, "result folder")->required();
+  optimize->add_option("--out", opt_out, "result folder")->required()->check(kNonEmptyPath);
   optimize->add_flag("--quiet", opt_quiet, "no progress lines");
   std::string man_out;
   bool man_quiet = false, man_video = false;
   auto* maneuver = app.add_subcommand("maneuver", "turn to a heading with tail strokes, open- and closed-loop (kind: maneuver experiment)");
   maneuver->add_option("experiment", exp_path, "maneuver experiment YAML")->required()->check(CLI::ExistingFile);
-  maneuver->add_option("--out", man_out, "result folder")->required();
+  maneuver->add_option("--out", man_out, "result folder")->required()->check(kNonEmptyPath);
   maneuver->add_flag("--video", man_video, "also render the closed-loop turn (renders/<name>.mp4)");
   maneuver->add_flag("--quiet", man_quiet, "no progress lines");
 

@@ -28,36 +28,6 @@ std::string g17(double v) {
   return b;
 }
 
-// The keys a struct declares (settings/fields.h).
-struct KeyList {
-  std::vector<std::string> keys;
-  template <class... T>
-  void number(const settings::Field& f, T&&...) { keys.push_back(f.key); }
-  template <class... T>
-  void integer(const settings::Field& f, T&&...) { keys.push_back(f.key); }
-  template <class... T>
-  void boolean(const settings::Field& f, T&&...) { keys.push_back(f.key); }
-};
-
-// Reads the declared fields from a YAML map through design_yaml::Reader (file:line:col errors).
-struct YamlFieldReader {
-  const Reader& r;
-  const std::vector<std::pair<std::string, Val>>& m;
-  void number(const settings::Field& f, double& x, const settings::Limits& l) {
-    const Val* v = Reader::get(m, f.key);
-    if (!v) return;
-    const double y = r.number(*v);
-    if (!l.ok(y)) r.fail(*v, "must " + l.text() + ", got " + fmtG(y));
-    x = y;
-  }
-  void integer(const settings::Field& f, int& x, const settings::Limits& l) {
-    if (const Val* v = Reader::get(m, f.key)) x = r.integer(*v, static_cast<int>(l.lo), static_cast<int>(l.hi));
-  }
-  void boolean(const settings::Field& f, bool& x) {
-    if (const Val* v = Reader::get(m, f.key)) x = r.boolean(*v);
-  }
-};
-
 OutputSettings segmentOutput(const ExperimentCase& base, double duration_s) {
   OutputSettings o = base.output;
   o.duration_s = duration_s;
@@ -168,47 +138,6 @@ ManeuverRun fromMujoco(const RunResult& rm, const std::string& label, int n) {
 }
 
 }  // namespace
-
-ManeuverSpec loadManeuverSpec(const std::string& path) {
-  ManeuverSpec s;
-  s.source_file = fs::absolute(path).lexically_normal().string();
-  const Reader r(s.source_file);
-  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "maneuver", "maneuver");
-  s.name = std::move(file.head.name);
-  s.description = std::move(file.head.description);
-  s.base_file = std::move(file.head.base_file);
-  const Val& base = file.base(r);  // the base experiment's own checks below point here
-  const Val& mv = file.section(r);
-  KeyList kl;
-  declareFields(kl, static_cast<const ManeuverSettings&>(s.settings));
-  if (!mv.node.IsMap()) r.fail(mv, "expected a map of key: value");
-  std::vector<std::pair<std::string, Val>> m;
-  {
-    // Reader::map takes the allowed keys as an initializer list: check them here from the declaration.
-    std::string names;
-    for (const auto& k : kl.keys) names += (names.empty() ? "" : ", ") + k;
-    for (const auto& kv : mv.node) {
-      const std::string key = "maneuver." + kv.first.Scalar();
-      if (!kv.first.IsScalar()) r.fail(kv.first.Mark(), "maneuver", "keys must be plain names");
-      if (std::find(kl.keys.begin(), kl.keys.end(), kv.first.Scalar()) == kl.keys.end())
-        r.fail(kv.first.Mark(), key, "unknown key (allowed here: " + names + ")");
-      for (const auto& e : m)
-        if (e.first == kv.first.Scalar()) r.fail(kv.first.Mark(), key, "duplicate key");
-      const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
-      m.emplace_back(kv.first.Scalar(), Val{kv.second, key, empty ? kv.first.Mark() : kv.second.Mark()});
-    }
-  }
-  YamlFieldReader fr{r, m};
-  declareFields(fr, s.settings);
-  if (s.settings.min_scale > 1.0) r.fail(*Reader::get(m, "min_scale"), "must be <= 1");
-
-  const Experiment e = loadExperiment(s.base_file);
-  if (e.cases.size() != 1)
-    r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
-  s.base = e.cases.front();
-  if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
-  return s;
-}
 
 CycleYaw analyticCycleYaw(const ExperimentCase& base, const ManeuverSettings& s, double scale) {
   const int n = base.robot.numLinks();

@@ -11,6 +11,7 @@
 
 #include "design/design_yaml.h"
 #include "experiments/experiment_loader.h"
+#include "results/work_limits.h"
 
 namespace tailsim {
 namespace {
@@ -26,6 +27,26 @@ bool isOptimizeFile(const std::string& path) {
   } catch (const std::exception&) {
     return false;
   }
+}
+
+double optimizeRunEstimate(const OptimizeSpec& s) {
+  const OptimizerSettings& o = s.optimizer;
+  auto restartRuns = [&](int r) {
+    const double pop = o.population * std::pow(static_cast<double>(o.restart_growth), r);
+    return o.islands * pop * (o.generations + 1.0 + o.refine_generations);
+  };
+  double later = 0;  // the restarts after the first, the local restarts and the polish
+  for (int r = 1; r < o.restarts; ++r) later += restartRuns(r);
+  later += o.local_restarts * static_cast<double>(o.islands) * o.population * (o.generations + 1.0);
+  if (o.polish != "none") later += o.polish_evaluations;
+  const double first = 2.0 + restartRuns(0);  // the start (base stroke and its box point) and restart 0
+  double per_search = first + later;
+  if (o.enumerate_directions) {
+    const double patterns = std::ldexp(1.0, std::min(s.problem.space.n_links, 1000));
+    const double kept = o.directions_kept > 0 ? std::min<double>(o.directions_kept, patterns) : patterns;
+    per_search = patterns * first + kept * later;
+  }
+  return per_search * static_cast<double>(s.seeds.size() + static_cast<std::size_t>(s.pareto_points));
 }
 
 OptimizeSpec loadOptimizeSpec(const std::string& path) {
@@ -153,9 +174,45 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   if (kept && sp.n_links <= kMaxKeptDirectionsLog2 && os.directions_kept > (1 << sp.n_links))
     r.fail(*kept, "keeps " + std::to_string(os.directions_kept) + " patterns, but an n = " + std::to_string(sp.n_links) +
                       " tail has only " + std::to_string(1 << sp.n_links));
+  if (os.enumerate_directions && sp.n_links > limits::kMaxEnumeratedLinks)
+    r.fail(*Reader::get(o, "directions"),
+           "enumerate would search 2^" + std::to_string(sp.n_links) + " = " + fmtG(std::ldexp(1.0, sp.n_links)) +
+               " joint-direction patterns for the base's n = " + std::to_string(sp.n_links) + " tail, more than 2^" +
+               std::to_string(limits::kMaxEnumeratedLinks) + " = " +
+               std::to_string(1 << limits::kMaxEnumeratedLinks) + " (n <= " +
+               std::to_string(limits::kMaxEnumeratedLinks) + "): use directions: free");
+  if (const double runs = optimizeRunEstimate(s); !(runs <= limits::kMaxOptimizeRuns))
+    r.fail(opt, "the search would run the analytic model about " + fmtG(runs) +
+                    " times (seeds + pareto_points) x (islands x population x (generations + 1 + refine_generations) "
+                    "per restart + local restarts + polish_evaluations)" +
+                    (os.enumerate_directions ? " x 2^n patterns" : "") + ", more than the limit " +
+                    fmtG(limits::kMaxOptimizeRuns) +
+                    " (docs/design-a-tail-stroke.md \"Limits\"): lower generations, population, islands, restarts or seeds");
   if (torque && L.torque_max_Nm == 0.0) {  // torque_max_Nm: base -- the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");
+  }
+  // Limits that leave no stroke to search (the search used to run to its end and report "limits
+  // VIOLATED"): a 1 deg split-cycle stroke of every joint over the longest duration must keep them.
+  {
+    const double amp = 1.0 * kRadPerDeg;
+    SplitCycleParams p;
+    p.theta0_rad = std::max(L.theta_min_rad, std::min(0.0, L.theta_max_rad - amp));
+    p.dtheta_rad = amp;
+    p.dT_s = L.dT_max_s;
+    p.w_ss = std::max(L.w_ss_min, std::min(0.5, L.w_ss_max));
+    TailTrajectory probe;
+    for (int i = 0; i < sp.n_links; ++i) probe.joints.emplace_back(p);
+    StrokeLimits at_rest = L;  // a stroke that must end where it started is a spline's: not this probe
+    at_rest.end = StrokeEnd::kAtRest;
+    const StrokeFigures f = strokeFigures(s.base.robot.tail, probe);
+    if (L.theta_max_rad - L.theta_min_rad < amp || limitViolation(f, at_rest) > 0.0)
+      r.fail(lv, "no stroke keeps these limits: 1 deg of every joint over the longest duration (dT_s " +
+                     fmtG(L.dT_max_s) + " s) needs a range of 1 deg (have " +
+                     fmtG((L.theta_max_rad - L.theta_min_rad) / kRadPerDeg) + "), peaks at " +
+                     fmtG(f.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
+                     fmtG(L.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(f.peak_torque_Nm) + " N m (limit " +
+                     (L.torque_max_Nm > 0 ? fmtG(L.torque_max_Nm) : std::string("none")) + "): widen them");
   }
   s.problem.base = s.base;
   return s;

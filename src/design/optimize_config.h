@@ -39,6 +39,12 @@ constexpr int kMaxPolishEvaluations = 100000;
 constexpr int kMaxSeeds = 20;
 constexpr int kMaxParetoPoints = 20;
 
+// Analytic model runs the whole optimisation asks for at most (every seed and Pareto point; each
+// search: the start, islands x population x (generations + 1 + refine_generations) per restart,
+// the local restarts, the polish; x 2^n patterns with directions: enumerate, later stages only in
+// directions_kept of them). The loader refuses more than limits::kMaxOptimizeRuns.
+double optimizeRunEstimate(const OptimizeSpec& s);
+
 // Throws ConfigError (experiments/experiment_loader.h) before any optimisation.
 OptimizeSpec loadOptimizeSpec(const std::string& path);
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -212,16 +213,20 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   rep.files.push_back("best_analytic.csv");
   // The per-foot friction model (issue 11): milliseconds, always run; a failure (e.g. the robot
   // tips) is reported, not thrown.
+  // A write error (a full disk) is not the model's: it ends the command.
+  std::optional<RunResult> rp;
   try {
-    const RunResult rp = simulatePerFoot(spec.base.robot, traj, spec.base.perfoot, spec.base.effects, out);
-    rep.perfoot = rp.summary;
-    writeCsvAtomic((fs::path(out_dir) / "best_perfoot.csv").string(), rp.series);
-    rep.files.push_back("best_perfoot.csv");
+    rp = simulatePerFoot(spec.base.robot, traj, spec.base.perfoot, spec.base.effects, out);
   } catch (const std::exception& e) {
     rep.perfoot.model = "perfoot";
     rep.perfoot.ok = false;
     rep.perfoot.error = e.what();
     rep.perfoot.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (rp) {
+    rep.perfoot = rp->summary;
+    writeCsvAtomic((fs::path(out_dir) / "best_perfoot.csv").string(), rp->series);
+    rep.files.push_back("best_perfoot.csv");
   }
   if (spec.mujoco_check) {
     const RunResult rm = simulateMujoco(spec.base.robot, traj, spec.base.mujoco, spec.base.effects, out);

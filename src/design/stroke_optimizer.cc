@@ -19,6 +19,7 @@
 #include <stdexcept>
 
 #include "analytic_model/analytic_simulation.h"
+#include "results/work_limits.h"
 
 namespace tailsim {
 
@@ -323,6 +324,9 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   // patterns whose first restart found the most (ties: the lower pattern index); the others keep
   // their first restart's best. A pattern's search is the same either way (same sub-seeds).
   const int n = prob.space.n_links;
+  if (n < 0 || n > limits::kMaxEnumeratedLinks)
+    throw std::invalid_argument("enumerating stroke directions: " + std::to_string(n) + " links, at most " +
+                                std::to_string(limits::kMaxEnumeratedLinks) + " (2^n patterns)");
   const int patterns = 1 << n;
   std::vector<StrokeProblem> problems(static_cast<std::size_t>(patterns), prob);
   std::vector<std::unique_ptr<SpaceSearch>> searches;

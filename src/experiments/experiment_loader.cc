@@ -731,7 +731,11 @@ YAML::Node parseYamlText(const std::string* file, const std::string& text) {
       YamlBounds bounds;
       parser.HandleNextDocument(bounds);
     }
-    return YAML::Load(text);
+    YAML::Node doc = YAML::Load(text);
+    if (doc.IsNull() && doc.Mark().is_null())
+      fail(Loc{file, YAML::Mark(), ""}, "the file holds no YAML value (it is empty or only comments): expected a map of "
+                                         "key: value (docs/experiment-format.md)");
+    return doc;
   } catch (const YamlLimitError& e) {
     fail(Loc{file, e.mark, ""}, e.what);
   } catch (const YAML::ParserException& e) {
@@ -1276,6 +1280,7 @@ Experiment readExperiment(Loader& L, const std::string* file, const YAML::Node& 
     while (i > 0 && ++idx[i - 1] == sweeps[i - 1].values.size()) idx[--i] = 0;
     if (i == 0) break;
   }
+  if (const WorkExcess x = checkExperimentWork(e.cases); !x.what.empty()) fail(Loc{file, doc.Mark(), ""}, x.what);
   e.name = e.cases.front().experiment;
   if (doc["description"] && doc["description"].IsScalar()) e.description = doc["description"].Scalar();
   return e;

@@ -37,12 +37,14 @@
 #include "experiments/sharding.h"
 #include "experiments/results_table.h"
 #include "experiments/time_series_h5.h"
+#include "experiments/work_estimate.h"
 #include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "results/atomic_file.h"
 #include "results/columns.h"
 #include "results/sha256.h"
 #include "results/thin_series.h"
+#include "results/work_limits.h"
 #include "tailsim_version.h"
 
 namespace tailsim {
@@ -175,6 +177,7 @@ std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {
     const ModelEntry* model = findModel(m);
     if (!model) throw std::invalid_argument("unknown model '" + m + "'");  // the loader refuses it first
     out.push_back(model->run(c, ctx));
+    if (const std::string w = jointSpeedWarning(c); !w.empty()) out.back().summary.warnings.push_back(w);
   }
   return out;
 }
@@ -914,7 +917,19 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
   std::vector<std::thread> pool;
   for (int t = 0; t < n_threads && !tasks.empty(); ++t) {
     ++running;
-    pool.emplace_back(worker);
+    try {
+      pool.emplace_back(worker);
+    } catch (const std::system_error& ex) {  // out of threads or memory (ulimit -u, -v; cgroup pids.max)
+      --running;
+      if (pool.empty()) {
+        if (opt.stop_on_sigint) pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+        throw std::runtime_error(std::string("cannot start a worker thread (") + ex.what() +
+                                 "): the process limits (ulimit -u, ulimit -v) leave no room for one; no case was run");
+      }
+      std::fprintf(stderr, "note: started %zu of %d worker threads (%s); running on %zu\n", pool.size(), n_threads,
+                   ex.what(), pool.size());
+      break;
+    }
   }
 
   // Progress: on a terminal one line redrawn with \r; in a log (not a TTY) a plain line every
@@ -953,10 +968,13 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
     if (running.load() == 0) break;
     pollfd fds[2] = {{wake_fd.fd, POLLIN, 0}, {sig_fd.fd, POLLIN, 0}};
     const int n_fds = opt.stop_on_sigint ? 2 : 1;
-    if (::poll(fds, n_fds, show ? static_cast<int>(period.count()) : -1) > 0) {
+    int timeout_ms = show ? static_cast<int>(period.count()) : -1;
+    if (opt.should_stop) timeout_ms = timeout_ms < 0 ? 200 : std::min(timeout_ms, 200);
+    if (::poll(fds, n_fds, timeout_ms) > 0) {
       uint64_t count = 0;
       if (fds[0].revents & POLLIN) (void)!::read(wake_fd.fd, &count, sizeof count);
     }
+    if (opt.should_stop && !stop.load() && opt.should_stop()) stop = true;
     if (opt.stop_on_sigint && (fds[1].revents & POLLIN)) {
       signalfd_siginfo info{};
       if (::read(sig_fd.fd, &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
@@ -1007,7 +1025,14 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
 
 }  // namespace
 
+void checkThreads(int threads) {
+  if (threads < 0 || threads > limits::kMaxThreads)
+    throw std::invalid_argument("threads must lie in 0.." + std::to_string(limits::kMaxThreads) + " (0: all cores), got " +
+                                std::to_string(threads));
+}
+
 RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
+  checkThreads(opt.threads);
   if (opt.resume) claimFolder(e, opt.out_dir, false);  // refuse before the lock file is created
   const RunLock lock(opt.out_dir);
   const std::vector<std::vector<char>> in_shard =
@@ -1019,6 +1044,7 @@ RunStats runExperiment(const Experiment& e, const RunOptions& opt) {
 }
 
 RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& opt) {
+  checkThreads(opt.threads);
   if (suite.size() == 1) return runExperiment(suite.front(), opt);
   if (opt.resume) {  // refuse before the lock file is created
     claimSuiteFolder(opt.out_dir, false);

@@ -3,6 +3,7 @@
 // interrupted sweep run again resumes without redoing or losing finished cases.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -16,7 +17,8 @@ namespace tailsim {
 
 struct RunOptions {
   std::string out_dir;           // result folder (a suite writes out_dir/<experiment>/)
-  int threads = 0;               // worker threads; 0 = all cores
+  int threads = 0;               // worker threads; 0 = all cores; at most limits::kMaxThreads
+                                 // (checkThreads); fewer start when the system refuses more
   bool progress = true;          // done/total, elapsed and ETA on stderr (redrawn on a TTY, a line
                                  // every 5 s otherwise)
   bool render = true;            // render cases whose experiment has a render section
@@ -33,7 +35,14 @@ struct RunOptions {
   bool merge_only = false;       // run nothing: every case must be finished in out_dir (tailsim merge)
   bool allow_other_build = false;  // finished cases of another tailsim build (version/commit) are reused
                                    // with a warning and recorded in summary.json ("other_builds"), not refused
+  // Asked by the calling thread at least every 200 ms while cases run: true stops the run as the
+  // first Ctrl-C does (no new case; running ones finish and are saved; RunStats::interrupted). The
+  // Python module checks Python's signals here (tailsim.run() and Ctrl-C).
+  std::function<bool()> should_stop;
 };
+
+// Throws std::invalid_argument unless 0 <= threads <= limits::kMaxThreads (results/work_limits.h).
+void checkThreads(int threads);
 
 struct RunStats {
   int total = 0;     // cases in the experiment(s)

@@ -131,4 +131,48 @@ WorkExcess checkWork(const ExperimentCase& c) {
   return x;
 }
 
+std::string jointSpeedWarning(const ExperimentCase& c) {
+  if (c.kind != CaseKind::kSimulate) return "";
+  const TailTrajectory traj = c.trajectory();
+  double peak = 0;
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < traj.joints.size(); ++i) {
+    const double w = std::abs(traj.joints[i].peakSpeed()) * 180.0 / M_PI;
+    if (w > peak) {
+      peak = w;
+      at = i;
+    }
+  }
+  if (!(peak > limits::kMaxJointSpeedDps)) return "";
+  return "tail joint " + std::to_string(at + 1) + " peaks at " + g(peak) + " deg/s, above " +
+         g(limits::kMaxJointSpeedDps) + " deg/s (100 turns a second, beyond any tail motor; " +
+         "docs/experiment-format.md \"Limits\"): the result describes a stroke no robot makes";
+}
+
+WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
+  WorkExcess x;
+  double steps = 0, bytes = 0;
+  for (const ExperimentCase& c : cases) {
+    if (c.kind != CaseKind::kSimulate) continue;
+    const WorkEstimate w = estimateWork(c);
+    steps += w.analytic_steps + w.mujoco_steps;
+    const double share = c.output.time_series == TimeSeriesOutput::kNone   ? 0.0
+                         : c.output.time_series == TimeSeriesOutput::kThin ? 0.1
+                                                                            : 1.0;
+    bytes += share * w.csv_bytes * static_cast<double>(c.models.size());
+  }
+  const std::string see = " (docs/experiment-format.md \"Limits\")";
+  const std::string n = std::to_string(cases.size()) + (cases.size() == 1 ? " case" : " cases");
+  if (!(steps <= limits::kMaxExperimentSteps))
+    x.what = "the " + n + " would take about " + g(steps) + " solver steps in all (analytic steps + MuJoCo steps, " +
+             "summed over the cases), more than the limit " + g(limits::kMaxExperimentSteps) + see +
+             ": sweep fewer values or split the experiment";
+  else if (!(bytes <= limits::kMaxExperimentBytes))
+    x.what = "the " + n + " would write about " + g(bytes) + " bytes of time series in all (rows x columns x " +
+             g(limits::kCsvBytesPerValue) + " B per model run, summed over the cases), more than the limit " +
+             g(limits::kMaxExperimentBytes) + see + ": set output.time_series: thin or none, raise output.sample_dt_s, " +
+             "or sweep fewer values";
+  return x;
+}
+
 }  // namespace tailsim

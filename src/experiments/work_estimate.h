@@ -32,4 +32,13 @@ struct WorkExcess {
 // Empty `what` when every estimate is within its limit. kind: pose cases do no work to bound.
 WorkExcess checkWork(const ExperimentCase& c);
 
+// A run warning when a joint of the case's trajectory peaks above limits::kMaxJointSpeedDps, else "".
+std::string jointSpeedWarning(const ExperimentCase& c);
+
+// The whole experiment's work: solver steps (analytic + MuJoCo) and time-series bytes summed over
+// its cases and models (output.time_series: none writes none, thin about a tenth), against
+// limits::kMaxExperimentSteps and kMaxExperimentBytes. Empty `what` when within both; `keys` empty
+// (the sweeps as a whole are the culprit).
+WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases);
+
 }  // namespace tailsim

@@ -18,6 +18,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/keyword_args.h"
 #include "experiments/model_registry.h"
 #include "experiments/settings_json.h"
 #include "results/columns.h"
@@ -61,16 +62,42 @@ json yamlKeys(const S& s) {
   return j;
 }
 
-// A Python dict -> the YAML text of one experiment (JSON is YAML; one key a line, so a loader
-// error's line:col points into this text). numpy scalars and arrays become plain numbers and lists.
-std::string yamlText(const py::dict& doc) {
-  const py::cpp_function plain([](py::object o) -> py::object {
-    if (py::hasattr(o, "tolist")) return o.attr("tolist")();
-    throw py::type_error("tailsim: cannot use a value of type " + std::string(py::str(o.get_type().attr("__name__"))) +
-                         " in a setting (numbers, strings, booleans, lists and dicts only)");
-  });
-  return py::module_::import("json").attr("dumps")(doc, py::arg("indent") = 1, py::arg("default") = plain)
-      .cast<std::string>();
+// A Python value -> JSON, as Python's json module writes it (keys that are numbers, booleans or
+// None become their text); numpy scalars and arrays become plain numbers and lists.
+nlohmann::ordered_json toJson(py::handle o) {
+  using oj = nlohmann::ordered_json;
+  if (o.is_none()) return nullptr;
+  if (py::isinstance<py::bool_>(o)) return o.cast<bool>();
+  if (py::isinstance<py::int_>(o)) {
+    try {
+      return o.cast<long long>();
+    } catch (const py::cast_error&) {
+      return o.cast<double>();  // beyond 64 bits: the loader's ranges refuse it
+    }
+  }
+  if (py::isinstance<py::float_>(o)) return o.cast<double>();
+  if (py::isinstance<py::str>(o)) return o.cast<std::string>();
+  if (py::isinstance<py::dict>(o)) {
+    oj j = oj::object();
+    for (auto kv : o.cast<py::dict>()) {
+      const py::handle k = kv.first;
+      if (!py::isinstance<py::str>(k) && !py::isinstance<py::int_>(k) && !py::isinstance<py::float_>(k) && !k.is_none())
+        throw py::type_error("tailsim: keys must be strings, not " + std::string(py::str(k.get_type().attr("__name__"))));
+      const std::string key = k.is_none() ? "null"
+                              : py::isinstance<py::bool_>(k) ? (k.cast<bool>() ? "true" : "false")
+                                                              : std::string(py::str(k));
+      j[key] = toJson(kv.second);
+    }
+    return j;
+  }
+  if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o)) {
+    oj j = oj::array();
+    for (py::handle e : o) j.push_back(toJson(e));
+    return j;
+  }
+  if (py::hasattr(o, "tolist")) return toJson(o.attr("tolist")());
+  throw py::type_error("tailsim: cannot use a value of type " + std::string(py::str(o.get_type().attr("__name__"))) +
+                       " in a setting (numbers, strings, booleans, lists and dicts only)");
 }
 
 // What simulate() returns: the time series (columns in the CSV's order), the summary (summary.json's
@@ -95,22 +122,23 @@ py::dict seriesToNumpy(const TimeSeries& ts, py::list& columns) {
   return out;
 }
 
+// A path or name given as a Python str: a NUL would silently cut it where the C library reads it,
+// so it is refused as Python's own file functions refuse it.
+void requireNoNul(const std::string& s, const char* arg) {
+  if (s.find('\0') != std::string::npos) throw py::value_error(std::string(arg) + ": embedded null character");
+}
+
 constexpr const char* kSimulateLabel = "<tailsim.simulate>";
 
 Simulation simulate(const std::string& robot, py::object trajectory, const std::string& model, py::kwargs sections) {
-  for (const char* k : {"name", "robot", "models"})
-    if (sections.contains(k))
-      throw py::type_error(std::string("tailsim.simulate: '") + k + "' is not a keyword here" +
-                           (std::string(k) == "models" ? " (model='analytic' or 'mujoco': one model a call)" : ""));
-  py::dict doc;
-  doc["name"] = "simulate";
-  doc["robot"] = robot;
-  for (auto kv : sections) doc[kv.first] = kv.second;
-  if (!trajectory.is_none()) doc["trajectory"] = trajectory;
-  py::list models;
-  models.append(model);
-  doc["models"] = models;
-  const std::string text = yamlText(doc);
+  requireNoNul(robot, "robot");
+  requireNoNul(model, "model");
+  std::string text;
+  try {
+    text = simulateExperimentText(robot, toJson(trajectory), model, toJson(sections));
+  } catch (const KeywordError& e) {
+    throw py::type_error(e.what());
+  }
 
   std::vector<RunResult> runs;
   ExperimentCase c;
@@ -149,7 +177,13 @@ Simulation simulate(const std::string& robot, py::object trajectory, const std::
 // tailsim run EXPERIMENT --out DIR [--models ...] [--threads N] [--case NAME] [--fresh] [--no-render]
 py::object run(const std::string& experiment, const std::string& out, std::vector<std::string> models, int threads,
                const std::string& case_name, bool fresh, bool render, bool progress) {
+  requireNoNul(experiment, "experiment");
+  requireNoNul(out, "out");
+  requireNoNul(case_name, "case");
+  if (out.empty()) throw py::value_error("out: the result folder is empty (give a folder name)");
+  checkThreads(threads);  // std::invalid_argument: ValueError
   std::vector<Experiment> suite;
+  bool interrupted = false;  // Python's SIGINT handler raised (KeyboardInterrupt is pending)
   {
     py::gil_scoped_release free;
     suite = loadExperimentSuite(experiment);  // all errors before any work
@@ -162,8 +196,21 @@ py::object run(const std::string& experiment, const std::string& out, std::vecto
     o.resume = !fresh;
     o.progress = progress;
     o.only_case = case_name;
-    runSuite(suite, o);
+    // Ctrl-C: Python's handler only sets a flag; run its handlers between cases so a KeyboardInterrupt
+    // stops the sweep as the CLI's first Ctrl-C does (finished cases saved).
+    o.should_stop = [&interrupted] {
+      if (interrupted) return true;
+      py::gil_scoped_acquire gil;
+      interrupted = PyErr_CheckSignals() != 0;
+      return interrupted;
+    };
+    try {
+      runSuite(suite, o);
+    } catch (const std::exception&) {
+      if (!interrupted) throw;  // else the KeyboardInterrupt is what the caller sees
+    }
   }
+  if (interrupted) throw py::error_already_set();
   // The summary as the folder holds it (a suite: one per member, by experiment name).
   auto read = [](const fs::path& f) {
     std::ifstream in(f);
@@ -177,6 +224,7 @@ py::object run(const std::string& experiment, const std::string& out, std::vecto
 }
 
 py::dict robotDict(const std::string& name_or_path) {
+  requireNoNul(name_or_path, "name_or_path");
   const RobotFileData rf = loadRobotFile(name_or_path);
   json j;
   j["quadruped"] = yamlKeys(rf.base.quadruped);

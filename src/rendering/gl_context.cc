@@ -96,7 +96,15 @@ MjOffscreen::MjOffscreen(mjModel* m, int width, int height, int msaa, int maxgeo
   mjv_makeScene(m, &scn_, maxgeom);
   mjr_defaultContext(&con_);
   const int fontscale = height >= 1400 ? mjFONTSCALE_200 : height >= 700 ? mjFONTSCALE_150 : mjFONTSCALE_100;
-  mjr_makeContext(m, &con_, fontscale);
+  try {
+    mjr_makeContext(m, &con_, fontscale);  // MuJoCo's errors throw (mujoco_handles.h)
+  } catch (const std::exception& e) {
+    mjr_freeContext(&con_);
+    mjv_freeScene(&scn_);
+    throw std::runtime_error("rendering: cannot make a " + std::to_string(width) + " x " + std::to_string(height) +
+                             " off-screen framebuffer with " + std::to_string(msaa) +
+                             " samples (" + e.what() + "): lower render.width, render.height or render.msaa");
+  }
   mjr_setBuffer(mjFB_OFFSCREEN, &con_);
   if (con_.currentBuffer != mjFB_OFFSCREEN) {
     mjr_freeContext(&con_);

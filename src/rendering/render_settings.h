@@ -44,7 +44,7 @@ struct RenderSettings {
 constexpr int kRenderMinSize = 16, kRenderMaxSize = 8192;  // width and height, pixels; both even (H.264 yuv420p)
 constexpr int kRenderMinFps = 1, kRenderMaxFps = 240;
 constexpr double kRenderMinSlowmo = 1e-3, kRenderMaxSlowmo = 1e3;  // video seconds per simulated second
-constexpr int kRenderMaxMsaa = 16;                                  // 0..16 multisamples
+constexpr int kRenderMaxMsaa = 4;  // 0..4 multisamples: llvmpipe's GL_MAX_SAMPLES (more rendered as 4)
 constexpr int kRenderMinCrf = 0, kRenderMaxCrf = 51;                // libx264
 constexpr double kRenderMaxFrames = limits::kMaxRenderFrames;  // declared with the other work limits
 

@@ -14,6 +14,20 @@ constexpr double kMaxAnalyticSteps = 1e7;   // accepted analytic solver steps pe
 constexpr double kMaxMujocoSteps = 1e7;     // mj_step calls per run (settling included)
 constexpr double kMaxRenderFrames = 1e5;    // video frames per case (~55 min at 30 fps; hours of rendering)
 
+// Worker threads of one run (--threads, tailsim.run(threads=...), merge --threads): far more than
+// any machine's cores; beyond it a run only spends memory on stacks (8 MB each) and may not start.
+constexpr int kMaxThreads = 1024;
+
+// Work of a whole experiment (all cases, all models), so a legal file cannot ask for months of
+// computing or terabytes of output.
+constexpr double kMaxExperimentSteps = 1e10;  // analytic solver steps + mj_step calls, summed over the cases
+constexpr double kMaxExperimentBytes = 1e11;  // estimated time-series output (100 GB), summed  [B]
+
+// Work of an optimize file (every seed and Pareto point): analytic model runs, and the
+// joint-direction patterns `directions: enumerate` searches (2^n for an n-link tail).
+constexpr double kMaxOptimizeRuns = 1e8;
+constexpr int kMaxEnumeratedLinks = 12;  // 4096 patterns
+
 // Inputs (physical ranges; the paper's cases lie well inside them).
 constexpr double kMinDT_s = 1e-3;              // tail motion duration dT  [s]
 constexpr double kMinWss = 0.01, kMaxWss = 0.99;  // acceleration share w_ss of dT
@@ -28,6 +42,10 @@ constexpr double kAtRestPhidotDps = 0.1;        // |phi_dot| at the end below th
 constexpr double kAtRestSpeedMps = 1e-3;        // body speed at the end below this: at rest  [m/s]
 constexpr double kMaxPaperSpuriousTurnDeg = 10.0;  // paper coupling: turn its momentum error alone causes  [deg]
 constexpr double kMaxTrackingErrorDeg = 1.0;       // MuJoCo: max servo tracking error above this warns  [deg]
+// A tail joint's peak speed above this warns (every model): 100 turns a second, beyond any tail
+// motor, where a result describes a stroke no robot makes (the loader's limits on dtheta and dT
+// allow 2 x 3600 deg / 1 ms = 7.2e6 deg/s).
+constexpr double kMaxJointSpeedDps = 36000.0;  // [deg/s]
 // MuJoCo contact fidelity (docs/mujoco-model.md "Contact fidelity"): share of the run's steps with
 // no foot loaded, and the peak summed foot normal force in units of the weight m g; above these warns.
 constexpr double kMaxAirborneFraction = 0.2;        // [1]
