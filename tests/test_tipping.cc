@@ -188,17 +188,27 @@ TEST(Tipping, FailedRunIsNullInJsonAndFailedInEveryReader) {
                                       "models: [analytic, mujoco]\n");
   const fs::path out = dir / "out";
   // Through the CLI: its case table says FAILED with the reason.
-  const std::string cmd = std::string(TAILSIM_BINARY_DIR) + "/tailsim run " + yaml.string() + " --out " +
-                          out.string() + " --quiet 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::string text;
-  char buf[512];
-  while (fgets(buf, sizeof buf, p)) text += buf;
-  pclose(p);
+  const auto console = [&](const char* flags) {
+    const std::string cmd = std::string(TAILSIM_BINARY_DIR) + "/tailsim run " + yaml.string() + " --out " +
+                            out.string() + " " + flags + " 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    std::string text;
+    if (p == nullptr) return text;
+    char buf[512];
+    while (fgets(buf, sizeof buf, p)) text += buf;
+    pclose(p);
+    return text;
+  };
+  std::string text = console("");
   EXPECT_NE(text.find("mujoco: FAILED (robot fell over at t = "), std::string::npos) << text;
   EXPECT_NE(text.find("analytic: FAILED ("), std::string::npos) << text;
   EXPECT_NE(text.find("mujoco: phi_net "), std::string::npos) << text;  // the 3 kg case stands
+  // --quiet (the same folder, resumed): the failed runs are errors, so they are still printed; the
+  // standing case's result is not.
+  text = console("--quiet");
+  EXPECT_NE(text.find(": mujoco: FAILED (robot fell over at t = "), std::string::npos) << text;
+  EXPECT_NE(text.find(": analytic: FAILED ("), std::string::npos) << text;
+  EXPECT_EQ(text.find("phi_net "), std::string::npos) << text;
 
   std::ifstream in(out / "summary.json");
   const json s = json::parse(in);

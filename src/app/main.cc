@@ -92,20 +92,32 @@ std::string poseQuantity(const ExperimentResults* r, const std::string& case_nam
   return {};
 }
 
-void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite) {
+void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite, bool failures_only) {
   // A short table per case and model, read back from the result folder's summary.json (its
   // entries name each case's folder: "dir"): phi_net of a simulation, the pose's own quantity of
   // a pose study. A warning that differs between runs only in its numbers is printed once, with
   // the number of runs (each run keeps its own in results.csv and summary.json).
+  // failures_only (run --quiet): one line per failed model run, "experiment/case: model: FAILED (why)".
   for (const Experiment& e : suite) {
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
-    std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
     std::ifstream in(dir / "summary.json");
     const nlohmann::json s = nlohmann::json::parse(in, nullptr, false);
     std::map<std::string, const nlohmann::json*> by_name;
     if (!s.is_discarded() && s.contains("cases") && s["cases"].is_array())
       for (const nlohmann::json& c : s["cases"])
         if (c.is_object() && c.contains("name") && c["name"].is_string()) by_name[c["name"].get<std::string>()] = &c;
+    if (failures_only) {
+      for (const ExperimentCase& c : e.cases) {
+        const auto it = by_name.find(c.name);
+        if (it == by_name.end() || !it->second->contains("runs") || !(*it->second)["runs"].is_object()) continue;
+        for (const auto& [model, r] : (*it->second)["runs"].items())
+          if (r.is_object() && !r.value("ok", false))
+            std::printf("%s/%s: %s: FAILED (%s)\n", e.name.c_str(), c.name.c_str(), model.c_str(),
+                        r.value("error", std::string()).c_str());
+      }
+      continue;
+    }
+    std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
     const bool pose = !s.is_discarded() && s.value("kind", std::string()) == "pose";
     std::optional<ExperimentResults> pose_results;
     if (pose) try {
@@ -433,8 +445,8 @@ int main(int argc, char** argv) {
         // 128 + the signal, as a shell reports a process it ended (SIGINT 130, SIGTERM 143, SIGHUP 129).
         return s.stop_signal > 0 ? 128 + s.stop_signal : kExitInterrupted;
       }
-      // --quiet: errors and the line above only
-      if (shard_text.empty() && !quiet) printCases(suite, out_dir, suite.size() > 1);  // a shard's table is mostly "not run"
+      // --quiet: the failed runs and the line above only
+      if (shard_text.empty()) printCases(suite, out_dir, suite.size() > 1, quiet);  // a shard's table is mostly "not run"
       if (plots) {
         if (!quiet) printSeriesNotes(out_dir);
         const std::string report_path = writeReport(out_dir);
