@@ -12,8 +12,8 @@
 #                   experiment.yaml, results.csv, summary.json; --fresh keeps the user's files under
 #                   cases/, plots/, renders/; optimize and maneuver refuse a run folder and take its
 #                   lock; mjcf --menagerie refuses to overwrite a hand-edited model file.
-#   folder-files    cases.jsonl, result.json and summary.json are opened only if they are regular
-#                   files: a symlink is refused (nothing written through it), a FIFO never blocks, a
+#   folder-files    cases.jsonl, result.json and summary.json are opened (by run and plot) only if
+#                   they are regular files: a symlink is refused (nothing written through it), a FIFO never blocks, a
 #                   huge file or /dev/zero is not read.
 # Usage: result_folder_test.sh SOURCE_DIR BINARY_DIR CLASS
 set -uo pipefail
@@ -227,6 +227,10 @@ YAML
   # summary.json a FIFO, a case's result.json a symlink out of the folder.
   mkdir -p "$W/o5" && mkfifo "$W/o5/summary.json"
   refused "summary.json a FIFO" summary.json "$W/f.yaml" o5
+  rc=0
+  timeout 10 "$TAILSIM" plot "$W/o5" > /dev/null 2> "$W/err" || rc=$?
+  [ $rc -eq 1 ] && grep -q summary.json "$W/err" || { cat "$W/err"; fail "plot of a folder whose summary.json is a FIFO: exit $rc"; }
+  echo "plot with summary.json a FIFO: refused ($(head -c 120 "$W/err"))"
   "$TAILSIM" run "$W/f.yaml" --out "$W/o6" --quiet > /dev/null || fail "run f"
   cp "$W/o6/cases/w_ss=0.3/result.json" "$W/outside.json"
   rm "$W/o6/cases/w_ss=0.3/result.json" && ln -s "$W/outside.json" "$W/o6/cases/w_ss=0.3/result.json"
