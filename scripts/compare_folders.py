@@ -1,17 +1,29 @@
 #!/usr/bin/env python3
 """Are two tailsim result folders the same, measured wall times aside?  usage: compare_folders.py A B
-Every file under A and B (except .tailsim.lock) must exist in both; JSON files are compared with every
+Every file under A and B (except .tailsim.lock and .tailsim-manifest) must exist in both; each
+.tailsim-manifest must name its folder's files as they are (it hashes them, wall times included); JSON files are compared with every
 "wall_time_s" removed (also each line of cases.jsonl), results.csv files without their wall_time_s column,
 time_series.h5 by its h5dump listing (contents, not file layout), everything else byte for byte.
 Prints the differences and exits 1, or "identical: N files" and 0."""
-import csv, io, json, os, subprocess, sys
+import csv, hashlib, io, json, os, subprocess, sys
+
+manifest_errors = []
+
+def check_manifest(d):  # "<sha256>  <name>" lines: each file as it is now
+    for line in open(os.path.join(d, ".tailsim-manifest")):
+        digest, name = line.rstrip("\n").split("  ", 1)
+        p = os.path.join(d, name)
+        if not os.path.isfile(p) or hashlib.sha256(open(p, "rb").read()).hexdigest() != digest:
+            manifest_errors.append(f"{d}/.tailsim-manifest: {name} is not as named")
 
 def walk(root):
     out = set()
     for d, _, files in os.walk(root):
         for f in files:
             rel = os.path.relpath(os.path.join(d, f), root)
-            if os.path.basename(rel) != ".tailsim.lock":
+            if f == ".tailsim-manifest":
+                check_manifest(d)
+            elif f != ".tailsim.lock":
                 out.add(rel)
     return out
 
@@ -47,6 +59,7 @@ for rel in sorted(fa & fb):
         same = open(pa, "rb").read() == open(pb, "rb").read()
     if not same:
         bad.append(f"differs: {rel}")
+bad = manifest_errors + bad
 for line in bad[:30]:
     print(line)
 if bad:

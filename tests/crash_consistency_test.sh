@@ -84,6 +84,10 @@ fi
 for d in fresh crashed; do
   cp -r "$W/$d" "$W/cmp_$d"
   rm -f "$W/cmp_$d/.tailsim.lock"
+  # The manifest hashes summary.json and results.csv, wall times included: it must name every file as
+  # it is (checked), and is then left out of the comparison.
+  (cd "$W/$d" && sha256sum --quiet -c .tailsim-manifest) || { echo "FAIL: $d/.tailsim-manifest does not match its files"; exit 1; }
+  rm -f "$W/cmp_$d/.tailsim-manifest"
   find "$W/cmp_$d" -name '*.json' -exec sed -i -E 's/"wall_time_s": [-0-9.eE+]+/"wall_time_s": W/' {} +
   find "$W/cmp_$d" -name '*.jsonl' -exec sed -i -E 's/"wall_time_s":[-0-9.eE+]+/"wall_time_s":W/g' {} +
   if [ -f "$W/cmp_$d/time_series.h5" ]; then  # contents, not layout

@@ -137,7 +137,8 @@ def files(root):
     out = set()
     for d, _, fs in os.walk(root):
         for f in fs:
-            if f != '.tailsim.lock': out.add(os.path.relpath(os.path.join(d, f), root))
+            # (.tailsim-manifest hashes summary.json and results.csv, wall times included)
+            if f not in ('.tailsim.lock', '.tailsim-manifest'): out.add(os.path.relpath(os.path.join(d, f), root))
     return out
 def strip(v):  # JSON without its wall-clock fields
     if isinstance(v, dict): return {k: strip(x) for k, x in v.items() if k != 'wall_time_s'}

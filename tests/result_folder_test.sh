@@ -8,8 +8,12 @@
 #   hdf5-signals    an hdf5 sweep stopped by SIGTERM, SIGHUP, SIGINT and kill -9 resumes every case
 #                   its journal had when the signal came; cases.jsonl holds one line per finished
 #                   case after the resume. Prints the table "signal -> cases resumed".
-#   folder-files    cases.jsonl, result.json and summary.json are opened only if they are regular
-#                   files: a symlink is refused (nothing written through it), a FIFO never blocks, a
+#   user-files      tailsim replaces or deletes only files it wrote: run --out D refuses D's own
+#                   experiment.yaml, results.csv, summary.json; --fresh keeps the user's files under
+#                   cases/, plots/, renders/; optimize and maneuver refuse a run folder and take its
+#                   lock; mjcf --menagerie refuses to overwrite a hand-edited model file.
+#   folder-files    cases.jsonl, result.json and summary.json are opened (by run and plot) only if
+#                   they are regular files: a symlink is refused (nothing written through it), a FIFO never blocks, a
 #                   huge file or /dev/zero is not read.
 # Usage: result_folder_test.sh SOURCE_DIR BINARY_DIR CLASS
 set -uo pipefail
@@ -123,6 +127,8 @@ hdf5-signals)
     start_and_stop "$d" $sig 100
     rc=$?
     if grep -q "HDF5-DIAG" "$d.err"; then fail "SIG$sig: libhdf5's error stack reached stderr"; fi
+    # SIGTERM and SIGHUP stop the run as Ctrl-C does: the running cases finish, the count is printed.
+    [ "$sig" = KILL ] || grep -q "cases saved in" "$d.err" || { cat "$d.err"; fail "SIG$sig: not a clean stop"; }
     journaled=$(lines "$d")
     [ "$journaled" -ge 100 ] || fail "SIG$sig: only $journaled cases journaled"
     out=$("$TAILSIM" run "$W/big.yaml" --out "$d" --quiet --threads 2 2>&1)
@@ -141,6 +147,55 @@ hdf5-signals)
     echo "kill -9 $k: $n journal lines, $distinct cases"
     [ "$n" -eq "$distinct" ] || fail "cases.jsonl has $n lines for $distinct cases after $k kills"
   done
+  ;;
+user-files)
+  sweep s 0.3  # 4 cases
+  sed 's/time_series: thin, time_series_file: hdf5/time_series: full/' "$W/s.yaml" > "$W/f.yaml"
+  refused() {  # refused WHAT FILE_NAMED CMD...: exit 1 naming the file
+    local what=$1 named=$2 rc=0
+    shift 2
+    "$@" > /dev/null 2> "$W/err" || rc=$?
+    [ $rc -eq 1 ] || { cat "$W/err"; fail "$what: exit $rc, want 1"; }
+    grep -q "$named" "$W/err" || { cat "$W/err"; fail "$what: the error does not name $named"; }
+    echo "$what: refused ($(head -c 160 "$W/err"))"
+  }
+  # run --out D where D holds the user's own files: each refused, unchanged.
+  for own in experiment.yaml results.csv summary.json; do
+    d="$W/own_$own"
+    mkdir -p "$d" && cp "$W/f.yaml" "$d/input.yaml"
+    echo '{"mine": true}' > "$d/$own"
+    [ "$own" = experiment.yaml ] && cp "$W/f.yaml" "$d/experiment.yaml"  # run from D's own experiment.yaml
+    refused "run --out D with the user's $own" "$own was not written by tailsim" "$TAILSIM" run "$d/input.yaml" --out "$d" --quiet
+    [ "$own" = experiment.yaml ] && ! cmp -s "$W/f.yaml" "$d/experiment.yaml" && fail "$own replaced"
+    [ "$own" = experiment.yaml ] || grep -q mine "$d/$own" || fail "$own replaced"
+  done
+  # --fresh deletes only what tailsim wrote.
+  d="$W/fresh"
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet > /dev/null || fail "run"
+  mkdir -p "$d/plots" "$d/renders" && echo n > "$d/cases/w_ss=0.35/notes.txt" && echo p > "$d/plots/mine.png"
+  echo r > "$d/renders/mine.png" && mkdir -p "$d/cases/mine" && echo m > "$d/cases/mine/data.csv"
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --fresh > /dev/null 2> "$W/err" || { cat "$W/err"; fail "--fresh"; }
+  for f in "cases/w_ss=0.35/notes.txt" plots/mine.png renders/mine.png cases/mine/data.csv; do
+    [ -f "$d/$f" ] || fail "--fresh deleted the user's $f"
+  done
+  grep -q "kept .*notes.txt" "$W/err" || { cat "$W/err"; fail "--fresh does not say what it kept"; }
+  [ -f "$d/cases/w_ss=0.35/result.json" ] && [ -f "$d/summary.json" ] || fail "--fresh run incomplete"
+  echo "--fresh: the user's files under cases/, plots/, renders/ kept"
+  # optimize / maneuver: a run folder's summary.json is not theirs; the folder lock is taken.
+  refused "optimize into a run folder" "holds the results of" "$TAILSIM" optimize "$SRC/configs/design/spline_n1.yaml" --out "$d" --quiet
+  refused "maneuver into a run folder" "holds the results of" "$TAILSIM" maneuver "$SRC/configs/design/maneuver_90.yaml" --out "$d" --quiet
+  mkdir -p "$W/opt" && flock "$W/opt/.tailsim.lock" sleep 20 &
+  lockpid=$!
+  sleep 0.5
+  refused "optimize into a folder in use" "in use" "$TAILSIM" optimize "$SRC/configs/design/spline_n1.yaml" --out "$W/opt" --quiet
+  kill $lockpid 2>/dev/null; wait $lockpid 2>/dev/null
+  # mjcf --menagerie: a hand-edited model file is never overwritten; tailsim's own ones are.
+  "$TAILSIM" mjcf --links 2 --menagerie "$W/men" > /dev/null || fail "mjcf --menagerie"
+  "$TAILSIM" mjcf --links 2 --menagerie "$W/men" > /dev/null || fail "mjcf --menagerie over its own files"
+  f=$(ls "$W/men"/tailsim_*.xml | head -1)
+  sed -i 's/<mujoco /<mujoco  /' "$f" && cp "$f" "$W/edited.xml"
+  refused "mjcf --menagerie over a hand-edited file" "$(basename "$f")" "$TAILSIM" mjcf --links 2 --menagerie "$W/men"
+  cmp -s "$f" "$W/edited.xml" || fail "the hand-edited model file was replaced"
   ;;
 folder-files)
   cat > "$W/n.yaml" <<YAML
@@ -174,6 +229,10 @@ YAML
   # summary.json a FIFO, a case's result.json a symlink out of the folder.
   mkdir -p "$W/o5" && mkfifo "$W/o5/summary.json"
   refused "summary.json a FIFO" summary.json "$W/f.yaml" o5
+  rc=0
+  timeout 10 "$TAILSIM" plot "$W/o5" > /dev/null 2> "$W/err" || rc=$?
+  [ $rc -eq 1 ] && grep -q summary.json "$W/err" || { cat "$W/err"; fail "plot of a folder whose summary.json is a FIFO: exit $rc"; }
+  echo "plot with summary.json a FIFO: refused ($(head -c 120 "$W/err"))"
   "$TAILSIM" run "$W/f.yaml" --out "$W/o6" --quiet > /dev/null || fail "run f"
   cp "$W/o6/cases/w_ss=0.3/result.json" "$W/outside.json"
   rm "$W/o6/cases/w_ss=0.3/result.json" && ln -s "$W/outside.json" "$W/o6/cases/w_ss=0.3/result.json"

@@ -22,6 +22,7 @@
 #include <memory>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -291,38 +292,46 @@ fs::path h5PartPath(const Job& job, size_t i) { return job.root / kH5Parts / (jo
 bool keepsSeries(const ExperimentCase& c) { return c.output.time_series != TimeSeriesOutput::kNone; }
 bool inH5(const ExperimentCase& c) { return keepsSeries(c) && c.output.time_series_file == TimeSeriesFile::kHdf5; }
 
-// DIR/.tailsim.lock, flock()ed for the whole run: a second run into the same folder fails at once
-// instead of interleaving its writes. The file holds the owner's pid (for the message). The lock
-// goes with the process (also on kill -9); the file stays.
-class RunLock {
- public:
-  explicit RunLock(const fs::path& dir) {
-    fs::create_directories(dir);
-    const fs::path p = dir / ".tailsim.lock";
-    fd_ = ::open(p.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
-    if (fd_ < 0) throw std::runtime_error("cannot open " + p.string() + ": " + std::strerror(errno));
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      const int err = errno;
-      char buf[32] = {};
-      const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
-      ::close(fd_);
-      if (err != EWOULDBLOCK) throw std::runtime_error("cannot lock " + p.string() + ": " + std::strerror(err));
-      std::string pid = n > 0 ? std::string(buf, static_cast<size_t>(n)) : "?";
-      while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
-      throw std::runtime_error(dir.string() + " is in use by another tailsim run (pid " + pid + ")");
-    }
-    const std::string me = std::to_string(::getpid()) + "\n";
-    if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
-      // the pid is only for the message of a second run; the lock itself holds
-    }
-  }
-  ~RunLock() { ::close(fd_); }  // releases the lock
-  RunLock(const RunLock&) = delete;
-  RunLock& operator=(const RunLock&) = delete;
+// The run lock goes with the process (also on kill -9); the file stays.
+}  // namespace
 
- private:
-  int fd_ = -1;
-};
+FolderLock::FolderLock(const std::string& dir_text) {
+  const fs::path dir(dir_text);
+  fs::create_directories(dir);
+  const fs::path p = dir / ".tailsim.lock";
+  fd_ = ::open(p.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+  if (fd_ < 0) throw std::runtime_error("cannot open " + p.string() + ": " + std::strerror(errno));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    char buf[32] = {};
+    const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
+    ::close(fd_);
+    if (err != EWOULDBLOCK) throw std::runtime_error("cannot lock " + p.string() + ": " + std::strerror(err));
+    std::string pid = n > 0 ? std::string(buf, static_cast<size_t>(n)) : "?";
+    while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+    throw std::runtime_error(dir.string() + " is in use by another tailsim run (pid " + pid + ")");
+  }
+  const std::string me = std::to_string(::getpid()) + "\n";
+  if (::ftruncate(fd_, 0) != 0 || ::pwrite(fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
+    // the pid is only for the message of a second run; the lock itself holds
+  }
+}
+
+FolderLock::~FolderLock() { ::close(fd_); }  // releases the lock
+
+void refuseRunResults(const std::string& dir, const std::string& command) {
+  const fs::path root(dir);
+  std::error_code ec;
+  const std::optional<std::string> text = readResultFile((root / "summary.json").string());
+  const json j = text ? json::parse(*text, nullptr, false) : json();
+  if ((j.is_object() && j.contains("cases") && j.contains("swept_keys")) || fs::exists(root / "cases", ec) ||
+      fs::exists(root / "cases.jsonl", ec) || fs::exists(root / "results.csv", ec))
+    throw std::runtime_error(dir + " holds the results of `tailsim run` (summary.json, results.csv, cases): `tailsim " +
+                             command + "` would replace them; choose another --out");
+}
+
+namespace {
+using RunLock = FolderLock;
 
 // A JSON file of the folder (discarded, not an exception, when absent or not JSON; an error when
 // it is not a regular file or too large: readResultFile).
@@ -384,19 +393,131 @@ bool holdsResults(const fs::path& root) {
          fs::exists(root / "cases.jsonl", ec);
 }
 
-// The entries tailsim writes into a result folder (docs/ARCHITECTURE.md); nothing else is touched.
-void clearResultFolder(const fs::path& root) {
-  for (const char* entry :
-       {"summary.json", "results.csv", "experiment.yaml", "robot.yaml", "mjcf", "report.md", "cases", "cases.jsonl",
-        "time_series.h5", kH5Parts, "renders", "plots"})
-    fs::remove_all(root / entry);
-  std::error_code ec;
-  for (const auto& f : fs::directory_iterator(root, ec)) {  // a swept robot's copies: robot-<k>.yaml
-    const std::string n = f.path().filename().string();
-    if (n.size() > 11 && n.compare(0, 6, "robot-") == 0 && n.compare(n.size() - 5, 5, ".yaml") == 0 &&
-        std::all_of(n.begin() + 6, n.end() - 5, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); }))
-      fs::remove(f.path(), ec);
+// ---- Which files of a folder are tailsim's ----------------------------------------------------
+// The files the runner writes at the top of a result folder (experiment.yaml, robot*.yaml,
+// summary.json, results.csv) are named in DIR/.tailsim-manifest (atomic_file.h) before they are
+// written. A file is tailsim's when the manifest names it with its current content; in a folder
+// without a manifest (written before it existed) when its content is recognisably tailsim's.
+// tailsim replaces and deletes only its own.
+bool isRobotCopy(const std::string& n) {  // robot-<k>.yaml: a swept robot's copies
+  return n.size() > 11 && n.compare(0, 6, "robot-") == 0 && n.compare(n.size() - 5, 5, ".yaml") == 0 &&
+         std::all_of(n.begin() + 6, n.end() - 5, [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); });
+}
+
+std::vector<fs::path> memberFolders(const fs::path& root);
+
+bool ownFile(const fs::path& root, const std::string& name) {
+  const std::optional<std::string> text = readResultFile((root / name).string());
+  if (!text) return true;  // absent: nothing to protect
+  if (name == "cases.jsonl") {  // appended case by case: recognised by content (its first line)
+    const json j = json::parse(text->substr(0, text->find('\n')), nullptr, false);
+    return text->empty() || (j.is_object() && j.contains("key") && j.contains("name"));
   }
+  if (hasManifest(root.string())) return manifestNames(root.string(), name, *text);
+  // No manifest: a folder of an earlier tailsim, recognised by content.
+  if (name == "summary.json") {
+    const json j = json::parse(*text, nullptr, false);
+    return j.is_object() && j.contains("tailsim_version") && j.contains("experiment");
+  }
+  if (name == "results.csv") return text->compare(0, 21, "experiment,case,model") == 0;
+  // experiment.yaml, robot*.yaml: beside tailsim's results (a suite's: in its member folders)
+  return !resultOwner(root).first.empty() || !memberFolders(root).empty();
+}
+
+// Writes DIR/<name> (a top-level file of the folder) when what is there is tailsim's; else refuses.
+// The first write into a folder without a manifest records its files recognised as tailsim's first.
+void writeOwnFile(const fs::path& root, const std::string& name, const std::string& text) {
+  if (!hasManifest(root.string())) {
+    std::vector<std::string> names = {"experiment.yaml", "robot.yaml", "summary.json", "results.csv"};
+    std::error_code ec;
+    for (const auto& f : fs::directory_iterator(root, ec))
+      if (isRobotCopy(f.path().filename().string())) names.push_back(f.path().filename().string());
+    std::vector<std::pair<std::string, std::string>> own;  // (all judged before the manifest exists)
+    for (const std::string& n : names)
+      if (const std::optional<std::string> there = readResultFile((root / n).string()); there && ownFile(root, n))
+        own.emplace_back(n, *there);
+    for (const auto& [n, there] : own) recordInManifest(root.string(), n, there);
+  }
+  if (!ownFile(root, name))
+    throw std::runtime_error((root / name).string() + " was not written by tailsim (or was changed since): not "
+                             "replaced; move it out of " + root.string() + " or choose another --out");
+  recordInManifest(root.string(), name, text);
+  writeFileAtomic((root / name).string(), text);
+}
+
+// The entries tailsim writes into a result folder (docs/ARCHITECTURE.md) are deleted, and in them
+// only what tailsim writes: its top-level files when they are its own (ownFile), a case folder's
+// result.json and <model>.csv, mjcf/<hash>.xml, renders/<case dir>.{mp4,png}, time_series.h5(.d),
+// its temporary files. Anything else stays (named on stderr), and so do plots/, report.md and
+// figures.html (`tailsim plot` and `report` rewrite them).
+void clearResultFolder(const fs::path& root) {
+  std::error_code ec;
+  std::vector<std::string> kept;
+  const auto removeIf = [&](const fs::path& p, bool own) {
+    if (!fs::exists(fs::symlink_status(p, ec))) return;
+    if (own) fs::remove(p, ec);
+    else kept.push_back(p.string());
+  };
+  const auto isTemp = [](const std::string& n) { return n.find(".tmp.") != std::string::npos; };
+  // Folders: delete tailsim's files in them, then the folder if it is empty.
+  const auto clearDir = [&](const fs::path& dir, const std::function<bool(const std::string&)>& own) {
+    if (!fs::is_directory(fs::symlink_status(dir, ec))) {
+      if (fs::exists(fs::symlink_status(dir, ec))) kept.push_back(dir.string());
+      return;
+    }
+    for (const auto& f : fs::directory_iterator(dir, ec)) {
+      const std::string n = f.path().filename().string();
+      removeIf(f.path(), f.is_regular_file(ec) && !f.is_symlink(ec) && (isTemp(n) || own(n)));
+    }
+    fs::remove(dir, ec);  // only if now empty
+  };
+  std::set<std::string> case_dirs;
+  const std::vector<std::string> models = modelNames();
+  if (fs::is_directory(fs::symlink_status(root / "cases", ec))) {
+    for (const auto& d : fs::directory_iterator(root / "cases", ec)) {
+      if (!d.is_directory(ec) || d.is_symlink(ec)) {
+        kept.push_back(d.path().string());
+        continue;
+      }
+      if (isRegularFile(d.path() / "result.json")) case_dirs.insert(d.path().filename().string());
+      clearDir(d.path(), [&](const std::string& n) {
+        if (n == "result.json") return true;
+        return std::any_of(models.begin(), models.end(), [&](const std::string& m) { return n == m + ".csv"; });
+      });
+    }
+    fs::remove(root / "cases", ec);
+  }
+  if (const json s = readJsonFile(root / "summary.json"); s.is_object() && s.contains("cases") && s["cases"].is_array())
+    for (const json& c : s["cases"])
+      if (c.is_object() && c.contains("dir") && c["dir"].is_string()) case_dirs.insert(c["dir"].get<std::string>());
+  clearDir(root / "renders", [&](const std::string& n) {
+    const size_t dot = n.rfind('.');
+    return dot != std::string::npos && (n.substr(dot) == ".mp4" || n.substr(dot) == ".png") &&
+           case_dirs.count(n.substr(0, dot));
+  });
+  clearDir(root / "mjcf", [](const std::string& n) {
+    return n.size() == 20 && n.compare(16, 4, ".xml") == 0 &&
+           std::all_of(n.begin(), n.begin() + 16, [](char ch) { return std::isxdigit(static_cast<unsigned char>(ch)); });
+  });
+  clearDir(root / kH5Parts, [](const std::string& n) { return n.size() > 3 && n.compare(n.size() - 3, 3, ".h5") == 0; });
+  {
+    const fs::path h5 = root / "time_series.h5";
+    removeIf(h5, fs::is_regular_file(fs::symlink_status(h5, ec)) && TimeSeriesH5Reader(h5.string()).ok());
+  }
+  std::vector<std::string> top = {"cases.jsonl", "results.csv", "experiment.yaml", "robot.yaml"};
+  for (const auto& f : fs::directory_iterator(root, ec))
+    if (isRobotCopy(f.path().filename().string())) top.push_back(f.path().filename().string());
+  top.push_back("summary.json");  // last: ownFile of the others may read it
+  for (const std::string& name : top) {
+    bool own = false;
+    try {
+      own = ownFile(root, name);
+    } catch (const std::exception&) {  // not a regular file: not tailsim's
+    }
+    removeIf(root / name, own);
+  }
+  compactManifest(root.string());
+  for (const std::string& k : kept) std::fprintf(stderr, "note: --fresh kept %s (not written by tailsim)\n", k.c_str());
 }
 
 // The experiment file a folder's results come from: e's file, unless e is run from the copy in a
@@ -530,7 +651,8 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   const bool any_folder = std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return e.cases[i].output.caseFolder(); });
   fs::create_directories(any_folder ? root / "cases" : root);
   // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
-  for (const auto& [name, text] : folderInputs(e)) writeFileAtomic((root / name).string(), text);
+  compactManifest(root.string());
+  for (const auto& [name, text] : folderInputs(e)) writeOwnFile(root, name, text);
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
   job.entries.resize(e.cases.size());
   // Cases without a folder are finished when DIR/cases.jsonl has them; with their time series in
@@ -813,8 +935,8 @@ void writeSummary(Job& job) {
   }
   cases += first ? "]" : "\n ]";
   text.replace(at + empty.size() - 2, 2, cases);
-  writeFileAtomic((job.root / "summary.json").string(), text);
-  writeFileAtomic((job.root / "results.csv").string(), resultsCsv({tableInput(job)}));
+  writeOwnFile(job.root, "summary.json", text);
+  writeOwnFile(job.root, "results.csv", resultsCsv({tableInput(job)}));
 }
 
 // All cases of all experiments share one pool of workers (workers share nothing mutable but
@@ -1012,7 +1134,9 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
       writeSummary(job);  // also after a failure: finished cases count
       tables.push_back(tableInput(job));
     }
-    if (!suite_root.empty()) writeFileAtomic((suite_root / "results.csv").string(), resultsCsv(tables));
+    if (!suite_root.empty()) writeOwnFile(suite_root, "results.csv", resultsCsv(tables));
+    for (Job& job : jobs) compactManifest(job.root.string());  // one line per file, as it is now
+    if (!suite_root.empty()) compactManifest(suite_root.string());
   } catch (const std::exception&) {
     if (first_error.empty()) throw;  // else report the first error (a full disk fails the summary too)
   }
@@ -1058,7 +1182,7 @@ RunStats runSuite(const std::vector<Experiment>& suite, const RunOptions& opt) {
   std::vector<Job> jobs;
   for (size_t k = 0; k < suite.size(); ++k)
     jobs.push_back(prepare(suite[k], opt, fs::path(opt.out_dir) / suite[k].name, in_shard[k]));
-  writeFileAtomic((fs::path(opt.out_dir) / "experiment.yaml").string(), suiteFolderFile(suite));
+  writeOwnFile(opt.out_dir, "experiment.yaml", suiteFolderFile(suite));
   return runJobs(jobs, opt, fs::path(opt.out_dir).filename().string(), opt.out_dir);
 }
 

@@ -54,6 +54,25 @@ struct RunStats {
   int stop_signal = 0;       // the signal that stopped it: SIGINT, SIGTERM or SIGHUP (0: none)
 };
 
+// DIR/.tailsim.lock, flock()ed while the object lives (created with DIR when absent): every command
+// writing a result folder (run, merge's staging folder, optimize, maneuver) holds it, so a second one
+// into the same folder fails at once ("DIR is in use by another tailsim run (pid N)"); the lock goes
+// with the process (also on kill -9), the file stays.
+class FolderLock {
+ public:
+  explicit FolderLock(const std::string& dir);
+  ~FolderLock();
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+// Throws (naming DIR) when DIR holds the results of `tailsim run` (its summary.json, results.csv,
+// cases/ or cases.jsonl): `command` (optimize, maneuver) writes a summary.json of its own there.
+void refuseRunResults(const std::string& dir, const std::string& command);
+
 // Keeps only the models named in `only` in every case (none given: all). Throws ConfigError naming
 // `file` for an unknown model name, or when the names select no model of any simulated case (the run
 // would write empty results).

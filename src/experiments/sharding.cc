@@ -90,7 +90,8 @@ std::string readAll(const fs::path& p) {
 // Files a run writes about the whole folder (rebuilt by the merge) or that belong to no case.
 bool rebuiltOrTransient(const fs::path& rel) {
   const std::string n = rel.filename().string();
-  if (n == ".tailsim.lock" || n == "summary.json" || n == "results.csv" || n == "report.md" || n == "figures.html")
+  if (n == ".tailsim.lock" || n == ".tailsim-manifest" || n == "summary.json" || n == "results.csv" || n == "report.md" ||
+      n == "figures.html")
     return true;
   if (n.find(".tmp.") != std::string::npos) return true;  // an interrupted writer's temporary
   for (const auto& part : rel)
@@ -211,6 +212,8 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
         }
         fs::create_directories(dst.parent_path());
         fs::copy_file(it->path(), dst, fs::copy_options::overwrite_existing);
+        if (!perCase(rel) && rel.parent_path().filename() != "mjcf")  // an input copy: the merge wrote it
+          recordInManifest(dst.parent_path().string(), rel.filename().string(), readAll(dst));
         ++st.files_copied;
       }
       taken_cases.insert(taken_cases.end(), this_shard_cases.begin(), this_shard_cases.end());

@@ -7,7 +7,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "results/atomic_file.h"
 
@@ -692,8 +694,20 @@ std::vector<std::string> writeMenagerie(const MenagerieFiles& f, const std::stri
   namespace fs = std::filesystem;
   fs::create_directories(dir);
   const std::string robot = (fs::path(dir) / f.robot_file).string(), scene = (fs::path(dir) / f.scene_file).string();
-  writeFileAtomic(robot, f.robot_xml);
-  writeFileAtomic(scene, f.scene_xml);
+  // A file there is replaced only when it is what would be written, or what tailsim wrote and
+  // unchanged since (DIR/.tailsim-manifest): a hand-edited model file is never overwritten.
+  for (const auto& [name, text] : {std::make_pair(f.robot_file, &f.robot_xml), std::make_pair(f.scene_file, &f.scene_xml)}) {
+    const std::optional<std::string> there = readResultFile((fs::path(dir) / name).string());
+    if (there && *there != *text && !manifestNames(dir, name, *there))
+      throw std::runtime_error((fs::path(dir) / name).string() +
+                               " was not written by tailsim or was edited since: not replaced (move it away, or "
+                               "choose another --menagerie folder)");
+  }
+  for (const auto& [name, text] : {std::make_pair(f.robot_file, &f.robot_xml), std::make_pair(f.scene_file, &f.scene_xml)}) {
+    recordInManifest(dir, name, *text);
+    writeFileAtomic((fs::path(dir) / name).string(), *text);
+  }
+  compactManifest(dir);
   return {robot, scene};
 }
 

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include "experiments/experiment_loader.h"
@@ -114,10 +116,11 @@ CaseRecord parseCase(const json& c) {
 }
 
 json readJson(const fs::path& p) {
-  std::ifstream in(p);
-  if (!in) throw std::runtime_error("cannot read " + p.string());
+  // A regular file of the folder only (no symlink, FIFO or device; bounded: readResultFile).
+  const std::optional<std::string> text = readResultFile(p.string());
+  if (!text) throw std::runtime_error("cannot read " + p.string());
   try {
-    return json::parse(in);
+    return json::parse(*text);
   } catch (const json::exception& e) {
     throw std::runtime_error(p.string() + ": " + e.what());
   }
@@ -214,7 +217,7 @@ ExperimentResults loadResults(const std::string& dir) {
       for (const json& c : *cs) r.cases.push_back(parseCase(c));
   } else if (fs::exists(root / "cases.jsonl") && !fs::is_directory(root / "cases")) {
     // an interrupted run whose cases have no folder: its journal (a torn last line is skipped)
-    std::ifstream in(root / "cases.jsonl");
+    std::istringstream in(readResultFile((root / "cases.jsonl").string()).value_or(std::string()));
     std::string line;
     while (std::getline(in, line)) {
       const json j = json::parse(line, nullptr, false);

@@ -12,13 +12,16 @@
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
 #include <vector>
 
 #include "results/number_text.h"
+#include "results/sha256.h"
 
 namespace tailsim {
 
@@ -77,6 +80,60 @@ std::optional<std::string> readResultFile(const std::string& path, long long max
   }
   out.resize(got);
   return out;
+}
+
+namespace {
+const char* const kManifestName = ".tailsim-manifest";
+std::string manifestPath(const std::string& dir) { return (std::filesystem::path(dir) / kManifestName).string(); }
+bool hasLine(const std::string& text, const std::string& line) {  // line with its '\n'
+  return text.compare(0, line.size(), line) == 0 || text.find("\n" + line) != std::string::npos;
+}
+}  // namespace
+
+bool hasManifest(const std::string& dir) { return readResultFile(manifestPath(dir)).has_value(); }
+
+bool manifestNames(const std::string& dir, const std::string& name, const std::string& content) {
+  const std::optional<std::string> m = readResultFile(manifestPath(dir));
+  return m && hasLine(*m, sha256Hex(content) + "  " + name + "\n");
+}
+
+void recordInManifest(const std::string& dir, const std::string& name, const std::string& content) {
+  const std::string line = sha256Hex(content) + "  " + name + "\n";
+  const std::string path = manifestPath(dir);
+  if (const std::optional<std::string> m = readResultFile(path); m && hasLine(*m, line)) return;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
+  struct stat st {};
+  if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (fd >= 0) ::close(fd);
+    throw std::runtime_error("cannot append to " + path + " (a regular file tailsim keeps there)");
+  }
+  const ssize_t n = ::write(fd, line.data(), line.size());
+  const int err = errno;
+  ::close(fd);
+  if (n != static_cast<ssize_t>(line.size())) throw std::system_error(err, std::generic_category(), "cannot append to " + path);
+}
+
+void compactManifest(const std::string& dir) {
+  const std::optional<std::string> m = readResultFile(manifestPath(dir));
+  if (!m) return;
+  std::string keep;
+  std::set<std::string> done;
+  std::istringstream in(*m);
+  for (std::string l; std::getline(in, l);) {
+    if (l.size() < 67 || l.compare(64, 2, "  ") != 0) continue;
+    const std::string name = l.substr(66);
+    if (done.count(name)) continue;
+    std::optional<std::string> text;
+    try {
+      text = readResultFile((std::filesystem::path(dir) / name).string());
+    } catch (const std::exception&) {  // no longer a regular file: not named any more
+    }
+    if (text && sha256Hex(*text) == l.substr(0, 64)) {
+      keep += l + "\n";
+      done.insert(name);
+    }
+  }
+  if (keep != *m) writeFileAtomic(manifestPath(dir), keep);
 }
 
 namespace {

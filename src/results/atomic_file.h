@@ -31,6 +31,19 @@ bool writeUserFile(const std::string& path, const std::string& contents);
 constexpr long long kMaxResultFileBytes = 1LL << 30;
 std::optional<std::string> readResultFile(const std::string& path, long long max_bytes = kMaxResultFileBytes);
 
+// DIR/.tailsim-manifest: the files tailsim wrote in DIR, one "<sha256>  <name>" line each
+// (sha256sum's format: `sha256sum -c .tailsim-manifest` checks them), so it replaces or deletes
+// only its own files, unchanged since it wrote them.
+// Whether DIR has a manifest at all.
+bool hasManifest(const std::string& dir);
+// Whether the manifest names `name` (relative to DIR) with exactly this content.
+bool manifestNames(const std::string& dir, const std::string& name, const std::string& content);
+// Appends "<sha256(content)>  <name>" unless there (before the file is written: whatever stops the
+// writer in between, the file holds a content the manifest names). Throws std::runtime_error.
+void recordInManifest(const std::string& dir, const std::string& name, const std::string& content);
+// Rewrites the manifest with one line per file that still has the content it names.
+void compactManifest(const std::string& dir);
+
 // CSV with a header row of column names; numbers with 12 significant digits.
 std::string toCsv(const TimeSeries& ts);
 void writeCsvAtomic(const std::string& path, const TimeSeries& ts);

@@ -10,6 +10,7 @@
 #include "design/maneuver.h"
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/experiment_runner.h"
 
 namespace {
 void copyMessage(const char* what, char* err, size_t err_len) {
@@ -40,6 +41,8 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
   using namespace tailsim;
   return guarded(err, err_len, [&] {
     const OptimizeSpec spec = loadOptimizeSpec(exp_path);  // all errors before any work
+    const FolderLock lock(out_dir);
+    refuseRunResults(out_dir, "optimize");
     const OptimizeReport r = runOptimize(spec, out_dir, quiet == 0);
     const std::string mujoco =
         spec.mujoco_check ? (r.mujoco.ok ? std::to_string(r.mujoco.phi_net_deg) + " deg" : std::string("failed")) : "not run";
@@ -65,6 +68,8 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
   using namespace tailsim;
   return guarded(err, err_len, [&] {
     const ManeuverSpec spec = loadManeuverSpec(exp_path);  // all errors before any work
+    const FolderLock lock(out_dir);
+    refuseRunResults(out_dir, "maneuver");
     const ManeuverReport r = runManeuver(spec, out_dir, video != 0, quiet == 0);
     bool all_ok = true;
     std::printf("%s: target %.4g deg, tolerance %.4g deg; analytic cycle %+.4f deg (stroke %+.4f, return %+.4f)\n",
