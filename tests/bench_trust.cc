@@ -1,15 +1,16 @@
 // How far MuJoCo at a given contact-setting rule is from a converged MuJoCo reference, over the
-// seeded random-robot corpus of tests/random_robots.h (docs/mujoco-model.md "Contact settings
-// derived from the robot"). Plain main, one thread; prints one Markdown row per rule:
-//   nice build/tests/bench_trust [--cases N=150] [--seed S=31] [--rules today,derived,..]
+// seeded random-robot corpus of tests/random_robots.h (docs/mujoco-model.md "Contact settings:
+// the rule and its evidence"). Plain main, one thread; prints one Markdown row per rule:
+//   nice build/tests/bench_trust [--cases N=120] [--seed S=31] [--rules "today;set:imp=100,ns=3;.."]
 //                                [--ref-cache FILE] [--check16 K=10] [--csv FILE]
 // Reference of a rule: the rule's settings at timestep / 8 (servo w_n kept), impratio >= 100,
-// noslip >= 3 (for "today", the reference of issue 31); every K-th case also at timestep / 16, to
+// noslip >= 3 (for "today": the old defaults' reference); every K-th case also at timestep / 16, to
 // show the reference itself has converged. --ref-cache keeps the reference runs (keyed by seed,
 // case and settings) so rules can be compared without re-running them.
 // Columns (cases where both the rule and its reference stand):
 //  * err median / p90 / max: |phi_net - phi_net,ref| / max(|phi_net,ref|, 0.5 deg);
 //  * vs today ref: the same against today's reference (what a rule's physics moves);
+//  * vs per-foot: the same against the per-foot model with load transfer (rigid Coulomb friction);
 //  * jitter p90: |phi_net(dT + 1 us) - phi_net(dT)| / max(|phi_net(dT)|, 0.5 deg), rule and reference;
 //  * sign flips: phi_net and phi_net,ref of opposite signs, |phi_net,ref| >= 0.5 deg;
 //  * airborne > 1 %: runs with no foot loaded in more than 1 % of the steps (summary extra
@@ -27,9 +28,11 @@
 #include <functional>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "analytic_model/per_foot_model.h"
 #include "mujoco_model/mujoco_settings.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "random_robots.h"
@@ -85,11 +88,11 @@ void toReference(MujocoSettings& s, double factor) {
 
 using Rule = std::function<void(const RobotParams&, const TailTrajectory&, MujocoSettings&)>;
 
-// Candidate rules (name -> settings); "today" is the before.
+// Named rules (name -> settings): "today" is the before, "default" MujocoSettings' defaults.
 std::map<std::string, Rule> rules() {
   std::map<std::string, Rule> m;
   m["today"] = today;
-  m["loader"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings&) {};  // MujocoSettings' defaults
+  m["default"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings&) {};  // MujocoSettings' defaults
   m["imp100"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
     today(r, t, s);
     s.impratio = 100.0;
@@ -128,6 +131,40 @@ std::map<std::string, Rule> rules() {
   return m;
 }
 
+// "set:key=value,..": today's rule with these changes (keys: h = timestep_s (servo w_n kept),
+// imp = impratio, ns = noslip_iterations, tau, zeta = solref, dmin, dmax, width, mid, power =
+// solimp, foot = sphere|capsule|box, r = foot_radius_m, settle = settle_s).
+Rule parseRule(const std::string& spec) {
+  std::vector<std::pair<std::string, std::string>> kv;
+  for (std::stringstream ss(spec.substr(4)); ss.good();) {
+    std::string item;
+    std::getline(ss, item, ',');
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("rule item without '=': " + item);
+    kv.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+  }
+  return [kv](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    for (const auto& [k, v] : kv) {
+      const double x = std::atof(v.c_str());
+      if (k == "h") refine(s, s.timestep_s / x);
+      else if (k == "imp") s.impratio = x;
+      else if (k == "ns") s.noslip_iterations = static_cast<int>(x);
+      else if (k == "tau") s.solref[0] = x;
+      else if (k == "zeta") s.solref[1] = x;
+      else if (k == "dmin") s.solimp[0] = x;
+      else if (k == "dmax") s.solimp[1] = x;
+      else if (k == "width") s.solimp[2] = x;
+      else if (k == "mid") s.solimp[3] = x;
+      else if (k == "power") s.solimp[4] = x;
+      else if (k == "r") s.foot_radius_m = x;
+      else if (k == "settle") s.settle_s = x;
+      else if (k == "foot") s.foot_shape = v == "box" ? MujocoFootShape::kBox : v == "capsule" ? MujocoFootShape::kCapsule : MujocoFootShape::kSphere;
+      else throw std::invalid_argument("unknown rule key " + k);
+    }
+  };
+}
+
 TailTrajectory jittered(const TailTrajectory& t, double d_s) {
   TailTrajectory out;
   for (const auto& j : t.joints) {
@@ -159,6 +196,20 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
     std::fprintf(stderr, "run threw: %s\n", ex.what());
   }
   return out;
+}
+
+// The per-foot model with load transfer (rigid Coulomb friction at four point feet), for scale.
+double perFootPhi(const RobotParams& r, const TailTrajectory& t) {
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  PerFootSettings p;
+  p.normal_loads = NormalLoadModel::kLoadTransfer;
+  try {
+    const RunResult res = simulatePerFoot(r, t, p, Effects{}, o);
+    return res.summary.ok ? res.summary.phi_net_deg : NAN;
+  } catch (const std::exception&) {
+    return NAN;
+  }
 }
 
 std::string key(const MujocoSettings& s) {
@@ -214,7 +265,7 @@ double rel(double a, double ref) { return std::abs(a - ref) / std::max(std::abs(
 }  // namespace
 
 int main(int argc, char** argv) {
-  int N = 150, check16 = 10;
+  int N = 120, check16 = 10;
   unsigned seed = 31;
   std::string rule_list = "today", cache_path, csv_path;
   for (int i = 1; i < argc; ++i) {
@@ -237,11 +288,12 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  const std::map<std::string, Rule> all = rules();
+  std::map<std::string, Rule> all = rules();
   std::vector<std::string> names;
   for (std::stringstream ss(rule_list); ss.good();) {
     std::string n;
-    std::getline(ss, n, ',');
+    std::getline(ss, n, ';');
+    if (n.rfind("set:", 0) == 0) all[n] = parseRule(n);
     if (!all.count(n)) {
       std::fprintf(stderr, "unknown rule %s; known:", n.c_str());
       for (const auto& [k, v] : all) std::fprintf(stderr, " %s", k.c_str());
@@ -254,13 +306,17 @@ int main(int argc, char** argv) {
   std::ofstream csv;
   if (!csv_path.empty()) {
     csv.open(csv_path);
-    csv << "rule,case,ok,phi_deg,phi_jitter_deg,ref_ok,ref_phi_deg,ref_jitter_deg,today_ref_phi_deg,ref16_phi_deg,airborne,"
+    csv << "rule,case,ok,phi_deg,phi_jitter_deg,ref_ok,ref_phi_deg,ref_jitter_deg,today_ref_phi_deg,ref16_phi_deg,perfoot_phi_deg,airborne,"
            "peak_over_mg,steps,wall_s,"
            "description\n";
   }
 
   std::vector<RandomRobotCase> cases;
-  for (int k = 0; k < N; ++k) cases.push_back(randomRobotCase(seed, k));
+  std::vector<double> perfoot;
+  for (int k = 0; k < N; ++k) {
+    cases.push_back(randomRobotCase(seed, k));
+    perfoot.push_back(perFootPhi(cases.back().robot, cases.back().trajectory));
+  }
   auto tag = [&](int k) { return std::to_string(seed) + ':' + std::to_string(k) + ':'; };
   // A rule's reference runs (cached): its settings refined by `factor`, impratio >= 100, noslip >= 3.
   auto refRun = [&](const Rule& rule, int k, double factor, double jitter_s) {
@@ -276,13 +332,13 @@ int main(int argc, char** argv) {
               ">= 100, noslip >= 3; 'today ref': today's rule's reference (the same for every rule)\n\n",
               N, seed);
   std::printf("| rule | compared | err median | err p90 | err max | vs today ref median | vs today ref p90 | "
-              "jitter p90 | ref jitter p90 | ref h/8 vs h/16 median / p90 (n) | sign flips | airborne > 1 %% | "
+              "vs per-foot median | vs per-foot p90 | jitter p90 | ref jitter p90 | ref h/8 vs h/16 median / p90 (n) | sign flips | airborne > 1 %% | "
               "airborne median | peak Fn/mg median | peak Fn/mg max | falls only here / only in ref | steps median | "
               "wall median [ms] |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& nm : names) {
     const Rule& rule = all.at(nm);
-    std::vector<double> err, errT, jit, rjit, conv, air, peak, steps, wall;
+    std::vector<double> err, errT, errP, jit, rjit, conv, air, peak, steps, wall;
     int flips = 0, air1 = 0, falls_here = 0, falls_ref = 0, compared = 0;
     for (int k = 0; k < N; ++k) {
       const RandomRobotCase& c = cases[k];
@@ -298,8 +354,8 @@ int main(int argc, char** argv) {
       steps.push_back(r.steps);
       wall.push_back(r.wall_s);
       if (csv.is_open())
-        csv << nm << ',' << k << ',' << r.ok << ',' << r.phi_deg << ',' << j.phi_deg << ',' << f.ok << ','
-            << f.phi_deg << ',' << fj.phi_deg << ',' << ft.phi_deg << ',' << f16.phi_deg << ',' << r.airborne << ','
+        csv << '"' << nm << "\"," << k << ',' << r.ok << ',' << r.phi_deg << ',' << j.phi_deg << ',' << f.ok << ','
+            << f.phi_deg << ',' << fj.phi_deg << ',' << ft.phi_deg << ',' << f16.phi_deg << ',' << perfoot[k] << ',' << r.airborne << ','
             << r.peak << ',' << r.steps << ',' << r.wall_s << ",\"" << describe(c) << "\"\n";
       if (r.ok && !f.ok) ++falls_ref;
       if (!r.ok && f.ok) ++falls_here;
@@ -307,6 +363,7 @@ int main(int argc, char** argv) {
       ++compared;
       err.push_back(rel(r.phi_deg, f.phi_deg));
       if (ft.ok) errT.push_back(rel(r.phi_deg, ft.phi_deg));
+      if (!std::isnan(perfoot[k])) errP.push_back(rel(r.phi_deg, perfoot[k]));
       if (j.ok) jit.push_back(rel(j.phi_deg, r.phi_deg));
       if (fj.ok) rjit.push_back(rel(fj.phi_deg, f.phi_deg));
       if (f16.ok) conv.push_back(rel(f.phi_deg, f16.phi_deg));
@@ -315,10 +372,11 @@ int main(int argc, char** argv) {
       if (r.airborne > 0.01) ++air1;
       peak.push_back(r.peak);
     }
-    std::printf("| %s | %d | %.2f %% | %.2f %% | %.1f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% / %.2f %% (%zu) "
+    std::printf("| %s | %d | %.2f %% | %.2f %% | %.1f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% / %.2f %% (%zu) "
                 "| %d | %d | %.1f %% | %.2f | %.1f | %d / %d | %.0f | %.1f |\n",
                 nm.c_str(), compared, 100 * quantile(err, 0.5), 100 * quantile(err, 0.9), 100 * quantile(err, 1.0),
-                100 * quantile(errT, 0.5), 100 * quantile(errT, 0.9), 100 * quantile(jit, 0.9),
+                100 * quantile(errT, 0.5), 100 * quantile(errT, 0.9), 100 * quantile(errP, 0.5), 100 * quantile(errP, 0.9),
+                100 * quantile(jit, 0.9),
                 100 * quantile(rjit, 0.9), 100 * quantile(conv, 0.5), 100 * quantile(conv, 0.9), conv.size(), flips,
                 air1, 100 * quantile(air, 0.5), quantile(peak, 0.5), quantile(peak, 1.0), falls_here, falls_ref,
                 quantile(steps, 0.5), 1e3 * quantile(wall, 0.5));

@@ -1,6 +1,6 @@
 // Seeded random quadrupeds with planar tails and tail strokes of the paper's kinds: the test bed of
 // the MuJoCo contact settings on robots other than the paper's (docs/mujoco-model.md "Contact
-// settings derived from the robot"). Every draw is a function of (seed, index) alone.
+// settings: the rule and its evidence"). Every draw is a function of (seed, index) alone.
 #pragma once
 
 #include <cmath>
