@@ -307,10 +307,10 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
           "models: [mujoco, analytic]\n"
           "analytic: {solver: fixed, rel_tol: 1e-6, abs_tol: 1e-9, fixed_dt_s: 1e-5, event_tol_s: 1e-10,\n"
           "           max_step_s: 0.001, v_stop_mps: 1e-6, coupling: exact}\n"
-          "mujoco: {timestep_s: 1e-4, integrator: RK4, solver: PGS, iterations: 50, tolerance: 1e-8,\n"
+          "mujoco: {timestep_s: 5e-5, integrator: RK4, solver: PGS, iterations: 50, tolerance: 1e-8,\n"
           "         cone: pyramidal, noslip_iterations: 3, condim: 4, impratio: 2, solref: [0.004, 0.9],\n"
           "         solimp: [0.9, 0.95, 0.002, 0.4, 3], mu: 0.3, kp: 50, kv: 2,\n"
-          "         velocity_feedforward: false, inverse_dynamics_feedforward: no, servo_wn_dt: 0.1,\n"
+          "         velocity_feedforward: false, inverse_dynamics_feedforward: no, servo_wn_dt: 0.3,\n"
           "         body_height_m: 0.2, foot_radius_m: 0.02, settle_s: 0.3, stop_phidot_radps: 1e-4}\n"
           "effects: {friction: none, translation: false, gravity: false, ground_contact: false,\n"
           "          foot_loads: constant, load_decomposition: false}\n"
@@ -333,7 +333,7 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
   EXPECT_DOUBLE_EQ(c.analytic.max_step_s, 0.001);
   EXPECT_DOUBLE_EQ(c.analytic.v_stop_mps, 1e-6);
   EXPECT_EQ(c.analytic.coupling, Coupling::kExact);
-  EXPECT_DOUBLE_EQ(c.mujoco.timestep_s, 1e-4);
+  EXPECT_DOUBLE_EQ(c.mujoco.timestep_s, 5e-5);
   EXPECT_EQ(c.mujoco.integrator, MujocoIntegrator::kRK4);
   EXPECT_EQ(c.mujoco.solver, MujocoSolver::kPGS);
   EXPECT_EQ(c.mujoco.iterations, 50);
@@ -351,7 +351,7 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
   EXPECT_DOUBLE_EQ(c.mujoco.kv, 2.0);
   EXPECT_FALSE(c.mujoco.velocity_feedforward);
   EXPECT_FALSE(c.mujoco.inverse_dynamics_feedforward);
-  EXPECT_DOUBLE_EQ(c.mujoco.servo_wn_dt, 0.1);
+  EXPECT_DOUBLE_EQ(c.mujoco.servo_wn_dt, 0.3);
   EXPECT_DOUBLE_EQ(c.mujoco.body_height_m, 0.2);
   EXPECT_DOUBLE_EQ(c.mujoco.foot_radius_m, 0.02);
   EXPECT_DOUBLE_EQ(c.mujoco.settle_s, 0.3);

@@ -10,6 +10,7 @@
 #include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_handles.h"
 #include "mujoco_model/mujoco_simulation.h"
+#include "random_robots.h"
 
 using namespace tailsim;
 
@@ -115,7 +116,10 @@ TEST(MujocoSimulation, RestingRobotCarriesItsWeightOnItsFeet) {
   expectCleanRun(r);
   double fn = 0.0;
   for (int k = 1; k <= 4; ++k) fn += r.series.values("foot" + std::to_string(k) + "_Fn_N")[0];
-  EXPECT_NEAR(fn, p.systemMass() * p.gravity_mps2, 1e-6 * fn);
+  // The soft first millimetre of the contact (docs/mujoco-model.md "Contact settings: the rule and
+  // its evidence") bounces the body on its feet at ~110 rad/s, damping ratio ~0.9: after the 0.1 s
+  // pre-roll 1e-5 of m g is left of the 0.15 mm drop into the floor (measured 1.0e-5).
+  EXPECT_NEAR(fn, p.systemMass() * p.gravity_mps2, 5e-5 * fn);
   EXPECT_NEAR(r.series.values("MzT_Nm")[0], 0.0, 1e-8);
   EXPECT_NEAR(r.series.values("MzF_Nm")[0], 0.0, 1e-8);
   // Symmetric pose: left and right feet carry the same load; rear feet more (tail behind).
@@ -323,7 +327,9 @@ TEST(MujocoSimulation, ContactFidelityFiguresAndTheirWarning) {
     }
     return s;
   };
-  // Default contact (solref 0.002): the feet chatter (~17 % of the steps airborne), below the limit.
+  // Default contact (docs/mujoco-model.md "Contact settings: the rule and its evidence"): every
+  // step has a loaded foot and the normal force has no spikes (the old hard contact: 17 % of the
+  // steps airborne, peaks of 12.6 m g; below).
   const RunResult def = simulateMujoco(p, tr, MujocoSettings{}, Effects{}, {});
   ASSERT_TRUE(def.summary.ok) << def.summary.error;
   const double air = def.summary.extra.at("airborne_fraction"), peak = def.summary.extra.at("peak_normal_force_over_mg");
@@ -332,15 +338,32 @@ TEST(MujocoSimulation, ContactFidelityFiguresAndTheirWarning) {
   size_t all_zero_rows = 0;
   for (double f : fn) mean += f / fn.size(), row_max = std::max(row_max, f), all_zero_rows += f == 0.0;
   EXPECT_NEAR(mean / weight, 1.0, 0.05);  // on average the feet carry the weight
-  // A row is the mean over its steps: its peak cannot exceed the steps' peak, and a row with no
-  // load at all has every step airborne.
+  // A row is the mean over its steps: its peak cannot exceed the steps' peak.
   EXPECT_GE(peak, row_max / weight - 1e-9);
-  EXPECT_GE(air, static_cast<double>(all_zero_rows) / fn.size() - 1e-9);
-  EXPECT_GT(air, 0.05);   // the chatter is there (measured 0.17)
-  EXPECT_GT(peak, 3.0);   // impulsive (measured 12.6)
-  EXPECT_LT(air, limits::kMaxAirborneFraction);
-  EXPECT_LT(peak, limits::kMaxPeakNormalForceOverMg);
+  EXPECT_EQ(air, 0.0);
+  EXPECT_LT(peak, 1.5);  // measured 1.2
   EXPECT_TRUE(def.summary.warnings.empty()) << def.summary.warnings.front();
+
+  // The old hard contact (impedance 0.95 at first touch, 0.99 from 1 mm, solref (0.002, 1), impratio 1,
+  // 2e-4 s): the sliding feet are pushed off the floor.
+  MujocoSettings hard;
+  hard.timestep_s = 2e-4;
+  hard.servo_wn_dt = 0.2;
+  hard.impratio = 1.0;
+  hard.solref = {0.002, 1.0};
+  hard.solimp = {0.95, 0.99, 0.001, 0.5, 2.0};
+  const RunResult hd = simulateMujoco(p, tr, hard, Effects{}, {});
+  ASSERT_TRUE(hd.summary.ok) << hd.summary.error;
+  const std::vector<double> hfn = summedFn(hd);
+  size_t hard_zero_rows = 0;
+  for (double f : hfn) hard_zero_rows += f == 0.0;
+  const double hair = hd.summary.extra.at("airborne_fraction");
+  // A row with no load at all has every step airborne.
+  EXPECT_GE(hair, static_cast<double>(hard_zero_rows) / hfn.size() - 1e-9);
+  EXPECT_GT(hair, 0.05);                                              // measured 0.17
+  EXPECT_GT(hd.summary.extra.at("peak_normal_force_over_mg"), 3.0);  // measured 12.6
+  EXPECT_LT(hair, limits::kMaxAirborneFraction);
+  EXPECT_TRUE(hd.summary.warnings.empty()) << hd.summary.warnings.front();
 
   // Without friction the feet never leave the ground and carry about the weight.
   Effects frictionless;
@@ -350,12 +373,30 @@ TEST(MujocoSimulation, ContactFidelityFiguresAndTheirWarning) {
   EXPECT_EQ(fl.summary.extra.at("airborne_fraction"), 0.0);
   EXPECT_LT(fl.summary.extra.at("peak_normal_force_over_mg"), 1.5);
 
-  // A stiffer contact (solref 0.001 s) chatters more: above the limit, and the run says so.
-  MujocoSettings stiff;
+  // The old hard contact stiffer still (solref 0.001 s) chatters more: above the limit, and the run says so.
+  MujocoSettings stiff = hard;
   stiff.solref[0] = 0.001;
   const RunResult st = simulateMujoco(p, tr, stiff, Effects{}, {});
   ASSERT_TRUE(st.summary.ok) << st.summary.error;
   EXPECT_GT(st.summary.extra.at("airborne_fraction"), limits::kMaxAirborneFraction);
   ASSERT_EQ(st.summary.warnings.size(), 1u);
   EXPECT_NE(st.summary.warnings[0].find("all four feet carry no load"), std::string::npos) << st.summary.warnings[0];
+}
+
+// Random robots (tests/random_robots.h, the corpus of tests/bench_trust.cc): at the default contact
+// a standing robot always has a loaded foot and no normal-force spikes. The first six cases (two
+// robots, 8.7 and 7.6 kg, 0.26 and 0.28 m, mu 0.34 and 0.53); the old hard contact left no foot
+// loaded in up to 12 % of the steps of these (case 3: 12 %, peak 11 m g).
+TEST(MujocoSimulation, RandomRobotsKeepAFootLoaded) {
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  for (int k = 0; k < 6; ++k) {
+    const tailsim::testing::RandomRobotCase c = tailsim::testing::randomRobotCase(31, k);
+    MujocoSettings s;
+    s.body_height_m = c.robot.quadruped.com_height_m;
+    const RunResult r = simulateMujoco(c.robot, c.trajectory, s, Effects{}, o);
+    ASSERT_TRUE(r.summary.ok) << k << ": " << r.summary.error;
+    EXPECT_LE(r.summary.extra.at("airborne_fraction"), 0.01) << k << ": " << tailsim::testing::describe(c);
+    EXPECT_LT(r.summary.extra.at("peak_normal_force_over_mg"), 3.0) << k << ": " << tailsim::testing::describe(c);
+  }
 }

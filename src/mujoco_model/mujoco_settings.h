@@ -48,7 +48,9 @@ inline const char* name(MujocoCone v) { return settings::nameOf(coneNames(), v);
 inline const char* name(MujocoFootShape v) { return settings::nameOf(footShapeNames(), v); }
 
 struct MujocoSettings {
-  double timestep_s = 2e-4;             // physics step  [s]
+  // Contact and integration defaults: docs/mujoco-model.md "Contact settings: the rule and its
+  // evidence" (measured on the random-robot corpus of tests/bench_trust.cc).
+  double timestep_s = 1e-4;             // physics step  [s]
   MujocoIntegrator integrator = MujocoIntegrator::kImplicit;
   MujocoSolver solver = MujocoSolver::kNewton;
   int iterations = 100;                 // constraint solver iterations
@@ -56,9 +58,14 @@ struct MujocoSettings {
   MujocoCone cone = MujocoCone::kElliptic;
   int noslip_iterations = 0;            // MuJoCo noslip post-processing iterations
   int condim = 3;                       // 1 (frictionless), 3 (sliding), 4 (+torsional), 6
-  double impratio = 1.0;                // frictional-to-normal impedance ratio
-  std::array<double, 2> solref = {0.002, 1.0};                  // contact time constant [s], damping ratio
-  std::array<double, 5> solimp = {0.95, 0.99, 0.001, 0.5, 2.0};  // contact impedance
+  double impratio = 100.0;              // frictional-to-normal impedance ratio (100: friction holds, no creep)
+  // Contact time constant [s] and damping ratio: 2 damps the soft first millimetre (impedance ~0.2
+  // there, effective damping ratio ~2 sqrt(0.2) ~ 0.9).
+  std::array<double, 2> solref = {0.002, 2.0};
+  // Contact impedance: 0.015 at first touch rising to 0.99 over 1 mm of penetration. A sliding foot
+  // in MuJoCo's convex contact is pushed off the floor at ~ mu |v_slip| times the impedance; a low
+  // impedance where the foot carries its share of the weight (~0.15 mm deep) keeps it on the floor.
+  std::array<double, 5> solimp = {0.015, 0.99, 0.001, 0.5, 2.0};
   double mu = -1.0;                     // contact friction; < 0: max(mu_s, mu_d)
   // Torsional friction of each foot (MuJoCo friction[1], a length: the largest torsional moment
   // is this times the normal force); acts with condim 4 or 6 only. 0: point feet, as the per-foot
@@ -69,7 +76,7 @@ struct MujocoSettings {
   bool velocity_feedforward = true;     // add kv * theta_dot_ref
   bool inverse_dynamics_feedforward = true;  // add MuJoCo's inverse-dynamics joint torque
   // Added by the MuJoCo model (docs/mujoco-model.md):
-  double servo_wn_dt = 0.2;             // kp = 0: servo natural frequency * timestep (w_n = servo_wn_dt / timestep_s)
+  double servo_wn_dt = 0.1;             // kp = 0: servo natural frequency * timestep (w_n = servo_wn_dt / timestep_s = 1000 rad/s)
   double body_height_m = 0.15;          // quadruped COM (= tail plane) height above the ground  [m]
   double foot_radius_m = 0.01;          // foot sphere / capsule radius, box half-size  [m]
   MujocoFootShape foot_shape = MujocoFootShape::kSphere;  // contact geometry of the feet (see the enum)

@@ -1,0 +1,386 @@
+// How far MuJoCo at a given contact-setting rule is from a converged MuJoCo reference, over the
+// seeded random-robot corpus of tests/random_robots.h (docs/mujoco-model.md "Contact settings:
+// the rule and its evidence"). Plain main, one thread; prints one Markdown row per rule:
+//   nice build/tests/bench_trust [--cases N=120] [--seed S=31] [--rules "today;set:imp=100,ns=3;.."]
+//                                [--ref-cache FILE] [--check16 K=10] [--csv FILE]
+// Reference of a rule: the rule's settings at timestep / 8 (servo w_n kept), impratio >= 100,
+// noslip >= 3 (for "today": the old defaults' reference); every K-th case also at timestep / 16, to
+// show the reference itself has converged. --ref-cache keeps the reference runs (keyed by seed,
+// case and settings) so rules can be compared without re-running them.
+// Columns (cases where both the rule and its reference stand):
+//  * err median / p90 / max: |phi_net - phi_net,ref| / max(|phi_net,ref|, 0.5 deg);
+//  * vs today ref: the same against today's reference (what a rule's physics moves);
+//  * vs per-foot: the same against the per-foot model with load transfer (rigid Coulomb friction);
+//  * jitter p90: |phi_net(dT + 1 us) - phi_net(dT)| / max(|phi_net(dT)|, 0.5 deg), rule and reference;
+//  * sign flips: phi_net and phi_net,ref of opposite signs, |phi_net,ref| >= 0.5 deg;
+//  * airborne > 1 %: runs with no foot loaded in more than 1 % of the steps (summary extra
+//    airborne_fraction), and the median share;
+//  * peak Fn / m g: median and max of summary extra peak_normal_force_over_mg;
+//  * falls: the rule fails (tips over, unstable) where the reference stands, and the other way round;
+//  * steps, wall: median mj_step calls (pre-roll included) and wall time per run.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "analytic_model/per_foot_model.h"
+#include "mujoco_model/mujoco_settings.h"
+#include "mujoco_model/mujoco_simulation.h"
+#include "random_robots.h"
+
+using namespace tailsim;
+using namespace tailsim::testing;
+
+namespace {
+
+struct Run {
+  bool ok = false;
+  double phi_deg = NAN, airborne = NAN, peak = NAN, wall_s = NAN;
+  long steps = 0;
+};
+
+// Settings every rule starts from: MujocoSettings' defaults with the body at the robot's COM
+// height (what the experiment loader does).
+MujocoSettings baseSettings(const RobotParams& r) {
+  MujocoSettings s;
+  s.body_height_m = r.quadruped.com_height_m;
+  return s;
+}
+
+// Today's (pre-rule) contact and integration settings, written out so that the "before" stays
+// reproducible whatever MujocoSettings' defaults become.
+void today(const RobotParams&, const TailTrajectory&, MujocoSettings& s) {
+  s.timestep_s = 2e-4;
+  s.servo_wn_dt = 0.2;
+  s.integrator = MujocoIntegrator::kImplicit;
+  s.cone = MujocoCone::kElliptic;
+  s.impratio = 1.0;
+  s.noslip_iterations = 0;
+  s.condim = 3;
+  s.solref = {0.002, 1.0};
+  s.solimp = {0.95, 0.99, 0.001, 0.5, 2.0};
+  s.foot_shape = MujocoFootShape::kSphere;
+  s.foot_radius_m = 0.01;
+  s.settle_s = 0.1;
+}
+
+// Finer step with the servo's natural frequency kept.
+void refine(MujocoSettings& s, double factor) {
+  s.timestep_s /= factor;
+  if (s.kp == 0.0) s.servo_wn_dt /= factor;
+}
+
+// A rule's converged reference: its own contact, a finer step, stiff friction and noslip.
+void toReference(MujocoSettings& s, double factor) {
+  refine(s, factor);
+  s.impratio = std::max(s.impratio, 100.0);
+  s.noslip_iterations = std::max(s.noslip_iterations, 3);
+}
+
+using Rule = std::function<void(const RobotParams&, const TailTrajectory&, MujocoSettings&)>;
+
+// Named rules (name -> settings): "today" is the before, "default" MujocoSettings' defaults.
+std::map<std::string, Rule> rules() {
+  std::map<std::string, Rule> m;
+  m["today"] = today;
+  m["default"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings&) {};  // MujocoSettings' defaults
+  m["imp100"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    s.impratio = 100.0;
+  };
+  m["imp100ns3"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    s.impratio = 100.0;
+    s.noslip_iterations = 3;
+  };
+  m["h2"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    refine(s, 2.0);
+  };
+  m["h2imp100ns3"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    refine(s, 2.0);
+    s.impratio = 100.0;
+    s.noslip_iterations = 3;
+  };
+  m["softimp"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    s.impratio = 100.0;
+    s.noslip_iterations = 3;
+    s.solimp = {0.015, 0.9999, 0.031, 0.5, 2.0};
+  };
+  m["box"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    s.foot_shape = MujocoFootShape::kBox;
+  };
+  m["boxns3"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    s.foot_shape = MujocoFootShape::kBox;
+    s.impratio = 100.0;
+    s.noslip_iterations = 3;
+  };
+  return m;
+}
+
+// "set:key=value,..": today's rule with these changes (keys: h = timestep_s (servo w_n kept),
+// imp = impratio, ns = noslip_iterations, tau, zeta = solref, dmin, dmax, width, mid, power =
+// solimp, foot = sphere|capsule|box, r = foot_radius_m, settle = settle_s).
+Rule parseRule(const std::string& spec) {
+  std::vector<std::pair<std::string, std::string>> kv;
+  for (std::stringstream ss(spec.substr(4)); ss.good();) {
+    std::string item;
+    std::getline(ss, item, ',');
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos) throw std::invalid_argument("rule item without '=': " + item);
+    kv.emplace_back(item.substr(0, eq), item.substr(eq + 1));
+  }
+  return [kv](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    today(r, t, s);
+    for (const auto& [k, v] : kv) {
+      const double x = std::atof(v.c_str());
+      if (k == "h") refine(s, s.timestep_s / x);
+      else if (k == "imp") s.impratio = x;
+      else if (k == "ns") s.noslip_iterations = static_cast<int>(x);
+      else if (k == "tau") s.solref[0] = x;
+      else if (k == "zeta") s.solref[1] = x;
+      else if (k == "dmin") s.solimp[0] = x;
+      else if (k == "dmax") s.solimp[1] = x;
+      else if (k == "width") s.solimp[2] = x;
+      else if (k == "mid") s.solimp[3] = x;
+      else if (k == "power") s.solimp[4] = x;
+      else if (k == "r") s.foot_radius_m = x;
+      else if (k == "settle") s.settle_s = x;
+      else if (k == "foot") s.foot_shape = v == "box" ? MujocoFootShape::kBox : v == "capsule" ? MujocoFootShape::kCapsule : MujocoFootShape::kSphere;
+      else throw std::invalid_argument("unknown rule key " + k);
+    }
+  };
+}
+
+TailTrajectory jittered(const TailTrajectory& t, double d_s) {
+  TailTrajectory out;
+  for (const auto& j : t.joints) {
+    SplitCycleParams p = j.params();
+    p.dT_s += d_s;
+    out.joints.emplace_back(p);
+  }
+  return out;
+}
+
+Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings& s) {
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  Effects e;
+  Run out;
+  try {
+    const RunResult res = simulateMujoco(r, t, s, e, o);
+    out.ok = res.summary.ok;
+    out.phi_deg = res.summary.phi_net_deg;
+    out.wall_s = res.summary.wall_time_s;
+    out.steps = res.summary.solver_steps + static_cast<long>(std::lround(s.settle_s / s.timestep_s));
+    auto x = [&](const char* k) {
+      const auto it = res.summary.extra.find(k);
+      return it == res.summary.extra.end() ? NAN : it->second;
+    };
+    out.airborne = x("airborne_fraction");
+    out.peak = x("peak_normal_force_over_mg");
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "run threw: %s\n", ex.what());
+  }
+  return out;
+}
+
+// The per-foot model with load transfer (rigid Coulomb friction at four point feet), for scale.
+double perFootPhi(const RobotParams& r, const TailTrajectory& t) {
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  PerFootSettings p;
+  p.normal_loads = NormalLoadModel::kLoadTransfer;
+  try {
+    const RunResult res = simulatePerFoot(r, t, p, Effects{}, o);
+    return res.summary.ok ? res.summary.phi_net_deg : NAN;
+  } catch (const std::exception&) {
+    return NAN;
+  }
+}
+
+std::string key(const MujocoSettings& s) {
+  std::ostringstream os;
+  os.precision(17);
+  os << s.timestep_s << '/' << s.servo_wn_dt << '/' << s.impratio << '/' << s.noslip_iterations << '/' << s.solref[0]
+     << '/' << s.solref[1] << '/' << s.solimp[0] << '/' << s.solimp[1] << '/' << s.solimp[2] << '/'
+     << s.solimp[3] << '/' << s.solimp[4] << '/' << name(s.foot_shape) << '/' << s.foot_radius_m << '/'
+     << s.foot_half_length_m << '/' << s.body_height_m << '/' << s.settle_s << '/' << name(s.cone) << '/'
+     << name(s.integrator) << '/' << s.condim << '/' << s.kp << '/' << s.kv << '/' << s.iterations;
+  return os.str();
+}
+
+// Reference runs, optionally kept in a file: one line "key ok phi airborne peak steps wall".
+class RefCache {
+ public:
+  explicit RefCache(std::string path) : path_(std::move(path)) {
+    if (path_.empty()) return;
+    std::ifstream in(path_);
+    std::string k;
+    Run r;
+    while (in >> k >> r.ok >> r.phi_deg >> r.airborne >> r.peak >> r.steps >> r.wall_s) map_[k] = r;
+  }
+  Run get(const std::string& k, const std::function<Run()>& make) {
+    const auto it = map_.find(k);
+    if (it != map_.end()) return it->second;
+    const Run r = make();
+    map_[k] = r;
+    if (!path_.empty()) {
+      std::ofstream out(path_, std::ios::app);
+      out.precision(17);
+      out << k << ' ' << r.ok << ' ' << r.phi_deg << ' ' << r.airborne << ' ' << r.peak << ' ' << r.steps << ' '
+          << r.wall_s << '\n';
+    }
+    return r;
+  }
+
+ private:
+  std::string path_;
+  std::map<std::string, Run> map_;
+};
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const double x = q * (v.size() - 1);
+  const size_t i = static_cast<size_t>(x);
+  return i + 1 < v.size() ? v[i] + (x - i) * (v[i + 1] - v[i]) : v.back();
+}
+
+double rel(double a, double ref) { return std::abs(a - ref) / std::max(std::abs(ref), 0.5); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int N = 120, check16 = 10;
+  unsigned seed = 31;
+  std::string rule_list = "today", cache_path, csv_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--cases") N = std::atoi(next().c_str());
+    else if (a == "--seed") seed = static_cast<unsigned>(std::atoll(next().c_str()));
+    else if (a == "--rules") rule_list = next();
+    else if (a == "--ref-cache") cache_path = next();
+    else if (a == "--check16") check16 = std::atoi(next().c_str());
+    else if (a == "--csv") csv_path = next();
+    else {
+      std::fprintf(stderr, "unknown argument %s\n", a.c_str());
+      return 2;
+    }
+  }
+  std::map<std::string, Rule> all = rules();
+  std::vector<std::string> names;
+  for (std::stringstream ss(rule_list); ss.good();) {
+    std::string n;
+    std::getline(ss, n, ';');
+    if (n.rfind("set:", 0) == 0) all[n] = parseRule(n);
+    if (!all.count(n)) {
+      std::fprintf(stderr, "unknown rule %s; known:", n.c_str());
+      for (const auto& [k, v] : all) std::fprintf(stderr, " %s", k.c_str());
+      std::fprintf(stderr, "\n");
+      return 2;
+    }
+    names.push_back(n);
+  }
+  RefCache cache(cache_path);
+  std::ofstream csv;
+  if (!csv_path.empty()) {
+    csv.open(csv_path);
+    csv << "rule,case,ok,phi_deg,phi_jitter_deg,ref_ok,ref_phi_deg,ref_jitter_deg,today_ref_phi_deg,ref16_phi_deg,perfoot_phi_deg,airborne,"
+           "peak_over_mg,steps,wall_s,"
+           "description\n";
+  }
+
+  std::vector<RandomRobotCase> cases;
+  std::vector<double> perfoot;
+  for (int k = 0; k < N; ++k) {
+    cases.push_back(randomRobotCase(seed, k));
+    perfoot.push_back(perFootPhi(cases.back().robot, cases.back().trajectory));
+  }
+  auto tag = [&](int k) { return std::to_string(seed) + ':' + std::to_string(k) + ':'; };
+  // A rule's reference runs (cached): its settings refined by `factor`, impratio >= 100, noslip >= 3.
+  auto refRun = [&](const Rule& rule, int k, double factor, double jitter_s) {
+    const RandomRobotCase& c = cases[k];
+    MujocoSettings s = baseSettings(c.robot);
+    rule(c.robot, c.trajectory, s);
+    toReference(s, factor);
+    const std::string kk = tag(k) + (jitter_s != 0.0 ? "refj:" : "ref:") + key(s);
+    return cache.get(kk, [&] { return runOnce(c.robot, jittered(c.trajectory, jitter_s), s); });
+  };
+
+  std::printf("corpus: %d cases (seed %u); reference: the rule's settings at timestep / 8 (servo w_n kept), impratio "
+              ">= 100, noslip >= 3; 'today ref': today's rule's reference (the same for every rule)\n\n",
+              N, seed);
+  std::printf("| rule | compared | err median | err p90 | err max | vs today ref median | vs today ref p90 | "
+              "vs per-foot median | vs per-foot p90 | jitter p90 | ref jitter p90 | ref h/8 vs h/16 median / p90 (n) | sign flips | airborne > 1 %% | "
+              "airborne median | peak Fn/mg median | peak Fn/mg max | falls only here / only in ref | steps median | "
+              "wall median [ms] |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const std::string& nm : names) {
+    const Rule& rule = all.at(nm);
+    std::vector<double> err, errT, errP, jit, rjit, conv, air, peak, steps, wall;
+    int flips = 0, air1 = 0, falls_here = 0, falls_ref = 0, compared = 0;
+    for (int k = 0; k < N; ++k) {
+      const RandomRobotCase& c = cases[k];
+      MujocoSettings s = baseSettings(c.robot);
+      rule(c.robot, c.trajectory, s);
+      const Run r = runOnce(c.robot, c.trajectory, s);
+      const Run j = runOnce(c.robot, jittered(c.trajectory, 1e-6), s);
+      const Run f = refRun(rule, k, 8.0, 0.0);
+      const Run fj = refRun(rule, k, 8.0, 1e-6);
+      const Run ft = refRun(all.at("today"), k, 8.0, 0.0);
+      Run f16;
+      if (check16 > 0 && k % check16 == 0) f16 = refRun(rule, k, 16.0, 0.0);
+      steps.push_back(r.steps);
+      wall.push_back(r.wall_s);
+      if (csv.is_open())
+        csv << '"' << nm << "\"," << k << ',' << r.ok << ',' << r.phi_deg << ',' << j.phi_deg << ',' << f.ok << ','
+            << f.phi_deg << ',' << fj.phi_deg << ',' << ft.phi_deg << ',' << f16.phi_deg << ',' << perfoot[k] << ',' << r.airborne << ','
+            << r.peak << ',' << r.steps << ',' << r.wall_s << ",\"" << describe(c) << "\"\n";
+      if (r.ok && !f.ok) ++falls_ref;
+      if (!r.ok && f.ok) ++falls_here;
+      if (!r.ok || !f.ok) continue;
+      ++compared;
+      err.push_back(rel(r.phi_deg, f.phi_deg));
+      if (ft.ok) errT.push_back(rel(r.phi_deg, ft.phi_deg));
+      if (!std::isnan(perfoot[k])) errP.push_back(rel(r.phi_deg, perfoot[k]));
+      if (j.ok) jit.push_back(rel(j.phi_deg, r.phi_deg));
+      if (fj.ok) rjit.push_back(rel(fj.phi_deg, f.phi_deg));
+      if (f16.ok) conv.push_back(rel(f.phi_deg, f16.phi_deg));
+      if (std::abs(f.phi_deg) >= 0.5 && r.phi_deg * f.phi_deg < 0) ++flips;
+      air.push_back(r.airborne);
+      if (r.airborne > 0.01) ++air1;
+      peak.push_back(r.peak);
+    }
+    std::printf("| %s | %d | %.2f %% | %.2f %% | %.1f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% / %.2f %% (%zu) "
+                "| %d | %d | %.1f %% | %.2f | %.1f | %d / %d | %.0f | %.1f |\n",
+                nm.c_str(), compared, 100 * quantile(err, 0.5), 100 * quantile(err, 0.9), 100 * quantile(err, 1.0),
+                100 * quantile(errT, 0.5), 100 * quantile(errT, 0.9), 100 * quantile(errP, 0.5), 100 * quantile(errP, 0.9),
+                100 * quantile(jit, 0.9),
+                100 * quantile(rjit, 0.9), 100 * quantile(conv, 0.5), 100 * quantile(conv, 0.9), conv.size(), flips,
+                air1, 100 * quantile(air, 0.5), quantile(peak, 0.5), quantile(peak, 1.0), falls_here, falls_ref,
+                quantile(steps, 0.5), 1e3 * quantile(wall, 0.5));
+    std::fflush(stdout);
+  }
+  return 0;
+}
