@@ -218,6 +218,15 @@ def main():
         driver.execute_script("document.getElementById('replaysec').scrollIntoView()")
         var = png_variance(driver.get_screenshot_as_png())
         assert var > 100, "screenshot looks blank (grey variance %.1f)" % var
+        # Over the 3D view, the text of each model's angles now and the legend of the models do not
+        # overlap, and both are inside the view.
+        r = driver.execute_script("""
+            const box = id => { const b = document.getElementById(id).getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; };
+            return [box('hud'), box('legend'), box('view3d')];""")
+        (h, l, v) = r
+        assert not (h[0] < l[2] and l[0] < h[2] and h[1] < l[3] and l[1] < h[3]), "the replay's text and legend overlap: %s" % r
+        for b in (h, l):
+            assert v[0] <= b[0] and b[2] <= v[2] and v[1] <= b[1] and b[3] <= v[3], "outside the 3D view: %s" % r
 
         # The MuJoCo case (second experiment): solid robot and foot forces.
         driver.execute_script("tailsim.openCase(arguments[0], 0)", mj)

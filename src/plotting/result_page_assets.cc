@@ -21,7 +21,7 @@ section{margin:1em 0}h2{font-size:1.1em;border-bottom:1px solid #ccc;margin:.8em
 #view3d{width:600px;height:420px;border:1px solid #ccc;background:#fff;position:relative}
 #view3d canvas{display:block}
 #hud{position:absolute;left:6px;top:4px;font-size:12px;background:rgba(255,255,255,.8);padding:2px 4px;pointer-events:none}
-#legend{position:absolute;right:6px;top:4px;font-size:12px;background:rgba(255,255,255,.8);padding:2px 4px;pointer-events:none}
+#legend{position:absolute;right:6px;bottom:4px;font-size:12px;background:rgba(255,255,255,.8);padding:2px 4px;pointer-events:none}
 #plots{border:1px solid #ccc;background:#fff;cursor:crosshair}
 .controls{display:flex;gap:.6em;align-items:center;margin:.4em 0;flex-wrap:wrap}
 .controls input[type=range]{width:420px}
