@@ -493,6 +493,25 @@ TEST(ResultFolder, FallsBackToCaseResultFiles) {
   EXPECT_THROW(loadResults((dir / "nothing").string()), std::runtime_error);
 }
 
+// A suite folder that already has its result page (DIR/page/cases/e<i>c<k>.js): `tailsim plot DIR`
+// again finds the experiments, not "page" as one more (empty) experiment; a run whose cases/ has
+// case folders but no summary.json yet is still one.
+TEST(ResultFolder, TheResultPageFolderIsNotAnExperiment) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_pagedir_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  writeExperiment(root / "sweep", "sweep", {"trajectory.dT_s"},
+                  {{{{"trajectory.dT_s", 0.2}}, {{"analytic", 1.0}}, {}}, {{{"trajectory.dT_s", 0.3}}, {{"analytic", 2.0}}, {}}},
+                  "name: sweep\n");
+  fs::create_directories(root / "partial" / "cases" / "w_ss=0.1");
+  fs::create_directories(root / "page" / "cases");
+  writeFileAtomic((root / "page" / "cases" / "e0c0.js").string(), "tailsim.caseLoaded({});\n");
+  writeFileAtomic((root / "page" / "data.js").string(), "tailsim.dataLoaded({});\n");
+  std::vector<std::string> dirs;
+  for (const ExperimentResults& r : loadResultTree(root.string())) dirs.push_back(fs::path(r.dir).filename().string());
+  EXPECT_EQ(dirs, (std::vector<std::string>{"partial", "sweep"}));
+  fs::remove_all(root);
+}
+
 // configs/paper/all.yaml: every figure's experiment loads, with the grids the paper states.
 TEST(PaperConfigs, SuiteLoadsWithThePaperGrids) {
   const std::vector<Experiment> ex = loadExperimentSuite(std::string(TAILSIM_SOURCE_DIR) + "/configs/paper/all.yaml");
