@@ -962,5 +962,25 @@ TEST(SweepSummary, BestTrendsDifferencesAndWarningsForAnyExperiment) {
   fs::remove_all(root);
 }
 
+// report.md and figures.html say what each model that ran is, and only those (a per-foot sweep was
+// told "Analytic = ...; MuJoCo = ..."); the swept keys and the models are listed with separators.
+TEST(SweepSummary, TheModelsThatRanAreNamedAndListed) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_glossary_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  writeGridExperiment(root / "mine", "mine", {{"trajectory.dT_s", {0.2, 0.4}}, {"trajectory.w_ss", {0.25, 0.5}}},
+                      {"analytic", "perfoot"},
+                      [](const std::string& m, const std::vector<double>& x) { return x[0] + (m == "perfoot"); });
+  const ExperimentResults r = loadResults((root / "mine").string());
+  const std::string md = reportMarkdown({r}, computeFindings({r}), {}, root.string());
+  const std::string html = figureSheetHtml(root.string(), {r}, {});
+  for (const std::string* t : {&md, &html}) {
+    EXPECT_NE(t->find("per-foot = Coulomb friction at each foot"), std::string::npos) << *t;
+    EXPECT_EQ(t->find("MuJoCo = the contact model"), std::string::npos) << "no MuJoCo run";
+  }
+  EXPECT_NE(md.find("dT_s (2 values, 0.2 .. 0.4); w_ss (2 values"), std::string::npos) << md;
+  EXPECT_NE(md.find(" s wall time in the simulations); perfoot (4 ok"), std::string::npos) << md;
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace tailsim

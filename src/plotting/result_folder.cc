@@ -328,4 +328,12 @@ std::string warningShape(const std::string& w) {
   return s;
 }
 
+std::vector<std::string> allModels(const std::vector<ExperimentResults>& results) {
+  std::vector<std::string> out;
+  for (const ExperimentResults& r : results)
+    for (const std::string& m : r.models)
+      if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+  return out;
+}
+
 }  // namespace tailsim
