@@ -156,6 +156,15 @@ def main():
         # The table: 4 cases, rows only for what is visible.
         assert driver.execute_script("return document.getElementById('count').textContent") == "4 of 4 cases"
         assert 0 < driver.execute_script("return tailsim.tableRows()") <= 4
+        # In a narrow window the case names keep a readable column: the value columns give way first
+        # (with 3 models and 2 keys the name column had shrunk to one character).
+        driver.set_window_size(1000, 1300)
+        time.sleep(0.3)
+        name_w = driver.execute_script("return document.querySelector('.row .cell.name').getBoundingClientRect().width")
+        head_w = driver.execute_script("return document.querySelector('#thead .cell.name').getBoundingClientRect().width")
+        assert name_w >= 120 and abs(name_w - head_w) < 1, "case name column %.0f px (header %.0f px)" % (name_w, head_w)
+        driver.set_window_size(1400, 1300)
+        time.sleep(0.3)
 
         # A heat-map cell opens its case: pick dtheta = -60, dT = 0.3 (case index from the table data).
         names = driver.execute_script("return Array.from(document.querySelectorAll('.row')).map(r => r.firstChild.textContent)")

@@ -15,7 +15,7 @@ section{margin:1em 0}h2{font-size:1.1em;border-bottom:1px solid #ccc;margin:.8em
 .thead{display:flex;background:#eee;border:1px solid #ccc;border-bottom:0;font-size:13px;font-weight:bold}
 .row{position:absolute;left:0;right:0;height:22px;display:flex;align-items:center;cursor:pointer;white-space:nowrap}
 .row:nth-child(even){background:#f4f6f8}.row:hover{background:#dde8f4}.row.sel{background:#fde7b0}
-.cell{flex:0 0 9em;overflow:hidden;text-overflow:ellipsis;padding:0 .4em}.cell.name{flex:1 1 16em}
+.cell{flex:0 1 9em;min-width:5.5em;overflow:hidden;text-overflow:ellipsis;padding:0 .4em}.cell.name{flex:1 1 16em;min-width:10em}
 .thead .cell{cursor:pointer;padding:.3em .4em}.bad{color:#b00}.warn{color:#a60}
 #replay{display:flex;gap:.6em;flex-wrap:wrap;align-items:flex-start}
 #view3d{width:600px;height:420px;border:1px solid #ccc;background:#fff;position:relative}
