@@ -611,7 +611,7 @@ void plotOneKey(Ctx& ctx) {
 
   const Txt title = ctx.title(W("net body rotation phi_net over ") + K(a.key) + ctx.tail);
   std::ostringstream b;
-  // The legend right of the plot: inside, it hid the curves' ends (phi_net largest at one end of the key).
+  // The legend right of the plot, never over the curves (phi_net is often largest at one end of the key).
   b << header(ctx, title, gpAxisLabel(a.key), "φ_{net} [deg]", 1300) << "set key outside right top vertical box\n";
   const bool bars = leafKey(a.key) == "links" || !a.numeric;
   if (bars) {
@@ -834,7 +834,7 @@ void plotTwoKeys(Ctx& ctx) {
   const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(ay.key) + ctx.tail);
   std::ostringstream b;
   // One panel per model, stacked: the figure keeps the width of figures.html's column, so its text
-  // stays legible there (side by side, three models made a 3300 px wide figure shown at a third).
+  // stays legible there (figures.html shows images at most 1100 px wide).
   const int panel_w = 1150, fig_w = panel_w, fig_h = 60 + 430 * static_cast<int>(grids.size());
   b << "reset\nset multiplot layout " << grids.size() << ",1 title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n";
   if (!ax.numeric) {
