@@ -166,6 +166,23 @@ def main():
         driver.set_window_size(1400, 1300)
         time.sleep(0.3)
 
+        # The heat map has the figures' colour maps: sequential white - dark orange (#7A4A00 at the
+        # largest magnitude) for phi_net of one sign, diverging blue - vermillion centred on zero for both.
+        phis = {r["case"]: float(r["phi_net_deg"]) for r in read_csv(os.path.join(out, SWEEP_NAME, "results.csv"))
+                if r["model"] == "analytic"}
+        lo, hi = min(phis.values()), max(phis.values())
+        sc = driver.execute_script("return tailsim.mapScale()")
+        assert sc and sc["kind"] == ("diverging" if lo < 0 < hi else "sequential"), (sc, lo, hi)
+        top = max(phis, key=lambda c: abs(phis[c]))
+        k_top = driver.execute_script("""
+            return +Array.from(document.querySelectorAll('.row')).find(r => r.firstChild.textContent === arguments[0]).getAttribute('data-case');""", top)
+        pt = driver.execute_script("return tailsim.mapPoint(arguments[0])", k_top)
+        rgb = driver.execute_script("""
+            const d = document.getElementById('map').getContext('2d').getImageData(arguments[0] - 20, arguments[1] + 8, 1, 1).data;
+            return [d[0], d[1], d[2]];""", pt["x"], pt["y"])
+        want = (122, 74, 0) if sc["kind"] == "sequential" else ((213, 94, 0) if phis[top] > 0 else (0, 114, 178))
+        assert all(abs(a - b) <= 3 for a, b in zip(rgb, want)), "largest |phi_net| cell %s: %s, want %s" % (top, rgb, want)
+
         # A heat-map cell opens its case: pick dtheta = -60, dT = 0.3 (case index from the table data).
         names = driver.execute_script("return Array.from(document.querySelectorAll('.row')).map(r => r.firstChild.textContent)")
         k = driver.execute_script("""
