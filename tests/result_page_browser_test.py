@@ -156,6 +156,32 @@ def main():
         # The table: 4 cases, rows only for what is visible.
         assert driver.execute_script("return document.getElementById('count').textContent") == "4 of 4 cases"
         assert 0 < driver.execute_script("return tailsim.tableRows()") <= 4
+        # In a narrow window the case names keep a readable column: the value columns give way first
+        # (with 3 models and 2 keys the name column had shrunk to one character).
+        driver.set_window_size(1000, 1300)
+        time.sleep(0.3)
+        name_w = driver.execute_script("return document.querySelector('.row .cell.name').getBoundingClientRect().width")
+        head_w = driver.execute_script("return document.querySelector('#thead .cell.name').getBoundingClientRect().width")
+        assert name_w >= 120 and abs(name_w - head_w) < 1, "case name column %.0f px (header %.0f px)" % (name_w, head_w)
+        driver.set_window_size(1400, 1300)
+        time.sleep(0.3)
+
+        # The heat map has the figures' colour maps: sequential white - dark orange (#7A4A00 at the
+        # largest magnitude) for phi_net of one sign, diverging blue - vermillion centred on zero for both.
+        phis = {r["case"]: float(r["phi_net_deg"]) for r in read_csv(os.path.join(out, SWEEP_NAME, "results.csv"))
+                if r["model"] == "analytic"}
+        lo, hi = min(phis.values()), max(phis.values())
+        sc = driver.execute_script("return tailsim.mapScale()")
+        assert sc and sc["kind"] == ("diverging" if lo < 0 < hi else "sequential"), (sc, lo, hi)
+        top = max(phis, key=lambda c: abs(phis[c]))
+        k_top = driver.execute_script("""
+            return +Array.from(document.querySelectorAll('.row')).find(r => r.firstChild.textContent === arguments[0]).getAttribute('data-case');""", top)
+        pt = driver.execute_script("return tailsim.mapPoint(arguments[0])", k_top)
+        rgb = driver.execute_script("""
+            const d = document.getElementById('map').getContext('2d').getImageData(arguments[0] - 20, arguments[1] + 8, 1, 1).data;
+            return [d[0], d[1], d[2]];""", pt["x"], pt["y"])
+        want = (122, 74, 0) if sc["kind"] == "sequential" else ((213, 94, 0) if phis[top] > 0 else (0, 114, 178))
+        assert all(abs(a - b) <= 3 for a, b in zip(rgb, want)), "largest |phi_net| cell %s: %s, want %s" % (top, rgb, want)
 
         # A heat-map cell opens its case: pick dtheta = -60, dT = 0.3 (case index from the table data).
         names = driver.execute_script("return Array.from(document.querySelectorAll('.row')).map(r => r.firstChild.textContent)")
@@ -218,6 +244,15 @@ def main():
         driver.execute_script("document.getElementById('replaysec').scrollIntoView()")
         var = png_variance(driver.get_screenshot_as_png())
         assert var > 100, "screenshot looks blank (grey variance %.1f)" % var
+        # Over the 3D view, the text of each model's angles now and the legend of the models do not
+        # overlap, and both are inside the view.
+        r = driver.execute_script("""
+            const box = id => { const b = document.getElementById(id).getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; };
+            return [box('hud'), box('legend'), box('view3d')];""")
+        (h, l, v) = r
+        assert not (h[0] < l[2] and l[0] < h[2] and h[1] < l[3] and l[1] < h[3]), "the replay's text and legend overlap: %s" % r
+        for b in (h, l):
+            assert v[0] <= b[0] and b[2] <= v[2] and v[1] <= b[1] and b[3] <= v[3], "outside the 3D view: %s" % r
 
         # The MuJoCo case (second experiment): solid robot and foot forces.
         driver.execute_script("tailsim.openCase(arguments[0], 0)", mj)

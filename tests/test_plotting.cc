@@ -493,6 +493,25 @@ TEST(ResultFolder, FallsBackToCaseResultFiles) {
   EXPECT_THROW(loadResults((dir / "nothing").string()), std::runtime_error);
 }
 
+// A suite folder that already has its result page (DIR/page/cases/e<i>c<k>.js): `tailsim plot DIR`
+// again finds the experiments, not "page" as one more (empty) experiment; a run whose cases/ has
+// case folders but no summary.json yet is still one.
+TEST(ResultFolder, TheResultPageFolderIsNotAnExperiment) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_pagedir_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  writeExperiment(root / "sweep", "sweep", {"trajectory.dT_s"},
+                  {{{{"trajectory.dT_s", 0.2}}, {{"analytic", 1.0}}, {}}, {{{"trajectory.dT_s", 0.3}}, {{"analytic", 2.0}}, {}}},
+                  "name: sweep\n");
+  fs::create_directories(root / "partial" / "cases" / "w_ss=0.1");
+  fs::create_directories(root / "page" / "cases");
+  writeFileAtomic((root / "page" / "cases" / "e0c0.js").string(), "tailsim.caseLoaded({});\n");
+  writeFileAtomic((root / "page" / "data.js").string(), "tailsim.dataLoaded({});\n");
+  std::vector<std::string> dirs;
+  for (const ExperimentResults& r : loadResultTree(root.string())) dirs.push_back(fs::path(r.dir).filename().string());
+  EXPECT_EQ(dirs, (std::vector<std::string>{"partial", "sweep"}));
+  fs::remove_all(root);
+}
+
 // configs/paper/all.yaml: every figure's experiment loads, with the grids the paper states.
 TEST(PaperConfigs, SuiteLoadsWithThePaperGrids) {
   const std::vector<Experiment> ex = loadExperimentSuite(std::string(TAILSIM_SOURCE_DIR) + "/configs/paper/all.yaml");
@@ -749,6 +768,87 @@ TEST(HeatMap, SequentialForOneSignDivergingForBothAndForTheDifference) {
   fs::remove_all(root);
 }
 
+// Three models (analytic, per-foot, MuJoCo): a difference panel for each model after the first,
+// that model minus the first, with the values of the results (a 3-model sweep had none).
+TEST(HeatMap, EveryModelAfterTheFirstGetsADifferencePanel) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_diff3_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const std::vector<std::pair<std::string, std::vector<json>>> axes = {
+      {"trajectory.dtheta_deg", {-60, -120, -180}}, {"trajectory.dT_s", {0.2, 0.4, 0.6, 0.8}}};
+  auto phi = [](const std::string& m, const std::vector<double>& x) {
+    return 1.0 + x[1] - 0.01 * x[0] + (m == "mujoco" ? 0.5 : m == "perfoot" ? -0.25 * x[1] : 0.0);
+  };
+  writeGridExperiment(root / "three", "three", axes, {"analytic", "perfoot", "mujoco"}, phi);
+  plotExperiment(loadResults((root / "three").string()));
+  const std::string gp = pngCommands(readText(root / "three" / "plots" / "three_phi_net_map.gp"));
+  EXPECT_NE(gp.find("set multiplot layout 3,2"), std::string::npos) << "each model beside its difference:\n" << gp;
+  EXPECT_NE(gp.find("set multiplot next"), std::string::npos) << "the first model has no difference beside it";
+  for (const char* m : {"perfoot", "mujoco"}) {
+    const fs::path dat = root / "three" / "plots" / (std::string("three_phi_net_map_difference_") + m + ".dat");
+    ASSERT_TRUE(fs::exists(dat)) << dat;
+    EXPECT_NE(gp.find(dat.filename().string()), std::string::npos);
+    std::ifstream in(dat);
+    std::string header;
+    std::getline(in, header);
+    double ix, iy, v;
+    int cells = 0;
+    while (in >> ix >> iy >> v) {
+      const std::vector<double> x = {axes[0].second[size_t(iy)].get<double>(), axes[1].second[size_t(ix)].get<double>()};
+      EXPECT_NEAR(v, phi(m, x) - phi("analytic", x), 1e-9) << m << " " << ix << " " << iy;
+      ++cells;
+    }
+    EXPECT_EQ(cells, 12);
+  }
+  fs::remove_all(root);
+}
+
+// One numeric key, three models: the legend is outside the plot (inside, at top left, it hid the
+// curves where phi_net is largest) and each model has its own marker (per-foot and MuJoCo shared one).
+TEST(OneKey, LegendOutsideThePlotAndAMarkerPerModel) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_onekey_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  writeGridExperiment(root / "one", "one", {{"trajectory.dtheta_deg", {-120, -100, -80, -60}}},
+                      {"analytic", "perfoot", "mujoco"},
+                      [](const std::string&, const std::vector<double>& x) { return -0.1 * x[0]; });
+  plotExperiment(loadResults((root / "one").string()));
+  const std::string gp = pngCommands(readText(root / "one" / "plots" / "one_phi_net.gp"));
+  const size_t plot = gp.find("\nplot ");
+  ASSERT_NE(plot, std::string::npos) << gp;
+  const size_t key = gp.rfind("set key", plot);
+  ASSERT_NE(key, std::string::npos);
+  const std::string key_line = gp.substr(key, gp.find('\n', key) - key);
+  EXPECT_TRUE(key_line.find("below") != std::string::npos || key_line.find("outside") != std::string::npos) << key_line;
+  std::set<std::string> points;
+  std::smatch m;
+  for (auto it = gp.cbegin() + plot; std::regex_search(it, gp.cend(), m, std::regex(R"( pt (\d+))")); it = m.suffix().first)
+    points.insert(m[1]);
+  EXPECT_EQ(points.size(), 3u) << gp.substr(plot);
+  fs::remove_all(root);
+}
+
+// phi(t) for each value of one key: a curve that lies on an earlier one is dashed, so both show (a
+// 1-link and a 2-link tail that did not turn the body drew one line, the 1-link one hidden).
+TEST(OneKey, ACurveOnAnEarlierOneIsDashed) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_phit_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const SplitCycleParams p{0.0, -90 * kDeg, 0.25, 0.25, 0.0};
+  std::vector<SynthCase> cs;
+  for (auto [dtheta, phi] : {std::pair<int, double>{-40, 0.0}, {-60, 0.0}, {-80, 3.0}, {-100, 6.0}})
+    cs.push_back({{{"trajectory.dtheta_deg", dtheta}}, {{"analytic", phi}}, {{"analytic", simCsv({p}, phi)}}});
+  writeExperiment(root / "phit", "phit", {"trajectory.dtheta_deg"}, cs, "name: phit\n");
+  plotExperiment(loadResults((root / "phit").string()));
+  const std::string gp = pngCommands(readText(root / "phit" / "plots" / "phit_phi_t.gp"));
+  std::vector<std::string> dashes;
+  std::smatch m;
+  for (auto it = gp.cbegin(); std::regex_search(it, gp.cend(), m, std::regex(R"(with lines lw 2 dt (\S+))")); it = m.suffix().first)
+    dashes.push_back(m[1]);
+  ASSERT_EQ(dashes.size(), 4u) << gp;
+  std::sort(dashes.begin(), dashes.end());
+  EXPECT_EQ(std::count(dashes.begin(), dashes.end(), "1"), 3) << gp;
+  EXPECT_EQ(std::count(dashes.begin(), dashes.end(), "(12,9)"), 1) << "the second zero curve, dashed:\n" << gp;
+  fs::remove_all(root);
+}
+
 // A model whose values span far more than another's (MuJoCo's spikes) does not squash the other's
 // curves: the phi_net curves get one y range per panel when the ranges differ more than threefold,
 // one shared range otherwise.
@@ -776,6 +876,11 @@ TEST(Lines, ModelPanelsShareAScaleUnlessTheirRangesAreFarApart) {
   };
   EXPECT_EQ(yranges("apart").size(), 2u) << "one y range per model panel";
   EXPECT_EQ(yranges("close").size(), 1u) << "one shared y range";
+  // the model panels are stacked: the figure fits figures.html's 1100 px column without shrinking
+  // its text to a third (side by side, three models drew 3300 x 720 px)
+  const auto [w, h] = pngSize(root / "apart" / "plots" / "apart_phi_net_lines.png");
+  EXPECT_LE(w, 1200u);
+  EXPECT_GT(h, w / 2) << w << " x " << h;
   fs::remove_all(root);
 }
 
@@ -854,6 +959,26 @@ TEST(SweepSummary, BestTrendsDifferencesAndWarningsForAnyExperiment) {
   const std::string html = figureSheetHtml(root.string(), {r}, {});
   EXPECT_EQ(html.find("Rone"), std::string::npos);
   EXPECT_NE(html.find("Where the models differ"), std::string::npos);
+  fs::remove_all(root);
+}
+
+// report.md and figures.html say what each model that ran is, and only those (a per-foot sweep was
+// told "Analytic = ...; MuJoCo = ..."); the swept keys and the models are listed with separators.
+TEST(SweepSummary, TheModelsThatRanAreNamedAndListed) {
+  const fs::path root = fs::path(TAILSIM_BINARY_DIR) / ("test_plotting_glossary_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  writeGridExperiment(root / "mine", "mine", {{"trajectory.dT_s", {0.2, 0.4}}, {"trajectory.w_ss", {0.25, 0.5}}},
+                      {"analytic", "perfoot"},
+                      [](const std::string& m, const std::vector<double>& x) { return x[0] + (m == "perfoot"); });
+  const ExperimentResults r = loadResults((root / "mine").string());
+  const std::string md = reportMarkdown({r}, computeFindings({r}), {}, root.string());
+  const std::string html = figureSheetHtml(root.string(), {r}, {});
+  for (const std::string* t : {&md, &html}) {
+    EXPECT_NE(t->find("per-foot = Coulomb friction at each foot"), std::string::npos) << *t;
+    EXPECT_EQ(t->find("MuJoCo = the contact model"), std::string::npos) << "no MuJoCo run";
+  }
+  EXPECT_NE(md.find("dT_s (2 values, 0.2 .. 0.4); w_ss (2 values"), std::string::npos) << md;
+  EXPECT_NE(md.find(" s wall time in the simulations); perfoot (4 ok"), std::string::npos) << md;
   fs::remove_all(root);
 }
 

@@ -78,7 +78,7 @@ std::string figureSheetHtml(const std::string& dir, const std::vector<Experiment
     << "</head>\n<body>\n<h1>" << heading << "</h1>\n"
     << "<p>Every figure drawn by <code>tailsim plot</code> from the result folder <code>" << html(where)
     << "</code>" << (paper ? ", in paper order" : "")
-    << ". Analytic = the paper's model (stiction friction), MuJoCo = the contact model. "
+    << ". " << html(modelGlossary(allModels(results))) << " "
     << "Under each experiment: what its results say (the largest φ<sub>net</sub> per model, its trend along "
        "each swept key, where the models differ, every run's warnings once), then its figures. "
     << "Each figure's SVG, gnuplot script and data files are beside its PNG.</p>\n<nav><ul>\n";

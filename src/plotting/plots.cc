@@ -436,9 +436,9 @@ namespace {
 
 // values[model][iy][ix]; x = axes[1], y = axes[0]. The models share one colour scale: sequential
 // (white to dark) when every value has one sign, dark at the largest magnitude; diverging centred on
-// zero only when the values have both signs. with_difference and two models: a third panel, the
-// second model minus the first, on its own diverging scale centred on zero. Cell text is white on
-// dark cells; a value that rounds to zero prints unsigned.
+// zero only when the values have both signs. with_difference and two or more models: one panel per
+// model after the first, that model minus the first, on one diverging scale of their own centred on
+// zero. Cell text is white on dark cells; a value that rounds to zero prints unsigned.
 void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::string& cblabel, const SweepAxis& ax,
              const SweepAxis& ay, const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& values,
              const std::string& caption_more, bool with_difference) {
@@ -469,22 +469,32 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
     panels.push_back(p);
   }
   std::string diff_caption;
-  if (with_difference && values.size() == 2) {
+  if (with_difference && values.size() >= 2) {
+    // One difference panel per model after the first (the reference), all on one diverging scale.
     const auto& [m0, g0] = values[0];
-    const auto& [m1, g1] = values[1];
-    Panel d{stem + "_difference", gpText(shortModel(m1)) + " − " + gpText(shortModel(m0)), "difference " + cblabel, g0};
+    std::vector<Panel> diffs;
     double dlo = std::numeric_limits<double>::infinity(), dhi = -dlo;
-    for (size_t iy = 0; iy < g0.size(); ++iy)
-      for (size_t ix = 0; ix < g0[iy].size(); ++ix) {
-        d.grid[iy][ix] = g1[iy][ix] - g0[iy][ix];
-        if (std::isfinite(d.grid[iy][ix])) dlo = std::min(dlo, d.grid[iy][ix]), dhi = std::max(dhi, d.grid[iy][ix]);
-      }
+    for (size_t k = 1; k < values.size(); ++k) {
+      const auto& [mk, gk] = values[k];
+      Panel d{stem + (values.size() == 2 ? std::string("_difference") : "_difference_" + mk),
+              gpText(shortModel(mk)) + " − " + gpText(shortModel(m0)), "difference " + cblabel, g0};
+      for (size_t iy = 0; iy < g0.size(); ++iy)
+        for (size_t ix = 0; ix < g0[iy].size(); ++ix) {
+          d.grid[iy][ix] = gk[iy][ix] - g0[iy][ix];
+          if (std::isfinite(d.grid[iy][ix])) dlo = std::min(dlo, d.grid[iy][ix]), dhi = std::max(dhi, d.grid[iy][ix]);
+        }
+      diffs.push_back(d);
+    }
     if (std::isfinite(dlo)) {
-      scale(d, dlo, dhi, true);
-      panels.push_back(d);
-      diff_caption = " The last panel is " + shortModel(m1) + " minus " + shortModel(m0) +
-                     " on its own scale (diverging, centred on zero: blue where " + shortModel(m1) +
-                     " is lower, vermillion where it is higher).";
+      for (Panel& d : diffs) scale(d, dlo, dhi, true), panels.push_back(d);
+      if (values.size() == 2)
+        diff_caption = " The last panel is " + shortModel(values[1].first) + " minus " + shortModel(m0) +
+                       " on its own scale (diverging, centred on zero: blue where " + shortModel(values[1].first) +
+                       " is lower, vermillion where it is higher).";
+      else
+        diff_caption = " The last " + std::to_string(diffs.size()) + " panels are each other model minus " +
+                       shortModel(m0) + ", on one scale of their own (diverging, centred on zero: blue where the "
+                       "model is lower than " + shortModel(m0) + ", vermillion where it is higher).";
     }
   }
   const HeatMapLayout lay = heatMapLayout(ax.values.size(), ay.values.size());
@@ -497,15 +507,33 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
     return o.str();
   };
   const std::string text = "(abs($3) < 0.05 ? '0.0' : sprintf('%.1f', $3))";
-  const bool stacked = ax.values.size() > ay.values.size() && panels.size() > 1;
-  const int pw = lay.panel_w, ph = lay.panel_h;
+  // Up to three panels in a row (a column when the maps are wider than tall); more in two columns:
+  // with differences, each model in the left column and its difference from the first model
+  // beside it (the first model's right cell empty).
   const int n = static_cast<int>(panels.size());
-  const int w = stacked ? pw : pw * n, h = (stacked ? ph * n : ph) + 40;
+  const bool stacked = ax.values.size() > ay.values.size() && n > 1;
+  const int cols = n > 3 ? 2 : stacked ? 1 : n;
+  std::vector<const Panel*> cells;  // in gnuplot's order (rows first); nullptr: an empty cell
+  const size_t nm = values.size();
+  if (n > 3 && !diff_caption.empty()) {
+    cells = {&panels[0], nullptr};
+    for (size_t k = 1; k < nm; ++k) cells.push_back(&panels[k]), cells.push_back(&panels[nm + k - 1]);
+  } else {
+    for (const Panel& p : panels) cells.push_back(&p);
+  }
+  const int rows = (static_cast<int>(cells.size()) + cols - 1) / cols;
+  const int pw = lay.panel_w, ph = lay.panel_h;
+  const int w = pw * cols, h = ph * rows + 40;
   const Txt title = ctx.title(what + ctx.tail);
   std::ostringstream b;
-  b << "reset\nset multiplot layout " << (stacked ? panels.size() : 1) << "," << (stacked ? 1 : panels.size())
+  b << "reset\nset multiplot layout " << rows << "," << cols
     << " title " << ctx.figTitle(title, w, 17) << " font 'Sans,17'\n";
-  for (const Panel& p : panels) {
+  for (const Panel* cell : cells) {
+    if (!cell) {
+      b << "set multiplot next\n";
+      continue;
+    }
+    const Panel& p = *cell;
     std::vector<std::vector<double>> rows;
     for (size_t iy = 0; iy < p.grid.size(); ++iy)
       for (size_t ix = 0; ix < p.grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), p.grid[iy][ix]});
@@ -544,6 +572,27 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
 
 // ---- simulate, sweeps -----------------------------------------------------------------------
 
+// phi(t) of a and b within tol of each other at 200 times over [0, t_end] (linear interpolation,
+// each series held at its last value after it ends).
+bool curvesCoincide(const TimeSeries& a, const TimeSeries& b, double t_end, double tol) {
+  auto at = [](const TimeSeries& s, double t) {
+    const auto& ts = s.values(col::kT);
+    const auto& ph = s.values(col::kPhi);
+    if (ts.empty()) return kNaN;
+    const size_t k = std::upper_bound(ts.begin(), ts.end(), t) - ts.begin();
+    if (k == 0) return ph.front();
+    if (k == ts.size()) return ph.back();
+    const double w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+    return ph[k - 1] + w * (ph[k] - ph[k - 1]);
+  };
+  for (int i = 0; i <= 200; ++i) {
+    const double t = t_end * i / 200.0;
+    const double d = std::fabs(at(a, t) - at(b, t));
+    if (!(d <= tol)) return false;
+  }
+  return true;
+}
+
 void plotOneKey(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
   const SweepAxis& a = r.axes[0];
@@ -562,7 +611,8 @@ void plotOneKey(Ctx& ctx) {
 
   const Txt title = ctx.title(W("net body rotation phi_net over ") + K(a.key) + ctx.tail);
   std::ostringstream b;
-  b << header(ctx, title, gpAxisLabel(a.key), "φ_{net} [deg]");
+  // The legend right of the plot, never over the curves (phi_net is often largest at one end of the key).
+  b << header(ctx, title, gpAxisLabel(a.key), "φ_{net} [deg]", 1300) << "set key outside right top vertical box\n";
   const bool bars = leafKey(a.key) == "links" || !a.numeric;
   if (bars) {
     b << "set style data histogram\nset style histogram cluster gap 1\nset style fill solid 0.85 border -1\n"
@@ -576,18 +626,20 @@ void plotOneKey(Ctx& ctx) {
     b << "set xzeroaxis lt -1\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
       b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2
-        << " with linespoints lw 2.5 pt " << (j ? 5 : 7) << " ps 1.3 lc rgb " << gpQuote(modelColor(r.models[j]))
+        << " with linespoints lw 2.5 pt " << seriesPoint(j) << " ps 1.3 lc rgb " << gpQuote(modelColor(r.models[j]))
         << " title " << gpQuote(gpText(modelTitle(r.models[j])));
   }
   b << "\n";
   ctx.render(stem, b.str(), title,
-             title.plain + ". Net body rotation φ_net of each case" + (bars ? " (bars)" : "") + ", one colour per model.");
+             title.plain + ". Net body rotation φ_net of each case" + (bars ? " (bars)" : "") + ", one colour per model.",
+             1300, 700);
 
   // phi(t) of every case, one panel per model, one time and one angle scale (few cases only).
   if (r.cases.size() > 12) return;
   struct Curve {
     std::string dat;
     size_t i;
+    size_t series;  // index in `loaded`
   };
   std::vector<std::pair<std::string, std::vector<Curve>>> panels;
   std::vector<TimeSeries> loaded;
@@ -614,7 +666,7 @@ void plotOneKey(Ctx& ctx) {
       for (double v : s.values(col::kPhi)) mine.push_back(v);
       if (auto it = c->runs.find(m); it != c->runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
       loaded.push_back(std::move(s));
-      curves.push_back({dstem + ".dat", i});
+      curves.push_back({dstem + ".dat", i, loaded.size() - 1});
     }
     if (!curves.empty()) panels.emplace_back(m, curves), phis.push_back(mine);
   }
@@ -624,6 +676,7 @@ void plotOneKey(Ctx& ctx) {
   const double t_end = timeAxisEnd(all, stops);
   const auto [yr, shared] = panelRanges(phis, 0.06);
   const Txt ttitle = ctx.title(W("body yaw phi(t) for each ") + K(a.key) + ctx.tail);
+  bool any_dashed = false;
   std::ostringstream t;
   t << "reset\nset multiplot layout " << panels.size() << ",1 title " << ctx.figTitle(ttitle, 1150, 17) << " font 'Sans,17'\n"
     << range("x", 0, t_end);
@@ -632,10 +685,18 @@ void plotOneKey(Ctx& ctx) {
     t << (std::isfinite(yr[p].first) ? range("y", yr[p].first, yr[p].second) : std::string("set autoscale y\n"));
     t << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {a}), 900)
       << "\nset xlabel 't [s]'\nset ylabel 'φ [deg]'\nplot ";
-    for (size_t n = 0; n < curves.size(); ++n)
+    // A curve that lies on an earlier one (within 1 % of the panel's range) is drawn dashed, so the
+    // earlier one shows between its dashes.
+    const double tol = 0.01 * (std::isfinite(yr[p].first) ? yr[p].second - yr[p].first : 1.0);
+    for (size_t n = 0; n < curves.size(); ++n) {
+      bool on_earlier = false;
+      for (size_t e = 0; e < n && !on_earlier; ++e)
+        on_earlier = curvesCoincide(loaded[curves[e].series], loaded[curves[n].series], t_end, tol);
       t << (n ? ", \\\n     " : "") << gpQuote(curves[n].dat) << " using 1:2 with lines lw 2 dt "
-        << seriesDash(curves[n].i) << " lc rgb " << gpQuote(seriesColor(curves[n].i)) << " title "
-        << gpQuote(V(a.key, a.values[curves[n].i]).gp);
+        << (on_earlier ? "(12,9)" : std::to_string(seriesDash(curves[n].i))) << " lc rgb "
+        << gpQuote(seriesColor(curves[n].i)) << " title " << gpQuote(V(a.key, a.values[curves[n].i]).gp);
+      if (on_earlier) any_dashed = true;
+    }
     t << "\n";
   }
   t << "unset multiplot\n";
@@ -643,7 +704,8 @@ void plotOneKey(Ctx& ctx) {
              ttitle.plain + ". Body yaw over time, one curve per value of " + K(a.key).plain +
                  ", one panel per model, one time scale; " +
                  (shared ? std::string("one angle scale.")
-                         : std::string("each panel its own angle scale (the models' ranges differ more than threefold).")),
+                         : std::string("each panel its own angle scale (the models' ranges differ more than threefold).")) +
+                 (any_dashed ? " A dashed curve lies on an earlier one of the legend (drawn under it)." : ""),
              1150, 60 + 430 * static_cast<int>(panels.size()));
 }
 
@@ -771,8 +833,10 @@ void plotTwoKeys(Ctx& ctx) {
   const auto [yr, shared] = panelRanges(per_model, 0.08);
   const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(ay.key) + ctx.tail);
   std::ostringstream b;
-  const int panel_w = 1100, fig_w = panel_w * static_cast<int>(grids.size());
-  b << "reset\nset multiplot layout 1," << grids.size() << " title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n";
+  // One panel per model, stacked: the figure keeps the width of figures.html's column, so its text
+  // stays legible there (figures.html shows images at most 1100 px wide).
+  const int panel_w = 1150, fig_w = panel_w, fig_h = 60 + 430 * static_cast<int>(grids.size());
+  b << "reset\nset multiplot layout " << grids.size() << ",1 title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n";
   if (!ax.numeric) {
     b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
     for (size_t i = 0; i < ax.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ax.key, ax.values[i])) << " " << i;
@@ -804,7 +868,7 @@ void plotTwoKeys(Ctx& ctx) {
                  ", one panel per model, " +
                  (shared ? std::string("same y scale.")
                          : std::string("each panel its own y scale (the models' ranges differ more than threefold).")),
-             fig_w, 720);
+             fig_w, fig_h);
 }
 
 // Small multiples for 3 or more swept keys (facetKeys): one figure per model, one panel per

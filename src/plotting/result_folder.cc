@@ -290,15 +290,26 @@ ExperimentResults loadResults(const std::string& dir) {
   return r;
 }
 
+// A subfolder is an experiment's result folder when it has summary.json, a journal, or a cases/
+// folder with a case folder in it (the result page's DIR/page/cases holds only .js files).
+namespace {
+bool isExperimentFolder(const fs::path& p) {
+  if (fs::exists(p / "summary.json") || fs::exists(p / "cases.jsonl")) return true;
+  std::error_code ec;
+  if (!fs::is_directory(p / "cases", ec)) return false;
+  for (const auto& e : fs::directory_iterator(p / "cases", ec))
+    if (e.is_directory()) return true;
+  return false;
+}
+}  // namespace
+
 std::vector<ExperimentResults> loadResultTree(const std::string& dir) {
   const fs::path root(dir);
   if (fs::exists(root / "summary.json")) return {loadResults(dir)};
   std::vector<fs::path> subs;
   if (fs::is_directory(root))
     for (const auto& e : fs::directory_iterator(root))
-      if (e.is_directory() && (fs::exists(e.path() / "summary.json") || fs::is_directory(e.path() / "cases") ||
-                               fs::exists(e.path() / "cases.jsonl")))
-        subs.push_back(e.path());
+      if (e.is_directory() && isExperimentFolder(e.path())) subs.push_back(e.path());
   std::sort(subs.begin(), subs.end());
   if (subs.empty()) throw std::runtime_error(dir + " holds no result folder (no summary.json in it or its subfolders)");
   std::vector<ExperimentResults> out;
@@ -318,6 +329,14 @@ std::string warningShape(const std::string& w) {
     while (digit(i) || (w[i] == '.' && digit(i + 1))) ++i;
   }
   return s;
+}
+
+std::vector<std::string> allModels(const std::vector<ExperimentResults>& results) {
+  std::vector<std::string> out;
+  for (const ExperimentResults& r : results)
+    for (const std::string& m : r.models)
+      if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
+  return out;
 }
 
 }  // namespace tailsim

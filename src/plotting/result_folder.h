@@ -89,6 +89,9 @@ ExperimentResults loadResults(const std::string& dir);
 // DIR itself if it holds summary.json, else every direct subfolder that does (sorted by name).
 std::vector<ExperimentResults> loadResultTree(const std::string& dir);
 
+// Every model that ran in any of `results`, each once, in the order first met.
+std::vector<std::string> allModels(const std::vector<ExperimentResults>& results);
+
 // A warning with each number masked ("all four feet carry no load in 22.3 % ..." and "... in 23 %
 // ..." -> "... in # % ..."): runs whose warnings differ only in their numbers say the same thing, shown once with
 // their count (the console table, figures.html, report.md).

@@ -15,13 +15,13 @@ section{margin:1em 0}h2{font-size:1.1em;border-bottom:1px solid #ccc;margin:.8em
 .thead{display:flex;background:#eee;border:1px solid #ccc;border-bottom:0;font-size:13px;font-weight:bold}
 .row{position:absolute;left:0;right:0;height:22px;display:flex;align-items:center;cursor:pointer;white-space:nowrap}
 .row:nth-child(even){background:#f4f6f8}.row:hover{background:#dde8f4}.row.sel{background:#fde7b0}
-.cell{flex:0 0 9em;overflow:hidden;text-overflow:ellipsis;padding:0 .4em}.cell.name{flex:1 1 16em}
+.cell{flex:0 1 9em;min-width:5.5em;overflow:hidden;text-overflow:ellipsis;padding:0 .4em}.cell.name{flex:1 1 16em;min-width:10em}
 .thead .cell{cursor:pointer;padding:.3em .4em}.bad{color:#b00}.warn{color:#a60}
 #replay{display:flex;gap:.6em;flex-wrap:wrap;align-items:flex-start}
 #view3d{width:600px;height:420px;border:1px solid #ccc;background:#fff;position:relative}
 #view3d canvas{display:block}
 #hud{position:absolute;left:6px;top:4px;font-size:12px;background:rgba(255,255,255,.8);padding:2px 4px;pointer-events:none}
-#legend{position:absolute;right:6px;top:4px;font-size:12px;background:rgba(255,255,255,.8);padding:2px 4px;pointer-events:none}
+#legend{position:absolute;right:6px;bottom:4px;font-size:12px;background:rgba(255,255,255,.8);padding:2px 4px;pointer-events:none}
 #plots{border:1px solid #ccc;background:#fff;cursor:crosshair}
 .controls{display:flex;gap:.6em;align-items:center;margin:.4em 0;flex-wrap:wrap}
 .controls input[type=range]{width:420px}
@@ -154,11 +154,28 @@ const char* const kResultPageJs = R"JS('use strict';
     grid = { kind: 'map', x: ax[0], y: ax[1], nx: nx, ny: ny, cell: cell };
   }
   const MAP = { x0: 70, y0: 20, x1: 470, y1: 310 };
-  function colour(u) {  // viridis, 5 stops
-    const s = [[68, 1, 84], [59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
-    u = Math.max(0, Math.min(1, u)) * 4; const i = Math.min(3, Math.floor(u)), f = u - i;
+  // The figures' colour maps (style.h): sequential white - orange - dark orange when every value
+  // has one sign (dark at the largest magnitude), diverging blue - white - vermillion centred on
+  // zero when the values have both signs.
+  const SEQ = [[255, 253, 247], [230, 159, 0], [122, 74, 0]];
+  const DIV = [[0, 114, 178], [140, 191, 224], [247, 247, 247], [238, 173, 126], [213, 94, 0]];
+  function ramp(s, u) {
+    u = Math.max(0, Math.min(1, u)) * (s.length - 1); const i = Math.min(s.length - 2, Math.floor(u)), f = u - i;
     return 'rgb(' + s[i].map((c, j) => Math.round(c + f * (s[i + 1][j] - c))).join(',') + ')';
   }
+  function mapScale(lo, hi) {
+    if (lo < 0 && hi > 0) { const m = Math.max(-lo, hi); return { kind: 'diverging', lo: -m, hi: m }; }
+    return { kind: 'sequential', lo: lo, hi: hi, dark_at_low: hi <= 0 && lo < 0 };
+  }
+  function darkness(sc, v) {  // 0 light .. 1 dark
+    const u = (v - sc.lo) / (sc.hi - sc.lo);
+    return sc.kind === 'diverging' ? Math.abs(2 * u - 1) : sc.dark_at_low ? 1 - u : u;
+  }
+  function colour(sc, v) {
+    const u = (v - sc.lo) / (sc.hi - sc.lo);
+    return sc.kind === 'diverging' ? ramp(DIV, u) : ramp(SEQ, sc.dark_at_low ? 1 - u : u);
+  }
+  T.mapScale = () => view.mapScale || null;
   function drawMap() {
     const cv = $('map'), g = cv.getContext('2d');
     g.clearRect(0, 0, cv.width, cv.height);
@@ -172,14 +189,15 @@ const char* const kResultPageJs = R"JS('use strict';
     if (hi === lo) hi = lo + 1;
     const W = MAP.x1 - MAP.x0, H = MAP.y1 - MAP.y0;
     if (grid.kind === 'map') {
+      const sc = view.mapScale = mapScale(lo, hi);
       const cw = W / grid.nx, ch = H / grid.ny;
       for (let iy = 0; iy < grid.ny; ++iy) for (let ix = 0; ix < grid.nx; ++ix) {
         const k = grid.cell[iy * grid.nx + ix];
         const v = k < 0 ? null : phi[k];
-        g.fillStyle = v === null ? '#ddd' : colour((v - lo) / (hi - lo));
+        g.fillStyle = v === null ? '#ddd' : colour(sc, v);
         g.fillRect(MAP.x0 + ix * cw, MAP.y1 - (iy + 1) * ch, Math.ceil(cw), Math.ceil(ch));
         if (v !== null && cw >= 36 && ch >= 14) {
-          g.fillStyle = (v - lo) / (hi - lo) > 0.6 ? '#222' : '#fff';
+          g.fillStyle = darkness(sc, v) > 0.6 ? '#fff' : '#222';
           g.fillText(fmt(v, 2), MAP.x0 + (ix + 0.5) * cw - 12, MAP.y1 - (iy + 0.5) * ch + 4);
         }
         if (view.c && k === view.k) {
@@ -190,9 +208,10 @@ const char* const kResultPageJs = R"JS('use strict';
       axisTicks(g, grid.x, MAP.x0, MAP.x1, true); axisTicks(g, grid.y, MAP.y1, MAP.y0, false);
       g.fillText(grid.x.label, MAP.x0 + W / 2 - 30, MAP.y1 + 34);
       g.save(); g.translate(14, MAP.y0 + H / 2 + 30); g.rotate(-Math.PI / 2); g.fillText(grid.y.label, 0, 0); g.restore();
-      for (let i = 0; i <= 50; ++i) { g.fillStyle = colour(i / 50); g.fillRect(MAP.x1 + 20, MAP.y1 - (i + 1) * H / 51, 14, H / 51 + 1); }
+      for (let i = 0; i <= 50; ++i) { g.fillStyle = colour(sc, sc.lo + i / 50 * (sc.hi - sc.lo)); g.fillRect(MAP.x1 + 20, MAP.y1 - (i + 1) * H / 51, 14, H / 51 + 1); }
       g.fillStyle = '#222';
-      g.fillText(fmt(hi, 2), MAP.x1 + 38, MAP.y0 + 8); g.fillText(fmt(lo, 2), MAP.x1 + 38, MAP.y1);
+      g.fillText(fmt(sc.hi, 2), MAP.x1 + 38, MAP.y0 + 8); g.fillText(fmt(sc.lo, 2), MAP.x1 + 38, MAP.y1);
+      if (sc.kind === 'diverging') g.fillText('0', MAP.x1 + 38, (MAP.y0 + MAP.y1) / 2 + 4);
       g.fillText('φ_net [deg]', MAP.x1 + 20, MAP.y0 - 6);
       if (exp.axes.length > 2) $('mapnote').textContent = 'Other swept keys at their first value.';
     } else {

@@ -27,6 +27,17 @@ std::string modelTitle(const std::string& model) {
   return m ? m->title : model;
 }
 
+std::string modelGlossary(const std::vector<std::string>& models) {
+  static const std::pair<const char*, const char*> known[] = {
+      {"analytic", "Analytic = the paper's model (stiction friction)"},
+      {"perfoot", "per-foot = Coulomb friction at each foot (docs/per-foot-model.md)"},
+      {"mujoco", "MuJoCo = the contact model"}};
+  std::string out;
+  for (const auto& [name, text] : known)
+    if (std::find(models.begin(), models.end(), name) != models.end()) out += (out.empty() ? "" : "; ") + std::string(text);
+  return out.empty() ? out : out + ".";
+}
+
 std::string gpPanelTitle(const std::string& model, const std::vector<SweepAxis>& axes) {
   std::string title = modelTitle(model);
   // "analytic (stiction)" with the friction law swept: the parenthesis would name one of its values

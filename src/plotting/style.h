@@ -20,6 +20,9 @@ namespace tailsim {
 std::string modelColor(const std::string& model);
 // Legend / panel name of a model: "analytic (stiction)", "MuJoCo (contact)".
 std::string modelTitle(const std::string& model);
+// One sentence naming what each of `models` is, in the order analytic, per-foot, MuJoCo, only the
+// models given: "Analytic = the paper's model (stiction friction); per-foot = ...; MuJoCo = ...".
+std::string modelGlossary(const std::vector<std::string>& models);
 // The title of one model's panel in a figure over swept keys (enhanced text): what the panel
 // compares. The model's title, without its parenthesis when that names a value of a swept key
 // ("analytic", not "analytic (stiction)", when the friction law is swept); then the values of each
