@@ -280,5 +280,16 @@ TEST_F(Smaller, EmptyDesignFilesAreRefusedWithLocation) {
   }
 }
 
+// A base path the file system cannot hold (a name over NAME_MAX, found by the fuzzer): an error at
+// the base key, not an uncaught filesystem_error.
+TEST_F(Smaller, BasePathTooLongForTheFileSystemIsAConfigError) {
+  const std::string base = "base: " + std::string(5000, 'b') + ".yaml\n";
+  const std::string o = write("long_o.yaml", "name: o\nkind: optimize\n" + base + "optimize:\n  family: split_cycle\n");
+  const std::string m = write("long_m.yaml", "name: m\nkind: maneuver\n" + base + "maneuver:\n  heading_deg: 20\n");
+  const std::string eo = errorOf([&] { loadOptimizeSpec(o); }), em = errorOf([&] { loadManeuverSpec(m); });
+  EXPECT_EQ(eo.rfind(o + ":3:7: base: no such experiment file: ", 0), 0u) << eo;
+  EXPECT_EQ(em.rfind(m + ":3:7: base: no such experiment file: ", 0), 0u) << em;
+}
+
 }  // namespace
 }  // namespace tailsim

@@ -189,7 +189,7 @@ TEST(DeclaredLimits, LoaderRefusesWhatTheRendererRefuses) {
            {"{fps: 1000}", "render.fps"},
            {"{width: 641}", "render.width"},
            {"{height: 8}", "render.height"},
-           {"{msaa: 17}", "render.msaa"},
+           {"{msaa: 5}", "render.msaa"},
            {"{crf: 52}", "render.crf"},
            {"{preset: quick}", "render.preset"},
            {"{ffmpeg: ''}", "render.ffmpeg"},
@@ -200,7 +200,7 @@ TEST(DeclaredLimits, LoaderRefusesWhatTheRendererRefuses) {
     EXPECT_NE(err.find(key + ": "), std::string::npos) << err;
   }
   // What the loader accepts, the renderer's check (the same declarations) accepts.
-  std::ofstream(f) << kBase << "render: {fps: 240, width: 8192, height: 16, msaa: 16, crf: 51, preset: placebo}\n";
+  std::ofstream(f) << kBase << "render: {fps: 240, width: 8192, height: 16, msaa: 4, crf: 51, preset: placebo}\n";
   const RenderSettings s = loadExperiment(f).cases.at(0).render;
   EXPECT_NO_THROW(settings::validateFields(s, "render."));
 }

@@ -167,7 +167,9 @@ inline DesignHead readDesignHead(const Reader& r, const Val& root, const Map& to
   r.choice(need(r, top, root, "kind"), {kind});
   const Val& base = need(r, top, root, "base");
   h.base_file = (fs::path(source_file).parent_path() / r.text(base)).lexically_normal().string();
-  if (!fs::is_regular_file(h.base_file)) r.fail(base, "no such experiment file: " + h.base_file);
+  std::error_code ec;  // a name too long for the file system is an error here, not an exception
+  if (!fs::is_regular_file(h.base_file, ec))
+    r.fail(base, "no such experiment file: " + h.base_file + (ec ? " (" + ec.message() + ")" : std::string()));
   return h;
 }
 
