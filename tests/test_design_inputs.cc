@@ -8,10 +8,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "design/maneuver.h"
 #include "design/optimize_config.h"
@@ -301,6 +304,62 @@ TEST_F(NoInputTextReachesAnInterpreterUnescaped, OptimizeNamesLeaveRoomForTheBes
                                          (dir_ / "o").string(), false);
   EXPECT_EQ(rep.best_yaml_error, "");
   EXPECT_EQ(loadExperiment((dir_ / "o/best.yaml").string()).name, std::string(longest, 'n') + "_best");
+}
+
+// A result folder read back by `plot` and `report` is input too: an experiment name, case folder
+// or model name in it that the loader or the runner would never write is refused naming the file,
+// before any figure is drawn (summary.json's name once ran a shell command through `plot` and wrote
+// '../../EVIL_phi.gp' outside the folder).
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, ResultFolderNamesAreCheckedWhenReadBack) {
+  const std::string f = write("ok.yaml", "name: ok\nrobot: paper\ntail: {links: 1}\n"
+                                         "trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.5}\n"
+                                         "models: [analytic]\n");
+  RunOptions o;
+  o.out_dir = (dir_ / "base").string();
+  o.progress = false;
+  o.threads = 1;
+  runExperiment(loadExperiment(f), o);
+  auto edited = [&](const std::string& folder, const std::function<void(nlohmann::json&)>& edit) {
+    const fs::path d = dir_ / "sub" / folder;
+    fs::create_directories(d.parent_path());
+    fs::copy(dir_ / "base", d, fs::copy_options::recursive);
+    nlohmann::json s;
+    {
+      std::ifstream in(d / "summary.json");
+      in >> s;
+    }
+    edit(s);
+    std::ofstream(d / "summary.json") << s.dump(1);
+    return d.string();
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {edited("pipe", [](nlohmann::json& s) { s["experiment"] = "|cd ..; cd ..; cd ..; touch PWNED_SUMMARY; true "; }),
+       "summary.json: experiment name '|cd ..; cd ..; cd ..; touch PWNED_SUMMARY; true ' must be a folder name"},
+      {edited("evil", [](nlohmann::json& s) { s["experiment"] = "../../EVIL"; }),
+       "summary.json: experiment name '../../EVIL' must be a folder name"},
+      {edited("dir", [](nlohmann::json& s) { s["cases"][0]["dir"] = "../../elsewhere"; }),
+       "summary.json: case 'base' has the folder '../../elsewhere', which tailsim never writes"},
+      {edited("model", [](nlohmann::json& s) {
+         s["cases"][0]["runs"]["../../../EVILMODEL"] = s["cases"][0]["runs"]["analytic"];
+       }),
+       "case 'base' has a run of the model '../../../EVILMODEL', a name that must be a folder name"}};
+  for (const auto& [d, want] : cases) {
+    std::string err = "(no error)";
+    try {
+      plotResults(d);
+    } catch (const std::exception& e) {
+      err = e.what();
+    }
+    EXPECT_NE(err.find(want), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(fs::path(d) / "plots")) << d;
+  }
+  std::vector<std::string> outside;
+  for (const auto& e : fs::recursive_directory_iterator(dir_))
+    if (e.path().filename().string().find("EVIL") != std::string::npos ||
+        e.path().filename().string().find("PWNED") != std::string::npos)
+      outside.push_back(e.path().string());
+  EXPECT_EQ(outside, std::vector<std::string>());
+  EXPECT_NO_THROW(plotResults((dir_ / "base").string()));  // the folder as written plots
 }
 
 // directions: enumerate searches 2^n patterns: a tail of more than 12 links is refused at the key
