@@ -241,6 +241,47 @@ class PythonInputs(unittest.TestCase):
             tailsim.run(FIG7, out="")
         self.assertFalse(os.path.exists(out))
 
+    def test_crashes_instead_of_errors_cyclic_and_deep_values(self):
+        # A list or dict that contains itself, or nested 10^5 deep, is a ConfigError naming the key
+        # (the recursive conversion overflowed the stack: SIGSEGV). In a child: a crash fails the test.
+        code = ("import sys, tailsim\n"
+                "a = []; a.append(a)\n"
+                "b = []; b.append(b); b.append(b)\n"
+                "c = {}; c['x'] = c\n"
+                "d = {}\n"
+                "for i in range(100000): d = {'a': d}\n"
+                "e = []\n"
+                "for i in range(100000): e = [e]\n"
+                "for kw in (dict(tail={'custom': a}), dict(tail={'custom': b}), dict(quadruped=c), dict(tail=d),\n"
+                "           dict(tail={'custom': e}), dict(trajectory=d)):\n"
+                "    try:\n"
+                "        tailsim.simulate(robot='paper', **kw)\n"
+                "        print('no error')\n"
+                "    except tailsim.ConfigError as x:\n"
+                "        print('ConfigError', str(x)[:600])\n")
+        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        lines = p.stdout.splitlines()
+        self.assertEqual(len(lines), 6, p.stdout)
+        for line, key in zip(lines, ("tail.custom[0][0]", "tail.custom[0][0]", "quadruped.x.x", "tail.a.a",
+                                     "tail.custom[0][0]", "trajectory.a.a")):
+            self.assertTrue(line.startswith("ConfigError <tailsim.simulate>: " + key), line)
+            self.assertIn("nested deeper than 64 levels", line)
+
+    def test_smaller_nul_and_nan_in_keywords(self):
+        # A NUL in a key or a value is refused naming it (the message was cut at the NUL); NaN and
+        # infinities are named as such (NaN was "got nothing (empty value)").
+        with self.assertRaisesRegex(tailsim.ConfigError, r"tail\.links\\0: the key 'links\\0' holds a NUL character"):
+            tailsim.simulate(robot="paper", tail={"links\0": 1})
+        with self.assertRaisesRegex(tailsim.ConfigError, r"kind: the value 'simu\\0late' holds a NUL character"):
+            tailsim.simulate(robot="paper", kind="simu\0late")
+        with self.assertRaisesRegex(tailsim.ConfigError, r"trajectory\.theta0_deg: nan is not a value"):
+            tailsim.simulate(**dict(FIG7_ARGS, trajectory=dict(FIG7_ARGS["trajectory"], theta0_deg=float("nan"))))
+        with self.assertRaisesRegex(tailsim.ConfigError, r"quadruped\.d_Q2B_m: -inf is not a value"):
+            tailsim.simulate(**dict(FIG7_ARGS, quadruped={"d_Q2B_m": float("-inf")}))
+        with self.assertRaisesRegex(tailsim.ConfigError, r"tail\.custom\[1\]: inf is not a value"):
+            tailsim.simulate(robot="paper", tail={"custom": [1, float("inf")]})
+
     def test_smaller_ctrl_c_stops_a_sweep(self):
         # SIGINT 3 s into a sweep of 16,261 cases (54 s to the end): KeyboardInterrupt within seconds, the
         # finished cases saved (the run waited for the whole sweep before).

@@ -5,17 +5,27 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "design/maneuver.h"
 #include "design/optimize_config.h"
 #include "design/optimize_experiment.h"
+#include "experiments/accuracy_study.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/experiment_runner.h"
+#include "plotting/accuracy_plot.h"
 #include "plotting/gnuplot.h"
+#include "plotting/plots.h"
+#include "plotting/result_folder.h"
 
 namespace tailsim {
 namespace {
@@ -185,6 +195,171 @@ TEST_F(NoInputTextReachesAnInterpreterUnescaped, DesignPlotsRunNoCommand) {
     EXPECT_TRUE(fs::is_regular_file(mout + "/plots/heading.png")) << n;
   }
   EXPECT_EQ(pwned(), std::vector<std::string>());
+}
+
+// Names gnuplot would open as a shell pipe (`set output '|cmd'`, `plot '<cmd'`) or read as a
+// datablock (`plot '$name'`) if a file name made from them began a script's file name. From a
+// result folder's plots/, `cd ..; cd ..` reaches dir_.
+std::vector<std::string> pipeNames() {
+  return {"|cd ..; cd ..; touch PWNED_PIPE; cat > PWNED_SINK; true ", "<cd ..; cd ..; touch PWNED_LT; echo 0 0 ",
+          "$PWNED_DATABLOCK"};
+}
+
+// Every file name in the .gp scripts under `dir` (what `set output` and `plot`/`every`/`using`
+// take) as written, for names not starting with "./" ('' is gnuplot's "the previous file").
+std::vector<std::string> unprefixedFileNames(const fs::path& dir) {
+  std::vector<std::string> bad;
+  const std::regex output(R"(set output '([^']*)')"), data(R"('([^']*)' (using|every) )");
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.path().extension() != ".gp") continue;
+    std::ifstream in(e.path());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string gp = ss.str();
+    int names = 0;
+    for (const std::regex* re : {&output, &data})
+      for (auto it = std::sregex_iterator(gp.begin(), gp.end(), *re); it != std::sregex_iterator(); ++it, ++names)
+        if (!(*it)[1].str().empty() && (*it)[1].str().rfind("./", 0) != 0) bad.push_back(e.path().filename().string() + ": " + (*it)[1].str());
+    if (names == 0) bad.push_back(e.path().filename().string() + ": no file name found (the check is out of date)");
+  }
+  return bad;
+}
+
+// A name starting with '|', '<' or '$' is refused at the name key by the one rule every file
+// kind uses (experiment, suite member, optimize, maneuver).
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, PipeAndDatablockNamesAreRefusedAtLoad) {
+  for (const std::string& n : pipeNames()) {
+    EXPECT_NE(experimentNameProblem(n), "") << n;
+    EXPECT_NE(errorOf([&] { loadOptimizeSpec(optimizeFile(n)); }).find("opt.yaml:1:7: name: must be a folder name"),
+              std::string::npos) << n;
+    EXPECT_NE(errorOf([&] { loadManeuverSpec(maneuverFile(n)); }).find("m.yaml:1:7: name: must be a folder name"),
+              std::string::npos) << n;
+    const std::string exp = write("e.yaml", "name: " + yamlQuoted(n) + "\nrobot: paper\ntail: {links: 1}\n"
+                                            "trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.5}\n");
+    EXPECT_NE(errorOf([&] { loadExperiment(exp); }).find("e.yaml:1:7: name: must be a folder name"), std::string::npos)
+        << n;
+    write("suite.yaml", "experiments: [e.yaml]\n");
+    EXPECT_NE(errorOf([&] { loadExperimentSuite((dir_ / "suite.yaml").string()); }).find("name: must be a folder name"),
+              std::string::npos) << n;
+  }
+  EXPECT_EQ(experimentNameProblem("a|b <c $d"), "");  // only the first character matters to gnuplot
+}
+
+// Whatever a name holds, no file name in a script tailsim writes starts with it: `run --plot` and
+// `plot` (plotExperiment: one case and a sweep), optimize, maneuver and accuracy write file names
+// that start with "./", so gnuplot opens no pipe and reads no datablock (the loader's rule bypassed:
+// the results renamed after loading).
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, ScriptFileNamesStartWithDotSlash) {
+  const std::string one = write("one.yaml", "name: one\nrobot: paper\ntail: {links: 1}\n"
+                                            "trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.5}\n"
+                                            "models: [analytic]\n");
+  const std::string sweep = write("sweep.yaml", "name: sweep\nrobot: paper\ntail: {links: 1}\n"
+                                                "trajectory: {theta0_deg: 45, dtheta_deg: {sweep: [-90, 90]}, dT_s: 0.25, "
+                                                "w_ss: {sweep: [0.25, 0.5]}}\nmodels: [analytic]\n");
+  for (const std::string& f : {one, sweep}) {
+    RunOptions o;
+    o.out_dir = (dir_ / fs::path(f).stem()).string();
+    o.progress = false;
+    o.threads = 1;
+    runExperiment(loadExperiment(f), o);
+    ExperimentResults r = loadResults(o.out_dir);
+    for (const std::string& n : pipeNames()) {
+      r.name = n;
+      EXPECT_NO_THROW(plotExperiment(r)) << n;
+    }
+  }
+  EXPECT_NO_THROW(runOptimize(loadOptimizeSpec(optimizeFile("opt")), (dir_ / "o").string(), false));
+  EXPECT_NO_THROW(runManeuver(loadManeuverSpec(maneuverFile("man")), (dir_ / "m").string(), false, false));
+  AccuracyStudy st;
+  st.case_name = pipeNames()[0];
+  for (int i = 1; i <= 3; ++i) {
+    AccuracyRow row;
+    row.model = "analytic";
+    row.family = "adaptive";
+    row.value = std::pow(10.0, -i);
+    row.is_default = i == 2;
+    row.err_phi_net_deg = std::pow(10.0, -2 * i);
+    row.wall_s = 1e-3 * i;
+    st.rows.push_back(row);
+  }
+  fs::create_directories(dir_ / "acc");
+  EXPECT_NO_THROW(plotAccuracy({st, st}, (dir_ / "acc").string()));
+  // The names' own data files hold PWNED in their names: look for what the shell would create.
+  std::vector<std::string> made;
+  for (const auto& e : fs::recursive_directory_iterator(dir_))
+    for (const char* f : {"PWNED_PIPE", "PWNED_SINK", "PWNED_LT"})
+      if (e.path().filename() == f) made.push_back(e.path().string());
+  EXPECT_EQ(made, std::vector<std::string>());
+  EXPECT_EQ(unprefixedFileNames(dir_), std::vector<std::string>());
+}
+
+// optimize writes best.yaml as the experiment <name>_best: an optimize name leaves room for the
+// suffix (refused at the key past 95 bytes), and best.yaml of the longest name loads back.
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, OptimizeNamesLeaveRoomForTheBestExperiment) {
+  const std::size_t longest = kMaxNameChars - std::string(kBestNameSuffix).size();
+  const std::string e = errorOf([&] { loadOptimizeSpec(optimizeFile(std::string(longest + 1, 'n'))); });
+  EXPECT_NE(e.find("opt.yaml:1:7: name: must be a folder name: 1 to 95 characters"), std::string::npos) << e;
+  EXPECT_EQ(errorOf([&] { loadManeuverSpec(maneuverFile(std::string(kMaxNameChars, 'n'))); }), "(no error)");
+  const OptimizeReport rep = runOptimize(loadOptimizeSpec(optimizeFile(std::string(longest, 'n'))),
+                                         (dir_ / "o").string(), false);
+  EXPECT_EQ(rep.best_yaml_error, "");
+  EXPECT_EQ(loadExperiment((dir_ / "o/best.yaml").string()).name, std::string(longest, 'n') + "_best");
+}
+
+// A result folder read back by `plot` and `report` is input too: an experiment name, case folder
+// or model name in it that the loader or the runner would never write is refused naming the file,
+// before any figure is drawn (summary.json's name once ran a shell command through `plot` and wrote
+// '../../EVIL_phi.gp' outside the folder).
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, ResultFolderNamesAreCheckedWhenReadBack) {
+  const std::string f = write("ok.yaml", "name: ok\nrobot: paper\ntail: {links: 1}\n"
+                                         "trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.5}\n"
+                                         "models: [analytic]\n");
+  RunOptions o;
+  o.out_dir = (dir_ / "base").string();
+  o.progress = false;
+  o.threads = 1;
+  runExperiment(loadExperiment(f), o);
+  auto edited = [&](const std::string& folder, const std::function<void(nlohmann::json&)>& edit) {
+    const fs::path d = dir_ / "sub" / folder;
+    fs::create_directories(d.parent_path());
+    fs::copy(dir_ / "base", d, fs::copy_options::recursive);
+    nlohmann::json s;
+    {
+      std::ifstream in(d / "summary.json");
+      in >> s;
+    }
+    edit(s);
+    std::ofstream(d / "summary.json") << s.dump(1);
+    return d.string();
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {edited("pipe", [](nlohmann::json& s) { s["experiment"] = "|cd ..; cd ..; cd ..; touch PWNED_SUMMARY; true "; }),
+       "summary.json: experiment name '|cd ..; cd ..; cd ..; touch PWNED_SUMMARY; true ' must be a folder name"},
+      {edited("evil", [](nlohmann::json& s) { s["experiment"] = "../../EVIL"; }),
+       "summary.json: experiment name '../../EVIL' must be a folder name"},
+      {edited("dir", [](nlohmann::json& s) { s["cases"][0]["dir"] = "../../elsewhere"; }),
+       "summary.json: case 'base' has the folder '../../elsewhere', which tailsim never writes"},
+      {edited("model", [](nlohmann::json& s) {
+         s["cases"][0]["runs"]["../../../EVILMODEL"] = s["cases"][0]["runs"]["analytic"];
+       }),
+       "case 'base' has a run of the model '../../../EVILMODEL', a name that must be a folder name"}};
+  for (const auto& [d, want] : cases) {
+    std::string err = "(no error)";
+    try {
+      plotResults(d);
+    } catch (const std::exception& e) {
+      err = e.what();
+    }
+    EXPECT_NE(err.find(want), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(fs::path(d) / "plots")) << d;
+  }
+  std::vector<std::string> outside;
+  for (const auto& e : fs::recursive_directory_iterator(dir_))
+    if (e.path().filename().string().find("EVIL") != std::string::npos ||
+        e.path().filename().string().find("PWNED") != std::string::npos)
+      outside.push_back(e.path().string());
+  EXPECT_EQ(outside, std::vector<std::string>());
+  EXPECT_NO_THROW(plotResults((dir_ / "base").string()));  // the folder as written plots
 }
 
 // directions: enumerate searches 2^n patterns: a tail of more than 12 links is refused at the key

@@ -71,6 +71,20 @@ TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepOutputIsBounded) {
   EXPECT_EQ(errorOf(g), "(no error)");
 }
 
+// The rendering of a whole sweep is bounded too: frames x pixels x MSAA summed over the cases (this
+// 981-case file was accepted and started: about 2 x 10^7 frames of 67 Mpixel).
+TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepRenderingIsBounded) {
+  const std::string sweep = "name: r\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: {range: [0.01, 0.99, 0.001]}}\n"
+                            "models: [mujoco]\noutput: {time_series: none}\n";
+  const std::string f = write("rend.yaml", sweep + "render: {width: 8192, height: 8192, fps: 240, slowmo: 160, msaa: 4}\n");
+  const std::string e = errorOf(f);
+  EXPECT_EQ(e.rfind(f + ":1:1: the 981 cases would render about ", 0), 0u) << e;
+  EXPECT_NE(e.find("samples in all (frames x render.width x render.height x render.msaa"), std::string::npos) << e;
+  EXPECT_NE(e.find("more than the limit 1e+12"), std::string::npos) << e;
+  // The same sweep at the default frame size, rate and MSAA loads.
+  EXPECT_EQ(errorOf(write("small.yaml", sweep + "render: {width: 640, height: 480}\n")), "(no error)");
+}
+
 // The solver steps of a whole sweep are bounded too.
 TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepStepsAreBounded) {
   const std::string f = write("steps.yaml",

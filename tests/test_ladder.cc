@@ -141,6 +141,11 @@ TEST(GapLadder, Fig7RungsAreTheRunsPhiNetAndTheReportIsWritten) {
   EXPECT_NE(md.find(b), std::string::npos) << md;
   EXPECT_NE(md.find("Per-foot model vs MuJoCo, same friction law (1 cases)"), std::string::npos);
   EXPECT_TRUE(fs::file_size(out / "plots" / "ladder_fig07_loading.png") > 1000);
+  // Its script names its files as "./<file>" (gpFileName): no name can be read as a pipe or datablock.
+  const std::string gp = slurp(out / "plots" / "ladder_fig07_loading.gp");
+  EXPECT_NE(gp.find("set output './ladder_fig07_loading.png'"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("'./ladder_fig07_loading.dat' using"), std::string::npos) << gp;
+  EXPECT_EQ(gp.find("'ladder_fig07_loading."), std::string::npos) << gp;
   EXPECT_NE(slurp(out / "ladder.csv").find("ladder_fig07_loading,\"base\","), std::string::npos);
   fs::remove_all(out);
 }

@@ -154,15 +154,16 @@ inline const Val& need(const Reader& r, const Map& m, const Val& parent, const c
 }
 
 // The keys every design file (kind optimize, kind maneuver) starts with: name (one safe path
-// component, experimentNameProblem), description, kind (must be `kind`) and base (an experiment file, relative to this one).
+// component of at most max_name_chars bytes, experimentNameProblem), description, kind (must be
+// `kind`) and base (an experiment file, relative to this one).
 struct DesignHead {
   std::string name, description, base_file;
 };
 inline DesignHead readDesignHead(const Reader& r, const Val& root, const Map& top, const std::string& source_file,
-                                 const char* kind) {
+                                 const char* kind, std::size_t max_name_chars) {
   DesignHead h;
   h.name = r.text(need(r, top, root, "name"));
-  if (const std::string why = experimentNameProblem(h.name); !why.empty()) r.fail(need(r, top, root, "name"), why);
+  if (const std::string why = experimentNameProblem(h.name, max_name_chars); !why.empty()) r.fail(need(r, top, root, "name"), why);
   if (const Val* d = Reader::get(top, "description")) h.description = r.text(*d);
   r.choice(need(r, top, root, "kind"), {kind});
   const Val& base = need(r, top, root, "base");
@@ -183,11 +184,14 @@ struct DesignFile {
   const Val& base(const Reader& r) const { return need(r, top, root, "base"); }
   const Val& section(const Reader& r) const { return need(r, top, root, section_key.c_str()); }
 };
-inline DesignFile openDesignFile(const Reader& r, const std::string& source_file, const char* kind, const char* section) {
+// max_name_chars: shorter than an experiment's kMaxNameChars when the command derives a longer
+// name from it (optimize's best.yaml is named <name>_best).
+inline DesignFile openDesignFile(const Reader& r, const std::string& source_file, const char* kind, const char* section,
+                                 std::size_t max_name_chars = kMaxNameChars) {
   DesignFile f{Val{loadYaml(source_file), "", YAML::Mark()}, {}, {}, section};
   if (!f.root.node.IsMap()) r.fail(f.root, "the file must be a map of key: value");
   f.top = r.map(f.root, {"name", "description", "kind", "base", section});
-  f.head = readDesignHead(r, f.root, f.top, source_file, kind);
+  f.head = readDesignHead(r, f.root, f.top, source_file, kind, max_name_chars);
   return f;
 }
 

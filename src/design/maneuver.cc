@@ -419,7 +419,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     const char* colours[] = {"#0072B2", "#E69F00", "#009E73"};
     const char* lines[] = {"lw 5 dt 1", "lw 2.5 dt 2", "lw 2 dt 4"};
     for (std::size_t i = 0; i < rep.runs.size(); ++i)
-      b << ", '../maneuver.csv' every ::1 using 1:" << i + 2 << " with lines " << lines[i % 3] << " lc rgb "
+      b << ", " << gpFileName("../maneuver.csv") << " every ::1 using 1:" << i + 2 << " with lines " << lines[i % 3] << " lc rgb "
         << gpQuote(colours[i % 3]) << " title " << gpQuote(rep.runs[i].label) << " noenhanced";
     b << "\n";
     fig.body = b.str();

@@ -53,7 +53,8 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   OptimizeSpec s;
   s.source_file = fs::absolute(path).lexically_normal().string();
   const Reader r(s.source_file);
-  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "optimize", "optimize");
+  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "optimize", "optimize",
+                                                                      kMaxNameChars - (sizeof kBestNameSuffix - 1));
   s.name = std::move(file.head.name);
   s.description = std::move(file.head.description);
   s.base_file = std::move(file.head.base_file);

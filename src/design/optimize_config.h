@@ -15,6 +15,10 @@
 
 namespace tailsim {
 
+// best.yaml's experiment is named <name> + this suffix; an optimize name is therefore at most
+// kMaxNameChars minus its length.
+inline constexpr char kBestNameSuffix[] = "_best";
+
 struct OptimizeSpec {
   std::string name, description;
   std::string source_file;  // absolute path of the optimize file

@@ -111,7 +111,7 @@ LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSer
 
 std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& traj) {
   YAML::Node doc = YAML::LoadFile(spec.base_file);
-  doc["name"] = spec.name + "_best";
+  doc["name"] = spec.name + kBestNameSuffix;
   doc["description"] = "Best stroke of " + spec.name + " (tailsim optimize, " + std::string(familyName(spec.problem.space.family)) + ")";
   doc["robot"] = spec.base.robot_file;  // absolute: the file runs from any folder
   YAML::Node t(YAML::NodeType::Map);
@@ -261,7 +261,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
       << gpQuote(std::string(objectiveName(prob.objective)) + (prob.objective == StrokeObjective::kPhiNet ? " [rad]" : ""))
       << " noenhanced\nplot ";
     for (std::size_t i = 0; i < spec.seeds.size(); ++i)
-      b << (i ? ", " : "") << "'../history.csv' every ::1 using ($1==" << spec.seeds[i]
+      b << (i ? ", " : "") << gpFileName("../history.csv") << " every ::1 using ($1==" << spec.seeds[i]
         << " ? $4 : 1/0):6 with steps lw 2 title " << gpQuote("seed " + std::to_string(spec.seeds[i]));
     b << "\n";
     fig.body = b.str();
@@ -298,7 +298,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
     fig.stem = "pareto";
     fig.body = "set datafile separator ','\nset grid\nset key off\nset title " +
                gpQuote("Net yaw vs peak joint torque (" + spec.name + ")") + " noenhanced\nset xlabel 'peak joint torque [N m]'\nset ylabel '|{/Symbol f}_{net}| [deg]'\n"
-               "plot '../pareto.csv' every ::1 using 2:(abs($3)) with linespoints lw 2 pt 7\n";
+               "plot " + gpFileName("../pareto.csv") + " every ::1 using 2:(abs($3)) with linespoints lw 2 pt 7\n";
     renderFigure((fs::path(out_dir) / "plots").string(), fig);
     rep.files.push_back("plots/pareto.png");
   }

@@ -1321,14 +1321,16 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
 
 YAML::Node loadBoundedYaml(const std::string& path) { return parseYaml(&path); }
 
-std::string experimentNameProblem(const std::string& nm) {
+std::string experimentNameProblem(const std::string& nm, std::size_t max_chars) {
   const bool control = std::any_of(nm.begin(), nm.end(), [](char ch) {
     return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
   });
-  if (nm.empty() || nm.size() > 100 || nm == "." || nm == ".." || nm[0] == '-' || control ||
-      nm.find_first_of("/\\") != std::string::npos)
-    return "must be a folder name: 1 to 100 characters, no '/', '\\' or control characters, "
-           "not '.' or '..', not starting with '-'";
+  // A leading '|', '<' or '$' would make gnuplot read a file name made from it as a shell pipe
+  // or a datablock (gpFileName guards the scripts as well).
+  if (nm.empty() || nm.size() > max_chars || nm == "." || nm == ".." || control ||
+      nm.find_first_of("/\\") != std::string::npos || std::string("-|<$").find(nm[0]) != std::string::npos)
+    return "must be a folder name: 1 to " + std::to_string(max_chars) +
+           " characters, no '/', '\\' or control characters, not '.' or '..', not starting with '-', '|', '<' or '$'";
   return "";
 }
 

@@ -47,11 +47,17 @@ RobotFileData loadRobotFile(const std::string& name_or_path);
 // be suites themselves). A normal experiment file yields a one-element vector. Throws ConfigError.
 std::vector<Experiment> loadExperimentSuite(const std::string& path);
 
-// The `name` of an experiment or design file (optimize, maneuver) becomes a folder and appears in
-// plot titles: one safe path component of 1 to 100 bytes, no '/', '\\' or control characters
-// (NUL and line breaks included), not '.' or '..', not starting with '-'. Returns "" when `name` is
-// fine, else what is wrong (for the caller's ConfigError at the key).
-std::string experimentNameProblem(const std::string& name);
+// The longest `name` of an experiment, in bytes.
+constexpr std::size_t kMaxNameChars = 100;
+
+// The `name` of an experiment or design file (optimize, maneuver) becomes a folder, a plot file
+// name and appears in plot titles: one safe path component of 1 to max_chars bytes, no '/', '\\'
+// or control characters (NUL and line breaks included), not '.' or '..', not starting with '-',
+// '|', '<' or '$' (gnuplot reads a file name starting with '|' or '<' as a shell pipe, with '$' as
+// a datablock). A file whose name yields a longer derived name (optimize's `<name>_best`) passes
+// a smaller max_chars. Returns "" when `name` is fine, else what is wrong (for the caller's
+// ConfigError at the key).
+std::string experimentNameProblem(const std::string& name, std::size_t max_chars = kMaxNameChars);
 
 // At most this many values per sweep/range and this many cases per experiment.
 constexpr std::size_t kMaxSweepValues = 10000;

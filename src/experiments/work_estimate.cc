@@ -71,6 +71,7 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
     if (c.render.enabled) {
       const double shown = c.render.duration_s > 0 ? std::min(c.render.duration_s, w.sim_time_s) : w.sim_time_s;
       w.render_frames = std::floor(shown * c.render.fps * c.render.slowmo) + 1;
+      w.render_samples = w.render_frames * c.render.width * c.render.height * std::max(1, c.render.msaa);
     }
   }
   w.csv_bytes = w.rows * cols * limits::kCsvBytesPerValue;
@@ -151,11 +152,13 @@ std::string jointSpeedWarning(const ExperimentCase& c) {
 
 WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
   WorkExcess x;
-  double steps = 0, bytes = 0;
+  double steps = 0, bytes = 0, samples = 0, frames = 0;
   for (const ExperimentCase& c : cases) {
     if (c.kind != CaseKind::kSimulate) continue;
     const WorkEstimate w = estimateWork(c);
     steps += w.analytic_steps + w.mujoco_steps;
+    samples += w.render_samples;
+    frames += w.render_frames;
     const double share = c.output.time_series == TimeSeriesOutput::kNone   ? 0.0
                          : c.output.time_series == TimeSeriesOutput::kThin ? 0.1
                                                                             : 1.0;
@@ -171,6 +174,12 @@ WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
     x.what = "the " + n + " would write about " + g(bytes) + " bytes of time series in all (rows x columns x " +
              g(limits::kCsvBytesPerValue) + " B per model run, summed over the cases), more than the limit " +
              g(limits::kMaxExperimentBytes) + see + ": set output.time_series: thin or none, raise output.sample_dt_s, " +
+             "or sweep fewer values";
+  else if (!(samples <= limits::kMaxExperimentRenderSamples))
+    x.what = "the " + n + " would render about " + g(frames) + " video frames, " + g(samples) +
+             " samples in all (frames x render.width x render.height x render.msaa, summed over the cases), more "
+             "than the limit " + g(limits::kMaxExperimentRenderSamples) + " (about 14 hours of rendering)" + see +
+             ": lower render.width, render.height, render.msaa, render.fps or render.slowmo, set render.duration_s, "
              "or sweep fewer values";
   return x;
 }

@@ -17,6 +17,7 @@ struct WorkEstimate {
   double analytic_steps = 0;  // lower bound: tail end time / largest step (0 without the analytic model)
   double mujoco_steps = 0;    // (mujoco.settle_s + sim time) / timestep_s (0 without MuJoCo)
   double render_frames = 0;   // shown sim time x slowmo x fps (0 without a render section)
+  double render_samples = 0;  // render_frames x width x height x MSAA samples (1 without MSAA)
 };
 
 WorkEstimate estimateWork(const ExperimentCase& c);
@@ -35,9 +36,10 @@ WorkExcess checkWork(const ExperimentCase& c);
 // A run warning when a joint of the case's trajectory peaks above limits::kMaxJointSpeedDps, else "".
 std::string jointSpeedWarning(const ExperimentCase& c);
 
-// The whole experiment's work: solver steps (analytic + MuJoCo) and time-series bytes summed over
-// its cases and models (output.time_series: none writes none, thin about a tenth), against
-// limits::kMaxExperimentSteps and kMaxExperimentBytes. Empty `what` when within both; `keys` empty
+// The whole experiment's work: solver steps (analytic + MuJoCo), time-series bytes and rendered
+// samples (frames x pixels x MSAA) summed over its cases and models (output.time_series: none writes
+// none, thin about a tenth), against limits::kMaxExperimentSteps, kMaxExperimentBytes and
+// kMaxExperimentRenderSamples. Empty `what` when within both; `keys` empty
 // (the sweeps as a whole are the culprit).
 WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases);
 

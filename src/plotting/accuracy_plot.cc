@@ -39,13 +39,13 @@ std::vector<std::string> plotAccuracy(const std::vector<AccuracyStudy>& studies,
       writeDataFile(dir + "/" + dat, {"wall_ms", "err_deg", "value"}, rows);
       // One Okabe-Ito colour per series (style.h); point type and, past seven series, dashes as well.
       const size_t i = static_cast<size_t>(k - 1);
-      parts.push_back(gpQuote(dat) + " using 1:2 with linespoints lw 2 pt " + std::to_string(1 + i % 13) + " ps 1.4 dt " +
+      parts.push_back(gpFileName(dat) + " using 1:2 with linespoints lw 2 pt " + std::to_string(1 + i % 13) + " ps 1.4 dt " +
                       std::to_string(1 + static_cast<int>(i / 7) % 4) + " lc rgb " + gpQuote(categoricalColor(i)) +
                       " title " + gpQuote(gpText(name)));
     }
     if (!defaults.empty()) {
       writeDataFile(dir + "/" + stem + "_defaults.dat", {"wall_ms", "err_deg", "value"}, defaults);
-      parts.push_back(gpQuote(stem + "_defaults.dat") +
+      parts.push_back(gpFileName(stem + "_defaults.dat") +
                       " using 1:2 with points pt 6 ps 4 lw 3 lc rgb 'black' title 'tailsim default'");
     }
     if (st.mujoco.present && st.mujoco.noise_default_deg > 0)

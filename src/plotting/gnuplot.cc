@@ -35,6 +35,8 @@ std::string gpQuote(const std::string& s) {
   return out + "'";
 }
 
+std::string gpFileName(const std::string& relative_name) { return gpQuote("./" + relative_name); }
+
 namespace {
 
 // Runs `gnuplot SCRIPT` in `dir` without a shell (as ffmpeg is started, rendering/ffmpeg_writer.cc):
@@ -72,11 +74,11 @@ std::string terminalBlock(const GnuplotFigure& f, bool png) {
   if (png)
     o << "set terminal pngcairo enhanced size " << f.width_px << "," << f.height_px
       << " font 'Sans,15'" << scale << " linewidth 2\n"
-      << "set output " << gpQuote(f.stem + ".png") << "\n";
+      << "set output " << gpFileName(f.stem + ".png") << "\n";
   else
     o << "set terminal svg enhanced size " << f.width_px << "," << f.height_px
       << " font 'Sans,15'" << scale << " linewidth 2 background rgb 'white'\n"
-      << "set output " << gpQuote(f.stem + ".svg") << "\n";
+      << "set output " << gpFileName(f.stem + ".svg") << "\n";
   o << f.body << "\nunset output\n";
   return o.str();
 }
@@ -116,7 +118,7 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
                              terminalBlock(fig, true) + terminalBlock(fig, false);
   writeFileAtomic((dir / (fig.stem + ".gp")).string(), script);
   const fs::path log = dir / (fig.stem + ".log");
-  const int status = runGnuplot(dir, fig.stem + ".gp", log);
+  const int status = runGnuplot(dir, "./" + fig.stem + ".gp", log);  // "./": gnuplot runs an argument starting with '<' as a command
   std::string err;
   {
     std::ifstream in(log);

@@ -35,4 +35,11 @@ void writeDataFile(const std::string& path, const std::vector<std::string>& head
 // tailsim writes quotes its text with it.
 std::string gpQuote(const std::string& s);
 
+// A file name relative to the script's folder (a data file, `set output`, `load`), for a gnuplot
+// script: "./" + name, quoted with gpQuote. gnuplot opens a name starting with '|' (set output)
+// or '<' (plot) as a pipe to a shell command and reads one starting with '$' as a datablock; with
+// "./" in front no name, whatever its text, is anything but a file. Every file name a tailsim
+// script holds goes through this function.
+std::string gpFileName(const std::string& relative_name);
+
 }  // namespace tailsim

@@ -192,16 +192,16 @@ std::string plotFigure(const std::string& plots, const std::string& exp, const s
   body << ") rotate by -25\nset xrange [0.5:" << rungs().size() + 0.5 << "]\nset xlabel 'rung of the ladder'\nplot ";
   if (few) {
     for (size_t k = 0; k < cs.size(); ++k)
-      body << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << k + 2
+      body << (k ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using 1:" << k + 2
            << " with linespoints lw 2 pt " << seriesPoint(k) << " dt " << seriesDash(k) << " lc rgb "
            << gpQuote(seriesColor(k)) << " title "
            << gpQuote(gpText(cs[k].name));
   } else {
     for (size_t k = 0; k < cs.size(); ++k)
-      body << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:" << k + 2
+      body << (k ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using 1:" << k + 2
            << " with lines lw 0.8 lc rgb '#B0B0B0' " << (k ? "notitle" : "title " + gpQuote(
                   gpText(std::to_string(cs.size()) + " cases, one line each")));
-    body << ", \\\n     " << gpQuote(stem + ".dat") << " using 1:" << cs.size() + 2
+    body << ", \\\n     " << gpFileName(stem + ".dat") << " using 1:" << cs.size() + 2
          << " with linespoints lw 3 pt 7 lc rgb '#000000' title 'median'";
   }
   body << "\n";

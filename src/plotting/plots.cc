@@ -319,7 +319,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     const double net = r.phiNet(c, m);
     std::string title = gpText(modelTitle(m));
     if (std::isfinite(net)) title += ", φ_{net} = " + fmt("%.2f", net) + "°";
-    body << (i ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using 1:2 with lines lw 2.5 lc rgb "
+    body << (i ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using 1:2 with lines lw 2.5 lc rgb "
          << gpQuote(modelColor(m)) << " title " << gpQuote(title);
   }
   body << "\n";
@@ -376,7 +376,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     int n = 0;
     for (size_t j = 0; j < cols.size(); ++j) {
       if (!s.has(cols[j].first)) continue;
-      mb << (n++ ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2 << " with lines lw 2 lc rgb "
+      mb << (n++ ? ", " : "") << gpFileName(stem + ".dat") << " using 1:" << j + 2 << " with lines lw 2 lc rgb "
          << gpQuote(quantityColor(j)) << " title " << gpQuote(cols[j].second);
     }
     mb << "\n";
@@ -550,12 +550,12 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
       << "set cblabel " << gpQuote(p.cblabel) << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
       << (p.diverging ? divergingPalette() : sequentialPalette(p.negative));
     if (lay.values_in_cells)
-      b << "plot " << gpQuote(p.dstem + ".dat")
+      b << "plot " << gpFileName(p.dstem + ".dat")
         << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
         << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
         << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
     else  // one pixel block per cell (the rows are a full grid, ix fastest); NaN cells stay empty
-      b << "set xtics rotate by -45\nplot " << gpQuote(p.dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
+      b << "set xtics rotate by -45\nplot " << gpFileName(p.dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
   }
   b << "unset multiplot\n";
   std::string cap = title.plain + ". " + caption_more;
@@ -620,12 +620,12 @@ void plotOneKey(Ctx& ctx) {
     for (size_t i = 0; i < a.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
     b << ")\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
-      b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using " << j + 2 << " lc rgb "
+      b << (j ? ", " : "") << gpFileName(stem + ".dat") << " using " << j + 2 << " lc rgb "
         << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(modelTitle(r.models[j])));
   } else {
     b << "set xzeroaxis lt -1\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
-      b << (j ? ", " : "") << gpQuote(stem + ".dat") << " using 1:" << j + 2
+      b << (j ? ", " : "") << gpFileName(stem + ".dat") << " using 1:" << j + 2
         << " with linespoints lw 2.5 pt " << seriesPoint(j) << " ps 1.3 lc rgb " << gpQuote(modelColor(r.models[j]))
         << " title " << gpQuote(gpText(modelTitle(r.models[j])));
   }
@@ -692,7 +692,7 @@ void plotOneKey(Ctx& ctx) {
       bool on_earlier = false;
       for (size_t e = 0; e < n && !on_earlier; ++e)
         on_earlier = curvesCoincide(loaded[curves[e].series], loaded[curves[n].series], t_end, tol);
-      t << (n ? ", \\\n     " : "") << gpQuote(curves[n].dat) << " using 1:2 with lines lw 2 dt "
+      t << (n ? ", \\\n     " : "") << gpFileName(curves[n].dat) << " using 1:2 with lines lw 2 dt "
         << (on_earlier ? "(12,9)" : std::to_string(seriesDash(curves[n].i))) << " lc rgb "
         << gpQuote(seriesColor(curves[n].i)) << " title " << gpQuote(V(a.key, a.values[curves[n].i]).gp);
       if (on_earlier) any_dashed = true;
@@ -784,13 +784,13 @@ void plotGroupedBars(Ctx& ctx) {
     std::string t = gpText(shortModel(sr.model));
     if (sr.ib >= 0) t += ", " + gpValueLabel(ab.key, ab.values[sr.ib]);
     else t += " (" + keyDisplay(ab.key).symbol + " not used)";
-    b << (k ? ", \\\n     " : "") << gpQuote(stem + ".dat") << " using " << k + 2 << " "
+    b << (k ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using " << k + 2 << " "
       << fills[sr.ib < 0 ? 0 : sr.ib % 5] << " lc rgb " << gpQuote(modelColor(sr.model)) << " title " << gpQuote(t);
   }
   // Each bar's value above it (below a negative bar): bar k of a cluster of nb (gap 1) is centred
   // at cluster + (k + 0.5 - nb / 2) / (nb + 1).
   for (size_t k = 0; k < nb; ++k)
-    b << ", \\\n     " << gpQuote(stem + ".dat") << " using ($1 + " << fmt("%.6g", (k + 0.5 - 0.5 * nb) / (nb + 1.0))
+    b << ", \\\n     " << gpFileName(stem + ".dat") << " using ($1 + " << fmt("%.6g", (k + 0.5 - 0.5 * nb) / (nb + 1.0))
       << "):($" << k + 2 << " + ($" << k + 2 << " < 0 ? -1 : 1) * " << fmt("%.6g", 0.35 * pad) << "):(sprintf('%.2f', $"
       << k + 2 << ")) with labels font 'Sans,12' notitle";
   b << "\n";
@@ -858,7 +858,7 @@ void plotTwoKeys(Ctx& ctx) {
     b << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {ax, ay}), panel_w - 250) << "\n"
       << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel 'φ_{net} [deg]'\nplot ";
     for (size_t iy = 0; iy < ay.values.size(); ++iy)
-      b << (iy ? ", \\\n     " : "") << gpQuote(dstem + ".dat") << " using 1:" << iy + 2
+      b << (iy ? ", \\\n     " : "") << gpFileName(dstem + ".dat") << " using 1:" << iy + 2
         << " with linespoints lw 2 pt " << seriesPoint(iy) << " ps 1.3 dt " << seriesDash(iy) << " lc rgb " << gpQuote(seriesColor(iy)) << " title " << gpQuote(V(ay.key, ay.values[iy]).gp);
     b << "\n";
   }
@@ -992,7 +992,7 @@ void plotManyKeys(Ctx& ctx) {
       }
       b << "plot ";
       for (size_t is = 0; is < as.values.size(); ++is)
-        b << (is ? ", \\\n     " : "") << gpQuote(dats[p]) << " using 1:" << is + 2 << " with linespoints lw 2 pt "
+        b << (is ? ", \\\n     " : "") << gpFileName(dats[p]) << " using 1:" << is + 2 << " with linespoints lw 2 pt "
           << seriesPoint(is) << " ps 1.1 dt " << seriesDash(is) << " lc rgb " << gpQuote(seriesColor(is))
           << " title " << gpQuote(gpValueLabel(as.key, as.values[is], false));
       b << "\n";
@@ -1066,7 +1066,7 @@ void plotPoseOneKey(Ctx& ctx) {
     b << "reset\nset multiplot layout 1,2 title " << ctx.figTitle(title, 1600, 17) << " font 'Sans,17'\n";
     for (int j = 0; j < 2; ++j)
       b << "set grid\nunset key\nset xzeroaxis lt -1\nset title " << gpTitle(parts[j].gp, 800) << "\nset xlabel "
-        << gpQuote(gpAxisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpQuote(stem + ".dat")
+        << gpQuote(gpAxisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpFileName(stem + ".dat")
         << " using 1:" << j + 2 << " with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
     b << "unset multiplot\n";
     ctx.render(stem, b.str(), title,
@@ -1082,7 +1082,7 @@ void plotPoseOneKey(Ctx& ctx) {
     writeDataFile(ctx.data(stem), {leafKey(a.key), "LF_mm"}, rows);
     const Txt title = ctx.title(W("friction moment arm L_F over ") + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << header(ctx, title, gpAxisLabel(a.key), "L_F [mm]") << "unset key\nplot " << gpQuote(stem + ".dat")
+    b << header(ctx, title, gpAxisLabel(a.key), "L_F [mm]") << "unset key\nplot " << gpFileName(stem + ".dat")
       << " using 1:2 with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
     ctx.render(stem, b.str(), title, title.plain + " (Eqs. 17-19, " + modelTitle(model) + ").");
   }

@@ -2,6 +2,7 @@
 
 
 #include <algorithm>
+#include <cctype>
 #include <unordered_map>
 #include <cstdio>
 #include <filesystem>
@@ -200,6 +201,39 @@ std::vector<std::vector<const CaseRecord*>> caseGrid(const ExperimentResults& r,
   return g;
 }
 
+namespace {
+
+// A name for a message: control characters as '?', at most 120 bytes.
+std::string shownName(const std::string& s) {
+  std::string out = s.substr(0, 120);
+  for (char& c : out)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  return out + (s.size() > 120 ? "..." : "");
+}
+
+// A result folder may come from elsewhere: the names read back from it are input. The experiment
+// name (figure stems, data files) follows the loader's rule (experimentNameProblem; an absent name
+// is taken from experiment.yaml or the folder later); a case's folder is one caseDirName could have
+// made: [A-Za-z0-9.=,_-] and '~', 1 to 100 bytes, not starting with '.' or '-'. Else an error
+// naming the file.
+void checkExperimentName(const std::string& name, const fs::path& file) {
+  if (name.empty()) return;
+  if (const std::string why = experimentNameProblem(name); !why.empty())
+    throw std::runtime_error(file.string() + ": experiment name '" + shownName(name) + "' " + why +
+                             " (this folder was not written by tailsim as it is)");
+}
+void checkCaseDir(const CaseRecord& c, const fs::path& file) {
+  bool ok = !c.dir.empty() && c.dir.size() <= 100 && c.dir[0] != '.' && c.dir[0] != '-';
+  for (const char ch : c.dir)
+    ok = ok && (std::isalnum(static_cast<unsigned char>(ch)) || std::string(".=,_-~").find(ch) != std::string::npos);
+  if (!ok)
+    throw std::runtime_error(file.string() + ": case '" + shownName(c.name) + "' has the folder '" + shownName(c.dir) +
+                             "', which tailsim never writes (1 to 100 of A-Z a-z 0-9 . = , _ - ~, not starting "
+                             "with '.' or '-'; this folder was not written by tailsim as it is)");
+}
+
+}  // namespace
+
 ExperimentResults loadResults(const std::string& dir) {
   ExperimentResults r;
   r.dir = dir;
@@ -208,13 +242,17 @@ ExperimentResults loadResults(const std::string& dir) {
   if (fs::exists(root / "summary.json")) {
     const json s = readJson(root / "summary.json");
     r.name = s.value("experiment", std::string());
+    checkExperimentName(r.name, root / "summary.json");
     r.source = s.value("source", std::string());
     r.description = s.value("description", std::string());
     r.kind = s.value("kind", std::string());
     if (auto k = s.find("swept_keys"); k != s.end() && k->is_array())
       for (const json& key : *k) keys.push_back(key.get<std::string>());
     if (auto cs = s.find("cases"); cs != s.end() && cs->is_array())
-      for (const json& c : *cs) r.cases.push_back(parseCase(c));
+      for (const json& c : *cs) {
+        r.cases.push_back(parseCase(c));
+        checkCaseDir(r.cases.back(), root / "summary.json");
+      }
   } else if (fs::exists(root / "cases.jsonl") && !fs::is_directory(root / "cases")) {
     // an interrupted run whose cases have no folder: its journal (a torn last line is skipped)
     std::istringstream in(readResultFile((root / "cases.jsonl").string()).value_or(std::string()));
@@ -222,9 +260,10 @@ ExperimentResults loadResults(const std::string& dir) {
     while (std::getline(in, line)) {
       const json j = json::parse(line, nullptr, false);
       if (!j.is_object()) continue;
-      if (r.name.empty()) r.name = j.value("experiment", std::string());
+      if (r.name.empty()) checkExperimentName(r.name = j.value("experiment", std::string()), root / "cases.jsonl");
       if (r.source.empty()) r.source = j.value("source", std::string());
       r.cases.push_back(parseCase(j));
+      checkCaseDir(r.cases.back(), root / "cases.jsonl");
     }
   } else if (fs::is_directory(root / "cases")) {
     std::vector<fs::path> files;
@@ -233,9 +272,10 @@ ExperimentResults loadResults(const std::string& dir) {
     std::sort(files.begin(), files.end());
     for (const fs::path& f : files) {
       const json j = readJson(f);
-      if (r.name.empty()) r.name = j.value("experiment", std::string());  // as the runner writes it
+      if (r.name.empty()) checkExperimentName(r.name = j.value("experiment", std::string()), f);  // as the runner writes it
       if (r.source.empty()) r.source = j.value("source", std::string());
       r.cases.push_back(parseCase(j));
+      checkCaseDir(r.cases.back(), f);
     }
   } else {
     throw std::runtime_error(dir + " is not a result folder (no summary.json, no cases/, no cases.jsonl)");
@@ -281,7 +321,13 @@ ExperimentResults loadResults(const std::string& dir) {
   }
   for (const CaseRecord& c : r.cases)
     for (const auto& [m, run] : c.runs)
-      if (!r.hasModel(m)) r.models.push_back(m);
+      if (!r.hasModel(m)) {
+        // a model name is part of figure and data file names too
+        if (const std::string why = experimentNameProblem(m); !why.empty())
+          throw std::runtime_error(dir + ": case '" + shownName(c.name) + "' has a run of the model '" + shownName(m) +
+                                   "', a name that " + why + " (this folder was not written by tailsim as it is)");
+        r.models.push_back(m);
+      }
   std::stable_sort(r.models.begin(), r.models.end(), [](const std::string& a, const std::string& b) {
     const std::vector<std::string> names = modelNames();  // registry order, unknown ones last
     auto rank = [&](const std::string& m) { return std::find(names.begin(), names.end(), m) - names.begin(); };

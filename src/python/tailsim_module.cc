@@ -10,6 +10,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -62,43 +63,83 @@ json yamlKeys(const S& s) {
   return j;
 }
 
+constexpr const char* kSimulateLabel = "<tailsim.simulate>";
+
 // A Python value -> JSON, as Python's json module writes it (keys that are numbers, booleans or
-// None become their text); numpy scalars and arrays become plain numbers and lists.
-nlohmann::ordered_json toJson(py::handle o) {
-  using oj = nlohmann::ordered_json;
-  if (o.is_none()) return nullptr;
-  if (py::isinstance<py::bool_>(o)) return o.cast<bool>();
-  if (py::isinstance<py::int_>(o)) {
-    try {
-      return o.cast<long long>();
-    } catch (const py::cast_error&) {
-      return o.cast<double>();  // beyond 64 bits: the loader's ranges refuse it
+// None become their text); numpy scalars and arrays become plain numbers and lists. Bounded as the
+// YAML loader bounds a file (kMaxYamlDepth levels, kMaxYamlNodes values), so a list or dict that
+// contains itself, or one nested 10^5 deep, is a ConfigError, not a stack overflow. A NUL in a key
+// or string and a NaN or infinite number are refused naming their key (the YAML text would cut the
+// string at the NUL and write NaN as an empty value).
+class JsonFromPython {
+ public:
+  nlohmann::ordered_json operator()(py::handle o, const std::string& path) { return convert(o, path, 0); }
+
+ private:
+  long nodes_ = 0;
+
+  [[noreturn]] static void fail(const std::string& path, const std::string& what) {
+    throw ConfigError(std::string(kSimulateLabel) + ": " + (path.empty() ? std::string("(arguments)") : path) + ": " + what);
+  }
+  static std::string shown(const std::string& s) {  // a NUL as \0, for the message
+    std::string out;
+    for (const char c : s) out += c == '\0' ? std::string("\\0") : std::string(1, c);
+    return out;
+  }
+
+  nlohmann::ordered_json convert(py::handle o, const std::string& path, int depth) {
+    using oj = nlohmann::ordered_json;
+    if (depth > kMaxYamlDepth)
+      fail(path.substr(0, 200), "nested deeper than " + std::to_string(kMaxYamlDepth) +
+                                    " levels of lists and dicts (a list or dict that contains itself?)");
+    if (++nodes_ > kMaxYamlNodes)
+      fail(path.substr(0, 200), "more than " + std::to_string(kMaxYamlNodes) + " values in the arguments");
+    if (o.is_none()) return nullptr;
+    if (py::isinstance<py::bool_>(o)) return o.cast<bool>();
+    if (py::isinstance<py::int_>(o)) {
+      try {
+        return o.cast<long long>();
+      } catch (const py::cast_error&) {
+        return o.cast<double>();  // beyond 64 bits: the loader's ranges refuse it
+      }
     }
-  }
-  if (py::isinstance<py::float_>(o)) return o.cast<double>();
-  if (py::isinstance<py::str>(o)) return o.cast<std::string>();
-  if (py::isinstance<py::dict>(o)) {
-    oj j = oj::object();
-    for (auto kv : o.cast<py::dict>()) {
-      const py::handle k = kv.first;
-      if (!py::isinstance<py::str>(k) && !py::isinstance<py::int_>(k) && !py::isinstance<py::float_>(k) && !k.is_none())
-        throw py::type_error("tailsim: keys must be strings, not " + std::string(py::str(k.get_type().attr("__name__"))));
-      const std::string key = k.is_none() ? "null"
-                              : py::isinstance<py::bool_>(k) ? (k.cast<bool>() ? "true" : "false")
-                                                              : std::string(py::str(k));
-      j[key] = toJson(kv.second);
+    if (py::isinstance<py::float_>(o)) {
+      const double x = o.cast<double>();
+      if (std::isnan(x)) fail(path, "nan is not a value (give a finite number)");
+      if (std::isinf(x)) fail(path, std::string(x > 0 ? "inf" : "-inf") + " is not a value (give a finite number)");
+      return x;
     }
-    return j;
+    if (py::isinstance<py::str>(o)) {
+      std::string v = o.cast<std::string>();
+      if (v.find('\0') != std::string::npos) fail(path, "the value '" + shown(v) + "' holds a NUL character");
+      return v;
+    }
+    if (py::isinstance<py::dict>(o)) {
+      oj j = oj::object();
+      for (auto kv : o.cast<py::dict>()) {
+        const py::handle k = kv.first;
+        if (!py::isinstance<py::str>(k) && !py::isinstance<py::int_>(k) && !py::isinstance<py::float_>(k) && !k.is_none())
+          throw py::type_error("tailsim: keys must be strings, not " + std::string(py::str(k.get_type().attr("__name__"))));
+        const std::string key = k.is_none() ? "null"
+                                : py::isinstance<py::bool_>(k) ? (k.cast<bool>() ? "true" : "false")
+                                                                : std::string(py::str(k));
+        const std::string sub = path.empty() ? key : path + "." + key;
+        if (key.find('\0') != std::string::npos) fail(shown(sub), "the key '" + shown(key) + "' holds a NUL character");
+        j[key] = convert(kv.second, sub, depth + 1);
+      }
+      return j;
+    }
+    if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o)) {
+      oj j = oj::array();
+      std::size_t i = 0;
+      for (py::handle e : o) j.push_back(convert(e, path + "[" + std::to_string(i++) + "]", depth + 1));
+      return j;
+    }
+    if (py::hasattr(o, "tolist")) return convert(o.attr("tolist")(), path, depth);
+    throw py::type_error("tailsim: cannot use a value of type " + std::string(py::str(o.get_type().attr("__name__"))) +
+                         " in a setting (numbers, strings, booleans, lists and dicts only)");
   }
-  if (py::isinstance<py::list>(o) || py::isinstance<py::tuple>(o)) {
-    oj j = oj::array();
-    for (py::handle e : o) j.push_back(toJson(e));
-    return j;
-  }
-  if (py::hasattr(o, "tolist")) return toJson(o.attr("tolist")());
-  throw py::type_error("tailsim: cannot use a value of type " + std::string(py::str(o.get_type().attr("__name__"))) +
-                       " in a setting (numbers, strings, booleans, lists and dicts only)");
-}
+};
 
 // What simulate() returns: the time series (columns in the CSV's order), the summary (summary.json's
 // entry for the run) and every resolved parameter (result.json's "resolved").
@@ -128,14 +169,14 @@ void requireNoNul(const std::string& s, const char* arg) {
   if (s.find('\0') != std::string::npos) throw py::value_error(std::string(arg) + ": embedded null character");
 }
 
-constexpr const char* kSimulateLabel = "<tailsim.simulate>";
-
 Simulation simulate(const std::string& robot, py::object trajectory, const std::string& model, py::kwargs sections) {
   requireNoNul(robot, "robot");
   requireNoNul(model, "model");
   std::string text;
   try {
-    text = simulateExperimentText(robot, toJson(trajectory), model, toJson(sections));
+    JsonFromPython tj;
+    const nlohmann::ordered_json traj = tj(trajectory, "trajectory");
+    text = simulateExperimentText(robot, traj, model, tj(sections, ""));
   } catch (const KeywordError& e) {
     throw py::type_error(e.what());
   }
