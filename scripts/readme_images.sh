@@ -43,7 +43,7 @@ sources() {
   local plots=$1 stem=$2
   (cd "$plots" && {
     sha256sum "$stem.gp"
-    grep -oE "'[^']*\.dat'" "$stem.gp" | tr -d "'" | sort -u | xargs sha256sum
+    grep -oE "'[^']*\.dat'" "$stem.gp" | tr -d "'" | sed 's,^\./,,' | sort -u | xargs sha256sum
   })
 }
 
