@@ -196,6 +196,40 @@ user-files)
   sed -i 's/<mujoco /<mujoco  /' "$f" && cp "$f" "$W/edited.xml"
   refused "mjcf --menagerie over a hand-edited file" "$(basename "$f")" "$TAILSIM" mjcf --links 2 --menagerie "$W/men"
   cmp -s "$f" "$W/edited.xml" || fail "the hand-edited model file was replaced"
+  # optimize, maneuver, report and the figures: the user's files refused before any work, unchanged.
+  own_file() {  # own_file WHAT FILE CMD...: DIR/FILE holds "mine"; the command refuses it, FILE unchanged
+    local what=$1 file=$2 dir=$W/own_${RANDOM}
+    shift 2
+    mkdir -p "$(dirname "$dir/$file")" && echo mine > "$dir/$file"
+    refused "$what with the user's $file" "$file was not written by tailsim" "${@//@DIR@/$dir}"
+    [ "$(cat "$dir/$file")" = mine ] || fail "$what replaced the user's $file"
+  }
+  for f in summary.json history.csv best.yaml plots/history.png plots/history.gp; do
+    own_file optimize "$f" "$TAILSIM" optimize "$SRC/configs/design/spline_n1.yaml" --out @DIR@ --quiet
+  done
+  for f in summary.json strokes.csv plots/heading.gp; do
+    own_file maneuver "$f" "$TAILSIM" maneuver "$SRC/configs/design/maneuver_90.yaml" --out @DIR@ --quiet
+  done
+  d="$W/plotted"
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --plot > /dev/null 2> "$W/err" || { cat "$W/err"; fail "run --plot"; }
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --plot > /dev/null 2> "$W/err" || { cat "$W/err"; fail "run --plot over its own figures"; }
+  "$TAILSIM" report "$d" > /dev/null 2> "$W/err" || { cat "$W/err"; fail "report"; }
+  "$TAILSIM" report "$d" > /dev/null 2> "$W/err" || { cat "$W/err"; fail "report over its own report.md"; }
+  for f in report.md figures.html index.html "plots/$(cd "$d/plots" && ls *.png | head -1)" page/data.js; do
+    cmd=plot
+    [ "$f" = report.md ] && cmd=report
+    cp -r "$d" "$W/p2" && echo mine > "$W/p2/$f"
+    refused "$cmd with the user's $f" "$f.*not written by tailsim" "$TAILSIM" $cmd "$W/p2"
+    [ "$(cat "$W/p2/$f")" = mine ] || fail "$cmd replaced the user's $f"
+    rm -rf "$W/p2"
+  done
+  # --fresh deletes tailsim's own figures and pages, keeps the user's.
+  echo mine > "$d/plots/mine.png"
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --fresh > /dev/null 2> "$W/err" || { cat "$W/err"; fail "--fresh of a plotted folder"; }
+  left=$(cd "$d" && ls plots page report.md figures.html index.html 2>/dev/null | grep -v -e '^mine.png$' -e '^plots:$' -e '^$' || true)
+  [ -z "$left" ] || fail "--fresh left tailsim's own figures or pages: $left"
+  [ -f "$d/plots/mine.png" ] || fail "--fresh deleted the user's plots/mine.png"
+  echo "optimize, maneuver, plot, report: the user's files refused; --fresh deletes tailsim's figures only"
   ;;
 folder-files)
   cat > "$W/n.yaml" <<YAML
@@ -237,6 +271,36 @@ YAML
   cp "$W/o6/cases/w_ss=0.3/result.json" "$W/outside.json"
   rm "$W/o6/cases/w_ss=0.3/result.json" && ln -s "$W/outside.json" "$W/o6/cases/w_ss=0.3/result.json"
   refused "result.json -> a file outside --out" result.json "$W/f.yaml" o6
+  # cases.jsonl read line by line: 900 MB without a newline is refused at once (never read whole,
+  # never cut to 0); a first line that is not a tailsim entry: not tailsim's file, left unchanged.
+  mkdir -p "$W/o7" && truncate -s 900M "$W/o7/cases.jsonl"
+  ( ulimit -v 1200000; refused "cases.jsonl of 900 MB without a newline (1.2 GB of memory)" cases.jsonl "$W/n.yaml" o7 ) || exit 1
+  [ "$(stat -c %s "$W/o7/cases.jsonl")" = 943718400 ] || fail "cases.jsonl of 900 MB was changed"
+  grep -q "bad_alloc" "$W/err" && fail "std::bad_alloc reached the user"
+  mkdir -p "$W/o8" && printf 'my notes\n{"not": "tailsim"}\n' > "$W/o8/cases.jsonl" && cp "$W/o8/cases.jsonl" "$W/notes"
+  refused "cases.jsonl whose first line is not a tailsim entry" cases.jsonl "$W/n.yaml" o8
+  cmp -s "$W/o8/cases.jsonl" "$W/notes" || fail "the user's cases.jsonl was changed"
+  mkdir -p "$W/o9" && printf 'my notes, no newline' > "$W/o9/cases.jsonl"
+  refused "cases.jsonl of one line that is not a tailsim entry, no newline" cases.jsonl "$W/n.yaml" o9
+  [ "$(cat "$W/o9/cases.jsonl")" = "my notes, no newline" ] || fail "the user's cases.jsonl was cut"
+  # A folder of --out that is a symlink to a folder outside it is never written through: cases/,
+  # time_series.h5.d/, one case's folder, plots/ (run --plot).
+  sed 's/{time_series: none}/{time_series: thin, time_series_file: hdf5}/' "$W/n.yaml" > "$W/h.yaml"
+  link_refused() {  # link_refused WHAT LINK YAML ARGS...: DIR/LINK -> outside: exit 1 naming it, nothing outside
+    local what=$1 link=$2 yaml=$3 rc=0
+    shift 3
+    rm -rf "$W/ol" "$W/outside_dir" && mkdir -p "$W/outside_dir" "$(dirname "$W/ol/$link")"
+    ln -s "$W/outside_dir" "$W/ol/$link"
+    timeout 20 "$TAILSIM" run "$yaml" --out "$W/ol" --quiet "$@" > /dev/null 2> "$W/err" || rc=$?
+    [ $rc -eq 1 ] || { cat "$W/err"; fail "$what: exit $rc, want 1"; }
+    grep -q "$link" "$W/err" || { cat "$W/err"; fail "$what: the error does not name $link"; }
+    [ -z "$(ls -A "$W/outside_dir")" ] || fail "$what: written through the link: $(ls "$W/outside_dir")"
+    echo "$what: refused ($(head -c 150 "$W/err"))"
+  }
+  link_refused "cases -> a folder outside --out" cases "$W/f.yaml"
+  link_refused "time_series.h5.d -> a folder outside --out" time_series.h5.d "$W/h.yaml"
+  link_refused "cases/w_ss=0.6 -> a folder outside --out" "cases/w_ss=0.6" "$W/f.yaml"
+  link_refused "plots -> a folder outside --out (run --plot)" plots "$W/f.yaml" --plot
   ;;
 *) echo "unknown CLASS $CLASS"; exit 2 ;;
 esac

@@ -228,6 +228,13 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
     o.render = true;
     o.merge_only = true;
     o.allow_other_build = allow_other_build;
+    o.case_origin = [&](const std::string& experiment, const std::string& name, const std::string& dir) -> std::string {
+      for (const fs::path& prefix : {fs::path(experiment), fs::path()}) {
+        if (const auto it = journal_lines.find((prefix / name).string()); it != journal_lines.end()) return it->second.second;
+        if (const auto it = taken_by.find(prefix / "cases" / dir); it != taken_by.end()) return it->second;
+      }
+      return out_dir;
+    };
     const RunStats rs = runSuite(suite, o);
     st.cases = rs.total;
     fs::remove(stage / ".tailsim.lock", ec);
