@@ -4,7 +4,8 @@
 #   hdf5-disk-full  an hdf5 sweep on a full disk reports the error and exits 1 (never a crash, no
 #                   libhdf5 error stack) and keeps its finished cases; a no-op resume of a finished
 #                   hdf5 folder on a nearly full disk copies nothing; merge onto a full disk and of a
-#                   truncated .h5 give an error, never a crash. Needs root (a tmpfs is mounted).
+#                   truncated .h5 give an error, never a crash; the final join needs only the room
+#                   of its copy. Needs root (a tmpfs is mounted).
 #   hdf5-signals    an hdf5 sweep stopped by SIGTERM, SIGHUP, SIGINT and kill -9 resumes every case
 #                   its journal had when the signal came; cases.jsonl holds one line per finished
 #                   case after the resume. Prints the table "signal -> cases resumed".
@@ -99,6 +100,17 @@ hdf5-disk-full)
   [ $rc -eq 1 ] || { cat "$W/e5"; fail "merge of a truncated .h5 exited $rc, want 1"; }
   grep -q "time_series.h5" "$W/e5" || { cat "$W/e5"; fail "merge of a truncated .h5: the error does not name the file"; }
   echo "merge: full disk and truncated .h5 refused with a message"
+  # The final join reserves what the copy can need (the parts' size and a little), not 1.5 x: a
+  # 91-case sweep (parts 4.5 MB, time_series.h5 3.8 MB) joins on a 10.5 MB disk (5.6 MB free at the
+  # join; 1.5 x parts would be 6.8 MB).
+  sweep j 0.01
+  small_disk "$W/d3" 10500k
+  "$TAILSIM" run "$W/j.yaml" --out "$W/d3/o" --quiet --threads 2 > /dev/null 2> "$W/e6"
+  rc=$?
+  no_crash $rc "$W/e6" "join on a disk with room for it"
+  [ $rc -eq 0 ] || { cat "$W/e6"; fail "join on a disk with room for it (parts $(du -sb "$W/d3/o/time_series.h5.d" 2>/dev/null | cut -f1) B, $(df --output=avail -B1 "$W/d3" | tail -1) B free) exited $rc"; }
+  [ -f "$W/d3/o/time_series.h5" ] && [ ! -e "$W/d3/o/time_series.h5.d" ] || fail "join: no time_series.h5, or parts left"
+  echo "join: $(stat -c %s "$W/d3/o/time_series.h5") B joined on a 10.5 MB disk"
   ;;
 hdf5-signals)
   sweep big 0.001  # 901 cases

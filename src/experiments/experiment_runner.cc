@@ -1001,11 +1001,15 @@ void publishTimeSeriesH5(Job& job) {
     return;
   }
   {
-    // Space for every group copied, reserved before libhdf5 writes (it must never meet a full disk).
-    long long bytes = 0;
+    // Space for every group copied, reserved before libhdf5 writes (it must never meet a full disk):
+    // a group's copy is no larger than the file it comes from (each part also holds a superblock
+    // and root group the joined file does not repeat); the joined file's root group adds an index
+    // entry per group (kH5LinkBytes, a wide margin) and its own header (kH5FileBytes).
+    constexpr long long kH5LinkBytes = 1024, kH5FileBytes = 64 << 10;
+    long long bytes = kH5FileBytes + kH5LinkBytes * static_cast<long long>(from_published.size() + from_parts.size());
     if (!from_published.empty()) bytes += static_cast<long long>(fs::file_size(job.published->path(), ec));
     for (size_t i : from_parts) bytes += static_cast<long long>(fs::file_size(h5PartPath(job, i), ec));
-    TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes + bytes / 2 + (64 << 10));
+    TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes);
     for (size_t i : from_published) out.copyCase(*job.published, job.dirs[i]);
     for (size_t i : from_parts) {
       const TimeSeriesH5Reader part(h5PartPath(job, i).string());
