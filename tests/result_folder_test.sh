@@ -13,6 +13,8 @@
 #                   experiment.yaml, results.csv, summary.json; --fresh keeps the user's files under
 #                   cases/, plots/, renders/; optimize and maneuver refuse a run folder and take its
 #                   lock; mjcf --menagerie refuses to overwrite a hand-edited model file.
+#   hdf5-damaged    random bytes in a finished folder's or a shard's time_series.h5: resume runs
+#                   the cases again (never a crash, never a stuck folder); merge refuses the shard.
 #   folder-files    cases.jsonl, result.json and summary.json are opened (by run and plot) only if
 #                   they are regular files: a symlink is refused (nothing written through it), a FIFO never blocks, a
 #                   huge file or /dev/zero is not read.
@@ -242,6 +244,45 @@ user-files)
   [ -z "$left" ] || fail "--fresh left tailsim's own figures or pages: $left"
   [ -f "$d/plots/mine.png" ] || fail "--fresh deleted the user's plots/mine.png"
   echo "optimize, maneuver, plot, report: the user's files refused; --fresh deletes tailsim's figures only"
+  ;;
+hdf5-damaged)
+  # Random bytes (seeded) written into a finished folder's time_series.h5: the resume never crashes
+  # and never stays stuck (rc 0, then a resume runs nothing); the same in a shard: merge refuses it
+  # naming the file and the shard.
+  sweep s 0.1  # 10 cases
+  flip() {  # flip FILE SEED COUNT: COUNT random bytes at random offsets
+    python3 - "$@" <<'PY'
+import random, sys
+p, seed, count = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+r = random.Random(seed); b = bytearray(open(p, 'rb').read())
+for _ in range(count): b[r.randrange(len(b))] = r.randrange(256)
+open(p, 'wb').write(b)
+PY
+  }
+  "$TAILSIM" run "$W/s.yaml" --out "$W/clean" --quiet > /dev/null || fail "clean run"
+  for seed in $(seq 1 12); do
+    rm -rf "$W/z" && cp -r "$W/clean" "$W/z" && flip "$W/z/time_series.h5" "$seed" 40
+    rc=0
+    timeout 60 "$TAILSIM" run "$W/s.yaml" --out "$W/z" --quiet > /dev/null 2> "$W/e" || rc=$?
+    no_crash $rc "$W/e" "resume of a damaged time_series.h5 (seed $seed)"
+    [ $rc -eq 0 ] || { cat "$W/e"; fail "resume of a damaged time_series.h5 (seed $seed) exited $rc"; }
+    out=$("$TAILSIM" run "$W/s.yaml" --out "$W/z" --quiet 2> "$W/e") || { cat "$W/e"; fail "second resume (seed $seed)"; }
+    echo "$out" | grep -q " 0 run" || fail "seed $seed: the second resume ran cases again: $out"
+  done
+  echo "damaged time_series.h5, 12 seeds: resumed, cases run again, no crash"
+  "$TAILSIM" run "$W/s.yaml" --out "$W/sh1" --shard 1/2 --quiet > /dev/null || fail "shard 1"
+  "$TAILSIM" run "$W/s.yaml" --out "$W/sh2" --shard 2/2 --quiet > /dev/null || fail "shard 2"
+  for seed in $(seq 1 6); do
+    rm -rf "$W/shx" "$W/m" && cp -r "$W/sh1" "$W/shx" && flip "$W/shx/time_series.h5" "$seed" 20
+    rc=0
+    timeout 60 "$TAILSIM" merge "$W/shx" "$W/sh2" --out "$W/m" > /dev/null 2> "$W/e" || rc=$?
+    no_crash $rc "$W/e" "merge of a damaged shard (seed $seed)"
+    [ $rc -eq 1 ] || { cat "$W/e"; fail "merge of a damaged shard (seed $seed) exited $rc, want 1"; }
+    grep -q "shx/time_series.h5" "$W/e" || { cat "$W/e"; fail "merge of a damaged shard: the error does not name the file"; }
+    [ -z "$(ls -d "$W"/m.merge.tmp.* 2>/dev/null)" ] || fail "merge left its staging folder"
+  done
+  "$TAILSIM" merge "$W/sh1" "$W/sh2" --out "$W/m" > /dev/null 2> "$W/e" || { cat "$W/e"; fail "merge of intact shards"; }
+  echo "damaged shard, 6 seeds: merge refused naming it; intact shards merge"
   ;;
 folder-files)
   cat > "$W/n.yaml" <<YAML

@@ -20,6 +20,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/sharding.h"
 #include "experiments/time_series_h5.h"
+#include "results/atomic_file.h"
 #include "results/sha256.h"
 #include "tailsim_version.h"
 
@@ -336,6 +337,11 @@ TEST(MixedBuilds, Hdf5GroupMissingADatasetOrFullOfNaNRunsAgain) {
     fs::create_directories(out / "time_series.h5.d");
     fs::rename(dir / "nan.h5", out / "time_series.h5.d" / "w_ss=0.4.h5");
   }
+  // Both files named as tailsim's in their manifests (else they are not read at all: the test
+  // Hdf5Damaged.NeverCrashesResumeOrMerge): the groups themselves must be vetted.
+  recordHashInManifest(out.string(), "time_series.h5", sha256OfFile((out / "time_series.h5").string()).value());
+  recordHashInManifest((out / "time_series.h5.d").string(), "w_ss=0.4.h5",
+                       sha256OfFile((out / "time_series.h5.d" / "w_ss=0.4.h5").string()).value());
   const RunStats s = runExperiment(e, options(out));
   EXPECT_EQ(s.ran, 2) << "a group missing a dataset or full of NaN was taken as finished";
   EXPECT_EQ(s.resumed, 2);

@@ -319,6 +319,16 @@ const char* const kH5Parts = "time_series.h5.d";
 
 fs::path h5PartPath(const Job& job, size_t i) { return job.root / kH5Parts / (job.dirs[i] + ".h5"); }
 
+// Whether case i's part is as tailsim wrote it: named with its content in time_series.h5.d's manifest.
+bool h5PartIntact(const Job& job, size_t i) {
+  try {
+    const std::optional<std::string> text = readResultFile(h5PartPath(job, i).string());
+    return text && manifestNames((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *text);
+  } catch (const std::exception&) {  // not a regular file
+    return false;
+  }
+}
+
 bool keepsSeries(const ExperimentCase& c) { return c.output.time_series != TimeSeriesOutput::kNone; }
 bool inH5(const ExperimentCase& c) { return keepsSeries(c) && c.output.time_series_file == TimeSeriesFile::kHdf5; }
 
@@ -783,6 +793,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     if (e.cases[i].output.caseFolder() && ::lstat((root / "cases" / job.dirs[i]).c_str(), &st) == 0)
       makeResultDir((root / "cases" / job.dirs[i]).string());
   }
+  fs::create_directories(root);  // (DIR itself, as given to --out, may be a link)
   if (any_folder) makeResultDir((root / "cases").string());
   // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
   compactManifest(root.string());
@@ -799,11 +810,25 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   std::map<std::string, std::string> journal = readJournal(root / "cases.jsonl", true);
   const bool had_journal = !journal.empty() || isRegularFile(root / "cases.jsonl");
   job.h5_from.assign(e.cases.size(), kH5None);
-  if (job.any_h5) job.published = std::make_unique<TimeSeriesH5Reader>((root / "time_series.h5").string());
-  // Where case i's whole group is: its own file, else the published file, else nowhere.
+  // HDF5 files are opened only when they are as tailsim wrote them (their SHA-256 named in their
+  // folder's manifest): libhdf5 crashes on some damaged files, and copies others silently. A
+  // damaged time_series.h5 or part is not read: its cases run again (and the file is replaced).
+  if (job.any_h5) {
+    const fs::path h5 = root / "time_series.h5";
+    bool intact = false;
+    if (isRegularFile(h5)) {
+      const std::optional<std::string> hash = sha256OfFile(h5.string());
+      intact = hash && manifestNamesHash(root.string(), "time_series.h5", *hash);
+      if (!intact)
+        std::fprintf(stderr, "note: %s is not as tailsim wrote it (damaged or changed): not read, its cases run again\n",
+                     h5.c_str());
+    }
+    job.published = std::make_unique<TimeSeriesH5Reader>(intact ? h5.string() : std::string());
+  }
+  // Where case i's whole group is: its own file (when intact), else the published file, else nowhere.
   const auto findH5 = [&](size_t i, const std::vector<std::string>& models, const std::string& key) -> char {
     const fs::path part = h5PartPath(job, i);
-    if (isRegularFile(part) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
+    if (h5PartIntact(job, i) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
       return kH5Part;
     return job.published->hasCase(job.dirs[i], key, models) ? kH5Published : kH5None;
   };
@@ -963,7 +988,12 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
-  if (part) part->publish();  // on disk before the journal says the case is finished
+  if (part) {  // on disk, and named with its content, before the journal says the case is finished
+    part->publish();
+    const std::optional<std::string> text = readResultFile(h5PartPath(job, i).string());
+    if (!text) throw std::runtime_error("cannot read back " + h5PartPath(job, i).string());
+    recordInManifest((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *text);
+  }
   std::string line = j.dump();
   if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
   else job.journal->append(line + "\n");  // one line, one write(): the case is finished
@@ -1019,6 +1049,9 @@ void publishTimeSeriesH5(Job& job) {
     job.published.reset();  // (closed before the rename replaces it)
     out.publish();
   }
+  const std::optional<std::string> hash = sha256OfFile((job.root / "time_series.h5").string());
+  if (!hash) throw std::runtime_error("cannot read back " + (job.root / "time_series.h5").string());
+  recordHashInManifest(job.root.string(), "time_series.h5", *hash);
   fs::remove_all(parts, ec);
 }
 

@@ -163,12 +163,20 @@ bool hasLine(const std::string& text, const std::string& line) {  // line with i
 bool hasManifest(const std::string& dir) { return readResultFile(manifestPath(dir)).has_value(); }
 
 bool manifestNames(const std::string& dir, const std::string& name, const std::string& content) {
+  return manifestNamesHash(dir, name, sha256Hex(content));
+}
+
+bool manifestNamesHash(const std::string& dir, const std::string& name, const std::string& sha256_hex) {
   const std::optional<std::string> m = readResultFile(manifestPath(dir));
-  return m && hasLine(*m, sha256Hex(content) + "  " + name + "\n");
+  return m && hasLine(*m, sha256_hex + "  " + name + "\n");
 }
 
 void recordInManifest(const std::string& dir, const std::string& name, const std::string& content) {
-  const std::string line = sha256Hex(content) + "  " + name + "\n";
+  recordHashInManifest(dir, name, sha256Hex(content));
+}
+
+void recordHashInManifest(const std::string& dir, const std::string& name, const std::string& sha256_hex) {
+  const std::string line = sha256_hex + "  " + name + "\n";
   const std::string path = manifestPath(dir);
   if (const std::optional<std::string> m = readResultFile(path); m && hasLine(*m, line)) return;
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
@@ -193,12 +201,9 @@ void compactManifest(const std::string& dir) {
     if (l.size() < 67 || l.compare(64, 2, "  ") != 0) continue;
     const std::string name = l.substr(66);
     if (done.count(name)) continue;
-    std::optional<std::string> text;
-    try {
-      text = readResultFile((std::filesystem::path(dir) / name).string());
-    } catch (const std::exception&) {  // no longer a regular file: not named any more
-    }
-    if (text && sha256Hex(*text) == l.substr(0, 64)) {
+    // read in blocks (time_series.h5 may be larger than memory); not a regular file: not named any more
+    const std::optional<std::string> hash = sha256OfFile((std::filesystem::path(dir) / name).string());
+    if (hash && *hash == l.substr(0, 64)) {
       keep += l + "\n";
       done.insert(name);
     }

@@ -60,6 +60,9 @@ bool manifestNames(const std::string& dir, const std::string& name, const std::s
 // Appends "<sha256(content)>  <name>" unless there (before the file is written: whatever stops the
 // writer in between, the file holds a content the manifest names). Throws std::runtime_error.
 void recordInManifest(const std::string& dir, const std::string& name, const std::string& content);
+// The same, by the content's SHA-256 (64 hex digits): for files too large to hold in memory.
+bool manifestNamesHash(const std::string& dir, const std::string& name, const std::string& sha256_hex);
+void recordHashInManifest(const std::string& dir, const std::string& name, const std::string& sha256_hex);
 // Rewrites the manifest with one line per file that still has the content it names.
 void compactManifest(const std::string& dir);
 // Recognises a file an earlier tailsim (before manifests) wrote, by its content.
