@@ -283,6 +283,28 @@ PY
   done
   "$TAILSIM" merge "$W/sh1" "$W/sh2" --out "$W/m" > /dev/null 2> "$W/e" || { cat "$W/e"; fail "merge of intact shards"; }
   echo "damaged shard, 6 seeds: merge refused naming it; intact shards merge"
+  # Damaged parts after a kill -9 (time_series.h5.d/<case>.h5): those cases run again, no crash.
+  sweep k 0.01  # 91 cases
+  "$TAILSIM" run "$W/k.yaml" --out "$W/pk" --quiet --threads 1 > /dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 1 200); do
+    [ "$(cat "$W/pk/cases.jsonl" 2> /dev/null | wc -l)" -ge 20 ] && break
+    sleep 0.02
+  done
+  kill -9 $pid 2> /dev/null; wait $pid 2> /dev/null
+  parts=$(ls "$W/pk/time_series.h5.d"/*.h5 2> /dev/null | head -8)
+  [ -n "$parts" ] || { echo "note: the sweep finished before kill -9: no parts to damage"; exit 0; }
+  seed=0
+  for p in $parts; do seed=$((seed + 1)); flip "$p" "$seed" 200; done
+  rc=0
+  timeout 60 "$TAILSIM" run "$W/k.yaml" --out "$W/pk" --quiet > /dev/null 2> "$W/e" || rc=$?
+  no_crash $rc "$W/e" "resume with damaged parts"
+  [ $rc -eq 0 ] || { cat "$W/e"; fail "resume with damaged parts exited $rc"; }
+  out=$("$TAILSIM" run "$W/k.yaml" --out "$W/pk" --quiet 2> "$W/e") || { cat "$W/e"; fail "second resume after damaged parts"; }
+  echo "$out" | grep -q " 0 run" || fail "damaged parts: the second resume ran cases again: $out"
+  "$TAILSIM" run "$W/k.yaml" --out "$W/kc" --quiet > /dev/null || fail "clean run of k"
+  python3 "$SRC/scripts/compare_folders.py" "$W/kc" "$W/pk" > "$W/cmp" 2>&1 || { cat "$W/cmp"; fail "damaged parts: the folder differs from a clean run (a damaged series published)"; }
+  echo "$(echo "$parts" | wc -w) damaged parts after kill -9: their cases ran again, no crash"
   ;;
 folder-files)
   cat > "$W/n.yaml" <<YAML
