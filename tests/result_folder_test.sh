@@ -4,7 +4,8 @@
 #   hdf5-disk-full  an hdf5 sweep on a full disk reports the error and exits 1 (never a crash, no
 #                   libhdf5 error stack) and keeps its finished cases; a no-op resume of a finished
 #                   hdf5 folder on a nearly full disk copies nothing; merge onto a full disk and of a
-#                   truncated .h5 give an error, never a crash. Needs root (a tmpfs is mounted).
+#                   truncated .h5 give an error, never a crash; the final join needs only the room
+#                   of its copy. Needs root (a tmpfs is mounted).
 #   hdf5-signals    an hdf5 sweep stopped by SIGTERM, SIGHUP, SIGINT and kill -9 resumes every case
 #                   its journal had when the signal came; cases.jsonl holds one line per finished
 #                   case after the resume. Prints the table "signal -> cases resumed".
@@ -12,6 +13,8 @@
 #                   experiment.yaml, results.csv, summary.json; --fresh keeps the user's files under
 #                   cases/, plots/, renders/; optimize and maneuver refuse a run folder and take its
 #                   lock; mjcf --menagerie refuses to overwrite a hand-edited model file.
+#   hdf5-damaged    random bytes in a finished folder's or a shard's time_series.h5: resume runs
+#                   the cases again (never a crash, never a stuck folder); merge refuses the shard.
 #   folder-files    cases.jsonl, result.json and summary.json are opened (by run and plot) only if
 #                   they are regular files: a symlink is refused (nothing written through it), a FIFO never blocks, a
 #                   huge file or /dev/zero is not read.
@@ -99,6 +102,17 @@ hdf5-disk-full)
   [ $rc -eq 1 ] || { cat "$W/e5"; fail "merge of a truncated .h5 exited $rc, want 1"; }
   grep -q "time_series.h5" "$W/e5" || { cat "$W/e5"; fail "merge of a truncated .h5: the error does not name the file"; }
   echo "merge: full disk and truncated .h5 refused with a message"
+  # The final join reserves what the copy can need (the parts' size and a little), not 1.5 x: a
+  # 91-case sweep (parts 4.5 MB, time_series.h5 3.8 MB) joins on a 10.5 MB disk (5.6 MB free at the
+  # join; 1.5 x parts would be 6.8 MB).
+  sweep j 0.01
+  small_disk "$W/d3" 10500k
+  "$TAILSIM" run "$W/j.yaml" --out "$W/d3/o" --quiet --threads 2 > /dev/null 2> "$W/e6"
+  rc=$?
+  no_crash $rc "$W/e6" "join on a disk with room for it"
+  [ $rc -eq 0 ] || { cat "$W/e6"; fail "join on a disk with room for it (parts $(du -sb "$W/d3/o/time_series.h5.d" 2>/dev/null | cut -f1) B, $(df --output=avail -B1 "$W/d3" | tail -1) B free) exited $rc"; }
+  [ -f "$W/d3/o/time_series.h5" ] && [ ! -e "$W/d3/o/time_series.h5.d" ] || fail "join: no time_series.h5, or parts left"
+  echo "join: $(stat -c %s "$W/d3/o/time_series.h5") B joined on a 10.5 MB disk"
   ;;
 hdf5-signals)
   sweep big 0.001  # 901 cases
@@ -196,6 +210,101 @@ user-files)
   sed -i 's/<mujoco /<mujoco  /' "$f" && cp "$f" "$W/edited.xml"
   refused "mjcf --menagerie over a hand-edited file" "$(basename "$f")" "$TAILSIM" mjcf --links 2 --menagerie "$W/men"
   cmp -s "$f" "$W/edited.xml" || fail "the hand-edited model file was replaced"
+  # optimize, maneuver, report and the figures: the user's files refused before any work, unchanged.
+  own_file() {  # own_file WHAT FILE CMD...: DIR/FILE holds "mine"; the command refuses it, FILE unchanged
+    local what=$1 file=$2 dir=$W/own_${RANDOM}
+    shift 2
+    mkdir -p "$(dirname "$dir/$file")" && echo mine > "$dir/$file"
+    refused "$what with the user's $file" "$file was not written by tailsim" "${@//@DIR@/$dir}"
+    [ "$(cat "$dir/$file")" = mine ] || fail "$what replaced the user's $file"
+  }
+  for f in summary.json history.csv best.yaml plots/history.png plots/history.gp; do
+    own_file optimize "$f" "$TAILSIM" optimize "$SRC/configs/design/spline_n1.yaml" --out @DIR@ --quiet
+  done
+  for f in summary.json strokes.csv plots/heading.gp; do
+    own_file maneuver "$f" "$TAILSIM" maneuver "$SRC/configs/design/maneuver_90.yaml" --out @DIR@ --quiet
+  done
+  d="$W/plotted"
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --plot > /dev/null 2> "$W/err" || { cat "$W/err"; fail "run --plot"; }
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --plot > /dev/null 2> "$W/err" || { cat "$W/err"; fail "run --plot over its own figures"; }
+  "$TAILSIM" report "$d" > /dev/null 2> "$W/err" || { cat "$W/err"; fail "report"; }
+  "$TAILSIM" report "$d" > /dev/null 2> "$W/err" || { cat "$W/err"; fail "report over its own report.md"; }
+  for f in report.md figures.html index.html "plots/$(cd "$d/plots" && ls *.png | head -1)" page/data.js; do
+    cmd=plot
+    [ "$f" = report.md ] && cmd=report
+    cp -r "$d" "$W/p2" && echo mine > "$W/p2/$f"
+    refused "$cmd with the user's $f" "$f.*not written by tailsim" "$TAILSIM" $cmd "$W/p2"
+    [ "$(cat "$W/p2/$f")" = mine ] || fail "$cmd replaced the user's $f"
+    rm -rf "$W/p2"
+  done
+  # --fresh deletes tailsim's own figures and pages, keeps the user's.
+  echo mine > "$d/plots/mine.png"
+  "$TAILSIM" run "$W/f.yaml" --out "$d" --quiet --fresh > /dev/null 2> "$W/err" || { cat "$W/err"; fail "--fresh of a plotted folder"; }
+  left=$(cd "$d" && ls plots page report.md figures.html index.html 2>/dev/null | grep -v -e '^mine.png$' -e '^plots:$' -e '^$' || true)
+  [ -z "$left" ] || fail "--fresh left tailsim's own figures or pages: $left"
+  [ -f "$d/plots/mine.png" ] || fail "--fresh deleted the user's plots/mine.png"
+  echo "optimize, maneuver, plot, report: the user's files refused; --fresh deletes tailsim's figures only"
+  ;;
+hdf5-damaged)
+  # Random bytes (seeded) written into a finished folder's time_series.h5: the resume never crashes
+  # and never stays stuck (rc 0, then a resume runs nothing); the same in a shard: merge refuses it
+  # naming the file and the shard.
+  sweep s 0.1  # 10 cases
+  flip() {  # flip FILE SEED COUNT: COUNT random bytes at random offsets
+    python3 - "$@" <<'PY'
+import random, sys
+p, seed, count = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+r = random.Random(seed); b = bytearray(open(p, 'rb').read())
+for _ in range(count): b[r.randrange(len(b))] = r.randrange(256)
+open(p, 'wb').write(b)
+PY
+  }
+  "$TAILSIM" run "$W/s.yaml" --out "$W/clean" --quiet > /dev/null || fail "clean run"
+  for seed in $(seq 1 12); do
+    rm -rf "$W/z" && cp -r "$W/clean" "$W/z" && flip "$W/z/time_series.h5" "$seed" 40
+    rc=0
+    timeout 60 "$TAILSIM" run "$W/s.yaml" --out "$W/z" --quiet > /dev/null 2> "$W/e" || rc=$?
+    no_crash $rc "$W/e" "resume of a damaged time_series.h5 (seed $seed)"
+    [ $rc -eq 0 ] || { cat "$W/e"; fail "resume of a damaged time_series.h5 (seed $seed) exited $rc"; }
+    out=$("$TAILSIM" run "$W/s.yaml" --out "$W/z" --quiet 2> "$W/e") || { cat "$W/e"; fail "second resume (seed $seed)"; }
+    echo "$out" | grep -q " 0 run" || fail "seed $seed: the second resume ran cases again: $out"
+  done
+  echo "damaged time_series.h5, 12 seeds: resumed, cases run again, no crash"
+  "$TAILSIM" run "$W/s.yaml" --out "$W/sh1" --shard 1/2 --quiet > /dev/null || fail "shard 1"
+  "$TAILSIM" run "$W/s.yaml" --out "$W/sh2" --shard 2/2 --quiet > /dev/null || fail "shard 2"
+  for seed in $(seq 1 6); do
+    rm -rf "$W/shx" "$W/m" && cp -r "$W/sh1" "$W/shx" && flip "$W/shx/time_series.h5" "$seed" 20
+    rc=0
+    timeout 60 "$TAILSIM" merge "$W/shx" "$W/sh2" --out "$W/m" > /dev/null 2> "$W/e" || rc=$?
+    no_crash $rc "$W/e" "merge of a damaged shard (seed $seed)"
+    [ $rc -eq 1 ] || { cat "$W/e"; fail "merge of a damaged shard (seed $seed) exited $rc, want 1"; }
+    grep -q "shx/time_series.h5" "$W/e" || { cat "$W/e"; fail "merge of a damaged shard: the error does not name the file"; }
+    [ -z "$(ls -d "$W"/m.merge.tmp.* 2>/dev/null)" ] || fail "merge left its staging folder"
+  done
+  "$TAILSIM" merge "$W/sh1" "$W/sh2" --out "$W/m" > /dev/null 2> "$W/e" || { cat "$W/e"; fail "merge of intact shards"; }
+  echo "damaged shard, 6 seeds: merge refused naming it; intact shards merge"
+  # Damaged parts after a kill -9 (time_series.h5.d/<case>.h5): those cases run again, no crash.
+  sweep k 0.01  # 91 cases
+  "$TAILSIM" run "$W/k.yaml" --out "$W/pk" --quiet --threads 1 > /dev/null 2>&1 &
+  pid=$!
+  for _ in $(seq 1 200); do
+    [ "$(cat "$W/pk/cases.jsonl" 2> /dev/null | wc -l)" -ge 20 ] && break
+    sleep 0.02
+  done
+  kill -9 $pid 2> /dev/null; wait $pid 2> /dev/null
+  parts=$(ls "$W/pk/time_series.h5.d"/*.h5 2> /dev/null | head -8)
+  [ -n "$parts" ] || { echo "note: the sweep finished before kill -9: no parts to damage"; exit 0; }
+  seed=0
+  for p in $parts; do seed=$((seed + 1)); flip "$p" "$seed" 200; done
+  rc=0
+  timeout 60 "$TAILSIM" run "$W/k.yaml" --out "$W/pk" --quiet > /dev/null 2> "$W/e" || rc=$?
+  no_crash $rc "$W/e" "resume with damaged parts"
+  [ $rc -eq 0 ] || { cat "$W/e"; fail "resume with damaged parts exited $rc"; }
+  out=$("$TAILSIM" run "$W/k.yaml" --out "$W/pk" --quiet 2> "$W/e") || { cat "$W/e"; fail "second resume after damaged parts"; }
+  echo "$out" | grep -q " 0 run" || fail "damaged parts: the second resume ran cases again: $out"
+  "$TAILSIM" run "$W/k.yaml" --out "$W/kc" --quiet > /dev/null || fail "clean run of k"
+  python3 "$SRC/scripts/compare_folders.py" "$W/kc" "$W/pk" > "$W/cmp" 2>&1 || { cat "$W/cmp"; fail "damaged parts: the folder differs from a clean run (a damaged series published)"; }
+  echo "$(echo "$parts" | wc -w) damaged parts after kill -9: their cases ran again, no crash"
   ;;
 folder-files)
   cat > "$W/n.yaml" <<YAML
@@ -237,6 +346,36 @@ YAML
   cp "$W/o6/cases/w_ss=0.3/result.json" "$W/outside.json"
   rm "$W/o6/cases/w_ss=0.3/result.json" && ln -s "$W/outside.json" "$W/o6/cases/w_ss=0.3/result.json"
   refused "result.json -> a file outside --out" result.json "$W/f.yaml" o6
+  # cases.jsonl read line by line: 900 MB without a newline is refused at once (never read whole,
+  # never cut to 0); a first line that is not a tailsim entry: not tailsim's file, left unchanged.
+  mkdir -p "$W/o7" && truncate -s 900M "$W/o7/cases.jsonl"
+  ( ulimit -v 1200000; refused "cases.jsonl of 900 MB without a newline (1.2 GB of memory)" cases.jsonl "$W/n.yaml" o7 ) || exit 1
+  [ "$(stat -c %s "$W/o7/cases.jsonl")" = 943718400 ] || fail "cases.jsonl of 900 MB was changed"
+  grep -q "bad_alloc" "$W/err" && fail "std::bad_alloc reached the user"
+  mkdir -p "$W/o8" && printf 'my notes\n{"not": "tailsim"}\n' > "$W/o8/cases.jsonl" && cp "$W/o8/cases.jsonl" "$W/notes"
+  refused "cases.jsonl whose first line is not a tailsim entry" cases.jsonl "$W/n.yaml" o8
+  cmp -s "$W/o8/cases.jsonl" "$W/notes" || fail "the user's cases.jsonl was changed"
+  mkdir -p "$W/o9" && printf 'my notes, no newline' > "$W/o9/cases.jsonl"
+  refused "cases.jsonl of one line that is not a tailsim entry, no newline" cases.jsonl "$W/n.yaml" o9
+  [ "$(cat "$W/o9/cases.jsonl")" = "my notes, no newline" ] || fail "the user's cases.jsonl was cut"
+  # A folder of --out that is a symlink to a folder outside it is never written through: cases/,
+  # time_series.h5.d/, one case's folder, plots/ (run --plot).
+  sed 's/{time_series: none}/{time_series: thin, time_series_file: hdf5}/' "$W/n.yaml" > "$W/h.yaml"
+  link_refused() {  # link_refused WHAT LINK YAML ARGS...: DIR/LINK -> outside: exit 1 naming it, nothing outside
+    local what=$1 link=$2 yaml=$3 rc=0
+    shift 3
+    rm -rf "$W/ol" "$W/outside_dir" && mkdir -p "$W/outside_dir" "$(dirname "$W/ol/$link")"
+    ln -s "$W/outside_dir" "$W/ol/$link"
+    timeout 20 "$TAILSIM" run "$yaml" --out "$W/ol" --quiet "$@" > /dev/null 2> "$W/err" || rc=$?
+    [ $rc -eq 1 ] || { cat "$W/err"; fail "$what: exit $rc, want 1"; }
+    grep -q "$link" "$W/err" || { cat "$W/err"; fail "$what: the error does not name $link"; }
+    [ -z "$(ls -A "$W/outside_dir")" ] || fail "$what: written through the link: $(ls "$W/outside_dir")"
+    echo "$what: refused ($(head -c 150 "$W/err"))"
+  }
+  link_refused "cases -> a folder outside --out" cases "$W/f.yaml"
+  link_refused "time_series.h5.d -> a folder outside --out" time_series.h5.d "$W/h.yaml"
+  link_refused "cases/w_ss=0.6 -> a folder outside --out" "cases/w_ss=0.6" "$W/f.yaml"
+  link_refused "plots -> a folder outside --out (run --plot)" plots "$W/f.yaml" --plot
   ;;
 *) echo "unknown CLASS $CLASS"; exit 2 ;;
 esac

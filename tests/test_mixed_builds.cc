@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/sharding.h"
 #include "experiments/time_series_h5.h"
+#include "results/atomic_file.h"
 #include "results/sha256.h"
 #include "tailsim_version.h"
 
@@ -102,6 +104,57 @@ TEST(MixedBuilds, ResumeAndMergeRefuseAnotherBuildUnlessAllowed) {
   // merge refuses them too
   EXPECT_THROW(mergeShards({out.string()}, (dir / "merged").string(), 1), std::runtime_error);
   EXPECT_FALSE(fs::exists(dir / "merged"));
+  fs::remove_all(dir);
+}
+
+// merge names the shard folder that holds another build's cases (not "finished in none of the
+// shard folders", not its staging folder), refused and, with allow_other_build, in the warning.
+TEST(MixedBuilds, MergeOfAnotherBuildsShardNamesTheShard) {
+  const fs::path dir = tempDir("mergebuild");
+  const Experiment e = loadExperiment(writeSweep(dir, "{time_series: none}").string());
+  const fs::path shard = dir / "shard_of_other_build";
+  runExperiment(e, options(shard));
+  const BuildId other{"0.0.1-other", "0123456789ab"};
+  std::vector<json> lines = journal(shard);
+  for (json& j : lines) {
+    j["tailsim_version"] = other.version;
+    j["tailsim_git_commit"] = other.git_commit;
+    for (const ExperimentCase& c : e.cases)
+      if (c.name == j["name"]) j["key"] = sha256Hex(caseKeyText(c, false, other));
+  }
+  writeJournal(shard, lines);
+  try {
+    mergeShards({shard.string()}, (dir / "merged").string(), 1);
+    ADD_FAILURE() << "merge accepted another build's shard";
+  } catch (const std::runtime_error& ex) {
+    const std::string m = ex.what();
+    EXPECT_NE(m.find("another tailsim build"), std::string::npos) << m;
+    EXPECT_NE(m.find(shard.string()), std::string::npos) << m;
+    EXPECT_EQ(m.find("finished in none"), std::string::npos) << m;
+    EXPECT_EQ(m.find(".merge.tmp."), std::string::npos) << m;
+  }
+  testing::internal::CaptureStderr();
+  mergeShards({shard.string()}, (dir / "merged").string(), 1, true);
+  const std::string warning = testing::internal::GetCapturedStderr();
+  EXPECT_NE(warning.find(shard.string()), std::string::npos) << warning;
+  EXPECT_EQ(warning.find(".merge.tmp."), std::string::npos) << warning;
+  fs::remove_all(dir);
+}
+
+TEST(MixedBuilds, ResumeOfAnotherBuildAllowedIsRecorded) {
+  const fs::path dir = tempDir("buildallowed");
+  const Experiment e = loadExperiment(writeSweep(dir, "{time_series: none}").string());
+  const fs::path out = dir / "out";
+  runExperiment(e, options(out));
+  const BuildId other{"0.0.1-other", "0123456789ab"};
+  std::vector<json> lines = journal(out);
+  for (json& j : lines) {
+    j["tailsim_version"] = other.version;
+    j["tailsim_git_commit"] = other.git_commit;
+    for (const ExperimentCase& c : e.cases)
+      if (c.name == j["name"]) j["key"] = sha256Hex(caseKeyText(c, false, other));
+  }
+  writeJournal(out, lines);
   // Allowed: kept (none run again), recorded in summary.json.
   RunOptions o = options(out);
   o.allow_other_build = true;
@@ -168,6 +221,70 @@ TEST(MixedBuilds, IncompleteJournalEntryRunsAgain) {
   fs::remove_all(dir);
 }
 
+// An entry is whole only with every field a run writes, of its type: each edit below makes its case
+// run again (never resumed, never published as a result).
+TEST(MixedBuilds, JournalEntryWithAMissingOrMistypedFieldRunsAgain) {
+  const fs::path dir = tempDir("mistyped");
+  const Experiment e = loadExperiment(writeSweep(dir, "{time_series: none}").string());
+  const fs::path out = dir / "out";
+  runExperiment(e, options(out));
+  const std::vector<json> clean = journal(out);
+  const std::vector<std::pair<std::string, std::function<void(json&)>>> edits = {
+      {"runs: {analytic: {ok: true}}", [](json& r) { r = json{{"ok", true}}; }},
+      {"phi_net_deg a string", [](json& r) { r["phi_net_deg"] = "abc"; }},
+      {"phi_net_deg null with ok true", [](json& r) { r["phi_net_deg"] = nullptr; }},
+      {"phi_net_deg missing", [](json& r) { r.erase("phi_net_deg"); }},
+      {"warnings a string", [](json& r) { r["warnings"] = "x"; }},
+      {"solver_steps a string", [](json& r) { r["solver_steps"] = "12"; }},
+      {"t_stop_s missing", [](json& r) { r.erase("t_stop_s"); }},
+      {"at_rest a number", [](json& r) { r["at_rest"] = 1; }},
+      {"error a number", [](json& r) { r["error"] = 3; }},
+  };
+  for (const auto& [what, edit] : edits) {
+    std::vector<json> lines = clean;
+    edit(lines[1]["runs"]["analytic"]);
+    writeJournal(out, lines);
+    const RunStats s = runExperiment(e, options(out));
+    EXPECT_EQ(s.ran, 1) << what;
+    EXPECT_EQ(s.resumed, 3) << what;
+    json now = journal(out)[1]["runs"]["analytic"], was = clean[1]["runs"]["analytic"];
+    now.erase("wall_time_s");
+    was.erase("wall_time_s");
+    EXPECT_EQ(now, was) << what;
+  }
+  fs::remove_all(dir);
+}
+
+// An entry whose own version or commit label disagrees with its key (this build's) is not this
+// build's: its case runs again, and no result labelled with another build is published as this one's.
+TEST(MixedBuilds, JournalEntryWithEditedBuildLabelsIsNotThisBuilds) {
+  const fs::path dir = tempDir("labels");
+  const Experiment e = loadExperiment(writeSweep(dir, "{time_series: none}").string());
+  const fs::path out = dir / "out";
+  runExperiment(e, options(out));
+  const std::vector<json> clean = journal(out);
+  const std::vector<std::pair<std::string, std::function<void(json&)>>> edits = {
+      {"tailsim_version 0.0.9", [](json& j) { j["tailsim_version"] = "0.0.9"; }},
+      {"tailsim_git_commit changed", [](json& j) { j["tailsim_git_commit"] = "0123456789ab"; }},
+      {"tailsim_version deleted", [](json& j) { j.erase("tailsim_version"); }},
+  };
+  for (const auto& [what, edit] : edits) {
+    std::vector<json> lines = clean;
+    edit(lines[0]);
+    writeJournal(out, lines);
+    const RunStats s = runExperiment(e, options(out));
+    EXPECT_EQ(s.ran, 1) << what;
+    EXPECT_EQ(s.resumed, 3) << what;
+    const json summary = json::parse(readAll(out / "summary.json"));
+    EXPECT_FALSE(summary.contains("other_builds")) << what;
+    for (const json& c : summary["cases"]) {  // this build's cases carry no label of their own (the header's)
+      EXPECT_EQ(c.value("tailsim_version", std::string(kVersion)), kVersion) << what;
+      EXPECT_EQ(c.value("tailsim_git_commit", std::string(kGitCommit)), kGitCommit) << what;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 namespace {
 // libhdf5 as tailsim loaded it (dlopen, RTLD_LOCAL): found among the loaded objects by name.
 void* loadedHdf5() {
@@ -220,6 +337,11 @@ TEST(MixedBuilds, Hdf5GroupMissingADatasetOrFullOfNaNRunsAgain) {
     fs::create_directories(out / "time_series.h5.d");
     fs::rename(dir / "nan.h5", out / "time_series.h5.d" / "w_ss=0.4.h5");
   }
+  // Both files named as tailsim's in their manifests (else they are not read at all: the test
+  // Hdf5Damaged.NeverCrashesResumeOrMerge): the groups themselves must be vetted.
+  recordHashInManifest(out.string(), "time_series.h5", sha256OfFile((out / "time_series.h5").string()).value());
+  recordHashInManifest((out / "time_series.h5.d").string(), "w_ss=0.4.h5",
+                       sha256OfFile((out / "time_series.h5.d" / "w_ss=0.4.h5").string()).value());
   const RunStats s = runExperiment(e, options(out));
   EXPECT_EQ(s.ran, 2) << "a group missing a dataset or full of NaN was taken as finished";
   EXPECT_EQ(s.resumed, 2);

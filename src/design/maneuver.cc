@@ -368,7 +368,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
       }
       csv << "\n";
     }
-    writeFileAtomic((fs::path(out_dir) / "maneuver.csv").string(), csv.str());
+    writeOwnedFile(out_dir, "maneuver.csv", csv.str());
     rep.files.push_back("maneuver.csv");
   }
   {
@@ -383,7 +383,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
             << g17(x.heading_after_rad * kDegPerRad) << "," << g17((x.heading_after_rad - x.heading_before_rad) * kDegPerRad)
             << "\n";
       }
-    writeFileAtomic((fs::path(out_dir) / "strokes.csv").string(), csv.str());
+    writeOwnedFile(out_dir, "strokes.csv", csv.str());
     rep.files.push_back("strokes.csv");
   }
   {
@@ -391,7 +391,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     csv << "scale,cycle_yaw_deg\n";
     for (std::size_t k = 0; k < rep.map.scale.size(); ++k)
       csv << g17(rep.map.scale[k]) << "," << g17(rep.map.yaw_rad[k] * kDegPerRad) << "\n";
-    writeFileAtomic((fs::path(out_dir) / "yaw_map.csv").string(), csv.str());
+    writeOwnedFile(out_dir, "yaw_map.csv", csv.str());
     rep.files.push_back("yaw_map.csv");
   }
   {
@@ -475,7 +475,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
   }
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;
-  writeFileAtomic((fs::path(out_dir) / "summary.json").string(), j.dump(2) + "\n");
+  writeOwnedFile(out_dir, "summary.json", j.dump(2) + "\n");
   rep.files.push_back("summary.json");
   return rep;
 }

@@ -209,7 +209,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   const RunResult ra = simulateAnalytic(spec.base.robot, traj, spec.base.analytic, spec.base.effects, out);
   rep.analytic = ra.summary;
   rep.limits_analytic = checkLimitsOnSeries(spec.base.robot.tail, ra.series, prob.space.limits);
-  writeCsvAtomic((fs::path(out_dir) / "best_analytic.csv").string(), ra.series);
+  writeOwnedFile(out_dir, "best_analytic.csv", toCsv(ra.series));
   rep.files.push_back("best_analytic.csv");
   // The per-foot friction model (issue 11): milliseconds, always run; a failure (e.g. the robot
   // tips) is reported, not thrown.
@@ -225,19 +225,18 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   }
   if (rp) {
     rep.perfoot = rp->summary;
-    writeCsvAtomic((fs::path(out_dir) / "best_perfoot.csv").string(), rp->series);
+    writeOwnedFile(out_dir, "best_perfoot.csv", toCsv(rp->series));
     rep.files.push_back("best_perfoot.csv");
   }
   if (spec.mujoco_check) {
     const RunResult rm = simulateMujoco(spec.base.robot, traj, spec.base.mujoco, spec.base.effects, out);
     rep.mujoco = rm.summary;
-    writeCsvAtomic((fs::path(out_dir) / "best_mujoco.csv").string(), rm.series);
+    writeOwnedFile(out_dir, "best_mujoco.csv", toCsv(rm.series));
     rep.files.push_back("best_mujoco.csv");
   }
-  writeCsvAtomic((fs::path(out_dir) / "best_trajectory.csv").string(),
-                 trajectorySeries(spec.base.robot.tail, traj, 1e-3, traj.endTime()));
+  writeOwnedFile(out_dir, "best_trajectory.csv", toCsv(trajectorySeries(spec.base.robot.tail, traj, 1e-3, traj.endTime())));
   rep.files.push_back("best_trajectory.csv");
-  writeFileAtomic((fs::path(out_dir) / "best.yaml").string(), best_yaml);
+  writeOwnedFile(out_dir, "best.yaml", best_yaml);
   rep.files.push_back("best.yaml");
 
   // Convergence history.
@@ -250,7 +249,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
         csv << spec.seeds[i] << "," << h.stage << "," << h.generation << "," << h.evaluations << "," << g17(h.wall_s) << ","
             << g17(h.best_objective) << "\n";
       }
-    writeFileAtomic((fs::path(out_dir) / "history.csv").string(), csv.str());
+    writeOwnedFile(out_dir, "history.csv", csv.str());
     rep.files.push_back("history.csv");
     GnuplotFigure fig;
     fig.stem = "history";
@@ -292,7 +291,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
         std::fprintf(stderr, "pareto %d/%d: torque <= %.4g N m: phi_net %.4f deg\n", k + 1, spec.pareto_points,
                      p.space.limits.torque_max_Nm, r.best.phi_net_rad * kDegPerRad);
     }
-    writeFileAtomic((fs::path(out_dir) / "pareto.csv").string(), csv.str());
+    writeOwnedFile(out_dir, "pareto.csv", csv.str());
     rep.files.push_back("pareto.csv");
     GnuplotFigure fig;
     fig.stem = "pareto";
@@ -385,7 +384,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;
   if (!rep.best_yaml_error.empty()) j["best_yaml_error"] = rep.best_yaml_error;
-  writeFileAtomic((fs::path(out_dir) / "summary.json").string(), j.dump(2) + "\n");
+  writeOwnedFile(out_dir, "summary.json", j.dump(2) + "\n");
   rep.files.push_back("summary.json");
   return rep;
 }

@@ -234,26 +234,55 @@ class CaseJournal {
   int fd_ = -1;
 };
 
-// The finished cases of DIR/cases.jsonl by name (a later line wins). A last line without its
-// newline (torn by a kill or a full disk) is cut off the file, so the next append starts a line.
+// The longest line tailsim writes into cases.jsonl (a case's entry: a few kB) with a wide margin.
+constexpr size_t kMaxJournalLine = size_t(1) << 22;
+
+// Whether a journal line is an entry tailsim writes: an object with a string "key" and "name".
+bool journalEntry(const json& j) {
+  return j.is_object() && j.contains("key") && j["key"].is_string() && j.contains("name") && j["name"].is_string();
+}
+
+// The first line of DIR/cases.jsonl (without its newline; a file without one: all of it), read
+// no further than kMaxJournalLine; std::nullopt when absent.
+std::optional<std::string> firstJournalLine(const fs::path& p) {
+  std::string first;
+  const std::optional<LinesRead> r = readResultFileLines(p.string(), kMaxJournalLine, [&](const std::string& line, long long) {
+    first = line;
+    return false;
+  });
+  if (!r) return std::nullopt;
+  return r->lines > 0 ? first : r->tail;
+}
+
+// The finished cases of DIR/cases.jsonl by name (a later line wins), read line by line (a line
+// longer than any entry tailsim writes: an error naming the file). A file whose first line is not a
+// tailsim entry is not tailsim's: an error naming it, the file untouched. A last line without its
+// newline (torn by a kill or a full disk: the start of an entry) is cut off the file, so the next
+// append starts a line.
 std::map<std::string, std::string> readJournal(const fs::path& p, bool repair) {
   std::map<std::string, std::string> out;
-  const std::optional<std::string> read = readResultFile(p.string());
-  if (!read) return out;
-  const std::string& text = *read;
-  const size_t end = text.rfind('\n');
-  const size_t whole = end == std::string::npos ? 0 : end + 1;  // bytes of complete lines
-  size_t at = 0;
-  while (at < whole) {
-    const size_t nl = text.find('\n', at);
-    const json j = json::parse(text.begin() + static_cast<long>(at), text.begin() + static_cast<long>(nl), nullptr, false);
-    if (j.is_object() && j.contains("name") && j["name"].is_string())
-      out[j["name"].get<std::string>()] = text.substr(at, nl - at);  // as text: see Job::entries
-    at = nl + 1;
+  const auto notOurs = [&](const std::string& why) {
+    return std::runtime_error(p.string() + " " + why + ": not a journal tailsim wrote, not changed (move it out of " +
+                              p.parent_path().string() + " or choose another --out)");
+  };
+  std::optional<LinesRead> read;
+  try {
+    read = readResultFileLines(p.string(), kMaxJournalLine, [&](const std::string& line, long long number) {
+      const json j = json::parse(line, nullptr, false);
+      if (number == 1 && !journalEntry(j)) throw notOurs("line 1 is not a case entry of tailsim");
+      if (journalEntry(j)) out[j["name"].get<std::string>()] = line;  // as text: see Job::entries
+      return true;
+    });
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(p.string() + " holds more than this process can read into memory: not tailsim's journal (move it away)");
   }
-  if (repair && whole < text.size()) {
-    std::error_code ec;
-    fs::resize_file(p, whole, ec);
+  if (!read) return out;
+  if (!read->tail.empty()) {
+    if (read->lines == 0 && read->tail.compare(0, 2, "{\"") != 0) throw notOurs("does not start with a case entry of tailsim");
+    if (repair) {
+      std::error_code ec;
+      fs::resize_file(p, static_cast<uintmax_t>(read->whole), ec);
+    }
   }
   return out;
 }
@@ -273,6 +302,7 @@ struct Job {
   std::vector<size_t> todo;       // case indices to run now
   std::string source;             // recordedSource(*e), as found before the folder is written
   std::map<std::string, int> other_builds;  // "version commit" -> finished cases of that build reused
+  std::map<std::string, std::set<std::string>> other_build_origins;  // "version commit" -> shard folders (merge)
   int total = 0, resumed = 0;
   std::unique_ptr<CaseJournal> journal;     // DIR/cases.jsonl (cases without a folder)
   std::vector<std::string> other_lines;     // per case: its journal line when not run now (else empty)
@@ -288,6 +318,16 @@ constexpr char kH5None = 0, kH5Published = 1, kH5Part = 2;
 const char* const kH5Parts = "time_series.h5.d";
 
 fs::path h5PartPath(const Job& job, size_t i) { return job.root / kH5Parts / (job.dirs[i] + ".h5"); }
+
+// Whether case i's part is as tailsim wrote it: named with its content in time_series.h5.d's manifest.
+bool h5PartIntact(const Job& job, size_t i) {
+  try {
+    const std::optional<std::string> text = readResultFile(h5PartPath(job, i).string());
+    return text && manifestNames((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *text);
+  } catch (const std::exception&) {  // not a regular file
+    return false;
+  }
+}
 
 bool keepsSeries(const ExperimentCase& c) { return c.output.time_series != TimeSeriesOutput::kNone; }
 bool inH5(const ExperimentCase& c) { return keepsSeries(c) && c.output.time_series_file == TimeSeriesFile::kHdf5; }
@@ -330,6 +370,32 @@ void refuseRunResults(const std::string& dir, const std::string& command) {
                              command + "` would replace them; choose another --out");
 }
 
+void claimDesignFolder(const std::string& dir, const std::vector<std::string>& outputs) {
+  const fs::path root(dir);
+  if (!hasManifest(dir)) {
+    const std::optional<std::string> text = readResultFile((root / "summary.json").string());
+    const json j = text ? json::parse(*text, nullptr, false) : json();
+    if (j.is_object() && j.contains("wall_s") && j.contains("files") && j["files"].is_array()) {
+      std::vector<std::string> own = {"summary.json"};  // all judged before the manifest exists
+      for (const json& f : j["files"]) {
+        if (!f.is_string()) continue;
+        const fs::path p(f.get<std::string>());
+        if (p.parent_path().empty()) own.push_back(p.string());
+        if (p.parent_path() == "plots" && p.extension() == ".png")  // a figure: with its SVG and script
+          for (const char* ext : {".png", ".svg", ".gp"}) own.push_back((p.parent_path() / p.stem()).string() + ext);
+      }
+      std::vector<std::pair<fs::path, std::string>> texts;
+      for (const std::string& n : own)
+        if (const std::optional<std::string> t = readResultFile((root / n).string())) texts.emplace_back(root / n, *t);
+      for (const auto& [p, t] : texts) recordInManifest(p.parent_path().string(), p.filename().string(), t);
+    }
+  }
+  for (const std::string& o : outputs) {
+    const fs::path p = root / o;
+    checkOwnedFile(p.parent_path().string(), p.filename().string());
+  }
+}
+
 namespace {
 using RunLock = FolderLock;
 
@@ -346,13 +412,54 @@ bool isRegularFile(const fs::path& p) {
   return fs::is_regular_file(fs::symlink_status(p, ec));
 }
 
-// Whether a finished case's entry holds a result for every model the case runs (a journal line
-// edited or torn to `"runs": {}` is not finished).
+// The build an entry says computed it ("" for a label that is missing or not a string).
+BuildId entryBuild(const json& j) {
+  const auto text = [&](const char* k) {
+    const auto it = j.find(k);
+    return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+  };
+  return {text("tailsim_version"), text("tailsim_git_commit")};
+}
+
+// Whether a run's entry has every field summaryJson writes, of its type: "ok" a boolean;
+// "phi_net_deg" a number when ok, null when not; "at_rest" a boolean when ok, null when not;
+// "t_stop_s" and "wall_time_s" numbers (null: not a number); "stick_slip_events" and
+// "solver_steps" integers; "warnings" an array of strings; "error" (if any) a string; "extra"
+// (if any) an object of numbers or nulls.
+bool runEntryWhole(const json& run) {
+  if (!run.is_object()) return false;
+  const auto has = [&](const char* k, auto&& test) {
+    const auto it = run.find(k);
+    return it != run.end() && test(*it);
+  };
+  const auto numberOrNull = [](const json& v) { return v.is_number() || v.is_null(); };
+  const auto integer = [](const json& v) { return v.is_number_integer(); };
+  if (!has("ok", [](const json& v) { return v.is_boolean(); })) return false;
+  const bool ok = run["ok"].get<bool>();
+  const auto resultField = [ok](const json& v, bool (json::*is)() const noexcept) { return ok ? (v.*is)() : v.is_null(); };
+  if (!has("phi_net_deg", [&](const json& v) { return resultField(v, &json::is_number); }) ||
+      !has("at_rest", [&](const json& v) { return resultField(v, &json::is_boolean); }) ||
+      !has("t_stop_s", numberOrNull) || !has("wall_time_s", numberOrNull) || !has("stick_slip_events", integer) ||
+      !has("solver_steps", integer) ||
+      !has("warnings", [](const json& v) {
+        return v.is_array() && std::all_of(v.begin(), v.end(), [](const json& w) { return w.is_string(); });
+      }))
+    return false;
+  if (run.contains("error") && !run["error"].is_string()) return false;
+  if (run.contains("extra") &&
+      (!run["extra"].is_object() || !std::all_of(run["extra"].begin(), run["extra"].end(), numberOrNull)))
+    return false;
+  return true;
+}
+
+// Whether a finished case's entry holds a whole result (runEntryWhole) for every model the case
+// runs (a journal line edited or torn to `"runs": {}`, or with a field missing or mistyped, is not
+// finished: the case runs again).
 bool entryComplete(const json& j, const ExperimentCase& c) {
   const auto runs = j.find("runs");
   if (runs == j.end() || !runs->is_object() || runs->empty()) return false;
   for (const auto& [model, run] : runs->items())
-    if (!run.is_object() || !run.contains("ok") || !run["ok"].is_boolean()) return false;
+    if (!runEntryWhole(run)) return false;
   if (c.kind != CaseKind::kSimulate) return true;
   for (const std::string& m : c.models)
     if (!runs->contains(m)) return false;
@@ -379,9 +486,8 @@ std::pair<std::string, std::string> resultOwner(const fs::path& root) {
       const auto o = owner(readJsonFile(d.path() / "result.json"), "experiment");
       if (!o.first.empty()) return o;
     }
-  if (const std::optional<std::string> text = readResultFile((root / "cases.jsonl").string())) {  // cases without a folder
-    const std::string line = text->substr(0, text->find('\n'));
-    const auto o = owner(json::parse(line, nullptr, false), "experiment");
+  if (const std::optional<std::string> line = firstJournalLine(root / "cases.jsonl")) {  // cases without a folder
+    const auto o = owner(json::parse(*line, nullptr, false), "experiment");
     if (!o.first.empty()) return o;
   }
   return {};
@@ -407,12 +513,12 @@ bool isRobotCopy(const std::string& n) {  // robot-<k>.yaml: a swept robot's cop
 std::vector<fs::path> memberFolders(const fs::path& root);
 
 bool ownFile(const fs::path& root, const std::string& name) {
+  if (name == "cases.jsonl") {  // appended case by case: recognised by content (its first line)
+    const std::optional<std::string> line = firstJournalLine(root / name);
+    return !line || line->empty() || journalEntry(json::parse(*line, nullptr, false));
+  }
   const std::optional<std::string> text = readResultFile((root / name).string());
   if (!text) return true;  // absent: nothing to protect
-  if (name == "cases.jsonl") {  // appended case by case: recognised by content (its first line)
-    const json j = json::parse(text->substr(0, text->find('\n')), nullptr, false);
-    return text->empty() || (j.is_object() && j.contains("key") && j.contains("name"));
-  }
   if (hasManifest(root.string())) return manifestNames(root.string(), name, *text);
   // No manifest: a folder of an earlier tailsim, recognised by content.
   if (name == "summary.json") {
@@ -448,8 +554,9 @@ void writeOwnFile(const fs::path& root, const std::string& name, const std::stri
 // The entries tailsim writes into a result folder (docs/ARCHITECTURE.md) are deleted, and in them
 // only what tailsim writes: its top-level files when they are its own (ownFile), a case folder's
 // result.json and <model>.csv, mjcf/<hash>.xml, renders/<case dir>.{mp4,png}, time_series.h5(.d),
-// its temporary files. Anything else stays (named on stderr), and so do plots/, report.md and
-// figures.html (`tailsim plot` and `report` rewrite them).
+// its temporary files, and the files of `tailsim plot` / `report` (plots/, page/, report.md,
+// figures.html, index.html) that their folder's manifest names unchanged. Anything else stays
+// (named on stderr).
 void clearResultFolder(const fs::path& root) {
   std::error_code ec;
   std::vector<std::string> kept;
@@ -500,9 +607,35 @@ void clearResultFolder(const fs::path& root) {
            std::all_of(n.begin(), n.begin() + 16, [](char ch) { return std::isxdigit(static_cast<unsigned char>(ch)); });
   });
   clearDir(root / kH5Parts, [](const std::string& n) { return n.size() > 3 && n.compare(n.size() - 3, 3, ".h5") == 0; });
+  // Folders of `tailsim plot` (figures, the result page): the files their manifest names unchanged.
+  const auto clearManifested = [&](const fs::path& dir) {
+    if (!fs::is_directory(fs::symlink_status(dir, ec))) return;
+    std::set<std::string> own = {".tailsim-manifest"};
+    for (const auto& f : fs::directory_iterator(dir, ec)) {
+      const std::string n = f.path().filename().string();
+      try {
+        if (const std::optional<std::string> t = readResultFile(f.path().string()); t && manifestNames(dir.string(), n, *t))
+          own.insert(n);
+      } catch (const std::exception&) {  // not a regular file: not tailsim's
+      }
+    }
+    clearDir(dir, [&](const std::string& n) { return own.count(n) > 0; });
+  };
+  clearManifested(root / "page" / "cases");
+  clearManifested(root / "page");
+  clearManifested(root / "plots");
   {
     const fs::path h5 = root / "time_series.h5";
     removeIf(h5, fs::is_regular_file(fs::symlink_status(h5, ec)) && TimeSeriesH5Reader(h5.string()).ok());
+  }
+  for (const char* name : {"report.md", "figures.html", "index.html"}) {
+    bool own = false;
+    try {
+      const std::optional<std::string> t = readResultFile((root / name).string());
+      own = t && manifestNames(root.string(), name, *t);
+    } catch (const std::exception&) {  // not a regular file: not tailsim's
+    }
+    removeIf(root / name, own);
   }
   std::vector<std::string> top = {"cases.jsonl", "results.csv", "experiment.yaml", "robot.yaml"};
   for (const auto& f : fs::directory_iterator(root, ec))
@@ -537,7 +670,7 @@ std::vector<fs::path> memberFolders(const fs::path& root) {
   if (!fs::is_directory(root, ec)) return out;
   for (const auto& d : fs::directory_iterator(root, ec)) {
     const std::string n = d.path().filename().string();
-    if (n == "cases" || n == "renders" || n == "plots") continue;
+    if (n == "cases" || n == "renders" || n == "plots" || n == "page" || n == "mjcf" || n == kH5Parts) continue;
     if (d.is_directory(ec) && holdsResults(d.path())) out.push_back(d.path());
   }
   std::sort(out.begin(), out.end());
@@ -649,7 +782,19 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   if (!opt.resume && opt.only_case.empty()) clearResultFolder(root);  // --fresh: no stale case folders
   removeStaleTemps(root);
   const bool any_folder = std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return e.cases[i].output.caseFolder(); });
-  fs::create_directories(any_folder ? root / "cases" : root);
+  // Every folder the run writes into is a real folder of DIR (never a link out of it), checked
+  // before any work.
+  for (const char* sub : {"cases", kH5Parts, "mjcf", "renders", "plots", "page"}) {
+    struct stat st {};
+    if (::lstat((root / sub).c_str(), &st) == 0) makeResultDir((root / sub).string());
+  }
+  for (size_t i : todo_all) {
+    struct stat st {};
+    if (e.cases[i].output.caseFolder() && ::lstat((root / "cases" / job.dirs[i]).c_str(), &st) == 0)
+      makeResultDir((root / "cases" / job.dirs[i]).string());
+  }
+  fs::create_directories(root);  // (DIR itself, as given to --out, may be a link)
+  if (any_folder) makeResultDir((root / "cases").string());
   // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
   compactManifest(root.string());
   for (const auto& [name, text] : folderInputs(e)) writeOwnFile(root, name, text);
@@ -665,11 +810,25 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   std::map<std::string, std::string> journal = readJournal(root / "cases.jsonl", true);
   const bool had_journal = !journal.empty() || isRegularFile(root / "cases.jsonl");
   job.h5_from.assign(e.cases.size(), kH5None);
-  if (job.any_h5) job.published = std::make_unique<TimeSeriesH5Reader>((root / "time_series.h5").string());
-  // Where case i's whole group is: its own file, else the published file, else nowhere.
+  // HDF5 files are opened only when they are as tailsim wrote them (their SHA-256 named in their
+  // folder's manifest): libhdf5 crashes on some damaged files, and copies others silently. A
+  // damaged time_series.h5 or part is not read: its cases run again (and the file is replaced).
+  if (job.any_h5) {
+    const fs::path h5 = root / "time_series.h5";
+    bool intact = false;
+    if (isRegularFile(h5)) {
+      const std::optional<std::string> hash = sha256OfFile(h5.string());
+      intact = hash && manifestNamesHash(root.string(), "time_series.h5", *hash);
+      if (!intact)
+        std::fprintf(stderr, "note: %s is not as tailsim wrote it (damaged or changed): not read, its cases run again\n",
+                     h5.c_str());
+    }
+    job.published = std::make_unique<TimeSeriesH5Reader>(intact ? h5.string() : std::string());
+  }
+  // Where case i's whole group is: its own file (when intact), else the published file, else nowhere.
   const auto findH5 = [&](size_t i, const std::vector<std::string>& models, const std::string& key) -> char {
     const fs::path part = h5PartPath(job, i);
-    if (isRegularFile(part) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
+    if (h5PartIntact(job, i) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
       return kH5Part;
     return job.published->hasCase(job.dirs[i], key, models) ? kH5Published : kH5None;
   };
@@ -696,15 +855,18 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     }
     // A case is reused only when everything its results depend on is unchanged (caseKey), and
     // its entry is whole (a result for every model it runs).
+    // An entry with this build's key is this build's only when its own labels say so (an edited
+    // label: neither this build's nor, its key not matching, another's: the case runs again).
     bool reuse = j.is_object() && j.value("key", std::string()) == job.keys[i] && j.value("name", std::string()) == c.name &&
-                 entryComplete(j, c);
+                 entryComplete(j, c) && entryBuild(j) == thisBuild();
     if (!reuse && j.is_object() && j.value("name", std::string()) == c.name && entryComplete(j, c)) {
       // A finished case of another build, for the same inputs: refused unless allowed.
-      const BuildId theirs{j.value("tailsim_version", std::string()), j.value("tailsim_git_commit", std::string())};
+      const BuildId theirs = entryBuild(j);
       if (theirs != thisBuild() && j.value("key", std::string()) == sha256Hex(caseKeyText(c, job.render, theirs))) {
         const std::string build = "tailsim " + theirs.version + " (commit " +
                                   (theirs.git_commit.empty() ? "unknown" : theirs.git_commit) + ")";
         ++job.other_builds[build];
+        if (opt.case_origin) job.other_build_origins[build].insert(opt.case_origin(e.name, c.name, job.dirs[i]));
         reuse = opt.allow_other_build;
       }
     }
@@ -720,9 +882,6 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       continue;
     }
     job.h5_from[i] = kH5None;
-    if (opt.merge_only)
-      throw std::runtime_error("merge: case '" + e.cases[i].name + "' of experiment " + e.name +
-                               " is finished in none of the shard folders (run its shard, or the shard again)");
     job.todo.push_back(i);
   }
   if (!job.other_builds.empty()) {
@@ -732,16 +891,29 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       list += (list.empty() ? "" : ", ") + std::to_string(count) + " by " + build;
       n += count;
     }
+    // Where those cases are: DIR, or for a merge the shard folders they come from.
+    std::string where = root.string();
+    if (opt.case_origin) {
+      std::set<std::string> shards;
+      for (const auto& [build, o] : job.other_build_origins) shards.insert(o.begin(), o.end());
+      where.clear();
+      for (const std::string& s : shards) where += (where.empty() ? "" : ", ") + s;
+      where = "merge: " + where;
+    }
     const std::string self = "tailsim " + std::string(kVersion) + " (commit " + (*kGitCommit ? kGitCommit : "unknown") + ")";
     if (!opt.allow_other_build)
-      throw std::runtime_error(root.string() + " holds finished cases computed by another tailsim build (" + list +
+      throw std::runtime_error(where + " hold" + (opt.case_origin ? "" : "s") +
+                               " finished cases computed by another tailsim build (" + list +
                                "; this is " + self + "): " +
                                (opt.merge_only ? "merge shards of one build, or add --allow-other-build to keep them"
                                                : "add --fresh to recompute them, or --allow-other-build to keep them") +
                                " (recorded in summary.json)");
     std::fprintf(stderr, "warning: %s: %d finished case%s of another tailsim build kept (%s; this is %s)\n",
-                 root.string().c_str(), n, n == 1 ? "" : "s", list.c_str(), self.c_str());
+                 where.c_str(), n, n == 1 ? "" : "s", list.c_str(), self.c_str());
   }
+  if (opt.merge_only && !job.todo.empty())
+    throw std::runtime_error("merge: case '" + e.cases[job.todo.front()].name + "' of experiment " + e.name +
+                             " is finished in none of the shard folders (run its shard, or the shard again)");
   if (had_journal) {  // compacted: one line per finished case, whatever earlier runs appended
     std::string lines;
     for (size_t i = 0; i < e.cases.size(); ++i)
@@ -759,7 +931,7 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
   const std::vector<RunResult> runs = runCase(c, &ctx);
   const fs::path dir = job.root / "cases" / job.dirs[i];
   const bool folder = c.output.caseFolder();
-  if (folder) fs::create_directories(dir);
+  if (folder) makeResultDir(dir.string());
   json j;
   j["name"] = c.name;
   j["dir"] = job.dirs[i];
@@ -785,7 +957,7 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
   const std::vector<double> marks = thin && c.kind == CaseKind::kSimulate ? c.trajectory().breakpoints() : std::vector<double>{};
   std::unique_ptr<TimeSeriesH5Writer> part;  // this case's DIR/time_series.h5.d/<dir>.h5
   if (inH5(c)) {
-    fs::create_directories(job.root / kH5Parts);
+    makeResultDir((job.root / kH5Parts).string());
     part = std::make_unique<TimeSeriesH5Writer>(h5PartPath(job, i).string(), H5Storage::kMemory);
   }
   for (const RunResult& r : runs) {
@@ -810,13 +982,18 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     }
     if (!xml.empty()) {
       const std::string name = mjcfFileName(xml);
-      fs::create_directories(job.root / "mjcf");
+      makeResultDir((job.root / "mjcf").string());
       if (!fs::exists(job.root / name)) writeFileAtomic((job.root / name).string(), xml);
       j["mjcf"] = name;
     }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
-  if (part) part->publish();  // on disk before the journal says the case is finished
+  if (part) {  // on disk, and named with its content, before the journal says the case is finished
+    part->publish();
+    const std::optional<std::string> text = readResultFile(h5PartPath(job, i).string());
+    if (!text) throw std::runtime_error("cannot read back " + h5PartPath(job, i).string());
+    recordInManifest((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *text);
+  }
   std::string line = j.dump();
   if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
   else job.journal->append(line + "\n");  // one line, one write(): the case is finished
@@ -854,11 +1031,15 @@ void publishTimeSeriesH5(Job& job) {
     return;
   }
   {
-    // Space for every group copied, reserved before libhdf5 writes (it must never meet a full disk).
-    long long bytes = 0;
+    // Space for every group copied, reserved before libhdf5 writes (it must never meet a full disk):
+    // a group's copy is no larger than the file it comes from (each part also holds a superblock
+    // and root group the joined file does not repeat); the joined file's root group adds an index
+    // entry per group (kH5LinkBytes, a wide margin) and its own header (kH5FileBytes).
+    constexpr long long kH5LinkBytes = 1024, kH5FileBytes = 64 << 10;
+    long long bytes = kH5FileBytes + kH5LinkBytes * static_cast<long long>(from_published.size() + from_parts.size());
     if (!from_published.empty()) bytes += static_cast<long long>(fs::file_size(job.published->path(), ec));
     for (size_t i : from_parts) bytes += static_cast<long long>(fs::file_size(h5PartPath(job, i), ec));
-    TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes + bytes / 2 + (64 << 10));
+    TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes);
     for (size_t i : from_published) out.copyCase(*job.published, job.dirs[i]);
     for (size_t i : from_parts) {
       const TimeSeriesH5Reader part(h5PartPath(job, i).string());
@@ -868,6 +1049,9 @@ void publishTimeSeriesH5(Job& job) {
     job.published.reset();  // (closed before the rename replaces it)
     out.publish();
   }
+  const std::optional<std::string> hash = sha256OfFile((job.root / "time_series.h5").string());
+  if (!hash) throw std::runtime_error("cannot read back " + (job.root / "time_series.h5").string());
+  recordHashInManifest(job.root.string(), "time_series.h5", *hash);
   fs::remove_all(parts, ec);
 }
 

@@ -33,6 +33,9 @@ struct RunOptions {
   int shard_index = 1;           // --shard K/N: run only the cases assigned to shard K (sharding.h)
   int shard_count = 1;
   bool merge_only = false;       // run nothing: every case must be finished in out_dir (tailsim merge)
+  // merge: the shard folder a finished case was taken from (for messages); empty: not a merge.
+  std::function<std::string(const std::string& experiment, const std::string& case_name, const std::string& case_dir)>
+      case_origin;
   bool allow_other_build = false;  // finished cases of another tailsim build (version/commit) are reused
                                    // with a warning and recorded in summary.json ("other_builds"), not refused
   // Asked by the calling thread at least every 200 ms while cases run: true stops the run as the
@@ -72,6 +75,11 @@ class FolderLock {
 // Throws (naming DIR) when DIR holds the results of `tailsim run` (its summary.json, results.csv,
 // cases/ or cases.jsonl): `command` (optimize, maneuver) writes a summary.json of its own there.
 void refuseRunResults(const std::string& dir, const std::string& command);
+// Before `tailsim optimize` or `maneuver` writes into DIR: the files of an earlier tailsim's
+// design folder (no manifest; summary.json with "files" and "wall_s") are recorded as tailsim's,
+// then each of `outputs` (names relative to DIR, e.g. "plots/history.png") must be tailsim's
+// (ownedFile), else std::runtime_error naming it, before any work.
+void claimDesignFolder(const std::string& dir, const std::vector<std::string>& outputs);
 
 // Keeps only the models named in `only` in every case (none given: all). Throws ConfigError naming
 // `file` for an unknown model name, or when the names select no model of any simulated case (the run

@@ -5,6 +5,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
 #include "mujoco_model/mjcf_generator.h"
+#include "results/atomic_file.h"
 
 namespace tailsim {
 
@@ -29,7 +30,7 @@ RenderStats renderCase(const ExperimentCase& c, const std::vector<RunResult>& ru
   in.solid_label = solid ? solid->title : "MuJoCo";
   in.outline_label = !outline_label.empty() ? outline_label : outline ? outline->title : "analytic model";
   in.title = c.experiment + (c.name == "base" ? "" : " " + c.name);
-  std::filesystem::create_directories(out_dir);
+  makeResultDir(out_dir);
   const std::string stem = (std::filesystem::path(out_dir) / caseDirName(c.name)).string();
   return renderVideo(in, c.render, stem + ".mp4", stem + ".png");
 }

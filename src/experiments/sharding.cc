@@ -7,12 +7,14 @@
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <unistd.h>
 
 #include "experiments/experiment_runner.h"
 #include "results/atomic_file.h"
+#include "results/sha256.h"
 
 #include <map>
 #include <nlohmann/json.hpp>
@@ -138,6 +140,18 @@ fs::path caseFolderOf(const fs::path& rel) {
 }
 }  // namespace
 
+namespace {
+// A shard's HDF5 file (time_series.h5 or a part) is merged only when its SHA-256 is named in its
+// folder's manifest: else std::runtime_error naming the file and the shard.
+void requireIntactH5(const fs::path& file, const std::string& shard) {
+  const std::optional<std::string> hash = sha256OfFile(file.string());
+  if (!hash || !manifestNamesHash(file.parent_path().string(), file.filename().string(), *hash))
+    throw std::runtime_error("merge: " + file.string() + " of shard " + shard +
+                             " is not as tailsim wrote it (damaged or changed): not merged; run that shard again "
+                             "(tailsim run ... --shard K/N --out " + shard + ")");
+}
+}  // namespace
+
 MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
                        bool allow_other_build) {
   if (shard_dirs.empty()) throw std::runtime_error("merge: no shard folders given");
@@ -167,6 +181,7 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
     std::vector<fs::path> taken_cases;
     std::map<fs::path, std::string> taken_by;  // case folder -> the shard folder it was taken from
     std::map<std::string, std::pair<std::string, std::string>> journal_lines;  // name -> {line, shard}
+    std::set<fs::path> merged_h5;  // the staging folder's time_series.h5 files
     for (const std::string& d : shard_dirs) {
       const fs::path root(d);
       std::vector<fs::path> this_shard_cases;
@@ -190,8 +205,18 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
           continue;
         }
         if (rel.filename() == "time_series.h5") {  // every shard's case groups (the first shard's win)
+          requireIntactH5(it->path(), d);  // libhdf5 crashes on some damaged files
           fs::create_directories(dst.parent_path());
           mergeTimeSeriesH5(it->path().string(), dst.string());
+          merged_h5.insert(dst);
+          continue;
+        }
+        if (rel.parent_path().filename() == "time_series.h5.d" && rel.extension() == ".h5") {  // an unjoined case
+          requireIntactH5(it->path(), d);
+          fs::create_directories(dst.parent_path());
+          fs::copy_file(it->path(), dst, fs::copy_options::overwrite_existing);
+          recordInManifest(dst.parent_path().string(), rel.filename().string(), readAll(dst));
+          ++st.files_copied;
           continue;
         }
         if (perCase(rel)) {
@@ -218,6 +243,11 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
       }
       taken_cases.insert(taken_cases.end(), this_shard_cases.begin(), this_shard_cases.end());
     }
+    for (const fs::path& h5 : merged_h5) {  // named as tailsim wrote them, for the runner's check
+      const std::optional<std::string> hash = sha256OfFile(h5.string());
+      if (!hash) throw std::runtime_error("merge: cannot read back " + h5.string());
+      recordHashInManifest(h5.parent_path().string(), h5.filename().string(), *hash);
+    }
     // The summary and results table are written by the runner itself, resuming every case and
     // running none (a case in no shard is an error): the same code as a single-process run.
     const std::vector<Experiment> suite = loadExperimentSuite((stage / "experiment.yaml").string());
@@ -228,6 +258,13 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
     o.render = true;
     o.merge_only = true;
     o.allow_other_build = allow_other_build;
+    o.case_origin = [&](const std::string& experiment, const std::string& name, const std::string& dir) -> std::string {
+      for (const fs::path& prefix : {fs::path(experiment), fs::path()}) {
+        if (const auto it = journal_lines.find((prefix / name).string()); it != journal_lines.end()) return it->second.second;
+        if (const auto it = taken_by.find(prefix / "cases" / dir); it != taken_by.end()) return it->second;
+      }
+      return out_dir;
+    };
     const RunStats rs = runSuite(suite, o);
     st.cases = rs.total;
     fs::remove(stage / ".tailsim.lock", ec);

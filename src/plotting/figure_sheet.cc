@@ -129,7 +129,9 @@ std::string figureSheetHtml(const std::string& dir, const std::vector<Experiment
 std::string writeFigureSheet(const std::string& dir, const std::vector<ExperimentResults>& results,
                              const std::vector<PlotFile>& plots) {
   const std::string path = figureSheetPath(dir);
-  writeFileAtomic(path, figureSheetHtml(dir, results, plots));
+  writeOwnedFile(dir, fs::path(path).filename().string(), figureSheetHtml(dir, results, plots), [](const std::string& text) {
+    return text.find("<title>tailsim figures: ") != std::string::npos;  // an earlier tailsim's sheet
+  });
   return path;
 }
 

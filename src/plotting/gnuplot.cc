@@ -103,11 +103,14 @@ void writeDataFile(const std::string& path, const std::vector<std::string>& head
     }
     out += '\n';
   }
-  writeFileAtomic(path, out);
+  const fs::path p(path);
+  writeOwnedFile(p.parent_path().string(), p.filename().string(), out, [](const std::string& text) {
+    return text.compare(0, 2, "# ") == 0;  // an earlier tailsim's data file: its header row
+  });
 }
 
 std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig) {
-  fs::create_directories(plots_dir);
+  makeResultDir(plots_dir);
   const fs::path user_dir(plots_dir);              // paths as the user gave them, for messages
   const fs::path dir = fs::absolute(plots_dir);  // gnuplot's working directory: any cwd works
   std::string comment_stem = fig.stem;  // a line break in the comment would start a command
@@ -116,9 +119,22 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
   const std::string script = "# " + comment_stem + ": written by tailsim plot; rerun with `gnuplot " + comment_stem +
                              ".gp` in this folder\nset encoding utf8\nset datafile missing 'NaN'\n" +
                              terminalBlock(fig, true) + terminalBlock(fig, false);
-  writeFileAtomic((dir / (fig.stem + ".gp")).string(), script);
+  // The script, its log and figures are replaced only when tailsim wrote them (DIR's manifest);
+  // beside a script of an earlier tailsim (no manifest line for it), its figures are taken as tailsim's.
+  const std::string header = "# " + comment_stem + ": written by tailsim plot";
+  bool earlier = false;
+  try {
+    const std::optional<std::string> gp = readResultFile((dir / (fig.stem + ".gp")).string());
+    earlier = gp && gp->compare(0, header.size(), header) == 0 && ownedFile(dir.string(), fig.stem + ".gp", std::nullopt,
+                                                                            [](const std::string&) { return true; });
+  } catch (const std::exception&) {  // not a regular file: refused below
+  }
+  const EarlierOwnFile ours = [earlier](const std::string&) { return earlier; };
+  for (const char* ext : {".png", ".svg", ".log"}) checkOwnedFile(dir.string(), fig.stem + ext, std::nullopt, ours);
+  writeOwnedFile(dir.string(), fig.stem + ".gp", script, ours);
   const fs::path log = dir / (fig.stem + ".log");
   const int status = runGnuplot(dir, "./" + fig.stem + ".gp", log);  // "./": gnuplot runs an argument starting with '<' as a command
+  for (const char* ext : {".png", ".svg", ".log"}) recordWrittenFile(dir.string(), fig.stem + ext);
   std::string err;
   {
     std::ifstream in(log);

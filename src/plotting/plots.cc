@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "plotting/figure_sheet.h"
+#include "results/atomic_file.h"
 #include "results/columns.h"
 #include "plotting/gnuplot.h"
 #include "plotting/style.h"
@@ -1120,7 +1121,7 @@ std::vector<PlotFile> plotExperiment(const ExperimentResults& r, const PlotOptio
     // the figure name may say it already ("Fig. 6 1-link case")
     if (name.find(std::to_string(r.links) + "-link") == std::string::npos) ctx.tail = {t, t};
   }
-  fs::create_directories(ctx.plots);
+  makeResultDir(ctx.plots);
   if (r.cases.empty() || r.models.empty()) return {};
   if (r.kind == "pose") {
     if (r.axes.size() == 1) plotPoseOneKey(ctx);

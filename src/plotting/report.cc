@@ -216,7 +216,11 @@ std::string reportMarkdown(const std::vector<ExperimentResults>& results, const 
   return o.str();
 }
 
+// A report.md of an earlier tailsim (before manifests), recognised by its title.
+bool earlierReport(const std::string& text) { return text.compare(0, 9, "# tailsim") == 0; }
+
 std::string writeReport(const std::string& dir, bool draw_plots) {
+  checkOwnedFile(dir, "report.md", std::nullopt, earlierReport);  // before any work
   const std::vector<ExperimentResults> results = loadResultTree(dir);
   std::vector<PlotFile> plots;
   if (draw_plots)
@@ -227,7 +231,7 @@ std::string writeReport(const std::string& dir, bool draw_plots) {
   if (draw_plots) writeFigureSheet(dir, results, plots);
   const std::vector<Finding> findings = computeFindings(results);
   const std::string path = (fs::path(dir) / "report.md").string();
-  writeFileAtomic(path, reportMarkdown(results, findings, plots, dir));
+  writeOwnedFile(dir, "report.md", reportMarkdown(results, findings, plots, dir), earlierReport);
   return path;
 }
 

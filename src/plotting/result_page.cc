@@ -274,6 +274,14 @@ std::vector<std::string> figuresOf(const ExperimentResults& r, const fs::path& r
 }
 
 // One experiment's entry of data.js; writes the replay file of each case that kept time series.
+// Writes DIR/name of the page's own files: replaced only when tailsim wrote them (DIR's manifest,
+// or the data of an earlier tailsim's page, recognised by its first call).
+void writePageFile(const fs::path& dir, const std::string& name, const std::string& text) {
+  writeOwnedFile(dir.string(), name, text, [](const std::string& there) {
+    return there.compare(0, 19, "tailsim.caseLoaded(") == 0 || there.compare(0, 19, "tailsim.dataLoaded(") == 0;
+  });
+}
+
 std::string experimentJson(const ExperimentResults& r, int index, const fs::path& root, GeometryCache& geometry) {
   std::vector<std::string> notes;
   if (!r.resolve_error.empty()) notes.push_back(r.resolve_error);
@@ -332,7 +340,7 @@ std::string experimentJson(const ExperimentResults& r, int index, const fs::path
                        ",\"geometry\":" + geometry.of(r, rc, &notes) + ",\"links\":" +
                        std::to_string(rc ? rc->robot.numLinks() : 0) + ",\"strokes\":" + numArray(phases) +
                        ",\"models\":{" + models + "}});\n";
-    writeFileAtomic((cases_dir / (id + ".js")).string(), text);
+    writePageFile(cases_dir, id + ".js", text);
     replay.push_back(jsString("page/cases/" + id + ".js"));
   }
   std::ostringstream o;
@@ -439,7 +447,8 @@ std::string writeResultPage(const std::string& dir) {
   }
   const std::vector<ExperimentResults> tree = loadResultTree(dir);
   const fs::path page = root / "page";
-  fs::create_directories(page / "cases");
+  makeResultDir(page.string());
+  makeResultDir((page / "cases").string());
   GeometryCache geometry;
   std::vector<std::string> experiments;
   for (size_t i = 0; i < tree.size(); ++i) experiments.push_back(experimentJson(tree[i], static_cast<int>(i), root, geometry));
@@ -449,13 +458,14 @@ std::string writeResultPage(const std::string& dir) {
                            ",\"figures_html\":" + (figures_html ? "true" : "false") + ",\"experiments\":[" +
                            joined(experiments, ",\n") + "]});\n";
   if (!three.empty()) {
-    writeFileAtomic((page / "three.min.js").string(), three);
-    writeFileAtomic((page / "OrbitControls.js").string(), orbit);
-    writeFileAtomic((page / "three-LICENSE").string(), licence);
+    writePageFile(page, "three.min.js", three);
+    writePageFile(page, "OrbitControls.js", orbit);
+    writePageFile(page, "three-LICENSE", licence);
   }
-  writeFileAtomic((page / "tailsim.js").string(), kResultPageJs);
-  writeFileAtomic((page / "data.js").string(), data);
-  writeFileAtomic(index, indexHtml(!three.empty()));
+  writePageFile(page, "tailsim.js", kResultPageJs);
+  writePageFile(page, "data.js", data);
+  writeOwnedFile(root.string(), "index.html", indexHtml(!three.empty()),
+                 [](const std::string& text) { return text.find(kGeneratorMeta) != std::string::npos; });
   if (!three_note.empty()) std::fprintf(stderr, "note: %s: %s\n", index.c_str(), three_note.c_str());
   return index;
 }

@@ -50,26 +50,96 @@ void writeFileAtomic(const std::string& path, const std::string& contents) {
   }
 }
 
-std::optional<std::string> readResultFile(const std::string& path, long long max_bytes) {
+namespace {
+// Opens a result-folder file for reading when it is a regular file of at most max_bytes (-1: absent;
+// std::runtime_error naming it otherwise); its size in *size.
+int openResultFile(const std::string& path, long long max_bytes, long long* size) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
     const int err = errno;
-    if (err == ENOENT) return std::nullopt;
+    if (err == ENOENT) return -1;
     if (err == ELOOP) throw std::runtime_error(path + " is a symbolic link: tailsim reads and writes only regular files in a result folder (remove it)");
     throw std::runtime_error("cannot open " + path + ": " + std::strerror(err));
   }
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw std::runtime_error("cannot stat " + path + ": " + std::strerror(errno));
-  if (!S_ISREG(st.st_mode))
-    throw std::runtime_error(path + " is not a regular file: tailsim reads and writes only regular files in a result folder (remove it)");
-  if (st.st_size > max_bytes)
-    throw std::runtime_error(path + " is " + std::to_string(st.st_size) + " bytes, more than tailsim ever writes there (" +
-                             std::to_string(max_bytes) + "): not read");
-  std::string out(static_cast<size_t>(st.st_size), '\0');
+  std::string problem;
+  if (::fstat(fd, &st) != 0)
+    problem = "cannot stat " + path + ": " + std::strerror(errno);
+  else if (!S_ISREG(st.st_mode))
+    problem = path + " is not a regular file: tailsim reads and writes only regular files in a result folder (remove it)";
+  else if (st.st_size > max_bytes)
+    problem = path + " is " + std::to_string(st.st_size) + " bytes, more than tailsim ever writes there (" +
+              std::to_string(max_bytes) + "): not read";
+  if (!problem.empty()) {
+    ::close(fd);
+    throw std::runtime_error(problem);
+  }
+  *size = st.st_size;
+  return fd;
+}
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+}  // namespace
+
+void makeResultDir(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);  // through a link too: refused below, nothing written
+  struct stat st {};
+  if (::lstat(dir.c_str(), &st) != 0)
+    throw std::runtime_error("cannot create the folder " + dir + ": " + (ec ? ec.message() : std::strerror(errno)));
+  if (S_ISLNK(st.st_mode))
+    throw std::runtime_error(dir + " is a symbolic link: tailsim writes only into real folders of a result folder, "
+                                   "never through a link (remove it)");
+  if (!S_ISDIR(st.st_mode)) throw std::runtime_error(dir + " is not a folder: not written (remove it)");
+}
+
+std::optional<LinesRead> readResultFileLines(const std::string& path, size_t max_line,
+                                             const std::function<bool(const std::string& line, long long number)>& fn) {
+  long long size = 0;
+  const int fd = openResultFile(path, kMaxResultFileBytes, &size);
+  if (fd < 0) return std::nullopt;
+  const FdCloser closer{fd};
+  LinesRead r;
+  std::string line;
+  std::vector<char> buf(1 << 16);
+  for (;;) {
+    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw std::runtime_error("cannot read " + path + ": " + std::strerror(errno));
+    if (n == 0) break;
+    for (ssize_t i = 0; i < n;) {
+      const char* start = buf.data() + i;
+      const char* nl = static_cast<const char*>(std::memchr(start, '\n', static_cast<size_t>(n - i)));
+      const size_t len = nl ? static_cast<size_t>(nl - start) : static_cast<size_t>(n - i);
+      if (line.size() + len > max_line)
+        throw std::runtime_error(path + ": line " + std::to_string(r.lines + 1) + " is longer than tailsim ever writes (" +
+                                 std::to_string(max_line) + " bytes): not tailsim's file, not read (move it away)");
+      line.append(start, len);
+      i += static_cast<ssize_t>(len);
+      r.size += static_cast<long long>(len);
+      if (nl) {
+        ++i;
+        ++r.size;
+        ++r.lines;
+        const bool more = fn(line, r.lines);
+        line.clear();
+        r.whole = r.size;
+        if (!more) return r;
+      }
+    }
+  }
+  r.tail = std::move(line);
+  return r;
+}
+
+std::optional<std::string> readResultFile(const std::string& path, long long max_bytes) {
+  long long size = 0;
+  const int fd = openResultFile(path, max_bytes, &size);
+  if (fd < 0) return std::nullopt;
+  const FdCloser closer{fd};
+  std::string out(static_cast<size_t>(size), '\0');
   size_t got = 0;
   while (got < out.size()) {
     const ssize_t n = ::read(fd, out.data() + got, out.size() - got);
@@ -93,12 +163,20 @@ bool hasLine(const std::string& text, const std::string& line) {  // line with i
 bool hasManifest(const std::string& dir) { return readResultFile(manifestPath(dir)).has_value(); }
 
 bool manifestNames(const std::string& dir, const std::string& name, const std::string& content) {
+  return manifestNamesHash(dir, name, sha256Hex(content));
+}
+
+bool manifestNamesHash(const std::string& dir, const std::string& name, const std::string& sha256_hex) {
   const std::optional<std::string> m = readResultFile(manifestPath(dir));
-  return m && hasLine(*m, sha256Hex(content) + "  " + name + "\n");
+  return m && hasLine(*m, sha256_hex + "  " + name + "\n");
 }
 
 void recordInManifest(const std::string& dir, const std::string& name, const std::string& content) {
-  const std::string line = sha256Hex(content) + "  " + name + "\n";
+  recordHashInManifest(dir, name, sha256Hex(content));
+}
+
+void recordHashInManifest(const std::string& dir, const std::string& name, const std::string& sha256_hex) {
+  const std::string line = sha256_hex + "  " + name + "\n";
   const std::string path = manifestPath(dir);
   if (const std::optional<std::string> m = readResultFile(path); m && hasLine(*m, line)) return;
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
@@ -123,17 +201,50 @@ void compactManifest(const std::string& dir) {
     if (l.size() < 67 || l.compare(64, 2, "  ") != 0) continue;
     const std::string name = l.substr(66);
     if (done.count(name)) continue;
-    std::optional<std::string> text;
-    try {
-      text = readResultFile((std::filesystem::path(dir) / name).string());
-    } catch (const std::exception&) {  // no longer a regular file: not named any more
-    }
-    if (text && sha256Hex(*text) == l.substr(0, 64)) {
+    // read in blocks (time_series.h5 may be larger than memory); not a regular file: not named any more
+    const std::optional<std::string> hash = sha256OfFile((std::filesystem::path(dir) / name).string());
+    if (hash && *hash == l.substr(0, 64)) {
       keep += l + "\n";
       done.insert(name);
     }
   }
   if (keep != *m) writeFileAtomic(manifestPath(dir), keep);
+}
+
+bool ownedFile(const std::string& dir, const std::string& name, const std::optional<std::string>& content,
+               const EarlierOwnFile& earlier) {
+  const std::string path = (std::filesystem::path(dir) / name).string();
+  std::optional<std::string> there;
+  try {
+    there = readResultFile(path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + " is not a regular file tailsim wrote: not replaced; move it out of " + dir);
+  }
+  if (!there || (content && *there == *content) || manifestNames(dir, name, *there)) return true;
+  if (!earlier) return false;
+  const std::optional<std::string> m = readResultFile(manifestPath(dir));
+  const bool named = m && m->find("  " + name + "\n") != std::string::npos;
+  return !named && earlier(*there);
+}
+
+void checkOwnedFile(const std::string& dir, const std::string& name, const std::optional<std::string>& content,
+                    const EarlierOwnFile& earlier) {
+  if (!ownedFile(dir, name, content, earlier))
+    throw std::runtime_error((std::filesystem::path(dir) / name).string() +
+                             " was not written by tailsim (or was changed since): not replaced; move it out of " + dir +
+                             " or choose another --out");
+}
+
+void writeOwnedFile(const std::string& dir, const std::string& name, const std::string& content,
+                    const EarlierOwnFile& earlier) {
+  checkOwnedFile(dir, name, content, earlier);
+  recordInManifest(dir, name, content);
+  writeFileAtomic((std::filesystem::path(dir) / name).string(), content);
+}
+
+void recordWrittenFile(const std::string& dir, const std::string& name) {
+  if (const std::optional<std::string> text = readResultFile((std::filesystem::path(dir) / name).string()))
+    recordInManifest(dir, name, *text);
 }
 
 namespace {

@@ -2,6 +2,7 @@
 // flush, then rename over it (rename is atomic within one filesystem).
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -31,6 +32,24 @@ bool writeUserFile(const std::string& path, const std::string& contents);
 constexpr long long kMaxResultFileBytes = 1LL << 30;
 std::optional<std::string> readResultFile(const std::string& path, long long max_bytes = kMaxResultFileBytes);
 
+// Reads a result-folder file as readResultFile does (the same checks), line by line: calls fn with
+// each complete line (without its '\n') and its number (1-based) until fn returns false, holding at
+// most max_line bytes in memory; std::nullopt when absent. A line longer than max_line:
+// std::runtime_error naming the file.
+struct LinesRead {
+  long long lines = 0;  // complete lines
+  long long whole = 0;  // their bytes, newlines included
+  long long size = 0;   // all bytes read
+  std::string tail;     // the bytes after the last newline (a torn last line)
+};
+std::optional<LinesRead> readResultFileLines(const std::string& path, size_t max_line,
+                                             const std::function<bool(const std::string& line, long long number)>& fn);
+
+// Creates DIR (and its parents) when absent; std::runtime_error naming DIR when it is a symbolic
+// link or not a directory (tailsim writes only into real folders of a result folder, never through
+// a link out of it).
+void makeResultDir(const std::string& dir);
+
 // DIR/.tailsim-manifest: the files tailsim wrote in DIR, one "<sha256>  <name>" line each
 // (sha256sum's format: `sha256sum -c .tailsim-manifest` checks them), so it replaces or deletes
 // only its own files, unchanged since it wrote them.
@@ -41,8 +60,28 @@ bool manifestNames(const std::string& dir, const std::string& name, const std::s
 // Appends "<sha256(content)>  <name>" unless there (before the file is written: whatever stops the
 // writer in between, the file holds a content the manifest names). Throws std::runtime_error.
 void recordInManifest(const std::string& dir, const std::string& name, const std::string& content);
+// The same, by the content's SHA-256 (64 hex digits): for files too large to hold in memory.
+bool manifestNamesHash(const std::string& dir, const std::string& name, const std::string& sha256_hex);
+void recordHashInManifest(const std::string& dir, const std::string& name, const std::string& sha256_hex);
 // Rewrites the manifest with one line per file that still has the content it names.
 void compactManifest(const std::string& dir);
+// Recognises a file an earlier tailsim (before manifests) wrote, by its content.
+using EarlierOwnFile = std::function<bool(const std::string& text)>;
+// Whether DIR/name is tailsim's to replace: absent, named in DIR's manifest with its current
+// content, byte-identical to `content` (when given), or, when the manifest does not name `name`
+// at all, recognised by `earlier` (when given). Throws std::runtime_error naming DIR/name when it
+// is not a regular file.
+bool ownedFile(const std::string& dir, const std::string& name, const std::optional<std::string>& content = std::nullopt,
+               const EarlierOwnFile& earlier = {});
+// Throws std::runtime_error naming DIR/name unless ownedFile(...).
+void checkOwnedFile(const std::string& dir, const std::string& name, const std::optional<std::string>& content = std::nullopt,
+                    const EarlierOwnFile& earlier = {});
+// Writes DIR/name (name relative to DIR, no '/') when it is tailsim's (checkOwnedFile), after
+// recording `content` in DIR's manifest; atomically, as writeFileAtomic.
+void writeOwnedFile(const std::string& dir, const std::string& name, const std::string& content,
+                    const EarlierOwnFile& earlier = {});
+// Records DIR/name's current content in the manifest (a file a program tailsim ran wrote).
+void recordWrittenFile(const std::string& dir, const std::string& name);
 
 // CSV with a header row of column names; numbers with 12 significant digits.
 std::string toCsv(const TimeSeries& ts);

@@ -2,8 +2,16 @@
 // standard's test vectors in tests/test_sha256.cc.
 #include "results/sha256.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
+#include <vector>
 
 namespace tailsim {
 namespace {
@@ -48,29 +56,76 @@ void compress(std::array<uint32_t, 8>& h, const unsigned char* block) {
 
 }  // namespace
 
+namespace {
+// Incremental SHA-256: blocks of 64 bytes, then the padding.
+class Sha256 {
+ public:
+  void update(const unsigned char* p, size_t n) {
+    bytes_ += n;
+    while (n > 0) {
+      const size_t take = std::min(n, size_t(64) - fill_);
+      std::memcpy(buf_ + fill_, p, take);
+      fill_ += take;
+      p += take;
+      n -= take;
+      if (fill_ == 64) {
+        compress(h_, buf_);
+        fill_ = 0;
+      }
+    }
+  }
+  std::string hex() {
+    // Padding: 0x80, zeros, the message length in bits as a 64-bit big-endian number.
+    const uint64_t bits = static_cast<uint64_t>(bytes_) * 8;
+    unsigned char pad[72] = {0x80};
+    const size_t zeros = (fill_ < 56 ? 56 - fill_ : 120 - fill_);
+    for (int i = 0; i < 8; ++i) pad[zeros + 7 - i] = static_cast<unsigned char>(bits >> (8 * i));
+    update(pad, zeros + 8);
+    static const char* hexd = "0123456789abcdef";
+    std::string out;
+    out.reserve(64);
+    for (uint32_t v : h_)
+      for (int s = 28; s >= 0; s -= 4) out += hexd[(v >> s) & 0xf];
+    return out;
+  }
+
+ private:
+  std::array<uint32_t, 8> h_ = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                                0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+  unsigned char buf_[64] = {};
+  size_t fill_ = 0;
+  size_t bytes_ = 0;
+};
+}  // namespace
+
 std::string sha256Hex(const std::string& data) {
-  std::array<uint32_t, 8> h = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
-                               0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-  const auto* p = reinterpret_cast<const unsigned char*>(data.data());
-  const size_t n = data.size();
-  size_t off = 0;
-  for (; off + 64 <= n; off += 64) compress(h, p + off);
-  // Padding: 0x80, zeros, the message length in bits as a 64-bit big-endian number.
-  unsigned char tail[128] = {};
-  const size_t rest = n - off;
-  for (size_t i = 0; i < rest; ++i) tail[i] = p[off + i];
-  tail[rest] = 0x80;
-  const size_t tail_len = rest + 1 + 8 <= 64 ? 64 : 128;
-  const uint64_t bits = static_cast<uint64_t>(n) * 8;
-  for (int i = 0; i < 8; ++i) tail[tail_len - 1 - i] = static_cast<unsigned char>(bits >> (8 * i));
-  compress(h, tail);
-  if (tail_len == 128) compress(h, tail + 64);
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  out.reserve(64);
-  for (uint32_t v : h)
-    for (int s = 28; s >= 0; s -= 4) out += hex[(v >> s) & 0xf];
-  return out;
+  Sha256 s;
+  s.update(reinterpret_cast<const unsigned char*>(data.data()), data.size());
+  return s.hex();
+}
+
+std::optional<std::string> sha256OfFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return std::nullopt;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return std::nullopt;
+  }
+  Sha256 s;
+  std::vector<unsigned char> buf(1 << 20);
+  for (;;) {
+    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      ::close(fd);
+      return std::nullopt;
+    }
+    if (n == 0) break;
+    s.update(buf.data(), static_cast<size_t>(n));
+  }
+  ::close(fd);
+  return s.hex();
 }
 
 }  // namespace tailsim

@@ -43,6 +43,10 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
     const OptimizeSpec spec = loadOptimizeSpec(exp_path);  // all errors before any work
     const FolderLock lock(out_dir);
     refuseRunResults(out_dir, "optimize");
+    claimDesignFolder(out_dir, {"summary.json", "best.yaml", "best_analytic.csv", "best_perfoot.csv", "best_mujoco.csv",
+                                "best_trajectory.csv", "history.csv", "pareto.csv", "plots/history.png",
+                                "plots/history.svg", "plots/history.gp", "plots/pareto.png", "plots/pareto.svg",
+                                "plots/pareto.gp"});
     const OptimizeReport r = runOptimize(spec, out_dir, quiet == 0);
     const std::string mujoco =
         spec.mujoco_check ? (r.mujoco.ok ? std::to_string(r.mujoco.phi_net_deg) + " deg" : std::string("failed")) : "not run";
@@ -70,6 +74,8 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
     const ManeuverSpec spec = loadManeuverSpec(exp_path);  // all errors before any work
     const FolderLock lock(out_dir);
     refuseRunResults(out_dir, "maneuver");
+    claimDesignFolder(out_dir, {"summary.json", "maneuver.csv", "strokes.csv", "yaw_map.csv", "plots/heading.png",
+                                "plots/heading.svg", "plots/heading.gp"});
     const ManeuverReport r = runManeuver(spec, out_dir, video != 0, quiet == 0);
     bool all_ok = true;
     std::printf("%s: target %.4g deg, tolerance %.4g deg; analytic cycle %+.4f deg (stroke %+.4f, return %+.4f)\n",
