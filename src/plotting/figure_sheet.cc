@@ -28,6 +28,15 @@ std::string html(const std::string& s) {
   return o;
 }
 
+
+bool under(const std::string& file, const std::string& dir) {
+  const fs::path f = fs::absolute(file).lexically_normal(), d = fs::absolute(dir).lexically_normal();
+  const std::string rel = f.lexically_relative(d).generic_string();
+  return !rel.empty() && rel.rfind("..", 0) != 0;
+}
+
+}  // namespace
+
 // Relative URL of `file` seen from `dir` (path segments percent-encoded where needed).
 std::string relUrl(const std::string& file, const std::string& dir) {
   const std::string rel = fs::absolute(file).lexically_normal().lexically_relative(fs::absolute(dir).lexically_normal()).generic_string();
@@ -44,14 +53,6 @@ std::string relUrl(const std::string& file, const std::string& dir) {
   }
   return o;
 }
-
-bool under(const std::string& file, const std::string& dir) {
-  const fs::path f = fs::absolute(file).lexically_normal(), d = fs::absolute(dir).lexically_normal();
-  const std::string rel = f.lexically_relative(d).generic_string();
-  return !rel.empty() && rel.rfind("..", 0) != 0;
-}
-
-}  // namespace
 
 std::string figureSheetPath(const std::string& dir) { return (fs::path(dir) / "figures.html").string(); }
 

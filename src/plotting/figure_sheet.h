@@ -12,6 +12,10 @@
 
 namespace tailsim {
 
+// Relative URL of `file` seen from `dir`: '/'-separated, every byte but [A-Za-z0-9/._~-] percent-encoded
+// (the figure sheet and the result page link their files with it).
+std::string relUrl(const std::string& file, const std::string& dir);
+
 // DIR/figures.html.
 std::string figureSheetPath(const std::string& dir);
 

@@ -14,6 +14,7 @@
 #include "experiments/model_registry.h"
 #include "mujoco_model/mjcf_generator.h"
 #include "mujoco_model/mujoco_handles.h"
+#include "plotting/figure_sheet.h"
 #include "plotting/result_folder.h"
 #include "plotting/result_page_assets.h"
 #include "rendering/replay.h"
@@ -97,22 +98,6 @@ std::string readFile(const std::string& path) {
   return s.str();
 }
 
-// Path of `file` relative to `dir`, '/'-separated and percent-encoded for a URL.
-std::string relUrl(const fs::path& file, const fs::path& dir) {
-  const std::string rel = fs::absolute(file).lexically_normal().lexically_relative(fs::absolute(dir).lexically_normal()).generic_string();
-  std::string o;
-  for (unsigned char c : rel) {
-    if (std::isalnum(c) || c == '/' || c == '.' || c == '_' || c == '-' || c == '~') {
-      o += static_cast<char>(c);
-    } else {
-      static const char* hex = "0123456789ABCDEF";
-      o += '%';
-      o += hex[c >> 4];
-      o += hex[c & 15];
-    }
-  }
-  return o;
-}
 
 // ---------------------------------------------------------------- geometry
 
@@ -268,7 +253,7 @@ std::vector<std::string> figuresOf(const ExperimentResults& r, const fs::path& r
   if (!fs::is_directory(plots, ec)) return out;
   for (const auto& e : fs::directory_iterator(plots, ec))
     if (e.path().extension() == ".png" && e.path().filename().string().find(".tmp.") == std::string::npos)
-      out.push_back(relUrl(e.path(), root));
+      out.push_back(relUrl(e.path().string(), root.string()));
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -345,7 +330,7 @@ std::string experimentJson(const ExperimentResults& r, int index, const fs::path
   }
   std::ostringstream o;
   o << "{\"name\":" << jsString(r.name) << ",\"description\":" << jsString(r.description)
-    << ",\"kind\":" << jsString(r.kind) << ",\"dir\":" << jsString(relUrl(r.dir, root))
+    << ",\"kind\":" << jsString(r.kind) << ",\"dir\":" << jsString(relUrl(r.dir, root.string()))
     << ",\"models\":" << modelsJson(r.models) << ",\"notes\":" << strArray(notes)
     << ",\"figures\":" << strArray(figuresOf(r, root)) << ",\"axes\":["
     << joined([&] {
