@@ -115,6 +115,9 @@ TEST_F(CrashesInsteadOfErrors, ThreadsAreBoundedBeforeAnyWork) {
 // A thread the system refuses to start (address space or process limit) is an error or fewer
 // workers, not std::terminate: run in a child with little address space left.
 TEST_F(CrashesInsteadOfErrors, ThreadCreationFailureIsNotAnAbort) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer cannot run under the address-space limit this test sets";
+#endif
   const Experiment e = loadExperiment(write("t.yaml", "name: t\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n"
                                                      "models: [analytic]\noutput: {time_series: none}\n"
                                                      "quadruped: {d_Q2B_m: {range: [0.1, 0.2, 0.0015625]}}\n"));
