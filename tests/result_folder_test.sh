@@ -23,6 +23,7 @@
 #   merge-signals   merge stopped by SIGTERM, SIGHUP or SIGINT exits 128+signal with a message and
 #                   leaves no staging folder; after a kill -9 the next merge removes the dead merge's
 #                   staging folder, and never a user's folder named like one.
+#   out-of-memory   a legal run out of memory is reported naming the case and what to change.
 # Usage: result_folder_test.sh SOURCE_DIR BINARY_DIR CLASS
 set -uo pipefail
 SRC=$1 BIN=$2 CLASS=$3
@@ -460,6 +461,25 @@ merge-signals)
   [ ! -e "$stale" ] || fail "the dead merge's staging folder $stale was not removed"
   [ "$(cat "$W/mk.merge.tmp.999999/mine.txt" 2>/dev/null)" = mine ] || fail "a user's folder named like a staging folder was deleted"
   echo "kill -9: the next merge removed the dead merge's staging folder, kept the user's"
+  ;;
+out-of-memory)
+  # A legal run (8e5 rows per run) of 2 threads under a 1.2 GB address-space limit: tailsim's own
+  # words naming the case and what to change, never a raw "std::bad_alloc".
+  cat > "$W/big.yaml" <<YAML
+name: big
+robot: paper
+tail: {links: 6}
+trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: {sweep: [0.3, 0.5]}}
+models: [analytic]
+output: {sample_dt_s: 0.000005, duration_s: 4, time_series: full, time_series_file: csv}
+YAML
+  rc=0
+  (ulimit -v 1200000; exec timeout 120 "$TAILSIM" run "$W/big.yaml" --out "$W/big" --threads 2 --quiet) > /dev/null 2> "$W/err" || rc=$?
+  no_crash $rc "$W/err" "run out of memory"
+  if [ $rc -eq 0 ]; then echo "SKIP: the run fit in 1.2 GB here"; exit 0; fi
+  grep -q "bad_alloc" "$W/err" && { cat "$W/err"; fail "out of memory reported as raw std::bad_alloc"; }
+  grep -q "out of memory while running" "$W/err" || { cat "$W/err"; fail "out of memory: no message in tailsim's words"; }
+  echo "out of memory: $(head -c 150 "$W/err")"
   ;;
 *) echo "unknown CLASS $CLASS"; exit 2 ;;
 esac

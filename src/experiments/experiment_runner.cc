@@ -24,6 +24,7 @@
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <set>
 #include <nlohmann/json.hpp>
@@ -1245,6 +1246,16 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
         failed += f;
         t.job->entries[t.i] = std::move(entry);  // distinct element per task: no lock needed
         if (inH5(t.job->e->cases[t.i])) t.job->h5_from[t.i] = kH5Part;
+      } catch (const std::bad_alloc&) {
+        // Out of memory: every case holds its series in memory while it runs; start no more.
+        stop = true;
+        std::lock_guard<std::mutex> lock(mu);
+        if (first_error.empty())
+          first_error = "case " + t.job->e->cases[t.i].name +
+                        ": out of memory while running it (each running case holds its time series in memory, one "
+                        "case per thread): use fewer --threads, raise output.sample_dt_s or set output.time_series: "
+                        "thin or none; no further case was started, the finished ones are saved (run the same "
+                        "command again to resume)";
       } catch (const std::exception& ex) {
         // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);
