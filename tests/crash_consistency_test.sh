@@ -77,8 +77,8 @@ cat "$W/final.txt" | head -1
 echo "$kills runs killed"
 
 # No temporary file survives the final run.
-if find "$W/crashed" -name '*.tmp.*' | grep -q .; then
-  echo "FAIL: temporary files left:"; find "$W/crashed" -name '*.tmp.*'; exit 1
+if find "$W/crashed" -name '*tmp.*' | grep -q .; then
+  echo "FAIL: temporary files left:"; find "$W/crashed" -name '*tmp.*'; exit 1
 fi
 # Every file equal to the fresh run's, wall times aside (JSON is written one key per line).
 for d in fresh crashed; do

@@ -5,7 +5,8 @@
 #                   libhdf5 error stack) and keeps its finished cases; a no-op resume of a finished
 #                   hdf5 folder on a nearly full disk copies nothing; merge onto a full disk and of a
 #                   truncated .h5 give an error, never a crash; the final join needs only the room
-#                   of its copy. Needs root (a tmpfs is mounted).
+#                   of its copy; plot on a full disk names the condition and leaves no partial figure.
+#                   Needs root (a tmpfs is mounted).
 #   hdf5-signals    an hdf5 sweep stopped by SIGTERM, SIGHUP, SIGINT and kill -9 resumes every case
 #                   its journal had when the signal came; cases.jsonl holds one line per finished
 #                   case after the resume. Prints the table "signal -> cases resumed".
@@ -17,7 +18,12 @@
 #                   the cases again (never a crash, never a stuck folder); merge refuses the shard.
 #   folder-files    cases.jsonl, result.json and summary.json are opened (by run and plot) only if
 #                   they are regular files: a symlink is refused (nothing written through it), a FIFO never blocks, a
-#                   huge file or /dev/zero is not read.
+#                   huge file or /dev/zero is not read; a hard-linked .tailsim.lock or cases.jsonl is
+#                   refused, the linked file never truncated.
+#   merge-signals   merge stopped by SIGTERM, SIGHUP or SIGINT exits 128+signal with a message and
+#                   leaves no staging folder; after a kill -9 the next merge removes the dead merge's
+#                   staging folder, and never a user's folder named like one.
+#   out-of-memory   a legal run out of memory is reported naming the case and what to change.
 # Usage: result_folder_test.sh SOURCE_DIR BINARY_DIR CLASS
 set -uo pipefail
 SRC=$1 BIN=$2 CLASS=$3
@@ -113,6 +119,26 @@ hdf5-disk-full)
   [ $rc -eq 0 ] || { cat "$W/e6"; fail "join on a disk with room for it (parts $(du -sb "$W/d3/o/time_series.h5.d" 2>/dev/null | cut -f1) B, $(df --output=avail -B1 "$W/d3" | tail -1) B free) exited $rc"; }
   [ -f "$W/d3/o/time_series.h5" ] && [ ! -e "$W/d3/o/time_series.h5.d" ] || fail "join: no time_series.h5, or parts left"
   echo "join: $(stat -c %s "$W/d3/o/time_series.h5") B joined on a 10.5 MB disk"
+  # plot on a full disk: a clean error naming the disk-full condition, no empty or partial figure left.
+  cat > "$W/c12.yaml" <<YAML
+name: c
+robot: paper
+tail: {links: 1}
+trajectory: {theta0_deg: 45, dtheta_deg: {sweep: [-90, -45, 45, 90]}, dT_s: 0.25, w_ss: {sweep: [0.3, 0.5, 0.7]}}
+models: [analytic]
+output: {sample_dt_s: 0.0005, time_series: thin, time_series_file: csv}
+YAML
+  small_disk "$W/d4" 2m
+  "$TAILSIM" run "$W/c12.yaml" --out "$W/d4/p" --quiet > /dev/null || fail "csv sweep for plot"
+  head -c $(( $(df --output=avail -B1 "$W/d4" | tail -1) - 150000 )) /dev/zero > "$W/d4/fill" 2>/dev/null
+  rc=0; "$TAILSIM" plot "$W/d4/p" > /dev/null 2> "$W/e6" || rc=$?
+  no_crash $rc "$W/e6" "plot on a full disk"
+  [ $rc -eq 1 ] || { cat "$W/e6"; fail "plot on a full disk exited $rc, want 1"; }
+  grep -q "No space left on device" "$W/e6" || { cat "$W/e6"; fail "plot on a full disk: no disk-full message"; }
+  bad=$(find "$W/d4/p/plots" -type f \( -size 0 -o -name '*.tmp.*' \) 2>/dev/null)
+  [ -z "$bad" ] || { ls -la "$W/d4/p/plots"; fail "plot on a full disk left empty or temporary files: $bad"; }
+  for f in "$W"/d4/p/plots/*.svg; do [ -e "$f" ] || continue; tail -c 20 "$f" | grep -q "</svg>" || fail "partial figure $f kept"; done
+  echo "plot on a full disk: $(head -c 150 "$W/e6")"
   ;;
 hdf5-signals)
   sweep big 0.001  # 901 cases
@@ -244,6 +270,18 @@ user-files)
   [ -z "$left" ] || fail "--fresh left tailsim's own figures or pages: $left"
   [ -f "$d/plots/mine.png" ] || fail "--fresh deleted the user's plots/mine.png"
   echo "optimize, maneuver, plot, report: the user's files refused; --fresh deletes tailsim's figures only"
+  # The hdf5 join deletes its own part files only: a user's file in time_series.h5.d stays, with a note.
+  sweep hj 0.3
+  mkdir -p "$W/hj/time_series.h5.d" && echo mine > "$W/hj/time_series.h5.d/mine.txt"
+  "$TAILSIM" run "$W/hj.yaml" --out "$W/hj" --quiet > /dev/null 2> "$W/err" || { cat "$W/err"; fail "hdf5 run beside a user's file"; }
+  [ "$(cat "$W/hj/time_series.h5.d/mine.txt" 2>/dev/null)" = mine ] || fail "the hdf5 join deleted the user's time_series.h5.d/mine.txt"
+  grep -q "mine.txt" "$W/err" || { cat "$W/err"; fail "the hdf5 join kept mine.txt without a note"; }
+  left=$(ls "$W/hj/time_series.h5.d" | grep -v '^mine.txt$' || true)
+  [ -z "$left" ] || fail "the hdf5 join left its own parts: $left"
+  sweep hk 0.3
+  "$TAILSIM" run "$W/hk.yaml" --out "$W/hk" --quiet > /dev/null || fail "hdf5 run"
+  [ ! -e "$W/hk/time_series.h5.d" ] || fail "the hdf5 join left time_series.h5.d with only its own files in it"
+  echo "hdf5 join: its own parts deleted, the user's time_series.h5.d/mine.txt kept with a note"
   ;;
 hdf5-damaged)
   # Random bytes (seeded) written into a finished folder's time_series.h5: the resume never crashes
@@ -328,6 +366,16 @@ YAML
   mkdir -p "$W/o1" && echo "precious" > "$W/outside.txt" && ln -s "$W/outside.txt" "$W/o1/cases.jsonl"
   refused "cases.jsonl -> a file outside --out" cases.jsonl "$W/n.yaml" o1
   [ "$(cat "$W/outside.txt")" = precious ] || fail "written through the cases.jsonl symlink"
+  # A hard link to a file outside --out as .tailsim.lock or as a cases.jsonl with a torn last line:
+  # refused naming it, the linked file unchanged (never truncated).
+  mkdir -p "$W/hl1" && echo "precious data" > "$W/precious1.txt" && ln "$W/precious1.txt" "$W/hl1/.tailsim.lock"
+  refused "hard-linked .tailsim.lock" "tailsim.lock.*hard link" "$W/n.yaml" hl1
+  [ "$(cat "$W/precious1.txt")" = "precious data" ] || fail "the hard-linked .tailsim.lock's file was changed"
+  mkdir -p "$W/hl2" && "$TAILSIM" run "$W/n.yaml" --out "$W/hl2" --quiet > /dev/null || fail "run into hl2"
+  printf '%s\nprecious tail without newline' "$(head -1 "$W/hl2/cases.jsonl")" > "$W/precious2.txt"
+  cp "$W/precious2.txt" "$W/precious2.orig" && rm "$W/hl2/cases.jsonl" && ln "$W/precious2.txt" "$W/hl2/cases.jsonl"
+  refused "hard-linked cases.jsonl" "cases.jsonl.*hard link" "$W/n.yaml" hl2
+  cmp -s "$W/precious2.txt" "$W/precious2.orig" || fail "the hard-linked cases.jsonl's file was changed"
   # a FIFO: never blocks; /dev/zero (through a symlink) and a 2 GiB file: never read.
   mkdir -p "$W/o2" && mkfifo "$W/o2/cases.jsonl"
   refused "cases.jsonl a FIFO" cases.jsonl "$W/n.yaml" o2
@@ -382,6 +430,62 @@ YAML
   link_refused "time_series.h5.d -> a folder outside --out" time_series.h5.d "$W/h.yaml"
   link_refused "cases/w_ss=0.6 -> a folder outside --out" "cases/w_ss=0.6" "$W/f.yaml"
   link_refused "plots -> a folder outside --out (run --plot)" plots "$W/f.yaml" --plot
+  ;;
+merge-signals)
+  sweep s 0.005  # 181 cases
+  for k in 1 2; do "$TAILSIM" run "$W/s.yaml" --out "$W/shard$k" --shard $k/2 --quiet > /dev/null || fail "shard $k"; done
+  start_merge() {  # start_merge OUT: a merge into OUT, returns once its staging folder exists (pid in $mpid)
+    "$TAILSIM" merge "$W/shard1" "$W/shard2" --out "$1" --threads 1 > /dev/null 2> "$1.err" &
+    mpid=$!
+    for _ in $(seq 1 2000); do
+      [ -d "$1.merge.tmp.$mpid" ] && return 0
+      kill -0 $mpid 2>/dev/null || break
+      sleep 0.005
+    done
+    fail "merge into $1: no staging folder seen"
+  }
+  for sig in TERM HUP INT; do
+    start_merge "$W/m_$sig"
+    kill -s $sig $mpid
+    rc=0; wait $mpid || rc=$?
+    want=$(( 128 + $(kill -l $sig) ))
+    [ $rc -eq $want ] || { cat "$W/m_$sig.err"; fail "merge stopped by SIG$sig exited $rc, want $want"; }
+    grep -q "interrupted" "$W/m_$sig.err" || { cat "$W/m_$sig.err"; fail "merge stopped by SIG$sig: no message"; }
+    left=$(ls -d "$W"/m_$sig.merge.tmp.* 2>/dev/null)
+    [ -z "$left" ] || fail "merge stopped by SIG$sig left its staging folder $left"
+    [ ! -e "$W/m_$sig" ] || [ -z "$(ls -A "$W/m_$sig")" ] || fail "merge stopped by SIG$sig wrote $W/m_$sig"
+    echo "merge stopped by SIG$sig: exit $rc, $(head -c 100 "$W/m_$sig.err")"
+  done
+  # kill -9: the staging folder stays; the next merge removes it (its pid is dead, its manifest marks
+  # it as tailsim's) and keeps a user's folder named like one.
+  start_merge "$W/mk"
+  kill -9 $mpid; wait $mpid 2>/dev/null
+  stale="$W/mk.merge.tmp.$mpid"
+  [ -d "$stale" ] || fail "kill -9: no staging folder to clean (the test needs one)"
+  mkdir -p "$W/mk.merge.tmp.999999" && echo mine > "$W/mk.merge.tmp.999999/mine.txt"
+  "$TAILSIM" merge "$W/shard1" "$W/shard2" --out "$W/mk" > /dev/null 2> "$W/mk.err2" || { cat "$W/mk.err2"; fail "merge after kill -9"; }
+  [ ! -e "$stale" ] || fail "the dead merge's staging folder $stale was not removed"
+  [ "$(cat "$W/mk.merge.tmp.999999/mine.txt" 2>/dev/null)" = mine ] || fail "a user's folder named like a staging folder was deleted"
+  echo "kill -9: the next merge removed the dead merge's staging folder, kept the user's"
+  ;;
+out-of-memory)
+  # A legal run (8e5 rows per run) of 2 threads under a 1.2 GB address-space limit: tailsim's own
+  # words naming the case and what to change, never a raw "std::bad_alloc".
+  cat > "$W/big.yaml" <<YAML
+name: big
+robot: paper
+tail: {links: 6}
+trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: {sweep: [0.3, 0.5]}}
+models: [analytic]
+output: {sample_dt_s: 0.000005, duration_s: 4, time_series: full, time_series_file: csv}
+YAML
+  rc=0
+  (ulimit -v 1200000; exec timeout 120 "$TAILSIM" run "$W/big.yaml" --out "$W/big" --threads 2 --quiet) > /dev/null 2> "$W/err" || rc=$?
+  no_crash $rc "$W/err" "run out of memory"
+  if [ $rc -eq 0 ]; then echo "SKIP: the run fit in 1.2 GB here"; exit 0; fi
+  grep -q "bad_alloc" "$W/err" && { cat "$W/err"; fail "out of memory reported as raw std::bad_alloc"; }
+  grep -q "out of memory while running" "$W/err" || { cat "$W/err"; fail "out of memory: no message in tailsim's words"; }
+  echo "out of memory: $(head -c 150 "$W/err")"
   ;;
 *) echo "unknown CLASS $CLASS"; exit 2 ;;
 esac

@@ -75,7 +75,7 @@ TEST(ExperimentRunner, InterruptedSweepResumesWithEveryCaseOnce) {
   EXPECT_EQ(sum["cases"].size(), 9u);
   // No temporary files left behind.
   for (const auto& f : fs::recursive_directory_iterator(dir / "out"))
-    EXPECT_EQ(f.path().string().find(".tmp."), std::string::npos) << f.path();
+    EXPECT_EQ(f.path().string().find(".tailsim-tmp."), std::string::npos) << f.path();
 }
 
 TEST(ExperimentRunner, ResultsDoNotDependOnThreadCount) {
@@ -376,13 +376,35 @@ TEST(ExperimentRunner, Finding11_KilledRunTemporariesAreCleaned) {
   const std::string dead = std::to_string(child), live = std::to_string(::getppid());
   const fs::path out = dir / "out", c = out / "cases" / "w_ss=0.2";
   fs::create_directories(out / "renders");
-  const std::vector<fs::path> stale = {c / ("analytic.csv.tmp." + dead), c / ("result.json.tmp." + dead + ".7"),
-                                       out / ("summary.json.tmp." + dead + ".0"),
-                                       out / "renders" / ("w_ss=0.2.tmp." + dead + ".3.mp4")};
-  const std::vector<fs::path> kept = {c / ("analytic.csv.tmp." + live), out / "notes.tmp.txt", out / "mine.tmp"};
+  const std::vector<fs::path> stale = {c / ("analytic.csv.tailsim-tmp." + dead), c / ("result.json.tailsim-tmp." + dead + ".7"),
+                                       out / ("summary.json.tailsim-tmp." + dead + ".0"),
+                                       out / "renders" / ("w_ss=0.2.tailsim-tmp." + dead + ".3.mp4")};
+  const std::vector<fs::path> kept = {c / ("analytic.csv.tailsim-tmp." + live), out / "notes.tmp.txt", out / "mine.tmp"};
   for (const auto& p : stale) std::ofstream(p) << "partial";
   for (const auto& p : kept) std::ofstream(p) << "keep";
   EXPECT_EQ(runExperiment(e, o).resumed, 2);
   for (const auto& p : stale) EXPECT_FALSE(fs::exists(p)) << p;
   for (const auto& p : kept) EXPECT_TRUE(fs::exists(p)) << p;
+}
+
+// A user's file named like a temporary of a dead process but without tailsim's infix
+// ("<name>.tmp.<pid>...") is not tailsim's: a run keeps it.
+TEST(UserFiles, TempLookalikesOfDeadPidsAreKept) {
+  const fs::path dir = tempDir("f19");
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  const Experiment e = loadExperiment(writeSweep(dir, "{sweep: [0.2, 0.3]}").string());
+  runExperiment(e, o);
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);  // a pid that is no longer running
+  const std::string dead = std::to_string(child);
+  const fs::path out = dir / "out";
+  fs::create_directories(out / "plots");
+  const std::vector<fs::path> mine = {out / ("notes.tmp." + dead + ".txt"), out / "plots" / ("fig.tmp." + dead + ".png"),
+                                      out / "cases" / "w_ss=0.2" / ("draft.tmp." + dead)};
+  for (const auto& p : mine) std::ofstream(p) << "mine";
+  EXPECT_EQ(runExperiment(e, o).resumed, 2);
+  for (const auto& p : mine) EXPECT_TRUE(fs::exists(p)) << p;
 }

@@ -141,7 +141,7 @@ TEST(TimeSeriesH5, WrittenFileReadsBackTheSameColumnsWithUnits) {
     w.publish();
   }
   ASSERT_TRUE(fs::exists(path));
-  for (const auto& f : fs::directory_iterator(dir)) EXPECT_EQ(f.path().string().find(".tmp."), std::string::npos);
+  for (const auto& f : fs::directory_iterator(dir)) EXPECT_EQ(f.path().string().find(".tailsim-tmp."), std::string::npos);
   const TimeSeriesH5Reader in(path);
   ASSERT_TRUE(in.ok());
   EXPECT_TRUE(in.hasCase("w_ss=0.25", "KEY1", {"analytic"}));

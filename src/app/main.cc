@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <set>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -458,6 +459,12 @@ int main(int argc, char** argv) {
     }
     if (*merge) {
       const MergeStats m = mergeShards(merge_dirs, merge_out, threads, allow_other_build);
+      if (m.stop_signal > 0) {
+        const char* name = m.stop_signal == SIGTERM ? "SIGTERM" : m.stop_signal == SIGHUP ? "SIGHUP" : "Ctrl-C";
+        std::fprintf(stderr, "interrupted by %s: merge stopped, nothing written to %s; run the same command again\n", name,
+                     merge_out.c_str());
+        return 128 + m.stop_signal;
+      }
       std::printf("merged %d shards: %d cases, %d files into %s\n", m.shards, m.cases, m.files_copied, merge_out.c_str());
       return kExitOk;
     }

@@ -24,6 +24,7 @@
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <set>
 #include <nlohmann/json.hpp>
@@ -208,10 +209,12 @@ class CaseJournal {
       fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
       if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + path_.string());
       struct stat st {};
-      if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
+      if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode) || st.st_nlink > 1) {
+        const bool linked = S_ISREG(st.st_mode) && st.st_nlink > 1;
         ::close(fd_);
         fd_ = -1;
-        throw std::runtime_error(path_.string() + " is not a regular file: not written");
+        throw std::runtime_error(path_.string() + (linked ? " has other hard links (the same file elsewhere): not written"
+                                                          : " is not a regular file: not written"));
       }
     }
     size_t done = 0;
@@ -280,6 +283,9 @@ std::map<std::string, std::string> readJournal(const fs::path& p, bool repair) {
   if (!read->tail.empty()) {
     if (read->lines == 0 && read->tail.compare(0, 2, "{\"") != 0) throw notOurs("does not start with a case entry of tailsim");
     if (repair) {
+      struct stat st {};
+      if (::lstat(p.c_str(), &st) == 0 && st.st_nlink > 1)
+        throw notOurs("has other hard links (the same file elsewhere)");
       std::error_code ec;
       fs::resize_file(p, static_cast<uintmax_t>(read->whole), ec);
     }
@@ -341,6 +347,13 @@ FolderLock::FolderLock(const std::string& dir_text) {
   const fs::path p = dir / ".tailsim.lock";
   fd_ = ::open(p.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
   if (fd_ < 0) throw std::runtime_error("cannot open " + p.string() + ": " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode) || st.st_nlink > 1) {
+    ::close(fd_);
+    throw std::runtime_error(p.string() + (S_ISREG(st.st_mode) ? " has other hard links (the same file elsewhere)"
+                                                                 : " is not a regular file") +
+                             ": tailsim writes its lock only into a file of its own (remove it)");
+  }
   if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
     char buf[32] = {};
@@ -565,7 +578,7 @@ void clearResultFolder(const fs::path& root) {
     if (own) fs::remove(p, ec);
     else kept.push_back(p.string());
   };
-  const auto isTemp = [](const std::string& n) { return n.find(".tmp.") != std::string::npos; };
+  const auto isTemp = [](const std::string& n) { return n.find(".tailsim-tmp.") != std::string::npos; };
   // Folders: delete tailsim's files in them, then the folder if it is empty.
   const auto clearDir = [&](const fs::path& dir, const std::function<bool(const std::string&)>& own) {
     if (!fs::is_directory(fs::symlink_status(dir, ec))) {
@@ -711,16 +724,18 @@ void claimSuiteFolder(const fs::path& root, bool fresh) {
   clearResultFolder(root);
 }
 
-// Temporary files of an earlier run that was killed: "<name>.tmp.<pid>[.<k>][.<ext>]" (atomic
-// writes, renders), removed when their pid is no longer running (the run lock already excludes
-// a concurrent run; this also spares a concurrent `tailsim plot` or `render`). Only in the
-// folders tailsim writes: DIR, DIR/cases/*, DIR/renders, DIR/plots.
+// Temporary files of an earlier run that was killed: "<name>.tailsim-tmp.<pid>[.<k>][.<ext>]"
+// (atomic writes, renders, figures, HDF5 parts; the infix is tailsim's alone), removed when their
+// pid is no longer running (the run lock already excludes a concurrent run; this also spares a
+// concurrent `tailsim plot` or `render`). Only in the folders tailsim writes: DIR, DIR/cases/*,
+// DIR/renders, DIR/plots, DIR/time_series.h5.d. A file named "<name>.tmp.<pid>..." without the
+// infix is a user's: kept, with a note.
 int removeStaleTemps(const fs::path& root) {
-  // The pid of "<name>.tmp.<pid>[.<k>][.<ext>]" (1-10 digits), or -1 when n is not such a name.
-  auto tempPid = [](const std::string& n) -> long {
-    const size_t at = n.rfind(".tmp.");
+  // The pid of "<name><infix><pid>[.<k>][.<ext>]" (1-10 digits), or -1 when n is not such a name.
+  auto tempPid = [](const std::string& n, const std::string& infix) -> long {
+    const size_t at = n.rfind(infix);
     if (at == std::string::npos || at == 0) return -1;
-    size_t i = at + 5, digits = 0;
+    size_t i = at + infix.size(), digits = 0;
     long pid = 0;
     for (; i < n.size() && std::isdigit(static_cast<unsigned char>(n[i])) && digits <= 10; ++i, ++digits)
       pid = pid * 10 + (n[i] - '0');
@@ -740,8 +755,14 @@ int removeStaleTemps(const fs::path& root) {
     for (const auto& f : fs::directory_iterator(dir, ec)) {
       const std::string n = f.path().filename().string();
       if (!f.is_regular_file(ec)) continue;
-      const long pid = tempPid(n);
-      if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) continue;
+      const long pid = tempPid(n, ".tailsim-tmp.");
+      if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) {
+        const long other = tempPid(n, ".tmp.");
+        if (other > 0 && other <= std::numeric_limits<pid_t>::max() && ::kill(static_cast<pid_t>(other), 0) != 0 &&
+            errno == ESRCH)
+          std::fprintf(stderr, "note: kept %s (named like a temporary file, but not one of tailsim's)\n", f.path().string().c_str());
+        continue;
+      }
       const bool dead = ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
       if ((dead || pid == ::getpid()) && fs::remove(f.path(), ec)) ++removed;
     }
@@ -1014,8 +1035,35 @@ ResultsCsvInput tableInput(const Job& job) {
           &job.extra_names};
 }
 
+// Removes the part files DIR/time_series.h5.d's manifest names with their current content, then
+// the manifest and the folder if nothing else is left in it; anything else (a user's file, a part
+// changed since) stays, with a note.
+void removeH5Parts(const fs::path& parts) {
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(parts, ec))) return;
+  std::vector<fs::path> own;
+  std::vector<std::string> kept;
+  for (const auto& f : fs::directory_iterator(parts, ec)) {
+    const std::string n = f.path().filename().string();
+    if (n == ".tailsim-manifest") continue;
+    std::optional<std::string> hash;
+    if (f.is_regular_file(ec) && !f.is_symlink(ec) && n.size() > 3 && n.compare(n.size() - 3, 3, ".h5") == 0)
+      hash = sha256OfFile(f.path().string());
+    if (hash && manifestNamesHash(parts.string(), n, *hash)) own.push_back(f.path());
+    else kept.push_back(f.path().string());
+  }
+  for (const fs::path& p : own) fs::remove(p, ec);
+  if (kept.empty()) {
+    fs::remove(parts / ".tailsim-manifest", ec);
+    fs::remove(parts, ec);
+    return;
+  }
+  compactManifest(parts.string());
+  for (const std::string& k : kept) std::fprintf(stderr, "note: kept %s (not written by tailsim)\n", k.c_str());
+}
+
 // DIR/time_series.h5 from the published file's groups and the finished cases' files of their own
-// (DIR/time_series.h5.d), which are then removed. When the published file already holds exactly
+// (DIR/time_series.h5.d), which are then removed (removeH5Parts). When the published file already holds exactly
 // the finished cases it is left as it is (a resume that ran nothing copies nothing).
 void publishTimeSeriesH5(Job& job) {
   std::vector<size_t> from_published, from_parts;
@@ -1027,7 +1075,7 @@ void publishTimeSeriesH5(Job& job) {
   std::error_code ec;
   if (from_parts.empty() && job.published && job.published->ok() &&
       job.published->caseDirs().size() == from_published.size()) {
-    fs::remove_all(parts, ec);
+    removeH5Parts(parts);
     return;
   }
   {
@@ -1052,7 +1100,7 @@ void publishTimeSeriesH5(Job& job) {
   const std::optional<std::string> hash = sha256OfFile((job.root / "time_series.h5").string());
   if (!hash) throw std::runtime_error("cannot read back " + (job.root / "time_series.h5").string());
   recordHashInManifest(job.root.string(), "time_series.h5", *hash);
-  fs::remove_all(parts, ec);
+  removeH5Parts(parts);
 }
 
 // Writes DIR/summary.json and DIR/results.csv (from the same entries: every finished case,
@@ -1198,6 +1246,16 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
         failed += f;
         t.job->entries[t.i] = std::move(entry);  // distinct element per task: no lock needed
         if (inH5(t.job->e->cases[t.i])) t.job->h5_from[t.i] = kH5Part;
+      } catch (const std::bad_alloc&) {
+        // Out of memory: every case holds its series in memory while it runs; start no more.
+        stop = true;
+        std::lock_guard<std::mutex> lock(mu);
+        if (first_error.empty())
+          first_error = "case " + t.job->e->cases[t.i].name +
+                        ": out of memory while running it (each running case holds its time series in memory, one "
+                        "case per thread): use fewer --threads, raise output.sample_dt_s or set output.time_series: "
+                        "thin or none; no further case was started, the finished ones are saved (run the same "
+                        "command again to resume)";
       } catch (const std::exception& ex) {
         // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);

@@ -8,8 +8,11 @@
 #include <fstream>
 #include <numeric>
 #include <set>
+#include <csignal>
+#include <ctime>
 #include <sstream>
 #include <stdexcept>
+#include <signal.h>
 #include <unistd.h>
 
 #include "experiments/experiment_runner.h"
@@ -95,7 +98,7 @@ bool rebuiltOrTransient(const fs::path& rel) {
   if (n == ".tailsim.lock" || n == ".tailsim-manifest" || n == "summary.json" || n == "results.csv" || n == "report.md" ||
       n == "figures.html")
     return true;
-  if (n.find(".tmp.") != std::string::npos) return true;  // an interrupted writer's temporary
+  if (n.find(".tmp.") != std::string::npos || n.find(".tailsim-tmp.") != std::string::npos) return true;  // an interrupted writer's temporary
   for (const auto& part : rel)
     if (part == "plots") return true;
   return false;
@@ -152,6 +155,71 @@ void requireIntactH5(const fs::path& file, const std::string& shard) {
 }
 }  // namespace
 
+namespace {
+// The file that marks a folder as a merge's staging folder, named in its manifest with this content.
+const char* const kStageMarker = ".tailsim-merge-stage";
+const char* const kStageMarkerText = "tailsim merge staging folder\n";
+
+// SIGINT, SIGTERM and SIGHUP blocked for the merge (its worker threads and children inherit the
+// mask) and read between files: the merge stops cleanly and removes its staging folder. The
+// caller's mask is restored on exit, and a signal still pending is taken so it does not kill the
+// process after the merge has answered for it.
+class StopSignals {
+ public:
+  StopSignals() {
+    sigemptyset(&set_);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set_, sig);
+    pthread_sigmask(SIG_BLOCK, &set_, &old_);
+  }
+  ~StopSignals() {
+    pending();
+    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+  // The first stop signal received so far (0: none).
+  int pending() {
+    const timespec zero{0, 0};
+    for (;;) {
+      const int sig = ::sigtimedwait(&set_, nullptr, &zero);
+      if (sig > 0) {
+        if (first_ == 0) first_ = sig;
+        continue;
+      }
+      if (errno != EINTR) return first_;
+    }
+  }
+
+ private:
+  sigset_t set_{}, old_{};
+  int first_ = 0;
+};
+
+struct MergeStopped {
+  int sig;
+};
+
+// Removes OUT.merge.tmp.<pid> folders beside OUT whose pid is no running process and that the
+// marker in their manifest shows to be a merge's staging folder; anything else is left alone.
+void removeStaleStages(const fs::path& out) {
+  std::error_code ec;
+  const std::string prefix = out.filename().string() + ".merge.tmp.";
+  for (auto it = fs::directory_iterator(out.parent_path(), ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string n = it->path().filename().string();
+    if (n.size() <= prefix.size() || n.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = n.substr(prefix.size());
+    if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::atol(digits.c_str()));
+    if (pid <= 0 || pid == ::getpid() || !(::kill(pid, 0) < 0 && errno == ESRCH)) continue;
+    std::error_code e2;
+    if (it->is_symlink(e2) || !it->is_directory(e2)) continue;
+    if (!manifestNames(it->path().string(), kStageMarker, kStageMarkerText)) continue;
+    fs::remove_all(it->path(), e2);
+  }
+}
+}  // namespace
+
 MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
                        bool allow_other_build) {
   if (shard_dirs.empty()) throw std::runtime_error("merge: no shard folders given");
@@ -174,10 +242,17 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
       throw std::runtime_error("merge: " + d + "/experiment.yaml differs from " + shard_dirs.front() +
                                "/experiment.yaml: the shards are not of the same run");
   }
+  StopSignals signals;
+  removeStaleStages(out);
   const fs::path stage = out.parent_path() / (out.filename().string() + ".merge.tmp." + std::to_string(::getpid()));
   fs::remove_all(stage, ec);
+  auto checkStop = [&signals]() {
+    if (const int sig = signals.pending()) throw MergeStopped{sig};
+  };
   try {
     fs::create_directories(stage);
+    recordInManifest(stage.string(), kStageMarker, kStageMarkerText);
+    writeFileAtomic((stage / kStageMarker).string(), kStageMarkerText);
     std::vector<fs::path> taken_cases;
     std::map<fs::path, std::string> taken_by;  // case folder -> the shard folder it was taken from
     std::map<std::string, std::pair<std::string, std::string>> journal_lines;  // name -> {line, shard}
@@ -186,6 +261,7 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
       const fs::path root(d);
       std::vector<fs::path> this_shard_cases;
       for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
+        checkStop();
         if (!it->is_regular_file()) continue;
         const fs::path rel = it->path().lexically_relative(root);
         if (rebuiltOrTransient(rel)) continue;
@@ -265,12 +341,19 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
       }
       return out_dir;
     };
+    checkStop();
     const RunStats rs = runSuite(suite, o);
     st.cases = rs.total;
+    checkStop();
     fs::remove(stage / ".tailsim.lock", ec);
     for (const Experiment& e : suite) fs::remove(stage / e.name / ".tailsim.lock", ec);
+    fs::remove(stage / kStageMarker);
+    compactManifest(stage.string());
     if (fs::exists(out, ec)) fs::remove(out);  // empty (checked above)
     fs::rename(stage, out);
+  } catch (const MergeStopped& m) {
+    fs::remove_all(stage, ec);
+    st.stop_signal = m.sig;
   } catch (...) {
     fs::remove_all(stage, ec);
     throw;

@@ -39,6 +39,7 @@ std::vector<std::vector<char>> shardMembership(const std::vector<Experiment>& su
 // Fails (nothing at DIR) when the shards come from different inputs or a case is in none of them.
 struct MergeStats {
   int shards = 0, cases = 0, files_copied = 0;
+  int stop_signal = 0;  // SIGINT, SIGTERM or SIGHUP stopped the merge: nothing written to --out (0: none)
 };
 MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
                        bool allow_other_build = false);

@@ -392,7 +392,7 @@ TimeSeries TimeSeriesH5Reader::read(const std::string& case_dir, const std::stri
 
 TimeSeriesH5Writer::TimeSeriesH5Writer(const std::string& final_path, H5Storage storage, long long reserve_bytes)
     : final_path_(final_path), storage_(storage) {
-  temp_path_ = final_path + ".tmp." + std::to_string(::getpid()) + ".h5";
+  temp_path_ = final_path + ".tailsim-tmp." + std::to_string(::getpid()) + ".h5";
   if (storage == H5Storage::kMemory) {
     // The core driver: the file is built in memory and written out by publish() (writeImage).
     const H5Handle fapl(h5().H5Pcreate(h5().file_access()), h5().H5Pclose);

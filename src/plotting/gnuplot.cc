@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <cstring>
 #include <stdexcept>
@@ -67,18 +69,41 @@ int runGnuplot(const fs::path& dir, const std::string& script, const fs::path& l
   return status;
 }
 
-std::string terminalBlock(const GnuplotFigure& f, bool png) {
+// Whether a figure gnuplot wrote is whole: a PNG ends with its IEND chunk, an SVG with </svg>.
+bool wholeFigure(const fs::path& p, bool png) {
+  std::optional<std::string> text;
+  try {
+    text = readResultFile(p.string());
+  } catch (const std::exception&) {
+    return false;
+  }
+  if (!text) return false;
+  if (png) {
+    static const std::string iend("\0\0\0\0IEND\xae\x42\x60\x82", 12);
+    return text->size() > iend.size() && text->compare(text->size() - iend.size(), iend.size(), iend) == 0;
+  }
+  const size_t end = text->rfind("</svg>");
+  return end != std::string::npos && text->find_first_not_of(" \r\n", end + 6) == std::string::npos;
+}
+
+// Whether the file system holding dir has no room left for a file (the reason a figure is not whole).
+bool diskFull(const fs::path& dir) {
+  struct statvfs v {};
+  return ::statvfs(dir.c_str(), &v) == 0 && static_cast<unsigned long long>(v.f_bavail) * v.f_frsize < (256u << 10);
+}
+
+std::string terminalBlock(const GnuplotFigure& f, bool png, const std::string& out_stem) {
   std::ostringstream o;
   char scale[48] = "";
   if (f.font_scale > 0 && f.font_scale != 1.0) std::snprintf(scale, sizeof scale, " fontscale %.3g", f.font_scale);
   if (png)
     o << "set terminal pngcairo enhanced size " << f.width_px << "," << f.height_px
       << " font 'Sans,15'" << scale << " linewidth 2\n"
-      << "set output " << gpFileName(f.stem + ".png") << "\n";
+      << "set output " << gpFileName(out_stem + ".png") << "\n";
   else
     o << "set terminal svg enhanced size " << f.width_px << "," << f.height_px
       << " font 'Sans,15'" << scale << " linewidth 2 background rgb 'white'\n"
-      << "set output " << gpFileName(f.stem + ".svg") << "\n";
+      << "set output " << gpFileName(out_stem + ".svg") << "\n";
   o << f.body << "\nunset output\n";
   return o.str();
 }
@@ -116,9 +141,12 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
   std::string comment_stem = fig.stem;  // a line break in the comment would start a command
   for (char& c : comment_stem)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == '\\') c = '_';
-  const std::string script = "# " + comment_stem + ": written by tailsim plot; rerun with `gnuplot " + comment_stem +
-                             ".gp` in this folder\nset encoding utf8\nset datafile missing 'NaN'\n" +
-                             terminalBlock(fig, true) + terminalBlock(fig, false);
+  const std::string preamble = "# " + comment_stem + ": written by tailsim plot; rerun with `gnuplot " + comment_stem +
+                               ".gp` in this folder\nset encoding utf8\nset datafile missing 'NaN'\n";
+  const std::string script = preamble + terminalBlock(fig, true, fig.stem) + terminalBlock(fig, false, fig.stem);
+  // gnuplot runs a copy that writes the figures under temporary names; each is renamed into place
+  // when whole, so a full disk or a killed gnuplot never leaves a partial figure.
+  const std::string temp_stem = fig.stem + ".tailsim-tmp." + std::to_string(::getpid());
   // The script, its log and figures are replaced only when tailsim wrote them (DIR's manifest);
   // beside a script of an earlier tailsim (no manifest line for it), its figures are taken as tailsim's.
   const std::string header = "# " + comment_stem + ": written by tailsim plot";
@@ -133,8 +161,20 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
   for (const char* ext : {".png", ".svg", ".log"}) checkOwnedFile(dir.string(), fig.stem + ext, std::nullopt, ours);
   writeOwnedFile(dir.string(), fig.stem + ".gp", script, ours);
   const fs::path log = dir / (fig.stem + ".log");
-  const int status = runGnuplot(dir, "./" + fig.stem + ".gp", log);  // "./": gnuplot runs an argument starting with '<' as a command
-  for (const char* ext : {".png", ".svg", ".log"}) recordWrittenFile(dir.string(), fig.stem + ext);
+  writeFileAtomic((dir / (temp_stem + ".gp")).string(),
+                  preamble + terminalBlock(fig, true, temp_stem) + terminalBlock(fig, false, temp_stem));
+  const auto removeTemps = [&dir, &temp_stem]() {
+    std::error_code ec;
+    for (const char* ext : {".gp", ".png", ".svg"}) fs::remove(dir / (temp_stem + ext), ec);
+  };
+  int status = 0;
+  try {
+    status = runGnuplot(dir, "./" + temp_stem + ".gp", log);  // "./": gnuplot runs an argument starting with '<' as a command
+  } catch (...) {
+    removeTemps();
+    throw;
+  }
+  recordWrittenFile(dir.string(), fig.stem + ".log");
   std::string err;
   {
     std::ifstream in(log);
@@ -142,16 +182,29 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
     ss << in.rdbuf();
     err = ss.str();
   }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw std::runtime_error("gnuplot failed on " + (user_dir / (fig.stem + ".gp")).string() +
-                             (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
-                                                : std::string(" (killed by a signal)")) +
-                             ":\n" + err);
-  for (const char* ext : {".png", ".svg"}) {
-    const fs::path p = user_dir / (fig.stem + ext);
-    if (!fs::exists(dir / p.filename()) || fs::file_size(dir / p.filename()) == 0)
-      throw std::runtime_error("gnuplot wrote no " + p.string() + ":\n" + err);
+  std::string missing;  // the first figure that is not whole
+  for (const char* ext : {".png", ".svg"})
+    if (missing.empty() && !wholeFigure(dir / (temp_stem + ext), ext[1] == 'p')) missing = (user_dir / (fig.stem + ext)).string();
+  const bool failed = !WIFEXITED(status) || WEXITSTATUS(status) != 0;
+  if (!missing.empty() || failed) {
+    removeTemps();
+    std::error_code ec;
+    if (err.empty()) fs::remove(log, ec);  // nothing to read in it
+    if (!missing.empty() && diskFull(dir))
+      throw std::runtime_error("cannot write " + missing + ": No space left on device (the figure is not whole; nothing kept)");
+    if (failed)
+      throw std::runtime_error("gnuplot failed on " + (user_dir / (fig.stem + ".gp")).string() +
+                               (WIFEXITED(status) ? " (exit " + std::to_string(WEXITSTATUS(status)) + ")"
+                                                  : std::string(" (killed by a signal)")) +
+                               ":\n" + err);
+    throw std::runtime_error("gnuplot wrote no whole " + missing + ":\n" + err);
   }
+  for (const char* ext : {".png", ".svg"}) {  // named in the manifest before it is there
+    const std::optional<std::string> text = readResultFile((dir / (temp_stem + ext)).string());
+    if (text) recordInManifest(dir.string(), fig.stem + ext, *text);
+    fs::rename(dir / (temp_stem + ext), dir / (fig.stem + ext));
+  }
+  removeTemps();
   if (err.empty()) fs::remove(log);
   return (user_dir / (fig.stem + ".png")).string();
 }

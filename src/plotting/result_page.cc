@@ -252,7 +252,8 @@ std::vector<std::string> figuresOf(const ExperimentResults& r, const fs::path& r
   std::error_code ec;
   if (!fs::is_directory(plots, ec)) return out;
   for (const auto& e : fs::directory_iterator(plots, ec))
-    if (e.path().extension() == ".png" && e.path().filename().string().find(".tmp.") == std::string::npos)
+    if (e.path().extension() == ".png" && e.path().filename().string().find(".tmp.") == std::string::npos &&
+        e.path().filename().string().find(".tailsim-tmp.") == std::string::npos)
       out.push_back(relUrl(e.path().string(), root.string()));
   std::sort(out.begin(), out.end());
   return out;

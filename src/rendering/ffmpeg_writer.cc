@@ -29,7 +29,7 @@ bool isExecutableFile(const std::string& p) {
   return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0;
 }
 
-// Temporary name beside the target, keeping the extension: dir/name.tmp.<pid>.<k>.ext
+// Temporary name beside the target, keeping the extension: dir/name.tailsim-tmp.<pid>.<k>.ext
 std::string tempNameFor(const std::string& final_path) {
   static std::atomic<int> counter{0};  // unique within the process (several sinks at once)
   const size_t slash = final_path.find_last_of('/');
@@ -37,7 +37,7 @@ std::string tempNameFor(const std::string& final_path) {
   const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
   const std::string stem = has_ext ? final_path.substr(0, dot) : final_path;
   const std::string ext = has_ext ? final_path.substr(dot) : "";
-  return stem + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ext;
+  return stem + ".tailsim-tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ext;
 }
 
 // write() with SIGPIPE blocked in this thread, so a dead reader gives EPIPE instead of killing

@@ -28,10 +28,10 @@ namespace tailsim {
 void writeFileAtomic(const std::string& path, const std::string& contents) {
   // Errors are std::system_error carrying errno (a full disk is ENOSPC, which a sweep stops at);
   // what() reads "cannot write PATH: <OS error>".
-  // "<path>.tmp.<pid>.<k>": unique per writer (process and call), so two threads writing the same
+  // "<path>.tailsim-tmp.<pid>.<k>": unique per writer (process and call), so two threads writing the same
   // path never share a temporary; `tailsim run` removes those of dead processes.
   static std::atomic<unsigned long> counter{0};
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  const std::string tmp = path + ".tailsim-tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   FILE* f = std::fopen(tmp.c_str(), "wb");
   if (!f) throw std::system_error(errno, std::generic_category(), "cannot write " + path);
   // No fsync: rename makes the file appear whole or not at all if the process dies (the
@@ -181,9 +181,9 @@ void recordHashInManifest(const std::string& dir, const std::string& name, const
   if (const std::optional<std::string> m = readResultFile(path); m && hasLine(*m, line)) return;
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK, 0644);
   struct stat st {};
-  if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+  if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_nlink > 1) {
     if (fd >= 0) ::close(fd);
-    throw std::runtime_error("cannot append to " + path + " (a regular file tailsim keeps there)");
+    throw std::runtime_error("cannot append to " + path + " (a regular file tailsim keeps there, with no other hard link)");
   }
   const ssize_t n = ::write(fd, line.data(), line.size());
   const int err = errno;
