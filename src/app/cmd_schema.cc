@@ -1,4 +1,4 @@
-// `tailsim schema`: the JSON Schema of experiment and suite files (or robot files, or the Markdown key tables).
+// `tailsim schema`: the JSON Schema of experiment, suite, optimize and maneuver files (or robot files, or the Markdown key tables).
 #include <cstdio>
 #include <memory>
 
@@ -12,7 +12,7 @@ void addSchemaCommand(CLI::App& app, int& exit_code) {
     bool markdown = false, robot = false;
   };
   auto a = std::make_shared<Args>();
-  auto* schema = app.add_subcommand("schema", "print the JSON Schema of experiment and suite files (for editors)");
+  auto* schema = app.add_subcommand("schema", "print the JSON Schema of experiment, suite, optimize and maneuver files (for editors)");
   schema->add_flag("--robot", a->robot, "the schema of robot files instead");
   schema->add_flag("--markdown", a->markdown, "the key tables of docs/experiment-format.md instead");
   schema->callback([a, &exit_code] {

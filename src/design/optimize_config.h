@@ -12,6 +12,7 @@
 #include "design/stroke_family.h"
 #include "design/stroke_optimizer.h"
 #include "experiments/experiment_config.h"
+#include "results/work_limits.h"
 
 namespace tailsim {
 
@@ -31,17 +32,17 @@ struct OptimizeSpec {
   bool mujoco_check = true;             // re-simulate the optimum in MuJoCo
 };
 
-// Limits of the optimize section (documented in docs/design-a-tail-stroke.md).
-constexpr int kMaxKnots = 12;
-constexpr int kMaxIslands = 64;
-constexpr int kMaxPopulation = 1000;
-constexpr int kMaxGenerations = 10000;
-constexpr int kMaxRestarts = 50;
-constexpr int kMaxLocalRestarts = 200;
-constexpr int kMaxKeptDirectionsLog2 = 12;  // directions_kept <= 2^12 (and <= 2^n)
-constexpr int kMaxPolishEvaluations = 100000;
-constexpr int kMaxSeeds = 20;
-constexpr int kMaxParetoPoints = 20;
+// Limits of the optimize section (documented in docs/design-a-tail-stroke.md; results/work_limits.h).
+constexpr int kMaxKnots = limits::kMaxOptimizeKnots;
+constexpr int kMaxIslands = limits::kMaxOptimizeIslands;
+constexpr int kMaxPopulation = limits::kMaxOptimizePopulation;
+constexpr int kMaxGenerations = limits::kMaxOptimizeGenerations;
+constexpr int kMaxRestarts = limits::kMaxOptimizeRestarts;
+constexpr int kMaxLocalRestarts = limits::kMaxOptimizeLocalRestarts;
+constexpr int kMaxKeptDirectionsLog2 = limits::kMaxKeptDirectionsLog2;
+constexpr int kMaxPolishEvaluations = limits::kMaxPolishEvaluations;
+constexpr int kMaxSeeds = limits::kMaxOptimizeSeeds;
+constexpr int kMaxParetoPoints = limits::kMaxParetoPoints;
 
 // Analytic model runs the whole optimisation asks for at most (every seed and Pareto point; each
 // search: the start, islands x population x (generations + 1 + refine_generations) per restart,

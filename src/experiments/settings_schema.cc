@@ -145,6 +145,80 @@ json perJoint(json value, const std::string& doc) {
           {"anyOf", json::array({value, sweepRef(), {{"type", "array"}, {"minItems", 1}, {"items", one}}})}};
 }
 
+// Declared properties without their sweep alternative (files that hold no sweeps).
+json plain(json props) {
+  for (auto& [k, p] : props.items())
+    if (p.contains("anyOf")) {
+      json v = p["anyOf"][0];
+      v["description"] = p["description"];
+      p = v;
+    }
+  return props;
+}
+
+// An experiment's name: one safe path component (experimentNameProblem).
+json nameSchema() {
+  return {{"type", "string"}, {"minLength", 1}, {"maxLength", 100}, {"pattern", "^[^/\\\\-][^/\\\\]*$"}};
+}
+
+json integerIn(int lo, int hi) { return {{"type", "integer"}, {"minimum", lo}, {"maximum", hi}}; }
+json numberIn(double lo, double hi) { return {{"type", "number"}, {"minimum", lo}, {"maximum", hi}}; }
+json oneOfNames(std::initializer_list<const char*> names) {
+  json e = json::array();
+  for (const char* n : names) e.push_back(n);
+  return {{"type", "string"}, {"enum", e}};
+}
+// [low, high], both in [lo, hi].
+json interval(double lo, double hi) {
+  return {{"type", "array"}, {"minItems", 2}, {"maxItems", 2}, {"items", numberIn(lo, hi)}};
+}
+
+// A design file (`tailsim optimize`, `tailsim maneuver`): name, description, kind, the base
+// experiment file and the section named like the kind. No sweeps.
+json designFile(const std::string& kind, json section_schema) {
+  return section({{"name", nameSchema()},
+                  {"description", {{"type", "string"}}},
+                  {"kind", {{"const", kind}}},
+                  {"base", {{"type", "string"}, {"minLength", 1}, {"description", "the one-case experiment file the design starts from, relative to this file"}}},
+                  {kind, std::move(section_schema)}},
+                 {"name", "kind", "base", kind});
+}
+
+// The optimize section as src/design/optimize_config.cc reads it (docs/design-a-tail-stroke.md).
+json optimizeSection() {
+  json lim = section({{"theta_deg", interval(-360, 360)},
+                      {"thetadot_max_dps", numberIn(1, 36000)},
+                      {"torque_max_Nm", {{"anyOf", json::array({{{"type", "number"}, {"exclusiveMinimum", 0}}, {{"const", "base"}}})}}},
+                      {"end", oneOfNames({"rest", "start"})},
+                      {"dT_s", interval(0.01, 10)},
+                      {"w_ss", interval(0.01, 0.99)},
+                      {"start_delay_s", numberIn(0, 10)}},
+                     {"theta_deg", "thetadot_max_dps"});
+  using namespace limits;
+  return section({{"family", oneOfNames({"split_cycle", "spline"})},
+                  {"knots", integerIn(0, kMaxOptimizeKnots)},
+                  {"objective", oneOfNames({"phi_net", "phi_net_per_torque", "phi_net_per_energy"})},
+                  {"limits", lim},
+                  {"algorithm", oneOfNames({"cmaes", "de"})},
+                  {"islands", integerIn(1, kMaxOptimizeIslands)},
+                  {"population", integerIn(5, kMaxOptimizePopulation)},
+                  {"generations", integerIn(1, kMaxOptimizeGenerations)},
+                  {"restarts", integerIn(1, kMaxOptimizeRestarts)},
+                  {"restart_growth", integerIn(1, 4)},
+                  {"refine_generations", integerIn(0, kMaxOptimizeGenerations)},
+                  {"local_restarts", integerIn(0, kMaxOptimizeLocalRestarts)},
+                  {"local_step", {{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 1}}},
+                  {"directions", oneOfNames({"free", "enumerate"})},
+                  {"directions_kept", integerIn(0, 1 << kMaxKeptDirectionsLog2)},
+                  {"polish", oneOfNames({"cobyla", "bobyqa", "none"})},
+                  {"polish_evaluations", integerIn(0, kMaxPolishEvaluations)},
+                  {"seeds", {{"type", "array"}, {"minItems", 1}, {"maxItems", kMaxOptimizeSeeds}, {"uniqueItems", true},
+                             {"items", integerIn(0, 1000000000)}}},
+                  {"pareto_points", {{"allOf", json::array({integerIn(0, kMaxParetoPoints), {{"not", {{"const", 1}}}}})}}},
+                  {"mujoco_check", {{"type", "boolean"}}}},
+                 {"family", "limits"});
+}
+
 }  // namespace
 
 json experimentSchema() {
@@ -181,7 +255,7 @@ json experimentSchema() {
                {"minProperties", 1},
                {"maxProperties", 1}};
   json exp = section(
-      {{"name", {{"type", "string"}, {"minLength", 1}, {"maxLength", 100}, {"pattern", "^[^/\\\\-][^/\\\\]*$"}}},
+      {{"name", nameSchema()},
        {"description", {{"type", "string"}}},
        {"robot", orSweep({{"type", "string"}, {"minLength", 1}})},
        {"kind", orSweep({{"type", "string"}, {"enum", settings::namesOf(kindNames())}})},
@@ -207,23 +281,16 @@ json experimentSchema() {
                         {"description", {{"type", "string"}}}},
                        {"experiments"});
   json s = {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
-            {"title", "tailsim experiment or suite file (docs/experiment-format.md)"},
+            {"title", "tailsim experiment, suite, optimize or maneuver file (docs/experiment-format.md, "
+                      "docs/design-a-tail-stroke.md)"},
             {"$defs", defs()},
-            {"oneOf", json::array({exp, suite})}};
+            {"oneOf", json::array({exp, suite, designFile("optimize", optimizeSection()),
+                                   designFile("maneuver", section(plain(describe<ManeuverSettings>().props)))})}};
   return s;
 }
 
 json robotSchema() {
   // Robot files hold no sweeps: the plain declared types.
-  auto plain = [](json props) {
-    for (auto& [k, p] : props.items())
-      if (p.contains("anyOf")) {
-        json v = p["anyOf"][0];
-        v["description"] = p["description"];
-        p = v;
-      }
-    return props;
-  };
   json link = section(plain(describe<TailLink>().props), {"mass_kg", "izz_kgm2", "length_m"});
   json tails = {{"type", "object"}, {"additionalProperties", false}, {"minProperties", 1}, {"properties", json::object()}};
   for (int n = 1; n <= 6; ++n) tails["properties"][std::to_string(n)] = link;

@@ -8,7 +8,9 @@
 
 namespace tailsim {
 
-// Experiment and suite files (oneOf). Any single value may be a sweep ({sweep: [...]} / {range: [a, b, step]}).
+// Every file kind `tailsim` reads besides robot files (oneOf): experiment files (kind simulate or
+// pose; any single value may be a sweep, {sweep: [...]} / {range: [a, b, step]}), suite files, and
+// the design files of `tailsim optimize` (kind: optimize) and `tailsim maneuver` (kind: maneuver).
 nlohmann::json experimentSchema();
 // Robot files (configs/robots/*.yaml).
 nlohmann::json robotSchema();

@@ -31,6 +31,17 @@ constexpr double kMaxExperimentRenderSamples = 1e12;
 // joint-direction patterns `directions: enumerate` searches (2^n for an n-link tail).
 constexpr double kMaxOptimizeRuns = 1e8;
 constexpr int kMaxEnumeratedLinks = 12;  // 4096 patterns
+// The optimize section's counts (design/optimize_config.h; the schema of `tailsim schema`).
+constexpr int kMaxOptimizeKnots = 12;
+constexpr int kMaxOptimizeIslands = 64;
+constexpr int kMaxOptimizePopulation = 1000;
+constexpr int kMaxOptimizeGenerations = 10000;
+constexpr int kMaxOptimizeRestarts = 50;
+constexpr int kMaxOptimizeLocalRestarts = 200;
+constexpr int kMaxKeptDirectionsLog2 = 12;  // directions_kept <= 2^12 (and <= 2^n)
+constexpr int kMaxPolishEvaluations = 100000;
+constexpr int kMaxOptimizeSeeds = 20;
+constexpr int kMaxParetoPoints = 20;
 
 // Inputs (physical ranges; the paper's cases lie well inside them).
 constexpr double kMinDT_s = 1e-3;              // tail motion duration dT  [s]
