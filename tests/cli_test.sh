@@ -57,6 +57,38 @@ grep -q "no case named 'nosuch'" err.txt || fail "run --case nosuch (suite): $(c
 [ ! -e runout ] || fail "run --case nosuch created its output folder"
 ok "render/run --case nosuch: exit 1, '$(cut -c1-90 err.txt)...'"
 
+echo "== a file given to the wrong command names the command that reads it (exit 1, or 2 for a folder argument), before any work"
+opt="$src/configs/design/split_n1.yaml"
+man="$src/configs/design/maneuver_90.yaml"
+exp="$src/configs/default.yaml"
+# want RC "COMMAND ARGS" "TEXT": exit RC, TEXT in stderr, no output folder/file made.
+want() {
+  run "$1" "$tailsim" $2
+  grep -qF -- "$3" err.txt || fail "tailsim $2: stderr does not say '$3': $(cat err.txt)"
+  [ ! -e wrongout ] || fail "tailsim $2 made its output before refusing"
+}
+for cmd in run render accuracy; do
+  want 1 "$cmd $opt --out wrongout" "$opt is an optimize file: run it with \`tailsim optimize $opt --out DIR\`"
+  want 1 "$cmd $man --out wrongout" "$man is a maneuver file: run it with \`tailsim maneuver $man --out DIR\`"
+done
+want 1 "mjcf $opt --out wrongout" "is an optimize file: run it with \`tailsim optimize"
+want 1 "mjcf $man --menagerie wrongout" "is a maneuver file: run it with \`tailsim maneuver"
+want 1 "run $robot --out wrongout" "is a robot file: name it in an experiment's robot: key"
+want 1 "optimize $exp --out wrongout" "is an experiment file: run it with \`tailsim run $exp --out DIR\`"
+want 1 "optimize $src/configs/paper/all.yaml --out wrongout" "is an experiment file: run it with \`tailsim run"
+want 1 "optimize $man --out wrongout" "is a maneuver file: run it with \`tailsim maneuver"
+want 1 "maneuver $exp --out wrongout" "is an experiment file: run it with \`tailsim run"
+want 1 "maneuver $opt --out wrongout" "is an optimize file: run it with \`tailsim optimize"
+for cmd in plot report ladder; do
+  want 2 "$cmd $exp" "is an experiment file: run it with \`tailsim run $exp --out DIR\`, then give DIR"
+  want 2 "$cmd $opt" "is an optimize file: run it with \`tailsim optimize"
+done
+printf 'name: typo\nrobot: paper\ntrajectroy: {dtheta_deg: -90, dT_s: 0.25}\n' >typo.yaml
+want 1 "run typo.yaml --out wrongout" "trajectroy: unknown key; did you mean 'trajectory'?"
+sed 's/^  islands:/  islnds:/' "$src/configs/design/split_n3_seeds_long.yaml" | sed "s|base: base/|base: $src/configs/design/base/|" >typo_opt.yaml
+want 1 "optimize typo_opt.yaml --out wrongout" "optimize.islnds: unknown key; did you mean 'islands'?"
+ok "run/render/accuracy/mjcf/optimize/maneuver/plot/report/ladder name the right command; 'did you mean' for a misspelt key"
+
 echo "== failed model runs: exit 3; tailsim_version in summary.json"
 printf 'name: tipping\nrobot: %s\ntail: {custom: [{mass_kg: 50, izz_kgm2: 0.5, length_m: 0.3}]}\n' "$robot" >tip.yaml
 printf 'trajectory: {theta0_deg: 0, dtheta_deg: -90, dT_s: 0.25, w_ss: 0.25}\nmodels: [analytic]\n' >>tip.yaml

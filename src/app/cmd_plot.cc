@@ -17,7 +17,7 @@ void addPlotCommand(CLI::App& app, int& exit_code) {
   };
   auto a = std::make_shared<Args>();
   auto* plot = app.add_subcommand("plot", "redraw the figures of a result folder (no simulation)");
-  plot->add_option("dir", a->dir, "result folder")->required()->check(CLI::ExistingDirectory);
+  plot->add_option("dir", a->dir, "result folder")->required()->check(resultFolder());
   plot->add_flag("--no-titles", a->no_titles, "no title drawn in the figures (figures.html's captions keep them)");
   plot->add_option("--size", a->size, "W,H: every figure W x H pixels (PNG; the SVG in points)");
   plot->add_option("--font-scale", a->opt.font_scale, "every font scaled by this factor (default 1)")

@@ -10,7 +10,7 @@ namespace tailsim {
 void addReportCommand(CLI::App& app, int& exit_code) {
   auto dir = std::make_shared<std::string>();
   auto* report = app.add_subcommand("report", "write DIR/report.md: plots and the paper's findings checked");
-  report->add_option("dir", *dir, "result folder")->required()->check(CLI::ExistingDirectory);
+  report->add_option("dir", *dir, "result folder")->required()->check(resultFolder());
   report->callback([dir, &exit_code] {
     printSeriesNotes(*dir);
     std::printf("%s\n", writeReport(*dir).c_str());

@@ -9,6 +9,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/yaml_file.h"
 #include "plotting/result_folder.h"
 
 namespace tailsim {
@@ -17,6 +18,18 @@ const CLI::Validator& nonEmptyPath() {
   static const CLI::Validator v(
       [](std::string& s) { return s.empty() ? std::string("is empty: give a folder or file name") : std::string(); },
       "PATH");
+  return v;
+}
+
+const CLI::Validator& resultFolder() {
+  static const CLI::Validator v(
+      [](std::string& s) {
+        std::string why = CLI::ExistingDirectory(s);
+        if (!why.empty())
+          if (const std::string note = inputFileNote(s); !note.empty()) why = note + ", then give DIR";
+        return why;
+      },
+      "DIR");
   return v;
 }
 

@@ -16,6 +16,11 @@ constexpr int kExitOk = 0, kExitError = 1, kExitUsage = 2, kExitRunsFailed = 3, 
 // to some calls and an error to others).
 const CLI::Validator& nonEmptyPath();
 
+// A result folder argument (plot, report, ladder): an existing folder. An input file given instead
+// is named with the command that reads it ("x.yaml is an experiment file: run it with `tailsim run
+// x.yaml --out DIR`, then give DIR").
+const CLI::Validator& resultFolder();
+
 // Plots and reports of a folder whose cases kept no time series say so (on stderr): the figures
 // over time are left out, those over the swept values come from the results table.
 void printSeriesNotes(const std::string& dir);

@@ -22,7 +22,6 @@ namespace tailsim {
 namespace design_yaml {
 
 namespace fs = std::filesystem;
-constexpr std::uintmax_t kMaxFileBytes = 1u << 20;
 
 inline std::string fmtG(double v) {
   std::ostringstream s;
@@ -54,14 +53,13 @@ class Reader {
   std::vector<std::pair<std::string, Val>> map(const Val& v, std::initializer_list<const char*> allowed) const {
     if (!v.node.IsMap()) fail(v, "expected a map of key: value");
     std::vector<std::pair<std::string, Val>> out;
-    std::string names;
-    for (const char* a : allowed) names += (names.empty() ? "" : ", ") + std::string(a);
+    const std::vector<std::string> names(allowed.begin(), allowed.end());
     for (const auto& kv : v.node) {
       const std::string key = v.key.empty() ? kv.first.Scalar() : v.key + "." + kv.first.Scalar();
       if (!kv.first.IsScalar()) fail(kv.first.Mark(), v.key, "keys must be plain names");
       const std::string k = kv.first.Scalar();
       if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }))
-        fail(kv.first.Mark(), key, "unknown key (allowed here: " + names + ")");
+        fail(kv.first.Mark(), key, unknownKeyMessage(k, names));
       for (const auto& e : out)
         if (e.first == k) fail(kv.first.Mark(), key, "duplicate key");
       const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
@@ -135,13 +133,6 @@ class Reader {
   std::string file_;
 };
 
-inline YAML::Node loadYaml(const std::string& abs) {
-  std::error_code ec;
-  const auto size = fs::file_size(abs, ec);
-  if (ec) throw ConfigError(abs + ": cannot read: " + ec.message());
-  if (size > kMaxFileBytes) throw ConfigError(abs + ": file is larger than 1 MiB");
-  return loadBoundedYaml(abs);  // the experiment loader's bounds and messages
-}
 
 
 using Map = std::vector<std::pair<std::string, Val>>;
@@ -188,8 +179,9 @@ struct DesignFile {
 // name from it (optimize's best.yaml is named <name>_best).
 inline DesignFile openDesignFile(const Reader& r, const std::string& source_file, const char* kind, const char* section,
                                  std::size_t max_name_chars = kMaxNameChars) {
-  DesignFile f{Val{loadYaml(source_file), "", YAML::Mark()}, {}, {}, section};
+  DesignFile f{Val{loadBoundedYaml(source_file), "", YAML::Mark()}, {}, {}, section};
   if (!f.root.node.IsMap()) r.fail(f.root, "the file must be a map of key: value");
+  requireInputFor(f.root.node, source_file, kind);  // an experiment file given to optimize names `tailsim run`
   f.top = r.map(f.root, {"name", "description", "kind", "base", section});
   f.head = readDesignHead(r, f.root, f.top, source_file, kind, max_name_chars);
   return f;

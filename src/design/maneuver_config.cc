@@ -135,13 +135,11 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   std::vector<std::pair<std::string, Val>> m;
   {
     // Reader::map takes the allowed keys as an initializer list: check them here from the declaration.
-    std::string names;
-    for (const auto& k : kl.keys) names += (names.empty() ? "" : ", ") + k;
     for (const auto& kv : mv.node) {
       const std::string key = "maneuver." + kv.first.Scalar();
       if (!kv.first.IsScalar()) r.fail(kv.first.Mark(), "maneuver", "keys must be plain names");
       if (std::find(kl.keys.begin(), kl.keys.end(), kv.first.Scalar()) == kl.keys.end())
-        r.fail(kv.first.Mark(), key, "unknown key (allowed here: " + names + ")");
+        r.fail(kv.first.Mark(), key, unknownKeyMessage(kv.first.Scalar(), kl.keys));
       for (const auto& e : m)
         if (e.first == kv.first.Scalar()) r.fail(kv.first.Mark(), key, "duplicate key");
       const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();

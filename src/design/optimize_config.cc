@@ -22,7 +22,7 @@ using namespace design_yaml;
 
 bool isOptimizeFile(const std::string& path) {
   try {
-    const YAML::Node doc = loadYaml(fs::absolute(path).lexically_normal().string());
+    const YAML::Node doc = loadBoundedYaml(fs::absolute(path).lexically_normal().string());
     return doc.IsMap() && doc["kind"] && doc["kind"].IsScalar() && doc["kind"].Scalar() == "optimize";
   } catch (const std::exception&) {
     return false;

@@ -19,6 +19,7 @@
 #include "results/work_limits.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <cmath>
@@ -274,11 +275,8 @@ class Reader {
       if (!kv.first.IsScalar()) tailsim::fail(Loc{file_, kv.first.Mark(), it.key}, "keys must be plain names");
       const std::string k = kv.first.Scalar();
       const Loc keyLoc{file_, kv.first.Mark(), joinKey(it.key, k)};
-      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
-        std::string list;
-        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        tailsim::fail(keyLoc, "unknown key (allowed here: " + list + ")");
-      }
+      if (std::find(allowed.begin(), allowed.end(), k) == allowed.end())
+        tailsim::fail(keyLoc, unknownKeyMessage(k, allowed));
       if (m.get(k)) tailsim::fail(keyLoc, "duplicate key");
       const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();
       m.fields.emplace_back(k, Item{kv.second, keyLoc.key, empty ? kv.first.Mark() : kv.second.Mark(), kv.first.Mark()});
@@ -1302,6 +1300,11 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
     if (!fs::is_regular_file(*path, ec)) r.fail(entry, "experiment file not found: " + *path);
     if (std::find(stack.begin(), stack.end(), *path) != stack.end()) r.fail(entry, "suite includes itself: " + *path);
     const YAML::Node sub = parseYaml(path);
+    try {
+      requireInputFor(sub, *path, "run");
+    } catch (const ConfigError& e) {
+      r.fail(entry, e.what());
+    }
     if (isSuite(sub)) {
       if (stack.size() >= kMaxSuiteDepth)
         r.fail(entry, "suites are nested more than " + std::to_string(kMaxSuiteDepth) +
@@ -1320,6 +1323,74 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
 }  // namespace
 
 YAML::Node loadBoundedYaml(const std::string& path) { return parseYaml(&path); }
+
+std::string unknownKeyMessage(const std::string& key, const std::vector<std::string>& allowed) {
+  // Optimal string alignment distance (an edit: insert, delete, replace, swap two neighbours), case ignored.
+  auto distance = [](const std::string& a, const std::string& b) {
+    auto lower = [](char ch) { return static_cast<char>(std::tolower(static_cast<unsigned char>(ch))); };
+    std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i)
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const bool same = lower(a[i - 1]) == lower(b[j - 1]);
+        d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (same ? 0 : 1)});
+        if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1]))
+          d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      }
+    return d[a.size()][b.size()];
+  };
+  std::string list, best;
+  std::size_t best_d = key.size() <= 3 ? 1 : 2;  // the most edits still taken for a misspelling
+  bool found = false;
+  for (const std::string& a : allowed) {
+    list += (list.empty() ? "" : ", ") + a;
+    if (key.size() > 200) continue;  // no quadratic work on a pathological key
+    const std::size_t dist = distance(key, a);
+    if (dist <= best_d && (!found || dist < best_d)) best = a, best_d = dist, found = true;
+  }
+  return "unknown key" + (found ? "; did you mean '" + best + "'?" : std::string()) + " (allowed here: " + list + ")";
+}
+
+namespace {
+
+// An input file's kind from its top-level keys: "optimize", "maneuver", "experiment" (also a
+// suite), "robot", or "" (none of these).
+std::string inputKindOf(const YAML::Node& doc) {
+  if (!doc.IsMap()) return "";
+  const YAML::Node kind = doc["kind"];
+  if (kind && kind.IsScalar() && (kind.Scalar() == "optimize" || kind.Scalar() == "maneuver")) return kind.Scalar();
+  if (doc["experiments"] || doc["robot"]) return "experiment";
+  if (doc["tails"] || (doc["quadruped"] && doc["friction"] && !doc["name"])) return "robot";
+  return "";
+}
+
+std::string inputNote(const std::string& kind, const std::string& path) {
+  if (kind == "robot")
+    return path + " is a robot file: name it in an experiment's robot: key (docs/experiment-format.md \"Robot file\")";
+  const std::string command = kind == "experiment" ? "run" : kind;
+  return path + " is " + (kind == "experiment" ? "an experiment" : "a" + std::string(kind == "optimize" ? "n " : " ") + kind) +
+         " file: run it with `tailsim " + command + " " + path + " --out DIR`";
+}
+
+}  // namespace
+
+void requireInputFor(const YAML::Node& doc, const std::string& path, const std::string& command) {
+  const std::string kind = inputKindOf(doc);
+  if (kind.empty() || kind == (command == "run" ? "experiment" : command)) return;
+  throw ConfigError(inputNote(kind, path));
+}
+
+std::string inputFileNote(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return "";
+  try {
+    const std::string kind = inputKindOf(loadBoundedYaml(path));
+    return kind.empty() ? "" : inputNote(kind, path);
+  } catch (const std::exception&) {
+    return "";
+  }
+}
 
 std::string experimentNameProblem(const std::string& nm, std::size_t max_chars) {
   const bool control = std::any_of(nm.begin(), nm.end(), [](char ch) {
@@ -1343,6 +1414,7 @@ Experiment loadExperiment(const std::string& path) {
   if (invalidUtf8At(*file) != std::string::npos)
     throw ConfigError(clip(*file, 200) + ": the file's path is not UTF-8; rename it");
   const YAML::Node doc = parseYaml(file);
+  requireInputFor(doc, path, "run");
   if (isSuite(doc))
     fail(Loc{file, doc["experiments"].Mark(), "experiments"}, "this is a suite file; load it with loadExperimentSuite");
   return readExperiment(L, file, doc);
@@ -1377,6 +1449,7 @@ std::vector<Experiment> loadExperimentSuite(const std::string& path) {
   if (invalidUtf8At(*file) != std::string::npos)
     throw ConfigError(clip(*file, 200) + ": the file's path is not UTF-8; rename it");
   const YAML::Node doc = parseYaml(file);
+  requireInputFor(doc, path, "run");
   std::vector<Experiment> out;
   if (!isSuite(doc)) {
     out.push_back(readExperiment(L, file, doc));
