@@ -44,8 +44,10 @@ TEST(Sharding, EqualCostsDealRoundRobin) {
 }
 
 TEST(Sharding, CostModelMakesMujocoHeavier) {
-  WorkEstimate w;
-  w.rows = 751;
-  w.mujoco_steps = 3850;
-  EXPECT_GT(expectedCaseCostS(w, false, true), 10 * expectedCaseCostS(w, true, false));
+  WorkEstimate mj, an;
+  mj.rows = an.rows = 751;
+  mj.models = {findModel(kMujocoModel)};
+  mj.model_steps = {{findModel(kMujocoModel), StepLimit{3850, 0}}};
+  an.models = {findModel(kAnalyticModel)};
+  EXPECT_GT(expectedCaseCostS(mj), 10 * expectedCaseCostS(an));
 }

@@ -1,6 +1,7 @@
 #include "analytic_model/analytic_recorder.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -9,16 +10,50 @@
 
 namespace tailsim {
 
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDeg = 180.0 / M_PI;
+
+// The analytic model's columns: name and value, in the CSV's order.
+std::vector<RowColumn<AnalyticRow>> columnTable(int links) {
+  using R = const AnalyticRow&;
+  std::vector<RowColumn<AnalyticRow>> t;
+  addTimeAndJointColumns(t, links);
+  const std::vector<RowColumn<AnalyticRow>> body = {
+      {col::kX, [](R r, int) { return r.y[kX]; }},
+      {col::kY, [](R r, int) { return r.y[kY]; }},
+      {col::kPhi, [](R r, int) { return r.y[kPhi] * kDeg; }},
+      {col::kPhidot, [](R r, int) { return r.y[kPhiDot] * kDeg; }},
+      {col::kPhiddot, [](R r, int) { return r.ev.phi_ddot * kDeg; }},
+      {col::kMzT, [](R r, int) { return r.ev.loads.MzT; }},
+      {col::kMzTAcc, [](R r, int) { return r.decomp ? r.ev.loads.MzT_acc : kNaN; }},
+      {col::kMzTSpeed, [](R r, int) { return r.decomp ? r.ev.loads.MzT_speed : kNaN; }},
+      {col::kMzTTan, [](R r, int) { return r.decomp ? r.ev.loads.MzT_tan : kNaN; }},
+      {col::kMzTCen, [](R r, int) { return r.decomp ? r.ev.loads.MzT_cen : kNaN; }},
+      {col::kMzF, [](R r, int) { return r.ev.MzF; }},
+      {col::kIzzPhiddot, [](R r, int) { return r.ev.loads.Izz_kgm2 * r.ev.phi_ddot; }},
+      {col::kIzz, [](R r, int) { return r.ev.loads.Izz_kgm2; }},
+      {col::kLF, [](R r, int) { return r.ev.L_F; }},
+      {col::kFTx, [](R r, int) { return r.ev.FT_W.x(); }},
+      {col::kFTy, [](R r, int) { return r.ev.FT_W.y(); }},
+      {col::kFFx, [](R r, int) { return r.ev.FF_W.x(); }},
+      {col::kFFy, [](R r, int) { return r.ev.FF_W.y(); }},
+      {col::kRotState, [](R r, int) { return r.stiction ? (r.modes.stuck[kRot] ? 0.0 : 1.0) : kNaN; }},
+      {col::kTransState,
+       [](R r, int) { return r.stiction && r.translation ? (r.modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN; }},
+  };
+  t.insert(t.end(), body.begin(), body.end());
+  return t;
+}
+
+}  // namespace
+
+std::vector<std::string> analyticColumns(int links) { return columnNames(columnTable(links)); }
+
 AnalyticRecorder::AnalyticRecorder(int n_links, double dt, long n_samples, const std::vector<double>* thin_marks)
-    : dt_(dt), n_samples_(n_samples), marks_(thin_marks) {
-  ts_.addColumn(col::kT);
-  for (int i = 1; i <= n_links; ++i) ts_.addColumn(col::theta(i));
-  for (int i = 1; i <= n_links; ++i) ts_.addColumn(col::thetadot(i));
-  for (int i = 1; i <= n_links; ++i) ts_.addColumn(col::thetaddot(i));
-  for (const char* c : {col::kX, col::kY, col::kPhi, col::kPhidot, col::kPhiddot, col::kMzT, col::kMzTAcc,
-                        col::kMzTSpeed, col::kMzTTan, col::kMzTCen, col::kMzF, col::kIzzPhiddot, col::kIzz,
-                        col::kLF, col::kFTx, col::kFTy, col::kFFx, col::kFFy, col::kRotState, col::kTransState})
-    ts_.addColumn(c);
+    : links_(n_links), dt_(dt), n_samples_(n_samples), table_(columnTable(n_links)), marks_(thin_marks) {
+  for (const RowColumn<AnalyticRow>& c : table_) ts_.addColumn(c.name);
   // Bounded by limits::kMaxRowsPerRun (planRun).
   if (thin_marks) thin_.reserve(static_cast<size_t>(n_samples));
   else {
@@ -47,26 +82,12 @@ void AnalyticRecorder::flushRows() {
 
 void AnalyticRecorder::fillRow(const AnalyticModel& m, AnalyticWorkspace& w, double t, const State& y,
                                const Modes& modes, double* out) {
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const bool decomp = m.effects.load_decomposition;
   const Eval ev = evaluate(m, w, t, y, modes, decomp);
-  const std::vector<JointState>& js = w.joints;  // the joint states at t (evaluate())
-  // Written in place (one slot per column: t, 3 per joint, 20 more): no capacity check per value.
-  if (row_.size() != 21 + 3 * js.size()) throw std::logic_error("analytic row: the joints do not match the columns");
-  double* r = out;
-  *r++ = t;
-  const double d = 180.0 / M_PI;
-  for (const auto& j : js) *r++ = j.theta * d;
-  for (const auto& j : js) *r++ = j.theta_dot * d;
-  for (const auto& j : js) *r++ = j.theta_ddot * d;
-  const bool stiction = m.stiction();
-  for (double v : {y[kX], y[kY], y[kPhi] * d, y[kPhiDot] * d, ev.phi_ddot * d, ev.loads.MzT,
-                   decomp ? ev.loads.MzT_acc : kNaN, decomp ? ev.loads.MzT_speed : kNaN,
-                   decomp ? ev.loads.MzT_tan : kNaN, decomp ? ev.loads.MzT_cen : kNaN, ev.MzF,
-                   ev.loads.Izz_kgm2 * ev.phi_ddot, ev.loads.Izz_kgm2, ev.L_F, ev.FT_W.x(), ev.FT_W.y(),
-                   ev.FF_W.x(), ev.FF_W.y(), stiction ? (modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
-                   stiction && m.translation() ? (modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN})
-    *r++ = v;
+  // w.joints: the joint states at t (evaluate()).
+  if (w.joints.size() != static_cast<size_t>(links_))
+    throw std::logic_error("analytic row: the joints do not match the columns");
+  fillColumns(table_, AnalyticRow{t, y, modes, ev, w.joints, decomp, m.stiction(), m.translation()}, out);
 }
 
 void AnalyticRecorder::repeatLastUntilDone() {
@@ -93,7 +114,6 @@ TimeSeries AnalyticRecorder::take(const AnalyticModel& m, AnalyticWorkspace& w) 
     return std::move(ts_);
   }
   // The columns the thinning rule reads, as fillRow writes them.
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const bool stiction = m.stiction(), trans = stiction && m.translation();
   auto light = [&](const Pending& p) {
     return std::array<double, 3>{p.y[kPhi] * (180.0 / M_PI), stiction ? (p.modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,

@@ -7,10 +7,26 @@
 #include <vector>
 
 #include "analytic_model/analytic_model.h"
+#include "analytic_model/row_columns.h"
 #include "results/thin_series.h"
 #include "results/time_series.h"
 
 namespace tailsim {
+
+// What one output row of the analytic model is read from (its column table, analytic_recorder.cc).
+struct AnalyticRow {
+  double t;
+  const State& y;
+  const Modes& modes;
+  const Eval& ev;
+  const std::vector<JointState>& joints;  // at t
+  bool decomp;       // effects.load_decomposition: the M_zT parts were evaluated
+  bool stiction;     // the stick/slip states exist
+  bool translation;  // the body translates
+};
+
+// The analytic model's columns for an n-link tail, in its CSV's order.
+std::vector<std::string> analyticColumns(int links);
 
 class AnalyticRecorder {
  public:
@@ -47,8 +63,10 @@ class AnalyticRecorder {
     State y;
     Modes modes;
   };
+  int links_;
   double dt_;
   long n_samples_ = 0, next_ = 0;
+  std::vector<RowColumn<AnalyticRow>> table_;
   TimeSeries ts_;
   // Every sample (not thin): up to kBlockRows rows recorded one after another, row-major, then
   // moved into ts_'s columns in one pass (flushRows): a row written in place costs no per-column

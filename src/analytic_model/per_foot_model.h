@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "analytic_model/foot_loads.h"
@@ -69,6 +70,9 @@ settings::For<S, PerFootSettings> declareFields(V& v, S& s) {
 // throws std::invalid_argument for settings it cannot run with.
 RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
                           const Effects& effects, const OutputSettings& output);
+
+// The per-foot model's columns for an n-link tail, in its CSV's order.
+std::vector<std::string> perFootColumns(int links);
 
 // How close a body held at rest is to breaking away: the load factor s of the wrench that holds it
 // at each time in `times` (held iff s <= 1; s scales as 1 / mu, the discs' radii being mu N_i, so

@@ -11,9 +11,11 @@
 
 #include "analytic_model/analytic_simulation.h"
 #include "analytic_model/per_foot_model.h"
+#include "analytic_model/row_columns.h"
 #include "analytic_model/step_control.h"
 #include "analytic_model/stick_slip.h"
 #include "analytic_model/support_check.h"
+#include "results/columns.h"
 #include "results/thin_series.h"
 #include "robot/friction_law.h"
 
@@ -429,19 +431,63 @@ Found findSwitch(const Model& model, bool stuck, double v_stop, double ta, doubl
   throw TippingError(supportLossMessage(q, SupportLoss{t, ev.cop_CC}, "centre of pressure (load transfer)"));
 }
 
+// What one output row is read from (its column table below).
+struct PerFootRow {
+  double t;
+  const State& y;
+  bool stuck;
+  const Eval& ev;
+  const std::vector<JointState>& joints;  // at t
+  bool decomp;       // effects.load_decomposition: the M_zT parts were evaluated
+  bool stiction;     // the stick/slip state exists
+  bool translation;  // the body translates
+};
+
+// The per-foot model's columns: name and value, in the CSV's order: the analytic model's columns,
+// then each foot's friction force and normal load, and the load factor of the held wrench.
+std::vector<RowColumn<PerFootRow>> perFootColumnTable(int links) {
+  using R = const PerFootRow&;
+  constexpr double kDeg = 180.0 / M_PI;
+  std::vector<RowColumn<PerFootRow>> t;
+  addTimeAndJointColumns(t, links);
+  const std::vector<RowColumn<PerFootRow>> body = {
+      {col::kX, [](R r, int) { return r.y[kX]; }},
+      {col::kY, [](R r, int) { return r.y[kY]; }},
+      {col::kPhi, [](R r, int) { return r.y[kPhi] * kDeg; }},
+      {col::kPhidot, [](R r, int) { return (r.stuck ? 0.0 : r.y[kW]) * kDeg; }},
+      {col::kPhiddot, [](R r, int) { return r.ev.phi_ddot * kDeg; }},
+      {col::kMzT, [](R r, int) { return r.ev.loads.MzT; }},
+      {col::kMzTAcc, [](R r, int) { return r.decomp ? r.ev.loads.MzT_acc : kNaN; }},
+      {col::kMzTSpeed, [](R r, int) { return r.decomp ? r.ev.loads.MzT_speed : kNaN; }},
+      {col::kMzTTan, [](R r, int) { return r.decomp ? r.ev.loads.MzT_tan : kNaN; }},
+      {col::kMzTCen, [](R r, int) { return r.decomp ? r.ev.loads.MzT_cen : kNaN; }},
+      {col::kMzF, [](R r, int) { return r.ev.friction.M; }},
+      {col::kIzzPhiddot, [](R r, int) { return r.ev.loads.Izz_kgm2 * r.ev.phi_ddot; }},
+      {col::kIzz, [](R r, int) { return r.ev.loads.Izz_kgm2; }},
+      {col::kLF, [](R r, int) { return r.ev.L_F; }},
+      {col::kFTx, [](R r, int) { return r.ev.FT_W.x(); }},
+      {col::kFTy, [](R r, int) { return r.ev.FT_W.y(); }},
+      {col::kFFx, [](R r, int) { return r.ev.friction.F.x(); }},
+      {col::kFFy, [](R r, int) { return r.ev.friction.F.y(); }},
+      {col::kRotState, [](R r, int) { return r.stiction ? (r.stuck ? 0.0 : 1.0) : kNaN; }},
+      {col::kTransState, [](R r, int) { return r.translation && r.stiction ? (r.stuck ? 0.0 : 1.0) : kNaN; }},
+  };
+  t.insert(t.end(), body.begin(), body.end());
+  for (int k = 1; k <= 4; ++k) {
+    t.push_back({col::footFx(k), [](R r, int i) { return r.ev.Ff[i].x(); }, k - 1});
+    t.push_back({col::footFy(k), [](R r, int i) { return r.ev.Ff[i].y(); }, k - 1});
+  }
+  for (int k = 1; k <= 4; ++k) t.push_back({col::footN(k), [](R r, int i) { return r.ev.N[i]; }, k - 1});
+  t.push_back({col::kLoadFactor, [](R r, int) { return r.stuck ? r.ev.load_factor : kNaN; }});
+  return t;
+}
+
 class Recorder {
  public:
-  Recorder(const Model& model, int n_links, double dt, long n_samples) : model_(model), dt_(dt), n_samples_(n_samples) {
-    ts_.addColumn("t_s");
-    for (const char* p : {"theta", "thetadot", "thetaddot"})
-      for (int i = 1; i <= n_links; ++i)
-        ts_.addColumn(p + std::to_string(i) + (std::string(p) == "theta" ? "_deg" : std::string(p) == "thetadot" ? "_dps" : "_dps2"));
-    for (const char* c : {"x_m", "y_m", "phi_deg", "phidot_dps", "phiddot_dps2", "MzT_Nm", "MzT_acc_Nm",
-                          "MzT_speed_Nm", "MzT_tan_Nm", "MzT_cen_Nm", "MzF_Nm", "Izz_phiddot_Nm", "Izz_kgm2",
-                          "LF_m", "FTx_N", "FTy_N", "FFx_N", "FFy_N", "rot_state", "trans_state", "F1x_N", "F1y_N",
-                          "F2x_N", "F2y_N", "F3x_N", "F3y_N", "F4x_N", "F4y_N", "N1_N", "N2_N", "N3_N", "N4_N",
-                          "load_factor"})
-      ts_.addColumn(c);
+  Recorder(const Model& model, int n_links, double dt, long n_samples)
+      : model_(model), dt_(dt), n_samples_(n_samples), table_(perFootColumnTable(n_links)) {
+    for (const RowColumn<PerFootRow>& c : table_) ts_.addColumn(c.name);
+    row_.assign(table_.size(), 0.0);
   }
   double nextTime() const { return next_ < n_samples_ ? next_ * dt_ : std::numeric_limits<double>::infinity(); }
   bool done() const { return next_ >= n_samples_; }
@@ -499,22 +545,7 @@ class Recorder {
     const bool decomp = model_.effects().load_decomposition;
     const Eval ev = model_.evaluate(t, y, stuck, decomp);
     model_.joints(t, js_);
-    row_.clear();
-    row_.push_back(t);
-    const double d = 180.0 / M_PI;
-    for (const auto& j : js_) row_.push_back(j.theta * d);
-    for (const auto& j : js_) row_.push_back(j.theta_dot * d);
-    for (const auto& j : js_) row_.push_back(j.theta_ddot * d);
-    const double state = model_.stiction() ? (stuck ? 0.0 : 1.0) : kNaN;
-    const bool tr = model_.translation();
-    row_.insert(row_.end(), {y[kX], y[kY], y[kPhi] * d, (stuck ? 0.0 : y[kW]) * d, ev.phi_ddot * d, ev.loads.MzT,
-                             decomp ? ev.loads.MzT_acc : kNaN, decomp ? ev.loads.MzT_speed : kNaN,
-                             decomp ? ev.loads.MzT_tan : kNaN, decomp ? ev.loads.MzT_cen : kNaN, ev.friction.M,
-                             ev.loads.Izz_kgm2 * ev.phi_ddot, ev.loads.Izz_kgm2, ev.L_F, ev.FT_W.x(), ev.FT_W.y(),
-                             ev.friction.F.x(), ev.friction.F.y(), state, tr ? state : kNaN});
-    for (int i = 0; i < 4; ++i) row_.insert(row_.end(), {ev.Ff[i].x(), ev.Ff[i].y()});
-    for (int i = 0; i < 4; ++i) row_.push_back(ev.N[i]);
-    row_.push_back(stuck ? ev.load_factor : kNaN);
+    fillColumns(table_, PerFootRow{t, y, stuck, ev, js_, decomp, model_.stiction(), model_.translation()}, row_.data());
   }
   struct Pending {
     double t;
@@ -524,6 +555,7 @@ class Recorder {
   const Model& model_;
   double dt_;
   long n_samples_ = 0, next_ = 0;
+  std::vector<RowColumn<PerFootRow>> table_;
   TimeSeries ts_;
   std::vector<double> row_;
   std::vector<JointState> js_;
@@ -814,5 +846,7 @@ RunResult simulatePerFoot(const RobotParams& robot, const TailTrajectory& trajec
   }
   return simulatePerFootImpl(robot, trajectory, settings, effects, output, &loads);
 }
+
+std::vector<std::string> perFootColumns(int links) { return columnNames(perFootColumnTable(links)); }
 
 }  // namespace tailsim

@@ -15,6 +15,7 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
+#include "experiments/model_registry.h"
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
 
@@ -380,6 +381,15 @@ class Reader {
     const std::string s = string(it);
     if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; }) == allowed.end())
       fail(it, "unknown value " + quote(s) + " (allowed: " + joinList(allowed) + ")");
+    return s;
+  }
+  std::string choice(const Item& it, const std::vector<std::string>& allowed) const {
+    const std::string s = string(it);
+    if (std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
+      std::string list;
+      for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      fail(it, "unknown value " + quote(s) + " (allowed: " + list + ")");
+    }
     return s;
   }
 
@@ -1198,14 +1208,19 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
 
   if (const Item* m = top.get("models")) {
     const std::vector<Item> v = r.list(*m);
-    if (v.empty()) r.fail(*m, "needs at least one model (analytic, perfoot, mujoco)");
+    const std::vector<std::string> names = modelNames();
+    if (v.empty()) {
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+      r.fail(*m, "needs at least one model (" + list + ")");
+    }
     for (const Item& x : v) {
-      const std::string s = r.choice(x, {"analytic", "perfoot", "mujoco"});
+      const std::string s = r.choice(x, names);
       if (std::find(c.models.begin(), c.models.end(), s) != c.models.end()) r.fail(x, "'" + s + "' is listed twice");
       c.models.push_back(s);
     }
   } else {
-    c.models = {"analytic"};
+    c.models = {modelRegistry().front().name};
   }
   // The settings sections (experiment_config.h forEachSection): declared fields, read by
   // readDeclared; the few with checks across keys or defaults from elsewhere have their own reader.

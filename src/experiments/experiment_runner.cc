@@ -993,9 +993,13 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     j["runs"][r.summary.model] = summaryJson(r.summary);
     if (!r.summary.ok) ++failed_runs;
   }
-  // The MJCF the MuJoCo run simulated, once per distinct model (mjcf/<hash>.xml); none when the
+  // The MJCF a model's run simulated, once per distinct model (mjcf/<hash>.xml); none when the
   // model could not be built (the run's error says why).
-  if (c.kind != CaseKind::kPose && std::find(c.models.begin(), c.models.end(), "mujoco") != c.models.end()) {
+  const bool simulates_mjcf = std::any_of(c.models.begin(), c.models.end(), [](const std::string& m) {
+    const ModelEntry* e = findModel(m);
+    return e && e->simulates_mjcf;
+  });
+  if (c.kind != CaseKind::kPose && simulates_mjcf) {
     std::string xml;
     try {
       xml = generateMjcf(c.robot, c.mujoco, c.effects);

@@ -1,11 +1,15 @@
 #include "experiments/model_registry.h"
 
 #include <algorithm>
+#include <stdexcept>
 
+#include "analytic_model/analytic_recorder.h"
 #include "analytic_model/analytic_simulation.h"
 #include "analytic_model/per_foot_model.h"
 #include "mujoco_model/mujoco_simulation.h"
+#include "experiments/work_estimate.h"
 #include "results/columns.h"
+#include "results/palette.h"
 
 namespace tailsim {
 
@@ -41,42 +45,83 @@ OutputSettings recordedOutput(const ExperimentCase& c) {
   return o;
 }
 
-std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
+// The built-in models and those ModelRegistration added, in order.
+std::deque<ModelEntry>& registry() {
+  static std::deque<ModelEntry> models = [] {
+    std::deque<ModelEntry> m;
+    ModelEntry analytic;
+    analytic.name = kAnalyticModel;
+    analytic.title = "analytic (stiction)";
+    analytic.color = kAnalyticColor;
+    analytic.glossary = "Analytic = the paper's model (stiction friction)";
+    analytic.run = [](const ExperimentCase& c, RunContext*) {
+      return simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, recordedOutput(c));
+    };
+    analytic.columns = analyticColumns;
+    analytic.steps = analyticStepEstimate;
+    analytic.too_many_steps = analyticStepExcess;
+    analytic.cost_fixed_s = 1e-3;
+    analytic.cost_per_row_s = 2e-6;
+    analytic.cost_group = "planar";  // the analytic and per-foot models: one measured cost per case
+    analytic.render_rank = 1;
+    m.push_back(analytic);
+
+    ModelEntry perfoot;
+    perfoot.name = kPerFootModel;
+    perfoot.title = "per-foot (Coulomb per foot)";
+    perfoot.color = okabe_ito::kGreen;
+    perfoot.glossary = "per-foot = Coulomb friction at each foot (docs/per-foot-model.md)";
+    perfoot.run = [](const ExperimentCase& c, RunContext*) {
+      try {
+        return simulatePerFoot(c.robot, c.trajectory(), c.perfoot, c.effects, recordedOutput(c));
+      } catch (const std::exception& e) {
+        return failedRun(kPerFootModel, e.what());
+      }
+    };
+    perfoot.columns = perFootColumns;
+    perfoot.cost_fixed_s = analytic.cost_fixed_s;
+    perfoot.cost_per_row_s = analytic.cost_per_row_s;
+    perfoot.cost_group = analytic.cost_group;
+    m.push_back(perfoot);
+
+    ModelEntry mujoco;
+    mujoco.name = kMujocoModel;
+    mujoco.title = "MuJoCo (contact)";
+    mujoco.color = kMujocoColor;
+    mujoco.glossary = "MuJoCo = the contact model";
+    mujoco.long_running = true;
+    mujoco.run = [](const ExperimentCase& c, RunContext* ctx) {
+      try {
+        return simulateMujoco(c.robot, c.trajectory(), c.mujoco, c.effects, c.output, nullptr,
+                              ctx ? &ctx->mujoco_settle : nullptr);
+      } catch (const std::exception& e) {
+        return failedRun(kMujocoModel, e.what());
+      }
+    };
+    mujoco.columns = [](int n) {
+      std::vector<std::string> c = col::shared(n);
+      for (const std::string& x : col::mujocoOnly(n)) c.push_back(x);
+      return c;
+    };
+    mujoco.steps = mujocoStepEstimate;
+    mujoco.too_many_steps = mujocoStepExcess;
+    mujoco.cost_per_step_s = 1e-5;
+    mujoco.render_rank = 2;
+    mujoco.simulates_mjcf = true;
+    mujoco.moments_note = "impulse-averaged over each output interval";
+    mujoco.moments_caption =
+        "MuJoCo's moments are impulse averages: the contact and joint impulses of the MuJoCo steps in each "
+        "output interval (t ± Δt/2) summed and divided by the interval's length, not single samples of the "
+        "chattering contact forces.";
+    m.push_back(mujoco);
+    return m;
+  }();
+  return models;
 }
 
 }  // namespace
 
-const std::vector<ModelEntry>& modelRegistry() {
-  static const std::vector<ModelEntry> kModels = {
-      {"analytic", "analytic (stiction)", "#0072B2", false,
-       [](const ExperimentCase& c, RunContext*) {
-         return simulateAnalytic(c.robot, c.trajectory(), c.analytic, c.effects, recordedOutput(c));
-       },
-       [](int n) { return concat(col::shared(n), col::analyticOnly()); }},
-      {"perfoot", "per-foot (Coulomb per foot)", "#009E73", false,
-       [](const ExperimentCase& c, RunContext*) {
-         try {
-           return simulatePerFoot(c.robot, c.trajectory(), c.perfoot, c.effects, recordedOutput(c));
-         } catch (const std::exception& e) {
-           return failedRun("perfoot", e.what());
-         }
-       },
-       [](int n) { return concat(concat(col::shared(n), col::analyticOnly()), col::perfootOnly()); }},
-      {"mujoco", "MuJoCo (contact)", "#D55E00", true,
-       [](const ExperimentCase& c, RunContext* ctx) {
-         try {
-           return simulateMujoco(c.robot, c.trajectory(), c.mujoco, c.effects, c.output, nullptr,
-                                 ctx ? &ctx->mujoco_settle : nullptr);
-         } catch (const std::exception& e) {
-           return failedRun("mujoco", e.what());
-         }
-       },
-       [](int n) { return concat(col::shared(n), col::mujocoOnly(n)); }},
-  };
-  return kModels;
-}
+const std::deque<ModelEntry>& modelRegistry() { return registry(); }
 
 const ModelEntry* findModel(const std::string& name) {
   for (const ModelEntry& m : modelRegistry())
@@ -96,6 +141,21 @@ std::vector<std::string> modelColumnOrder(int links) {
     for (const std::string& c : m.columns(links))
       if (std::find(order.begin(), order.end(), c) == order.end()) order.push_back(c);
   return order;
+}
+
+ModelRegistration::ModelRegistration(ModelEntry entry) : name_(entry.name) {
+  if (name_.empty()) throw std::invalid_argument("a model needs a name");
+  if (findModel(name_)) throw std::invalid_argument("model '" + name_ + "' is already registered");
+  registry().push_back(std::move(entry));
+}
+
+ModelRegistration::~ModelRegistration() {
+  std::deque<ModelEntry>& r = registry();
+  for (auto it = r.begin(); it != r.end(); ++it)
+    if (it->name == name_) {
+      r.erase(it);  // the last ones added go first: the entries before stay where they are
+      return;
+    }
 }
 
 }  // namespace tailsim

@@ -11,24 +11,33 @@ namespace tailsim {
 
 RenderStats renderCase(const ExperimentCase& c, const std::vector<RunResult>& runs, const std::string& out_dir,
                        const std::string& outline_label) {
-  const RunResult* mj = nullptr;
-  const RunResult* an = nullptr;
+  // The body: the run of the highest render rank; the outline (render.ghost): the run of rank 1
+  // beside a higher one (ModelEntry::render_rank).
+  const RunResult* solid = nullptr;
+  const RunResult* outline = nullptr;
+  const ModelEntry* solid_model = nullptr;
+  const ModelEntry* outline_model = nullptr;
+  for (const ModelEntry& m : modelRegistry())
+    if (m.render_rank == 1 && !outline_model) outline_model = &m;
   for (const RunResult& r : runs) {
-    if (r.summary.model == "mujoco") mj = &r;
-    if (r.summary.model == "analytic") an = &r;
+    const ModelEntry* e = findModel(r.summary.model);
+    if (!e || e->render_rank <= 0) continue;
+    if (!solid_model || e->render_rank > solid_model->render_rank) {
+      solid = &r;
+      solid_model = e;
+    }
+    if (e == outline_model) outline = &r;
   }
-  if (!mj && !an) throw std::runtime_error("case " + c.name + ": nothing to render (no model ran)");
+  if (!solid) throw std::runtime_error("case " + c.name + ": nothing to render (no model ran)");
   const TailTrajectory traj = c.trajectory();
   RenderInputs in;
   in.robot = &c.robot;
   in.trajectory = &traj;
-  in.mujoco = mj ? &mj->series : &an->series;
-  in.analytic = (mj && an && c.render.ghost) ? &an->series : nullptr;
+  in.mujoco = &solid->series;
+  in.analytic = (outline && outline != solid && c.render.ghost) ? &outline->series : nullptr;
   in.mjcf_xml = generateMjcf(c.robot, c.mujoco, c.effects);
-  const ModelEntry* solid = findModel(mj ? "mujoco" : "analytic");
-  const ModelEntry* outline = findModel("analytic");
-  in.solid_label = solid ? solid->title : "MuJoCo";
-  in.outline_label = !outline_label.empty() ? outline_label : outline ? outline->title : "analytic model";
+  in.solid_label = solid_model->title;
+  in.outline_label = !outline_label.empty() ? outline_label : outline_model ? outline_model->title : "analytic model";
   in.title = c.experiment + (c.name == "base" ? "" : " " + c.name);
   makeResultDir(out_dir);
   const std::string stem = (std::filesystem::path(out_dir) / caseDirName(c.name)).string();

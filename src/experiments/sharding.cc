@@ -43,10 +43,15 @@ ShardSpec parseShard(const std::string& text) {
   return s;
 }
 
-double expectedCaseCostS(const WorkEstimate& w, bool analytic, bool mujoco) {
+double expectedCaseCostS(const WorkEstimate& w) {
   double c = 0.0;
-  if (analytic) c += 1e-3 + 2e-6 * w.rows;
-  if (mujoco) c += 1e-5 * w.mujoco_steps;
+  std::vector<std::string> charged;  // cost groups already charged their fixed and per-row cost
+  for (const ModelEntry* m : w.models) {
+    if (m->cost_group.empty() || std::find(charged.begin(), charged.end(), m->cost_group) == charged.end())
+      c += m->cost_fixed_s + m->cost_per_row_s * w.rows;
+    if (!m->cost_group.empty()) charged.push_back(m->cost_group);
+  }
+  for (const WorkEstimate::ModelSteps& m : w.model_steps) c += m.model->cost_per_step_s * m.steps.steps;
   c += 5e-3 * w.render_frames;
   return c;
 }
@@ -69,11 +74,7 @@ std::vector<int> assignShards(const std::vector<double>& cost, int n_shards) {
 std::vector<std::vector<char>> shardMembership(const std::vector<Experiment>& suite, ShardSpec shard) {
   std::vector<double> cost;
   for (const Experiment& e : suite)
-    for (const ExperimentCase& c : e.cases) {
-      const bool analytic = std::find(c.models.begin(), c.models.end(), "analytic") != c.models.end();
-      const bool mujoco = std::find(c.models.begin(), c.models.end(), "mujoco") != c.models.end();
-      cost.push_back(expectedCaseCostS(estimateWork(c), analytic || c.models.size() > (mujoco ? 1u : 0u), mujoco));
-    }
+    for (const ExperimentCase& c : e.cases) cost.push_back(expectedCaseCostS(estimateWork(c)));
   const std::vector<int> a = assignShards(cost, shard.count);
   std::vector<std::vector<char>> in(suite.size());
   size_t k = 0;

@@ -19,9 +19,9 @@ constexpr int kMaxShards = 100000;
 ShardSpec parseShard(const std::string& text);
 
 // Expected wall time of one case on one core [s], from its work estimate: a rough, documented cost
-// model used only to balance shards (docs/scale.md): analytic 1 ms + 2 us per output row, MuJoCo
-// 10 us per step, rendering 5 ms per frame.
-double expectedCaseCostS(const WorkEstimate& w, bool analytic, bool mujoco);
+// model used only to balance shards (docs/scale.md): each model's registry cost (analytic and
+// per-foot together 1 ms + 2 us per output row, MuJoCo 10 us per step), rendering 5 ms per frame.
+double expectedCaseCostS(const WorkEstimate& w);
 
 // Assigns every case to a shard 0..n_shards-1, balancing the summed cost: longest processing time
 // first (cases sorted by cost, descending, ties by index; each to the least loaded shard, ties to

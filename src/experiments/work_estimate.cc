@@ -10,17 +10,11 @@
 namespace tailsim {
 namespace {
 
-bool has(const std::vector<std::string>& v, const char* s) { return std::find(v.begin(), v.end(), s) != v.end(); }
-
 std::string g(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", v);
   return b;
 }
-
-// Output columns per model run (analytic_simulation.cc Recorder, mujoco_simulation.cc makeColumns).
-double analyticColumns(int n) { return 1 + 3 * n + 20; }
-double mujocoColumns(int n) { return 1 + 3 * n + 14 + 8 + n; }
 
 // The keys that set the simulated time, most likely culprit first.
 std::vector<std::string> timeKeys(const ExperimentCase& c) {
@@ -33,46 +27,100 @@ std::vector<std::string> timeKeys(const ExperimentCase& c) {
 
 void append(std::vector<std::string>& a, const std::vector<std::string>& b) { a.insert(a.end(), b.begin(), b.end()); }
 
+const std::string kSeeLimits = " (docs/experiment-format.md \"Limits\")";
+
 }  // namespace
+
+double WorkEstimate::solverSteps() const {
+  double s = 0;
+  for (const ModelSteps& m : model_steps) s += m.steps.steps;
+  return s;
+}
+
+StepLimit analyticStepEstimate(const ExperimentCase& c) {
+  StepLimit s;
+  s.limit = limits::kMaxAnalyticSteps;
+  const TailTrajectory traj = c.trajectory();
+  // While the tail moves (t0 delay included) the adaptive step is at most max_step_s, by default
+  // 1/8 of the shortest phase of the joints moving in each segment between two breakpoints
+  // (analytic_simulation.cc segmentScales); the fixed step is fixed_dt_s.
+  const double moving_until = std::min(traj.endTime(), c.simDuration());
+  const bool fixed = c.analytic.solver == AnalyticSolver::kFixed;
+  if (fixed || c.analytic.max_step_s > 0) {
+    const double h = fixed ? c.analytic.fixed_dt_s : c.analytic.max_step_s;
+    s.steps = moving_until / h;
+  } else {
+    // A segment where no joint moves before the tail's end (a start delay) keeps the run's bound.
+    const double shortest = traj.shortestPhase();
+    std::vector<double> b = traj.breakpoints();
+    b.insert(b.begin(), 0.0);
+    for (std::size_t k = 0; k + 1 < b.size() && b[k] < moving_until; ++k) {
+      const double lo = b[k], hi = std::min(b[k + 1], moving_until);
+      const double phase = traj.shortestActivePhase(0.5 * (lo + hi));
+      if (hi > lo) s.steps += (hi - lo) / ((std::isfinite(phase) ? phase : shortest) / 8.0);
+    }
+  }
+  return s;
+}
+
+WorkExcess analyticStepExcess(const ExperimentCase& c, const StepLimit& s) {
+  WorkExcess x;
+  const bool fixed = c.analytic.solver == AnalyticSolver::kFixed;
+  x.keys = {fixed ? "analytic.fixed_dt_s" : "analytic.max_step_s", "trajectory.t0_s", "trajectory.dT_s"};
+  x.what = "the analytic model would take at least " + g(s.steps) + " steps (tail motion until t = " +
+           g(std::min(c.trajectory().endTime(), c.simDuration())) + " s / step " +
+           (fixed ? g(c.analytic.fixed_dt_s) : g(c.analytic.max_step_s > 0 ? c.analytic.max_step_s : 0.0)) +
+           " s), more than the limit " + g(s.limit) + kSeeLimits;
+  if (!fixed && !(c.analytic.max_step_s > 0))
+    x.what = "the analytic model would take at least " + g(s.steps) +
+             " steps (its step is at most 1/8 of the shortest acceleration or deceleration phase of the joints "
+             "moving at each time), more "
+             "than the limit " + g(s.limit) + kSeeLimits;
+  return x;
+}
+
+StepLimit mujocoStepEstimate(const ExperimentCase& c) {
+  StepLimit s;
+  s.limit = limits::kMaxMujocoSteps;
+  const double sim_time_s = c.simDuration();
+  s.steps = (c.mujoco.settle_s + sim_time_s) / c.mujoco.timestep_s;
+  return s;
+}
+
+WorkExcess mujocoStepExcess(const ExperimentCase& c, const StepLimit& s) {
+  WorkExcess x;
+  const double sim_time_s = c.simDuration();
+  x.keys = c.mujoco.timestep_s < MujocoSettings{}.timestep_s ? std::vector<std::string>{"mujoco.timestep_s"}
+                                                              : std::vector<std::string>{};
+  if (c.mujoco.settle_s > sim_time_s) x.keys.push_back("mujoco.settle_s");
+  append(x.keys, timeKeys(c));
+  x.keys.push_back("mujoco.settle_s");
+  x.keys.push_back("mujoco.timestep_s");
+  x.what = "MuJoCo would take " + g(s.steps) + " steps ((mujoco.settle_s " + g(c.mujoco.settle_s) + " s + " +
+           g(sim_time_s) + " s simulated) / timestep_s " + g(c.mujoco.timestep_s) + " s), more than the limit " +
+           g(s.limit) + kSeeLimits;
+  return x;
+}
 
 WorkEstimate estimateWork(const ExperimentCase& c) {
   WorkEstimate w;
   if (c.kind != CaseKind::kSimulate) return w;
   const int n = c.robot.numLinks();
-  const TailTrajectory traj = c.trajectory();
-  const double tail_end = traj.endTime();
   w.sim_time_s = c.simDuration();
   w.rows = std::floor(w.sim_time_s / c.output.sample_dt_s) + 1;
   double cols = 0;
-  if (has(c.models, "analytic")) {
-    cols = std::max(cols, analyticColumns(n));
-    // While the tail moves (t0 delay included) the adaptive step is at most max_step_s, by default
-    // 1/8 of the shortest phase of the joints moving in each segment between two breakpoints
-    // (analytic_simulation.cc segmentScales); the fixed step is fixed_dt_s.
-    const double moving_until = std::min(tail_end, w.sim_time_s);
-    if (c.analytic.solver == AnalyticSolver::kFixed || c.analytic.max_step_s > 0) {
-      const double h = c.analytic.solver == AnalyticSolver::kFixed ? c.analytic.fixed_dt_s : c.analytic.max_step_s;
-      w.analytic_steps = moving_until / h;
-    } else {
-      // A segment where no joint moves before the tail's end (a start delay) keeps the run's bound.
-      const double shortest = traj.shortestPhase();
-      std::vector<double> b = traj.breakpoints();
-      b.insert(b.begin(), 0.0);
-      for (std::size_t k = 0; k + 1 < b.size() && b[k] < moving_until; ++k) {
-        const double lo = b[k], hi = std::min(b[k + 1], moving_until);
-        const double phase = traj.shortestActivePhase(0.5 * (lo + hi));
-        if (hi > lo) w.analytic_steps += (hi - lo) / ((std::isfinite(phase) ? phase : shortest) / 8.0);
-      }
-    }
+  bool shown = false;
+  for (const ModelEntry& m : modelRegistry()) {
+    if (std::find(c.models.begin(), c.models.end(), m.name) == c.models.end()) continue;
+    w.models.push_back(&m);
+    cols = std::max(cols, static_cast<double>(m.columns(n).size()));
+    if (m.steps) w.model_steps.push_back({&m, m.steps(c)});
+    shown = shown || m.render_rank > 0;
   }
-  if (has(c.models, "mujoco")) {
-    cols = std::max(cols, mujocoColumns(n));
-    w.mujoco_steps = (c.mujoco.settle_s + w.sim_time_s) / c.mujoco.timestep_s;
-    if (c.render.enabled) {
-      const double shown = c.render.duration_s > 0 ? std::min(c.render.duration_s, w.sim_time_s) : w.sim_time_s;
-      w.render_frames = std::floor(shown * c.render.fps * c.render.slowmo) + 1;
-      w.render_samples = w.render_frames * c.render.width * c.render.height * std::max(1, c.render.msaa);
-    }
+  if (shown && c.render.enabled) {
+    const double on_screen = c.render.duration_s > 0 ? std::min(c.render.duration_s, w.sim_time_s) : w.sim_time_s;
+    w.render_frames = std::floor(on_screen * c.render.fps * c.render.slowmo) + 1;
+    w.render_samples = w.render_frames * c.render.width * c.render.height * std::max(1, c.render.msaa);
   }
   w.csv_bytes = w.rows * cols * limits::kCsvBytesPerValue;
   return w;
@@ -96,32 +144,9 @@ WorkExcess checkWork(const ExperimentCase& c) {
              " bytes per model run" + see + ": raise sample_dt_s or shorten the run";
     return x;
   }
-  if (!(w.analytic_steps <= limits::kMaxAnalyticSteps)) {
-    const bool fixed = c.analytic.solver == AnalyticSolver::kFixed;
-    x.keys = {fixed ? "analytic.fixed_dt_s" : "analytic.max_step_s", "trajectory.t0_s", "trajectory.dT_s"};
-    x.what = "the analytic model would take at least " + g(w.analytic_steps) + " steps (tail motion until t = " +
-             g(std::min(c.trajectory().endTime(), w.sim_time_s)) + " s / step " +
-             (fixed ? g(c.analytic.fixed_dt_s) : g(c.analytic.max_step_s > 0 ? c.analytic.max_step_s : 0.0)) +
-             " s), more than the limit " + g(limits::kMaxAnalyticSteps) + see;
-    if (!fixed && !(c.analytic.max_step_s > 0))
-      x.what = "the analytic model would take at least " + g(w.analytic_steps) +
-               " steps (its step is at most 1/8 of the shortest acceleration or deceleration phase of the joints "
-               "moving at each time), more "
-               "than the limit " + g(limits::kMaxAnalyticSteps) + see;
-    return x;
-  }
-  if (!(w.mujoco_steps <= limits::kMaxMujocoSteps)) {
-    x.keys = c.mujoco.timestep_s < MujocoSettings{}.timestep_s ? std::vector<std::string>{"mujoco.timestep_s"}
-                                                                : std::vector<std::string>{};
-    if (c.mujoco.settle_s > w.sim_time_s) x.keys.push_back("mujoco.settle_s");
-    append(x.keys, timeKeys(c));
-    x.keys.push_back("mujoco.settle_s");
-    x.keys.push_back("mujoco.timestep_s");
-    x.what = "MuJoCo would take " + g(w.mujoco_steps) + " steps ((mujoco.settle_s " + g(c.mujoco.settle_s) + " s + " +
-             span + ") / timestep_s " + g(c.mujoco.timestep_s) + " s), more than the limit " +
-             g(limits::kMaxMujocoSteps) + see;
-    return x;
-  }
+  for (const WorkEstimate::ModelSteps& m : w.model_steps)
+    if (m.steps.limit > 0 && !(m.steps.steps <= m.steps.limit) && m.model->too_many_steps)
+      return m.model->too_many_steps(c, m.steps);
   if (!(w.render_frames <= limits::kMaxRenderFrames)) {
     x.keys = {"render.slowmo", "render.fps", "render.duration_s"};
     append(x.keys, timeKeys(c));
@@ -156,7 +181,7 @@ WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
   for (const ExperimentCase& c : cases) {
     if (c.kind != CaseKind::kSimulate) continue;
     const WorkEstimate w = estimateWork(c);
-    steps += w.analytic_steps + w.mujoco_steps;
+    steps += w.solverSteps();
     samples += w.render_samples;
     frames += w.render_frames;
     const double share = c.output.time_series == TimeSeriesOutput::kNone   ? 0.0
@@ -167,7 +192,7 @@ WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
   const std::string see = " (docs/experiment-format.md \"Limits\")";
   const std::string n = std::to_string(cases.size()) + (cases.size() == 1 ? " case" : " cases");
   if (!(steps <= limits::kMaxExperimentSteps))
-    x.what = "the " + n + " would take about " + g(steps) + " solver steps in all (analytic steps + MuJoCo steps, " +
+    x.what = "the " + n + " would take about " + g(steps) + " solver steps in all (every model's steps, " +
              "summed over the cases), more than the limit " + g(limits::kMaxExperimentSteps) + see +
              ": sweep fewer values or split the experiment";
   else if (!(bytes <= limits::kMaxExperimentBytes))

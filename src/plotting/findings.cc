@@ -433,8 +433,8 @@ Finding modelComparison(const std::vector<ExperimentResults>& all) {
     const ExperimentResults* r = findExperiment(all, prefix);
     if (!r) continue;
     ++panels;
-    const double a = r->cases.empty() ? kNaN : r->phiNet(r->cases.front(), "analytic");
-    const double mj = r->cases.empty() ? kNaN : r->phiNet(r->cases.front(), "mujoco");
+    const double a = r->cases.empty() ? kNaN : r->phiNet(r->cases.front(), kAnalyticModel);
+    const double mj = r->cases.empty() ? kNaN : r->phiNet(r->cases.front(), kMujocoModel);
     d += (d.empty() ? "" : "; ") + r->name + ": analytic " +
          (std::isfinite(a) ? signedDeg(a) : std::string("n/a")) + ", MuJoCo " +
          (std::isfinite(mj) ? signedDeg(mj) : std::string("n/a"));

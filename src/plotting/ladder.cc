@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "experiments/model_registry.h"
 #include "plotting/gnuplot.h"
 #include "plotting/result_folder.h"
 #include "plotting/style.h"
@@ -76,7 +77,7 @@ void addExperiment(const ExperimentResults& r, std::vector<LadderCase>& out) {
   if (!has_coupling || !has_friction)
     throw std::runtime_error(r.dir + ": not a ladder experiment (analytic.coupling and effects.friction must be swept, "
                                      "configs/ladder/)");
-  for (const char* m : {"analytic", "perfoot", "mujoco"})
+  for (const char* m : {kAnalyticModel, kPerFootModel, kMujocoModel})
     if (!r.hasModel(m)) throw std::runtime_error(r.dir + ": model " + std::string(m) + " was not run");
   std::map<std::string, LadderCase> by;  // figure case name -> rungs
   std::vector<std::string> order;
@@ -99,7 +100,7 @@ void addExperiment(const ExperimentResults& r, std::vector<LadderCase>& out) {
       for (const Rung& g : rungs()) L.*g.value = kNaN;
       L.paper_adams = kNaN;
     }
-    const double a = r.phiNet(c, "analytic"), p = r.phiNet(c, "perfoot"), mj = r.phiNet(c, "mujoco");
+    const double a = r.phiNet(c, kAnalyticModel), p = r.phiNet(c, kPerFootModel), mj = r.phiNet(c, kMujocoModel);
     if (friction == "stiction") {
       if (coupling == "paper") {
         L.paper = a;

@@ -49,14 +49,6 @@ Txt V(const std::string& key, const std::string& value) {
   return {gpValueLabel(key, value), plainValueLabel(key, value)};
 }
 
-// A model's name without its parenthesis ("MuJoCo", "analytic"): for panels that compare models
-// over a swept key the parenthesis may name ("analytic (stiction)" when the friction law is swept).
-std::string shortModel(const std::string& m) {
-  const std::string t = modelTitle(m);
-  const size_t open = t.find(" (");
-  return open == std::string::npos ? t : t.substr(0, open);
-}
-
 // Whether a model reads a key: "analytic.coupling" is read by the analytic model only (a section
 // named after another model); every other section by every model.
 bool modelReads(const std::string& model, const std::string& key) {
@@ -297,10 +289,13 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     if (auto it = c.runs.find(m); it != c.runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
   }
   const double t_end = timeAxisEnd(all, stops);
-  const Phases phases = ts.count("analytic") ? findPhases(ts["analytic"]) : Phases{};
+  const Phases phases = ts.count(kAnalyticModel) ? findPhases(ts[kAnalyticModel]) : Phases{};
 
   Txt vs = {"", ""};
-  if (models.size() == 2 && ts.count("analytic") && ts.count("mujoco")) vs = {": analytic vs MuJoCo", ": analytic vs MuJoCo"};
+  if (models.size() == 2 && ts.count(kAnalyticModel) && ts.count(kMujocoModel)) {
+    const std::string v = ": " + modelShortTitle(kAnalyticModel) + " vs " + modelShortTitle(kMujocoModel);
+    vs = {v, v};
+  }
   else if (models.size() == 1) vs = {": " + gpText(modelTitle(models[0])), ": " + modelTitle(models[0])};
 
   // phi(t), all models overlaid (Figs. 6, 7a).
@@ -370,7 +365,7 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
     }
     writeDataFile(ctx.data(stem), names, rows);
     std::string panel = gpText(modelTitle(m));
-    if (m == "mujoco") panel += ": impulse-averaged over each output interval";
+    if (const ModelEntry* e = findModel(m); e && !e->moments_note.empty()) panel += ": " + e->moments_note;
     // the legend beside the panel: inside, it hid curves wherever it was put
     mb << "set grid\nset key outside right top vertical box\nset title " << gpTitle(panel, 1000)
        << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
@@ -386,10 +381,8 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   std::string cap = mom_title.plain +
                     ". Tail moment M_z,T (Eq. 13), friction moment M_z,F and inertial moment I_zz φ̈ over time, one "
                     "panel per model, one time scale; each panel has its own moment scale (read the y tics).";
-  if (ts.count("mujoco") && std::find(mm.begin(), mm.end(), "mujoco") != mm.end())
-    cap += " MuJoCo's moments are impulse averages: the contact and joint impulses of the MuJoCo steps in each "
-           "output interval (t ± Δt/2) summed and divided by the interval's length, not single samples of the "
-           "chattering contact forces.";
+  for (const std::string& m : mm)
+    if (const ModelEntry* e = findModel(m); e && !e->moments_caption.empty()) cap += " " + e->moments_caption;
   ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1200,
              60 + 430 * static_cast<int>(mm.size()));
 }
@@ -478,7 +471,7 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
     for (size_t k = 1; k < values.size(); ++k) {
       const auto& [mk, gk] = values[k];
       Panel d{stem + (values.size() == 2 ? std::string("_difference") : "_difference_" + mk),
-              gpText(shortModel(mk)) + " − " + gpText(shortModel(m0)), "difference " + cblabel, g0};
+              gpText(modelShortTitle(mk)) + " − " + gpText(modelShortTitle(m0)), "difference " + cblabel, g0};
       for (size_t iy = 0; iy < g0.size(); ++iy)
         for (size_t ix = 0; ix < g0[iy].size(); ++ix) {
           d.grid[iy][ix] = gk[iy][ix] - g0[iy][ix];
@@ -489,13 +482,13 @@ void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::stri
     if (std::isfinite(dlo)) {
       for (Panel& d : diffs) scale(d, dlo, dhi, true), panels.push_back(d);
       if (values.size() == 2)
-        diff_caption = " The last panel is " + shortModel(values[1].first) + " minus " + shortModel(m0) +
-                       " on its own scale (diverging, centred on zero: blue where " + shortModel(values[1].first) +
+        diff_caption = " The last panel is " + modelShortTitle(values[1].first) + " minus " + modelShortTitle(m0) +
+                       " on its own scale (diverging, centred on zero: blue where " + modelShortTitle(values[1].first) +
                        " is lower, vermillion where it is higher).";
       else
         diff_caption = " The last " + std::to_string(diffs.size()) + " panels are each other model minus " +
-                       shortModel(m0) + ", on one scale of their own (diverging, centred on zero: blue where the "
-                       "model is lower than " + shortModel(m0) + ", vermillion where it is higher).";
+                       modelShortTitle(m0) + ", on one scale of their own (diverging, centred on zero: blue where the "
+                       "model is lower than " + modelShortTitle(m0) + ", vermillion where it is higher).";
     }
   }
   const HeatMapLayout lay = heatMapLayout(ax.values.size(), ay.values.size());
@@ -782,7 +775,7 @@ void plotGroupedBars(Ctx& ctx) {
                                       "fs pattern 5 border -1", "fs empty border -1"};
   for (size_t k = 0; k < series.size(); ++k) {
     const Series& sr = series[k];
-    std::string t = gpText(shortModel(sr.model));
+    std::string t = gpText(modelShortTitle(sr.model));
     if (sr.ib >= 0) t += ", " + gpValueLabel(ab.key, ab.values[sr.ib]);
     else t += " (" + keyDisplay(ab.key).symbol + " not used)";
     b << (k ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using " << k + 2 << " "
@@ -799,7 +792,7 @@ void plotGroupedBars(Ctx& ctx) {
                     "; colour = model, fill = " + K(ab.key).plain + " (solid, light, hatched, in the legend's order).";
   for (const std::string& m : r.models)
     if (!modelReads(m, ab.key))
-      cap += " " + shortModel(m) + " does not read " + K(ab.key).plain + ": one bar per group.";
+      cap += " " + modelShortTitle(m) + " does not read " + K(ab.key).plain + ": one bar per group.";
   ctx.render(stem, b.str(), title, cap, w + 360, 700);
 }
 

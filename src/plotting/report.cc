@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "experiments/model_registry.h"
 #include "plotting/figure_sheet.h"
 #include "plotting/style.h"
 #include "plotting/sweep_summary.h"
@@ -65,7 +66,7 @@ void findingsSection(std::ostringstream& o, const std::vector<Finding>& findings
       if (const ModelVerdict* mv = f.verdictFor(m)) return verdictText(mv->verdict);
       return "";
     };
-    std::string a = v("analytic"), mj = v("mujoco");
+    std::string a = v(kAnalyticModel), mj = v(kMujocoModel);
     if (const ModelVerdict* cmp = f.verdictFor("mujoco vs analytic")) a = mj = std::string(verdictText(cmp->verdict)) + " (comparison)";
     o << "| " << cell(f.where) << " | " << cell(f.brief.empty() ? f.claim : f.brief) << " | " << a << " | " << mj
       << " |\n";

@@ -27,14 +27,17 @@ std::string modelTitle(const std::string& model) {
   return m ? m->title : model;
 }
 
+std::string modelShortTitle(const std::string& model) {
+  const std::string t = modelTitle(model);
+  const size_t open = t.find(" (");
+  return open == std::string::npos ? t : t.substr(0, open);
+}
+
 std::string modelGlossary(const std::vector<std::string>& models) {
-  static const std::pair<const char*, const char*> known[] = {
-      {"analytic", "Analytic = the paper's model (stiction friction)"},
-      {"perfoot", "per-foot = Coulomb friction at each foot (docs/per-foot-model.md)"},
-      {"mujoco", "MuJoCo = the contact model"}};
   std::string out;
-  for (const auto& [name, text] : known)
-    if (std::find(models.begin(), models.end(), name) != models.end()) out += (out.empty() ? "" : "; ") + std::string(text);
+  for (const ModelEntry& m : modelRegistry())
+    if (!m.glossary.empty() && std::find(models.begin(), models.end(), m.name) != models.end())
+      out += (out.empty() ? "" : "; ") + m.glossary;
   return out.empty() ? out : out + ".";
 }
 
@@ -307,9 +310,12 @@ KeyDisplay keyDisplay(const std::string& key) {
       std::string w = d.plain;
       std::replace(w.begin(), w.end(), '_', ' ');
       const std::string section = key.substr(0, key.find('.'));
-      static const std::map<std::string, std::string> owner = {
-          {"quadruped", "body "}, {"mujoco", "MuJoCo "}, {"perfoot", "per-foot "}, {"analytic", "analytic "}, {"tail", "tail "}};
-      if (const auto it = owner.find(section); it != owner.end() && key.find('.') != std::string::npos) w = it->second + w;
+      // A model's own section: its title without the parenthesis ("MuJoCo foot shape").
+      static const std::map<std::string, std::string> owner = {{"quadruped", "body "}, {"tail", "tail "}};
+      if (key.find('.') != std::string::npos) {
+        if (const auto it = owner.find(section); it != owner.end()) w = it->second + w;
+        else if (findModel(section)) w = modelShortTitle(section) + " " + w;
+      }
       d.plain = w;
       d.symbol = gpText(w);
     }

@@ -20,6 +20,10 @@ namespace tailsim {
 std::string modelColor(const std::string& model);
 // Legend / panel name of a model: "analytic (stiction)", "MuJoCo (contact)".
 std::string modelTitle(const std::string& model);
+// Its title without the parenthesis ("MuJoCo", "analytic"): for panels that compare models over a
+// swept key the parenthesis may name ("analytic (stiction)" when the friction law is swept), and
+// for the keys of a model's own section ("MuJoCo foot shape").
+std::string modelShortTitle(const std::string& model);
 // One sentence naming what each of `models` is, in the order analytic, per-foot, MuJoCo, only the
 // models given: "Analytic = the paper's model (stiction friction); per-foot = ...; MuJoCo = ...".
 std::string modelGlossary(const std::vector<std::string>& models);

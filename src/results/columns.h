@@ -46,11 +46,8 @@ inline std::string trackErr(int i) { return "track_err" + std::to_string(i) + "_
 // Columns every model writes (a pose evaluation: those that exist at one instant), in order.
 std::vector<std::string> shared(int links);
 
-// Each model's own columns, in order (a new model adds its list here and names it in its
-// registry entry, experiments/model_registry.cc).
-inline std::vector<std::string> analyticOnly() {
-  return {kMzTAcc, kMzTSpeed, kMzTTan, kMzTCen, kLF, kRotState, kTransState};
-}
+// MuJoCo's own columns, in order (the planar models' come from their column tables,
+// analytic_model/row_columns.h).
 inline std::vector<std::string> mujocoOnly(int links) {
   std::vector<std::string> c;
   for (int k = 1; k <= 4; ++k) {
