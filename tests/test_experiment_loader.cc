@@ -311,7 +311,8 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
           "         cone: pyramidal, noslip_iterations: 3, condim: 4, impratio: 2, solref: [0.004, 0.9],\n"
           "         solimp: [0.9, 0.95, 0.002, 0.4, 3], mu: 0.3, kp: 50, kv: 2,\n"
           "         velocity_feedforward: false, inverse_dynamics_feedforward: no, servo_wn_dt: 0.3,\n"
-          "         body_height_m: 0.2, foot_radius_m: 0.02, settle_s: 0.3, stop_phidot_radps: 1e-4}\n"
+          "         foot_radius_m: 0.02, settle_s: 0.3, stop_phidot_radps: 1e-4}\n"
+          "quadruped: {com_height_m: 0.2}\n"
           "effects: {friction: none, translation: false, gravity: false, ground_contact: false,\n"
           "          foot_loads: constant, load_decomposition: false}\n"
           "output: {sample_dt_s: 0.002, duration_s: 1.5, settle_s: 0.2}\n"
@@ -592,7 +593,9 @@ TEST_F(LoaderTest, BadSettings) {
               "at least 2 rows");
   expectError(exp(std::string(kTraj) + "mujoco:\n  timestep_s: -1e-4\n"), 6, "mujoco.timestep_s", "> 0");
   expectError(exp(std::string(kTraj) + "mujoco: {condim: 2}\n"), 5, "mujoco.condim", "1, 3, 4, 6");
-  expectError(exp(std::string(kTraj) + "mujoco: {body_height_m: 0}\n"), 5, "mujoco.body_height_m", "> 0");
+  expectError(exp(std::string(kTraj) + "mujoco: {body_height_m: 0.2}\n"), 5, "mujoco.body_height_m",
+              "one key for both");
+  expectError(exp(std::string(kTraj) + "quadruped: {com_height_m: 0}\n"), 5, "quadruped.com_height_m", "> 0");
   expectError(exp(std::string(kTraj) + "mujoco: {solref: [0.002]}\n"), 5, "mujoco.solref", "2 values");
   expectError(exp(std::string(kTraj) + "mujoco: {solimp: [0.9, 1.5, 0.001, 0.5, 2]}\n"), 5, "mujoco.solimp[1]", "(0, 1)");
 }
@@ -809,6 +812,81 @@ TEST(ShippedConfigs, AllLoad) {
     ++loaded;
   }
   EXPECT_GE(loaded, 1);
+}
+
+// A robot given by its size (issue 34, item 3): a uniform box; the explicit numbers derived from it.
+TEST_F(LoaderTest, RobotGivenByItsSize) {
+  write("robots/box.yaml",
+        "quadruped: {mass_kg: 12, size_m: [0.5, 0.3, 0.2], foot_inset_m: 0.03}\n"
+        "friction: {mu_s: 0.5, mu_d: 0.4}\n"
+        "gravity_mps2: 9.81\n"
+        "tails:\n  1: {mass_kg: 1.2, izz_kgm2: 0.025, length_m: 0.5}\n");
+  const std::string head = "name: t\nrobot: robots/box.yaml\ntail: {links: 1}\n";
+  const ExperimentCase c = loadExperiment(write("exp.yaml", head + kTraj)).cases.at(0);
+  const QuadrupedParams& q = c.robot.quadruped;
+  EXPECT_DOUBLE_EQ(q.mass_kg, 12.0);
+  EXPECT_NEAR(q.izz_kgm2, 12.0 * (0.25 + 0.09) / 12.0, 1e-15);  // m (l^2 + w^2) / 12
+  EXPECT_NEAR(q.l_F_m, 0.44, 1e-15);
+  EXPECT_NEAR(q.w_F_m, 0.24, 1e-15);
+  EXPECT_EQ(q.d_Q2C_m, 0.0);
+  EXPECT_NEAR(q.d_Q2B_m, 0.25, 1e-15);
+  EXPECT_NEAR(q.com_height_m, 0.1, 1e-15);
+  EXPECT_NEAR(c.mujoco.body_height_m, 0.1, 1e-15);  // one COM-height key
+  // The experiment's size_m without mass_kg keeps the file's mass; the inset defaults to 0.02 m.
+  const ExperimentCase d =
+      loadExperiment(write("exp.yaml", head + kTraj + "quadruped: {size_m: [0.6, 0.3, 0.2]}\n")).cases.at(0);
+  EXPECT_NEAR(d.robot.quadruped.izz_kgm2, 12.0 * (0.36 + 0.09) / 12.0, 1e-15);
+  EXPECT_NEAR(d.robot.quadruped.l_F_m, 0.6 - 2 * QuadrupedBox{}.foot_inset_m, 1e-15);
+  // On the paper robot (explicit numbers) too.
+  const ExperimentCase e =
+      loadExperiment(write("exp.yaml", exp(std::string(kTraj) + "quadruped: {mass_kg: 10, size_m: [0.4, 0.2, 0.3]}\n")))
+          .cases.at(0);
+  EXPECT_NEAR(e.robot.quadruped.izz_kgm2, 10.0 * (0.16 + 0.04) / 12.0, 1e-15);
+  EXPECT_NEAR(e.robot.quadruped.com_height_m, 0.15, 1e-15);
+
+  expectError(exp(std::string(kTraj) + "quadruped: {size_m: [0.4, 0.2, 0.3], izz_kgm2: 0.2}\n"), 5,
+              "quadruped.izz_kgm2", "not both: size_m sets izz_kgm2");
+  expectError(exp(std::string(kTraj) + "quadruped: {foot_inset_m: 0.01}\n"), 5, "quadruped.foot_inset_m",
+              "only used with size_m");
+  expectError(exp(std::string(kTraj) + "quadruped: {size_m: [0.4, 0.2, 0.3], foot_inset_m: 0.1}\n"), 5,
+              "quadruped.foot_inset_m", "less than half");
+  expectError(exp(std::string(kTraj) + "quadruped: {size_m: [0.4, 0, 0.3]}\n"), 5, "quadruped.size_m", "> 0");
+  expectError(exp(std::string(kTraj) + "quadruped: {size_m: [0.4, 0.3]}\n"), 5, "quadruped.size_m", "3 values");
+  // A robot file of explicit numbers still needs every one of them.
+  write("robots/short.yaml",
+        "quadruped: {mass_kg: 12, izz_kgm2: 0.3, d_Q2C_m: 0, d_Q2B_m: 0.2, l_F_m: 0.4}\n"
+        "friction: {mu_s: 0.5, mu_d: 0.4}\ngravity_mps2: 9.81\n"
+        "tails:\n  1: {mass_kg: 1.2, izz_kgm2: 0.025, length_m: 0.5}\n");
+  try {
+    loadExperiment(write("exp.yaml", "name: t\nrobot: robots/short.yaml\n" + std::string(kTraj)));
+    ADD_FAILURE() << "no error for a robot file without w_F_m";
+  } catch (const ConfigError& x) {
+    EXPECT_NE(std::string(x.what()).find("short.yaml:1:1: quadruped.w_F_m: required key is missing (or give the size"),
+              std::string::npos)
+        << x.what();
+  }
+}
+
+// The continuous law's thresholds are needed only when that law is used (issue 34, item 3).
+TEST_F(LoaderTest, ContinuousThresholdsOnlyWithThatLaw) {
+  write("robots/plain.yaml",
+        "quadruped: {mass_kg: 12, size_m: [0.5, 0.3, 0.2]}\n"
+        "friction: {mu_s: 0.5, mu_d: 0.4}\n"
+        "gravity_mps2: 9.81\n"
+        "tails:\n  1: {mass_kg: 1.2, izz_kgm2: 0.025, length_m: 0.5}\n");
+  const std::string head = std::string("name: t\nrobot: robots/plain.yaml\ntail: {links: 1}\n") + kTraj;
+  EXPECT_NO_THROW(loadExperiment(write("exp.yaml", head)));
+  expectError(head + "effects: {friction: continuous}\n", 5, "effects.friction",
+              "the continuous law needs friction.phidot_s_radps");
+  expectError(head + "effects: {friction: continuous}\nfriction: {phidot_s_radps: 0.1, phidot_d_radps: 1}\n", 5,
+              "effects.friction", "needs friction.v_s_mps");
+  EXPECT_NO_THROW(loadExperiment(write(
+      "exp.yaml", head + "effects: {friction: continuous, translation: false}\n"
+                         "friction: {phidot_s_radps: 0.1, phidot_d_radps: 1}\n")));
+  const ExperimentCase c = loadExperiment(write(
+      "exp.yaml", head + "effects: {friction: continuous}\n"
+                         "friction: {phidot_s_radps: 0.1, phidot_d_radps: 1, v_s_mps: 0.02, v_d_mps: 0.2}\n")).cases.at(0);
+  EXPECT_DOUBLE_EQ(c.robot.friction.v_d_mps, 0.2);
 }
 
 }  // namespace

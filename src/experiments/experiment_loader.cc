@@ -529,15 +529,54 @@ MapView readDeclared(const Reader& r, const Item& item, S& s, bool all = false, 
 
 // Robot parts: ranges are checked by validate() (robot_params.cc, the same declarations), with
 // each message at the value that set it (origin).
+//
+// quadruped: the explicit numbers (QuadrupedParams; a robot file gives every key but com_height_m,
+// default 0.15 m), or the size form {mass_kg, size_m, foot_inset_m} (QuadrupedBox), which sets every
+// value but the mass from the box (quadrupedFromBox). An experiment's size_m without mass_kg keeps the
+// robot file's mass.
 void readQuadruped(const Reader& r, const Item& item, bool all, QuadrupedParams& q, Origins& origin) {
-  // A robot file gives every key but com_height_m (added later, default 0.15 m: the MuJoCo body height).
-  const MapView m = readDeclared(r, item, q, false, &origin, "quadruped.", false);
+  static const std::vector<std::string> kExplicit = declaredKeys<QuadrupedParams>();
+  static const std::vector<std::string> kAllowed = [] {
+    std::vector<std::string> k = kExplicit;
+    for (const std::string& b : declaredKeys<QuadrupedBox>())
+      if (std::find(k.begin(), k.end(), b) == k.end()) k.push_back(b);
+    return k;
+  }();
+  const MapView m = r.map(item, kAllowed);
+  if (const Item* size = m.get("size_m")) {
+    for (const std::string& k : kExplicit)
+      if (const Item* x = m.get(k); x && k != "mass_kg")
+        r.fail(*x, "give the size (mass_kg, size_m, foot_inset_m) or the explicit numbers, not both: size_m sets " + k);
+    if (all) r.need(m, "mass_kg");
+    QuadrupedBox box;
+    box.mass_kg = q.mass_kg;
+    YamlFields v(r, m, false, true, &origin, "quadruped.");
+    declareFields(v, box);
+    try {
+      q = quadrupedFromBox(box);
+    } catch (const std::invalid_argument& e) {
+      rethrowAt(e.what(), origin, r.loc(*size));
+    }
+    for (const std::string& k : kExplicit)
+      if (k != "mass_kg") origin["quadruped." + k] = r.loc(*size);
+    return;
+  }
+  if (const Item* x = m.get("foot_inset_m")) r.fail(*x, "only used with size_m (a robot given by its size)");
+  YamlFields v(r, m, false, false, &origin, "quadruped.");
+  declareFields(v, q);
   if (all)
-    for (const std::string& k : declaredKeys<QuadrupedParams>())
-      if (k != "com_height_m") r.need(m, k);
+    for (const std::string& k : kExplicit)
+      if (k != "com_height_m" && !m.get(k))
+        tailsim::fail(r.locAt(m.self, k), "required key is missing (or give the size: {mass_kg, size_m: [l, w, h]})");
 }
+
+// friction: mu_s and mu_d always; the continuous law's thresholds are checked where that law is
+// chosen (requireContinuousThresholds).
+const char* const kContinuousKeys[] = {"phidot_s_radps", "phidot_d_radps", "v_s_mps", "v_d_mps"};
 void readFriction(const Reader& r, const Item& item, bool all, FrictionParams& fp, Origins& origin) {
-  readDeclared(r, item, fp, all, &origin, "friction.", false);
+  const MapView m = readDeclared(r, item, fp, false, &origin, "friction.", false);
+  if (all)
+    for (const char* k : {"mu_s", "mu_d"}) r.need(m, k);
 }
 
 // One tail link {mass_kg, izz_kgm2, length_m, com_offset_m?}; origins under "tail link <i> ".
@@ -1040,6 +1079,11 @@ PoseSpec readPose(const Reader& r, const Item& item, int n) {
 
 MujocoSettings readMujoco(const Reader& r, const Item& item) {
   MujocoSettings s;
+  if (!r.pick(item) && item.node.IsMap())
+    if (const YAML::Node b = item.node["body_height_m"])
+      tailsim::fail(Loc{r.file(), b.Mark(), joinKey(item.key, "body_height_m")},
+                    "not a key: the MuJoCo body stands at the robot's COM height, quadruped.com_height_m "
+                    "(one key for both)");
   const MapView m = readDeclared(r, item, s);
   // MuJoCo's own rules on solref and solimp (element by element).
   if (const Item* x = m.get("solref")) {
@@ -1116,6 +1160,24 @@ void checkCaseWork(const Reader& r, const MapView& top, const ExperimentCase& c)
   }
   if (first_section) r.fail(*first_section, x.what);
   r.fail(r.root(top.self.node), x.what);
+}
+
+// effects.friction: continuous needs the law's thresholds (robot file or the experiment's friction:):
+// phidot_s/d_radps always, v_s/d_mps when translation is simulated.
+void requireContinuousThresholds(const Reader& r, const MapView& top, const ExperimentCase& c, const Origins& origin) {
+  if (c.effects.friction != FrictionLaw::kContinuous) return;
+  const Item* eff = top.get("effects");
+  // effects.friction: continuous is set there. (No Item assignment: a YAML::Node's operator=
+  // would rewrite the document.)
+  const bool direct = !r.pick(*eff) && eff->node.IsMap() && eff->node["friction"];
+  const Item at = direct ? Item{eff->node["friction"], "effects.friction", eff->node["friction"].Mark()} : *eff;
+  for (const char* k : kContinuousKeys) {
+    const bool translation = k[0] == 'v';
+    if (translation && !c.effects.translation) continue;
+    if (!origin.count(std::string("friction.") + k))
+      r.fail(at, std::string("the continuous law needs friction.") + k + " (in the robot file or the experiment's friction:)" +
+                     (translation ? "; or effects: {translation: false}" : ""));
+  }
 }
 
 // Pass 2: one case, with the sweeps resolved by `r`.
@@ -1229,8 +1291,8 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     const Item* x = top.get(sec.key);
     if constexpr (std::is_same_v<T, MujocoSettings>) {
       if (x) v = readMujoco(r, *x);
-      // The MuJoCo body stands at the robot's COM height unless mujoco.body_height_m says otherwise.
-      if (!(x && x->node.IsMap() && x->node["body_height_m"])) v.body_height_m = c.robot.quadruped.com_height_m;
+      // The MuJoCo body stands at the robot's COM height (one key: quadruped.com_height_m).
+      v.body_height_m = c.robot.quadruped.com_height_m;
     } else if constexpr (std::is_same_v<T, OutputSettings>) {
       if (x) v = readOutput(r, *x, c.kind == CaseKind::kSimulate ? c.trajectory().endTime() : -1.0);
     } else if constexpr (std::is_same_v<T, RenderSettings>) {
@@ -1242,6 +1304,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
       readDeclared(r, *x, v);
     }
   });
+  requireContinuousThresholds(r, top, c, origin);
   checkCaseWork(r, top, c);
   return c;
 }

@@ -139,6 +139,16 @@ json defs() {
 }
 
 // A number for all joints, or one per joint.
+// The quadruped section: the explicit numbers or the size form (QuadrupedBox), one map of both
+// forms' keys (the loader refuses a mix).
+json quadrupedProps() {
+  json p = describe<QuadrupedParams>().props;
+  const json box = describe<QuadrupedBox>().props;  // named: not a range-for over a temporary's items()
+  for (const auto& [k, v] : box.items())
+    if (!p.contains(k)) p[k] = v;
+  return p;
+}
+
 json perJoint(json value, const std::string& doc) {
   json one = orSweep(value);
   return {{"description", doc},
@@ -260,7 +270,7 @@ json experimentSchema() {
        {"robot", orSweep({{"type", "string"}, {"minLength", 1}})},
        {"kind", orSweep({{"type", "string"}, {"enum", settings::namesOf(kindNames())}})},
        {"tail", tail},
-       {"quadruped", section(describe<QuadrupedParams>().props)},
+       {"quadruped", section(quadrupedProps())},
        {"friction", section(describe<FrictionParams>().props)},
        {"gravity_mps2", orSweep({{"type", "number"}, {"minimum", 0}})},
        {"trajectory", traj},
@@ -300,12 +310,15 @@ json robotSchema() {
           {"additionalProperties", false},
           {"required", {"quadruped", "friction", "gravity_mps2", "tails"}},
           {"properties",
-           {{"quadruped", section(plain(describe<QuadrupedParams>().props), [] {
-              std::vector<std::string> k = allKeys<QuadrupedParams>();  // com_height_m is optional
+           {{"quadruped", [&] {
+              // Every explicit key but com_height_m (optional), or mass_kg and size_m.
+              json q = section(plain(quadrupedProps()));
+              std::vector<std::string> k = allKeys<QuadrupedParams>();
               k.erase(std::remove(k.begin(), k.end(), "com_height_m"), k.end());
-              return k;
-            }())},
-            {"friction", section(plain(describe<FrictionParams>().props), allKeys<FrictionParams>())},
+              q["oneOf"] = json::array({{{"required", k}}, {{"required", {"mass_kg", "size_m"}}}});
+              return q;
+            }()},
+            {"friction", section(plain(describe<FrictionParams>().props), {"mu_s", "mu_d"})},
             {"gravity_mps2", {{"type", "number"}, {"minimum", 0}}},
             {"tails", tails}}}};
 }
@@ -318,7 +331,13 @@ std::string settingsMarkdown() {
   };
   table("quadruped", "Overrides of the robot file's values (defaults: `robot: paper`, Table 1).",
         describe<QuadrupedParams>().rows);
-  table("friction", "Overrides of the robot file's values (defaults: `robot: paper`, Table 1).",
+  table("quadruped by its size", "Instead of the explicit numbers above (robot file or experiment): a uniform box "
+                                 "on four feet; `mass_kg` and `size_m` required. The explicit keys are then derived "
+                                 "(docs/experiment-format.md \"A robot given by its size\").",
+        describe<QuadrupedBox>().rows);
+  table("friction", "Overrides of the robot file's values (defaults: `robot: paper`, Table 1). A robot file "
+                    "needs `mu_s` and `mu_d`; the thresholds only with `effects.friction: continuous` "
+                    "(`v_s_mps`, `v_d_mps` only when translation is simulated too).",
         describe<FrictionParams>().rows);
   table("tail links", "Each entry of `tail: {custom: [...]}` and of a robot file's `tails.n`; `mass_kg`, "
                       "`izz_kgm2`, `length_m` required.",

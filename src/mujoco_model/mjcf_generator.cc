@@ -79,7 +79,7 @@ void validateSettings(const MujocoSettings& s) {
   if (s.kp == 0.0 && !(s.servo_wn_dt > 0.0)) throw std::invalid_argument("mujoco.servo_wn_dt must be > 0");
   if (!(s.foot_radius_m > 0.0)) throw std::invalid_argument("mujoco.foot_radius_m must be > 0");
   if (!(s.body_height_m > s.foot_radius_m + kTailGeomRadius))
-    throw std::invalid_argument("mujoco.body_height_m must exceed foot_radius_m + tail radius");
+    throw std::invalid_argument("quadruped.com_height_m (the MuJoCo body height) must exceed mujoco.foot_radius_m + tail radius");
   if (!(s.settle_s >= 0.0)) throw std::invalid_argument("mujoco.settle_s must be >= 0");
 }
 

@@ -123,8 +123,9 @@ settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
   v.boolean(Field{"inverse_dynamics_feedforward", "add MuJoCo's inverse-dynamics joint torque"},
             s.inverse_dynamics_feedforward);
   v.number(Field{"servo_wn_dt", "kp = 0: servo natural frequency * timestep"}, s.servo_wn_dt, Limits::positive());
-  v.number(Field{"body_height_m", "quadruped COM (= tail plane) height above the ground [m]"}, s.body_height_m,
-           Limits::positive());
+  v.internal(Field{"body_height_m", "quadruped COM (= tail plane) height above the ground, = quadruped.com_height_m; "
+                                   "not a YAML key [m]"},
+             s.body_height_m);
   v.number(Field{"foot_radius_m", "foot sphere / capsule radius, box half-size [m]"}, s.foot_radius_m,
            Limits::positive());
   v.choice(Field{"foot_shape", "feet's contact geometry: sphere, capsule (axis along body x) or box (cube, flat bottom)"},

@@ -31,6 +31,24 @@ void requireNonNegative(double v, const std::string& what) {
 }
 }  // namespace
 
+QuadrupedParams quadrupedFromBox(const QuadrupedBox& b) {
+  settings::validateFields(b, "quadruped.");
+  const double l = b.size_m[0], w = b.size_m[1], h = b.size_m[2];
+  for (double x : b.size_m)
+    if (!(x > 0.0)) throw std::invalid_argument("quadruped.size_m must be three lengths > 0 [l, w, h]");
+  if (!(l - 2.0 * b.foot_inset_m > 0.0) || !(w - 2.0 * b.foot_inset_m > 0.0))
+    throw std::invalid_argument("quadruped.foot_inset_m must be less than half the box's length and width");
+  QuadrupedParams q;
+  q.mass_kg = b.mass_kg;
+  q.izz_kgm2 = b.mass_kg * (l * l + w * w) / 12.0;
+  q.d_Q2C_m = 0.0;
+  q.d_Q2B_m = 0.5 * l;
+  q.l_F_m = l - 2.0 * b.foot_inset_m;
+  q.w_F_m = w - 2.0 * b.foot_inset_m;
+  q.com_height_m = 0.5 * h;
+  return q;
+}
+
 void validate(const RobotParams& p) {
   settings::validateFields(p.quadruped, "quadruped.");  // the declared ranges (robot_params.h)
   if (p.tail.empty()) throw std::invalid_argument("tail must have at least one link (n >= 1)");

@@ -1,6 +1,7 @@
 // Robot parameters shared by the analytic and the MuJoCo model (paper Tables 1, 2).
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -25,9 +26,24 @@ struct QuadrupedParams {
   double l_F_m = 0.3;       // foot spacing along body x  [m]
   double w_F_m = 0.26;      // foot spacing along body y  [m]
   // Height of the COM above the foot contacts  [m]: the per-foot model's load transfer and the
-  // MuJoCo body height (unless mujoco.body_height_m is given); the paper's models ignore it.
+  // MuJoCo body height (the one COM-height key); the paper's models ignore it.
   double com_height_m = 0.15;
 };
+
+// A quadruped given by its size (docs/experiment-format.md "A robot given by its size"): a uniform
+// box l x w x h (x forward, z up) standing on four feet at the corners of its footprint, each foot
+// inset foot_inset_m from the box's edges in x and y. quadrupedFromBox turns it into QuadrupedParams.
+struct QuadrupedBox {
+  double mass_kg = 0.0;                // m_Q  [kg]
+  std::array<double, 3> size_m{};      // [l, w, h]: length (x), width (y), height (z)  [m]
+  double foot_inset_m = 0.02;          // feet this far inside the footprint's edges, in x and y  [m]
+};
+
+// I_zz = m (l^2 + w^2) / 12 (uniform box about its centre), l_F = l - 2 inset, w_F = w - 2 inset,
+// d_Q2C = 0 (feet centred under the COM), d_Q2B = l / 2 (tail base at the middle of the rear face),
+// com_height = h / 2 (the box's centre, its bottom face at the foot contacts). Throws
+// std::invalid_argument naming the key when the box has no footprint left after the inset.
+QuadrupedParams quadrupedFromBox(const QuadrupedBox& b);
 
 // Foot-ground friction (paper Table 1, Fig. 4; paper-notes points 1 and 6).
 struct FrictionParams {
@@ -66,13 +82,27 @@ settings::For<S, QuadrupedParams> declareFields(V& v, S& s) {
                                  "height (optional in a robot file; default 0.15)"},
            s.com_height_m, Limits::positive());
 }
+// The keys of the size form `quadruped: {mass_kg, size_m, foot_inset_m}` (mass_kg shared with the
+// explicit form above).
+template <class V, class S>
+settings::For<S, QuadrupedBox> declareFields(V& v, S& s) {
+  using settings::Field;
+  using settings::Limits;
+  v.number(Field{"mass_kg", "m_Q, quadruped mass [kg]"}, s.mass_kg, Limits::positive());
+  v.numbers(Field{"size_m", "[l, w, h]: a uniform box on feet at its footprint's corners; sets izz_kgm2, l_F_m, "
+                            "w_F_m, d_Q2C_m = 0, d_Q2B_m = l/2, com_height_m = h/2 [m]"},
+            s.size_m);
+  v.number(Field{"foot_inset_m", "size_m only: feet this far inside the footprint's edges in x and y [m]"},
+           s.foot_inset_m, Limits::nonNegative());
+}
 template <class V, class S>
 settings::For<S, FrictionParams> declareFields(V& v, S& s) {
   using settings::Field;
   using settings::Limits;
   v.number(Field{"mu_s", "static coefficient (Table 1)"}, s.mu_s, Limits::nonNegative());
   v.number(Field{"mu_d", "dynamic coefficient (Table 1)"}, s.mu_d, Limits::nonNegative());
-  v.number(Field{"phidot_s_radps", "continuous law: mu reaches mu_s at this yaw rate [rad/s]"}, s.phidot_s_radps,
+  v.number(Field{"phidot_s_radps", "continuous law: mu reaches mu_s at this yaw rate; required only with "
+                                   "effects.friction: continuous [rad/s]"}, s.phidot_s_radps,
            Limits::positive());
   v.number(Field{"phidot_d_radps", "continuous law: mu reaches mu_d at this yaw rate (> phidot_s_radps) [rad/s]"},
            s.phidot_d_radps, Limits::positive());
