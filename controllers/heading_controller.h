@@ -16,6 +16,7 @@
 
 #include "settings/fields.h"
 #include "trajectory/split_cycle_profile.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -34,9 +35,9 @@ struct ManeuverSettings {
   int map_points = 12;                    // analytic yaw-vs-scale map: points in [min_scale, 1]
   bool mujoco = true;                     // run MuJoCo open- and closed-loop (false: analytic plan only)
 
-  double heading() const { return heading_deg * M_PI / 180.0; }  // [rad]
-  double tolerance() const { return tolerance_deg * M_PI / 180.0; }
-  double stroke() const { return stroke_deg * M_PI / 180.0; }
+  double heading() const { return units::radians(heading_deg); }  // [rad]
+  double tolerance() const { return units::radians(tolerance_deg); }
+  double stroke() const { return units::radians(stroke_deg); }
 };
 
 template <class V, class S>

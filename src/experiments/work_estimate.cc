@@ -6,17 +6,15 @@
 #include <limits>
 
 #include "results/work_limits.h"
+#include "results/number_text.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
 bool has(const std::vector<std::string>& v, const char* s) { return std::find(v.begin(), v.end(), s) != v.end(); }
 
-std::string g(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
+std::string g(double v) { return formatG(v, 3); }
 
 // Output columns per model run (analytic_simulation.cc Recorder, mujoco_simulation.cc makeColumns).
 double analyticColumns(int n) { return 1 + 3 * n + 20; }
@@ -138,7 +136,7 @@ std::string jointSpeedWarning(const ExperimentCase& c) {
   double peak = 0;
   std::size_t at = 0;
   for (std::size_t i = 0; i < traj.joints.size(); ++i) {
-    const double w = std::abs(traj.joints[i].peakSpeed()) * 180.0 / M_PI;
+    const double w = units::degrees(std::abs(traj.joints[i].peakSpeed()));
     if (w > peak) {
       peak = w;
       at = i;

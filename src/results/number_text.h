@@ -4,7 +4,15 @@
 // precision takes ~400 instructions a number, this ~100.
 #pragma once
 
+#include <string>
+
 namespace tailsim {
+
+// The text of v as printf's format f writes it (f takes one double: "%g", "%.3f", "%+.17g", ...):
+// every number in messages, Markdown, scripts and JSON-free text goes through here or formatG12.
+std::string formatNumber(const char* f, double v);
+// "%.<digits>g" (default "%g"): the shortest general form, for messages and labels.
+std::string formatG(double v, int digits = 6);
 
 // Writes v as "%.12g" would (C locale) at p, returns one past the last character. p must hold
 // 32 characters. Bit-for-bit the same text as std::to_chars(..., general, 12) for every double
