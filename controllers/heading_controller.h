@@ -1,4 +1,4 @@
-// Issue 12 item 3: turning the robot to a commanded heading with a sequence of tail strokes
+// Turning the robot to a commanded heading with a sequence of tail strokes
 // (docs/design-a-tail-stroke.md "Maneuvers"). A cycle is a fast stroke from the rest angle 0 to
 // +-s A (every joint alike, peak speed 2 A / dT_fast whatever the scale s) and a slow return to 0
 // in return_dT_s: the fast stroke breaks stiction and turns the body, the slow one stays below it

@@ -569,7 +569,7 @@ struct RobotFile {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Reading a YAML file within bounds (issue 16, finding 8): the file is read whole (at most
+// Reading a YAML file within bounds: the file is read whole (at most
 // kMaxYamlBytes), then walked once as parser events before any node is built. The walk refuses,
 // at the offending line:col, nesting deeper than kMaxYamlDepth, more than kMaxYamlNodes nodes
 // counting every alias as the nodes it stands for (an alias "bomb" expands exponentially), an

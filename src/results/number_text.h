@@ -1,6 +1,6 @@
 // The text of a number in the CSV files: 12 significant digits, printf's "%.12g" (what
 // std::to_chars(first, last, v, std::chars_format::general, 12) writes), made fast for the
-// common case. Formatting was most of the cost of a run's output (issue 13): to_chars with a
+// common case. Formatting is most of the cost of writing a run's output: to_chars with a
 // precision takes ~400 instructions a number, this ~100.
 #pragma once
 
