@@ -1,4 +1,4 @@
-// Issue 12 item 3: turning the robot to a commanded heading with a sequence of tail strokes
+// Turning the robot to a commanded heading with a sequence of tail strokes
 // (docs/design-a-tail-stroke.md "Maneuvers"). A cycle is a fast stroke from the rest angle 0 to
 // +-s A (every joint alike, peak speed 2 A / dT_fast whatever the scale s) and a slow return to 0
 // in return_dT_s: the fast stroke breaks stiction and turns the body, the slow one stays below it
@@ -16,6 +16,7 @@
 
 #include "settings/fields.h"
 #include "trajectory/split_cycle_profile.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -34,9 +35,9 @@ struct ManeuverSettings {
   int map_points = 12;                    // analytic yaw-vs-scale map: points in [min_scale, 1]
   bool mujoco = true;                     // run MuJoCo open- and closed-loop (false: analytic plan only)
 
-  double heading() const { return heading_deg * M_PI / 180.0; }  // [rad]
-  double tolerance() const { return tolerance_deg * M_PI / 180.0; }
-  double stroke() const { return stroke_deg * M_PI / 180.0; }
+  double heading() const { return units::radians(heading_deg); }  // [rad]
+  double tolerance() const { return units::radians(tolerance_deg); }
+  double stroke() const { return units::radians(stroke_deg); }
 };
 
 template <class V, class S>

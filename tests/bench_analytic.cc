@@ -1,5 +1,5 @@
-// Speed of the analytic model (issue 2: one Fig. 7 run at the default tolerance under 1 ms) and
-// of the whole paper reproduction's analytic cases (issue 4: about 130 runs under 1 s).
+// Speed of the analytic model (one Fig. 7 run at the default tolerance under 1 ms) and
+// of the whole paper reproduction's analytic cases (about 130 runs under 1 s).
 #include <benchmark/benchmark.h>
 
 #include "analytic_test_util.h"

@@ -1,4 +1,4 @@
-// MuJoCo contact fidelity (issue 11 item 3; docs/mujoco-model.md "Contact fidelity"): for each
+// MuJoCo contact fidelity (docs/mujoco-model.md "Contact fidelity"): for each
 // candidate contact setting, how far MuJoCo's soft convex contact is from rigid Coulomb friction
 // at four point feet. Prints one Markdown table row per candidate:
 //   build/tests/bench_contact_fidelity [NAME..]   (about 30 s a candidate on one core)

@@ -1,4 +1,4 @@
-// Simulate only what a scene calls for (issue 6), measured in one run: wall time of the full
+// Simulate only what a scene calls for, measured in one run: wall time of the full
 // scene against reduced scenes of the same case, for both models.
 //   build/tests/bench_effects
 #include <algorithm>

@@ -1,4 +1,4 @@
-// What holds the per-foot model and MuJoCo apart (issue 11): one MuJoCo effect isolated per
+// What holds the per-foot model and MuJoCo apart: one MuJoCo effect isolated per
 // variant, over every case of Figs. 6, 7, 9, 11-14 (configs/paper), measured as the change of the
 // gap |phi_net,perfoot - phi_net,MuJoCo| / |phi_net,MuJoCo| (median / max over the cases with
 // |phi_net,MuJoCo| >= 1 deg). docs/per-foot-model.md "What holds the per-foot model and MuJoCo apart".

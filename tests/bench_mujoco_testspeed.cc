@@ -1,4 +1,4 @@
-// Issue 3 speed goal, measured in one run: steps per second of tailsim's MuJoCo loop (controller,
+// The speed of the MuJoCo loop, measured in one run: steps per second of tailsim's MuJoCo loop (controller,
 // friction update, warning checks and 1 ms logging included) against `mujoco-testspeed` on the
 // same generated XML and timestep. testspeed runs the model with ctrl = 0 noise, i.e. the tail
 // held still, so the loop is timed on the same scene: the tail held at theta_0 for 4 s.

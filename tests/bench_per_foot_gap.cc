@@ -1,4 +1,4 @@
-// The per-foot model (issue 11 item 1): its cost per run next to the analytic and MuJoCo models,
+// The per-foot model: its cost per run next to the analytic and MuJoCo models,
 // and (with --gap) the first gap measurement: |phi_net difference| / |phi_net| against MuJoCo with
 // the same friction law, over every case of Figs. 6, 7, 9, 11-14 (configs/paper), for the
 // exact-coupling analytic model and the per-foot model (quasi-static loads / load transfer).

@@ -1,4 +1,4 @@
-// Issue 5 speed goal: the full video pipeline (replay + kinematics + scene + ghost + text +
+// The full video pipeline (replay + kinematics + scene + ghost + text +
 // render + read pixels + flip + ffmpeg H.264 encode + PNG poster) runs at >= 0.8 of the frame
 // rate of the bare render loop (mjr_render + mjr_readPixels of the same scene and settings).
 // Each benchmark does one run of both on the paper's Fig. 7 case (Sec. 4.3) and reports

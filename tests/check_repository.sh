@@ -63,7 +63,7 @@ for f in "${files[@]}"; do
                 }' "$f")
 done
 
-# Reports and plots read result folders, never YAML inputs (issue 10): no yaml-cpp in src/plotting
+# Reports and plots read result folders, never YAML inputs: no yaml-cpp in src/plotting
 # or src/app, and the CMake plotting target does not name it.
 while IFS= read -r hit; do
   report "$hit: the plotting and app layers read result folders through the experiments layer, not YAML"

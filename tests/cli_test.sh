@@ -227,7 +227,7 @@ run 2 "$tailsim" run "$src/configs/default.yaml" --out r --threads -1
 run 2 "$tailsim" accuracy "$src/configs/accuracy/fig07.yaml" --out r --repeats 0
 ok "--models selecting nothing exits 1 and writes nothing; bad --shard/--threads/--repeats exit 2"
 
-# Issue 13: a run that renders nothing does not load OSMesa (LLVM, z3, ICU) at all.
+# A run that renders nothing does not load OSMesa (LLVM, z3, ICU) at all.
 LD_DEBUG=libs "$tailsim" run "$src/configs/default.yaml" --out lazy_gl --quiet >out.txt 2>err.txt || fail "lazy-GL run: $(tail -3 err.txt)"
 grep -q "calling init: .*libyaml-cpp" err.txt || fail "LD_DEBUG=libs printed no library list: cannot check OSMesa"
 ! grep -q "libOSMesa\|libLLVM" err.txt || fail "an analytic run loaded OSMesa/LLVM: $(grep -m1 'libOSMesa\|libLLVM' err.txt)"

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Crash consistency (issue 16): a multi-case analytic sweep killed with SIGKILL at seeded random
+# Crash consistency: a multi-case analytic sweep killed with SIGKILL at seeded random
 # moments, then run to completion, gives the same result folder as one uninterrupted run: every
 # file byte for byte, except the wall-clock fields ("wall_time_s"). No temporary file is left.
-# OUTPUT (issue 13): full (default: a folder per case), none (no time series: no case folders, resume
+# OUTPUT: full (default: a folder per case), none (no time series: no case folders, resume
 # from DIR/cases.jsonl, whose last line is also torn by hand before the final run), or hdf5-thin
 # (thin series in DIR/time_series.h5, compared through h5dump: the file's bytes may be laid out
 # differently after a resume, its contents must not).

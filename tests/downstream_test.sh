@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 14: tailsim as a library. A small downstream project (tests/downstream) is built against
+# tailsim as a library. A small downstream project (tests/downstream) is built against
 #   (1) an installed tailsim: `cmake --install` of this build into a temporary prefix, then
 #       find_package(tailsim); the installed program runs the README's experiment from elsewhere;
 #   (2) the source tree through add_subdirectory (only the libraries it links are built).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A result folder stands alone (issue 10): it holds the robot file (built-in ones too), an
+# A result folder stands alone: it holds the robot file (built-in ones too), an
 # experiment.yaml naming that copy (comments kept), one MJCF per distinct MuJoCo model, and a
 # results.csv that matches summary.json. Copied to another directory, with the robot file under
 # configs/ edited afterwards, it re-runs to the same files (wall times aside), and its report does

@@ -1,4 +1,4 @@
-"""CTest python_module (issue 14, item 2): the Python module against the CLI.
+"""CTest python_module: the Python module against the CLI.
 
 usage: python_module_test.py SOURCE_DIR BUILD_DIR   (PYTHONPATH=BUILD_DIR/python)
 The CLI (BUILD_DIR/tailsim) is the independent reference: its summary.json and CSV.
@@ -189,7 +189,7 @@ class PythonModule(unittest.TestCase):
 
 
 class PythonInputs(unittest.TestCase):
-    """CTest python_inputs: hostile or unbounded inputs through the module (issue 32, classes 7 and 9)."""
+    """CTest python_inputs: hostile or unbounded inputs through the module."""
 
     def setUp(self):
         self.tmp = tempfile.TemporaryDirectory(prefix="tailsim-py-inputs-")

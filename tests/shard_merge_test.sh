@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 13: a sweep split with `tailsim run --shard K/N`, run by GNU parallel (scripts/parallel_sweep.sh),
+# A sweep split with `tailsim run --shard K/N`, run by GNU parallel (scripts/parallel_sweep.sh),
 # and joined by `tailsim merge` gives the folder a single process writes (every file; wall times aside,
 # scripts/compare_folders.py). Also a suite (the paper suite, 3 shards), and the merge's refusals.
 # usage: shard_merge_test.sh SOURCE_DIR BUILD_DIR

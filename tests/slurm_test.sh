@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 13: the Slurm path for real. Starts a single-node Slurm cluster in a temporary folder
+# The Slurm path for real. Starts a single-node Slurm cluster in a temporary folder
 # (scripts/slurm/local_cluster.sh: munged, slurmctld, slurmd, generated slurm.conf), submits a sweep
 # as a job array + dependent merge (scripts/slurm/submit.sh), waits, and compares the merged folder
 # with a single-process run (scripts/compare_folders.py). Needs root and Debian's slurm-wlm + munge.

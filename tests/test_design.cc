@@ -1,4 +1,4 @@
-// Issue 12: the stroke optimiser (src/design/): spline profiles, limits kept on the re-simulated
+// The stroke optimiser (src/design/): spline profiles, limits kept on the re-simulated
 // optimum, a brute-force optimum found, `kind: optimize` errors at file:line:col, the best
 // stroke as a ready-to-run experiment.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// A full disk (issue 16, finding 4): a video that could not be written whole is never published
+// A full disk: a video that could not be written whole is never published
 // under its final name, and a sweep stops at the first "No space left on device" instead of
 // computing every remaining case. The disk is a 200 KiB tmpfs mounted for the test (root with
 // CAP_SYS_ADMIN); where mounting is not allowed the tests are skipped with a message.

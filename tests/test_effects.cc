@@ -1,4 +1,4 @@
-// Effect selection (issue 6): a scene that leaves an effect out neither computes it nor feels it.
+// Effect selection: a scene that leaves an effect out neither computes it nor feels it.
 // The MJCF side (disable flags, omitted floor, joints) is covered in test_mujoco_model.cc.
 #include <gtest/gtest.h>
 

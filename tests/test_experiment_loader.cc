@@ -741,7 +741,7 @@ TEST_F(LoaderTest, SuiteErrors) {
   expectSuiteError("experiments: [a.yaml, bad.yaml]\n", "bad.yaml", 3, "trajectory.dT_s");
 }
 
-// Issue 16, finding 5: counts that overflowed a float-to-integer conversion (0 rows, phi_net 0,
+// Counts that overflowed a float-to-integer conversion (0 rows, phi_net 0,
 // ok) are refused at load, at the key that makes them.
 TEST_F(LoaderTest, Finding5OverflowingCountsAreRefusedAtLoad) {
   expectError(exp(std::string(kTraj) + "output: {sample_dt_s: 1e-20}\n"), 5, "output.sample_dt_s", "rows");
@@ -752,7 +752,7 @@ TEST_F(LoaderTest, Finding5OverflowingCountsAreRefusedAtLoad) {
   expectError(exp(std::string(kTraj) + "models: [mujoco]\nrender: {slowmo: 1000, fps: 240}\n"), 6, "render.slowmo", "frames");
 }
 
-// Issue 16, finding 7: accepted values that never finished or exhausted memory are refused at
+// Accepted values that never finished or exhausted memory are refused at
 // load with file:line:col at the offending key; the limits' own edges and the paper's extremes load.
 TEST_F(LoaderTest, Finding7UnboundedWorkIsRefusedAtLoad) {
   expectError(exp("trajectory: {dtheta_deg: -90, dT_s: 1e-9}\n"), 4, "trajectory.dT_s", ">= 0.001 s");
@@ -779,7 +779,7 @@ TEST_F(LoaderTest, Finding7UnboundedWorkIsRefusedAtLoad) {
   EXPECT_EQ(ok.cases.size(), 8u);
 }
 
-// Issue 16, finding 6 (b, c): angles and masses are bounded at load (dtheta -1e300 deg gave NaN
+// Angles and masses are bounded at load (dtheta -1e300 deg gave NaN
 // loads reported ok; a 1e-6 kg body disagreed between the models).
 TEST_F(LoaderTest, Finding6AnglesAndMassesAreBoundedAtLoad) {
   expectError(exp("trajectory: {dtheta_deg: -1e300, dT_s: 0.25}\n"), 4, "trajectory.dtheta_deg", "[-3600, 3600]");

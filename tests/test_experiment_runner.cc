@@ -167,7 +167,7 @@ Experiment onlyModels(Experiment e, const std::vector<std::string>& models) {
 
 }  // namespace
 
-// Issue 16 finding 1: editing the second robot file of a robot sweep must recompute its cases.
+// Editing the second robot file of a robot sweep must recompute its cases.
 TEST(ExperimentRunner, Finding1_EditedSweptRobotFileInvalidatesItsCases) {
   const fs::path dir = tempDir("f1robot");
   writeRobot(dir / "robotA.yaml", 8.458);
@@ -191,7 +191,7 @@ TEST(ExperimentRunner, Finding1_EditedSweptRobotFileInvalidatesItsCases) {
     EXPECT_EQ(phiNet(dir / "out", c.name, "analytic"), phiNet(dir / "fresh", c.name, "analytic")) << c.name;
 }
 
-// Issue 16 finding 1: `run X --models analytic` then `run X` must compute MuJoCo.
+// `run X --models analytic` then `run X` must compute MuJoCo.
 TEST(ExperimentRunner, Finding1_ModelsFilterIsPartOfTheResumeKey) {
   const fs::path dir = tempDir("f1models");
   const fs::path f = writeExperiment(dir, "both.yaml",
@@ -211,7 +211,7 @@ TEST(ExperimentRunner, Finding1_ModelsFilterIsPartOfTheResumeKey) {
   EXPECT_EQ(runExperiment(e, o).resumed, 1);  // and now it is finished
 }
 
-// Issue 16 finding 1: rendering on/off, the version and every resolved setting are in the key.
+// Rendering on/off, the version and every resolved setting are in the key.
 TEST(ExperimentRunner, Finding1_ResumeKeyCoversRenderVersionAndSettings) {
   const fs::path dir = tempDir("f1key");
   const Experiment e = loadExperiment(
@@ -238,7 +238,7 @@ TEST(ExperimentRunner, Finding1_ResumeKeyCoversRenderVersionAndSettings) {
   EXPECT_FALSE(changed([](ExperimentCase& d) { d.robot_file = "/elsewhere/same_robot.yaml"; }));  // values count
 }
 
-// Issue 16 finding 2: names that sanitize alike get distinct folders, and the printed/recorded
+// Names that sanitize alike get distinct folders, and the printed/recorded
 // results belong to the right case.
 TEST(ExperimentRunner, Finding2_CaseFoldersAreUniqueByConstruction) {
   EXPECT_EQ(caseDirName("w_ss=0.25"), "w_ss=0.25");  // plain names stay readable
@@ -283,7 +283,7 @@ TEST(ExperimentRunner, Finding2_CaseFoldersAreUniqueByConstruction) {
   }
 }
 
-// Issue 16 finding 2: two threads writing one path atomically never share a temporary file.
+// Two threads writing one path atomically never share a temporary file.
 TEST(ExperimentRunner, Finding2_ConcurrentAtomicWritesNeverTear) {
   const fs::path dir = tempDir("f2atomic");
   const std::string path = (dir / "same.csv").string();
@@ -307,7 +307,7 @@ TEST(ExperimentRunner, Finding2_ConcurrentAtomicWritesNeverTear) {
   for (const auto& f : fs::directory_iterator(dir)) EXPECT_EQ(f.path().filename(), "same.csv");
 }
 
-// Issue 16 finding 3: a second experiment into the same --out is refused, nothing written.
+// A second experiment into the same --out is refused, nothing written.
 TEST(ExperimentRunner, Finding3_OtherExperimentInSameOutIsRefused) {
   const fs::path dir = tempDir("f3other");
   RunOptions o;
@@ -339,7 +339,7 @@ TEST(ExperimentRunner, Finding3_OtherExperimentInSameOutIsRefused) {
   EXPECT_EQ(readJson(dir / "out" / "summary.json")["experiment"], "other");
 }
 
-// Issue 16 finding 3: a run into a folder another run holds fails at once, naming its pid.
+// A run into a folder another run holds fails at once, naming its pid.
 TEST(ExperimentRunner, Finding3_ConcurrentRunIntoSameOutFails) {
   const fs::path dir = tempDir("f3lock");
   fs::create_directories(dir / "out");
@@ -361,7 +361,7 @@ TEST(ExperimentRunner, Finding3_ConcurrentRunIntoSameOutFails) {
   EXPECT_EQ(runExperiment(loadExperiment((dir / "sweep.yaml").string()), o).ran, 2);
 }
 
-// Issue 16 finding 11: temporaries a killed run left are removed by the next run of the folder;
+// Temporaries a killed run left are removed by the next run of the folder;
 // those of a live process and files not named like tailsim's temporaries stay.
 TEST(ExperimentRunner, Finding11_KilledRunTemporariesAreCleaned) {
   const fs::path dir = tempDir("f11");

@@ -1,4 +1,4 @@
-// Hard cases stay numerically stable (issue 6): extreme trajectories, friction at the edge of
+// Hard cases stay numerically stable: extreme trajectories, friction at the edge of
 // sticking, no or huge friction, a COM at the edge of the support polygon, MuJoCo steps near the
 // stability limit, and a randomized sweep over the valid parameter ranges.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Hostile and malformed experiment files (issue 16, findings 8 and 10): every one is refused
+// Hostile and malformed experiment files: every one is refused
 // quickly with "<file>:<line>:<col>: ..." naming what is wrong; none crashes, hangs, runs cases
 // first or quotes megabytes back at the user.
 #include <gtest/gtest.h>
@@ -57,7 +57,7 @@ class HostileInput : public ::testing::Test {
   fs::path dir_;
 };
 
-// ---------------------------------------------------------------- finding 8: hostile YAML
+// ---------------------------------------------------------------- hostile YAML
 
 TEST_F(HostileInput, Finding8_SelfReferentialAliasIsRefused) {
   // 11 bytes that made the loader recurse until it crashed.
@@ -134,7 +134,7 @@ TEST_F(HostileInput, Finding8_DeepSuiteChainIsRefused) {
   EXPECT_EQ(loadExperimentSuite((dir_ / "s1.yaml").string()).size(), 1u) << "s1 -> ... -> s10 -> leaf";
 }
 
-// ---------------------------------------------------------------- finding 10: late or ugly errors
+// ---------------------------------------------------------------- late or ugly errors
 
 TEST_F(HostileInput, Finding10_NonUtf8TextIsRefusedAtLoad) {
   expectAt(errorOf("name: t\xff\n" + exp("").substr(8)), 1, "UTF-8");

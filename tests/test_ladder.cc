@@ -1,5 +1,5 @@
-// The per-foot model as a registered model (issue 11 item 1: `models: [.., perfoot, ..]`, the
-// `perfoot:` section) and the gap ladder (item 2: configs/ladder/, `tailsim ladder`).
+// The per-foot model as a registered model (`models: [.., perfoot, ..]`, the
+// `perfoot:` section) and the gap ladder (configs/ladder/, `tailsim ladder`).
 #include <gtest/gtest.h>
 
 #include <unistd.h>

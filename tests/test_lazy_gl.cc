@@ -1,4 +1,4 @@
-// Issue 13: libhdf5 (with curl, GnuTLS, Kerberos, LDAP: 18 shared libraries) is loaded only when an
+// Libhdf5 (with curl, GnuTLS, Kerberos, LDAP: 18 shared libraries) is loaded only when an
 // HDF5 file is opened. OSMesa (Mesa's llvmpipe with LLVM, z3 and ICU; ~14 ms of dynamic loading) is loaded
 // only when something is rendered. This binary links the whole program's libraries like the CLI does.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Issue 12 item 3: maneuvers to a heading (src/design/maneuver.h, controllers/heading_controller.h):
+// Maneuvers to a heading (src/design/maneuver.h, controllers/heading_controller.h):
 // the open-loop plan lands on the target in the model it was planned on, the slow return alone
 // hardly turns the body, +-90 deg are mirror images, the closed loop reaches 90 deg in MuJoCo, and
 // bad `maneuver:` settings are refused at file:line:col naming the key.

@@ -313,7 +313,7 @@ TEST(Menagerie, CustomRobotsAndEffectsCompile) {
   EXPECT_THROW(generateMenagerie(p, MujocoSettings{}, Effects{}, ""), std::invalid_argument);
 }
 
-// Issue 14 item 4: no model element of MuJoCo 2.2 can run a time profile inside mujoco-simulate; the
+// No model element of MuJoCo 2.2 can run a time profile inside mujoco-simulate; the
 // engine-plugin mechanism that could (<extension><plugin>) arrived in MuJoCo 2.3.0. Measured here so
 // the note in mjcf/README.md is revisited when MuJoCo is upgraded.
 TEST(Menagerie, MuJoCo22HasNoEnginePlugins) {

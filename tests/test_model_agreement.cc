@@ -1,4 +1,4 @@
-// The bridge between the paper's model and MuJoCo (issue 3): with no friction, the exact planar
+// The bridge between the paper's model and MuJoCo: with no friction, the exact planar
 // coupling of the analytic model and the MuJoCo contact model must agree on phi(t); the paper's
 // coupling (which drops the base-motion terms, paper-notes point 3) must not.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The MuJoCo pre-roll once per model (issue 13 item 4): a run that starts from the cached settled
+// The MuJoCo pre-roll once per model: a run that starts from the cached settled
 // state is the run that simulates its own pre-roll, bit for bit (every column of every row, every
 // summary field); the cache is keyed by everything the pre-roll depends on; the work it saves is
 // counted in steps.

@@ -1,4 +1,4 @@
-// Issue 16 finding 9: nothing is written outside --out. An experiment name becomes a folder only
+// Nothing is written outside --out. An experiment name becomes a folder only
 // when it is one safe path component; MuJoCo's messages never become MUJOCO_LOG.TXT in the
 // current directory.
 #include <gtest/gtest.h>
@@ -97,7 +97,7 @@ TEST(OutputConfinement, Finding9_MujocoErrorIsAnExceptionNotAnExit) {
   EXPECT_FALSE(fs::exists(dir / "MUJOCO_LOG.TXT"));
 }
 
-// Issue 16 finding 11: ffmpeg's log file never outlives its creation (unlinked at once), so a
+// Ffmpeg's log file never outlives its creation (unlinked at once), so a
 // run killed while rendering leaves no /tmp/tailsim-ffmpeg-* behind; its messages still arrive.
 TEST(OutputConfinement, Finding11_FfmpegLogLeavesNoFileInTmp) {
   const std::string exe = findExecutable("ffmpeg");

@@ -1,4 +1,4 @@
-// The per-foot friction model (issue 11 item 1; docs/per-foot-model.md) against closed forms and
+// The per-foot friction model (docs/per-foot-model.md) against closed forms and
 // against the exact-coupling analytic model.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Issue 5: headless video renders. Checks the replay kinematics against MuJoCo's own
+// Headless video renders. Checks the replay kinematics against MuJoCo's own
 // kinematics, the encoded files against ffprobe, and the error paths (no file under the final
 // name on any failure).
 #include <gtest/gtest.h>
@@ -434,7 +434,7 @@ TEST(RenderVideo, ReplaysBothModelsOfFig7) {
   EXPECT_GE(robotRowExtent(last, 320, 240), 120);
 }
 
-// The default 640x480 frame as a reader sees it (issue 15): the robot fills at least half the
+// The default 640x480 frame as a reader sees it: the robot fills at least half the
 // frame height, the analytic model is a blue outline, the colour key names each model in its
 // colour, and the phi(t) inset shows both curves with a time cursor that moves.
 TEST(RenderVideo, DefaultFrameHasTheRobotLargeTheKeyAndTheInset) {

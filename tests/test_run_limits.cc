@@ -1,4 +1,4 @@
-// Issue 16, findings 5-7 at the model level: counts that would overflow are refused, step budgets
+// Limits at the model level: counts that would overflow are refused, step budgets
 // end a run with a clear error, a run that ends while the body moves says so, non-finite loads
 // fail the run, and doubtful results (paper coupling outside its validity, coarse MuJoCo step)
 // carry warnings. (The loader's refusals of the same inputs are in test_experiment_loader.cc.)

@@ -1,4 +1,4 @@
-// Settings declared once (issue 10, item 4) and the resolved case (item 1): the declarations drive
+// Settings declared once and the resolved case: the declarations drive
 // the loader, validation, the resolved JSON and the resume key.
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// Shards of a sweep (issue 13): parsing, determinism, balance, every case exactly once.
+// Shards of a sweep: parsing, determinism, balance, every case exactly once.
 #include <gtest/gtest.h>
 
 #include <algorithm>

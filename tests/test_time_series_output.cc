@@ -1,4 +1,4 @@
-// Issue 13: output.time_series full | thin | none and output.time_series_file csv | hdf5 — which
+// Output.time_series full | thin | none and output.time_series_file csv | hdf5 — which
 // rows thin keeps, the HDF5 file's round trip, and the runner's folders, journal and resume.
 #include <gtest/gtest.h>
 #include <unistd.h>

@@ -1,4 +1,4 @@
-// Tipping over (issue 9, part 3): the MuJoCo model fails a run whose robot tips over, the two
+// Tipping over: the MuJoCo model fails a run whose robot tips over, the two
 // models agree on which cases tip, and a failed run has phi_net_deg = null in summary.json and
 // result.json, which every reader (report, plots, findings, the CLI's case table) shows as failed.
 #include <gtest/gtest.h>

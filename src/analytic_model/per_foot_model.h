@@ -1,4 +1,4 @@
-// The per-foot friction model ("perfoot", issue 11 item 1; docs/per-foot-model.md): the quadruped
+// The per-foot friction model ("perfoot", docs/per-foot-model.md): the quadruped
 // as a planar rigid body (x, y, phi) on four point feet, each carrying one Coulomb friction force
 // limited by mu N_i and opposing that foot's own slip velocity, with the tail coupled exactly
 // (the planar multibody of `analytic.coupling: exact`).

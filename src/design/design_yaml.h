@@ -17,18 +17,14 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/yaml_file.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 namespace design_yaml {
 
 namespace fs = std::filesystem;
 
-inline std::string fmtG(double v) {
-  std::ostringstream s;
-  s.precision(10);
-  s << v;
-  return s.str();
-}
+inline std::string fmtG(double v) { return formatG(v, 10); }  // "%.10g"
 
 // One value with where it came from.
 struct Val {

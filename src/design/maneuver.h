@@ -1,4 +1,4 @@
-// Issue 12 item 3: `kind: maneuver` experiment files and `tailsim maneuver EXP.yaml --out DIR`
+// `kind: maneuver` experiment files and `tailsim maneuver EXP.yaml --out DIR`
 // (docs/design-a-tail-stroke.md "Maneuvers"): turn the robot to a commanded heading with cycles of
 // a fast stroke and a slow return (controllers/heading_controller.h),
 //   (a) planned open-loop on the analytic model and run as planned in both models,

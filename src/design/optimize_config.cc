@@ -193,8 +193,8 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");
   }
-  // Limits that leave no stroke to search (the search used to run to its end and report "limits
-  // VIOLATED"): a 1 deg split-cycle stroke of every joint over the longest duration must keep them.
+  // Limits that leave no stroke to search are refused here, not after a whole search that could only
+  // report "limits VIOLATED": a 1 deg split-cycle stroke of every joint over the longest duration must keep them.
   {
     const double amp = 1.0 * kRadPerDeg;
     SplitCycleParams p;

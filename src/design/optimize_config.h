@@ -1,4 +1,4 @@
-// Issue 12: `kind: optimize` experiment files (docs/design-a-tail-stroke.md). The file names a
+// `kind: optimize` experiment files (docs/design-a-tail-stroke.md). The file names a
 // one-case base experiment (robot, tail, effects, solver settings, and the start trajectory),
 // read by the experiment loader, and an `optimize:` section read here with the loader's
 // conventions: ConfigError "<file>:<line>:<col>: <key>: <what>", unknown keys refused, every

@@ -211,7 +211,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   rep.limits_analytic = checkLimitsOnSeries(spec.base.robot.tail, ra.series, prob.space.limits);
   writeOwnedFile(out_dir, "best_analytic.csv", toCsv(ra.series));
   rep.files.push_back("best_analytic.csv");
-  // The per-foot friction model (issue 11): milliseconds, always run; a failure (e.g. the robot
+  // The per-foot friction model: milliseconds, always run; a failure (e.g. the robot
   // tips) is reported, not thrown.
   // A write error (a full disk) is not the model's: it ends the command.
   std::optional<RunResult> rp;

@@ -1,4 +1,4 @@
-// Issue 12: `tailsim optimize EXPERIMENT.yaml --out DIR`: run the optimiser for every seed, keep
+// `tailsim optimize EXPERIMENT.yaml --out DIR`: run the optimiser for every seed, keep
 // the best stroke, verify it (limits on the re-simulated trajectory, MuJoCo re-run), and write
 // the result folder (docs/design-a-tail-stroke.md):
 //   DIR/best.yaml            the best stroke as a ready-to-run experiment (split-cycle family)

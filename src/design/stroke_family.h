@@ -1,4 +1,4 @@
-// Issue 12: tail-stroke families for the optimiser, the limits a stroke must keep, and the
+// Tail-stroke families for the optimiser, the limits a stroke must keep, and the
 // stroke's figures (peak joint speed, angle range, peak joint torque, energy) measured on a
 // sampled trajectory. SI units inside (radians); degrees only in the YAML (optimize_config.h).
 #pragma once

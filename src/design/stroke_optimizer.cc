@@ -139,7 +139,7 @@ class SpaceSearch {
     return tracker_->have_best ? tracker_->best_objective : -1.0;
   }
 
-  // Restarts (issue 12: a multimodal problem): each is a fresh archipelago with its own sub-seeds
+  // Restarts (a multimodal problem): each is a fresh archipelago with its own sub-seeds
   // and random populations; only the first holds the start point (CMA-ES centres on a population's
   // best, so the start in every restart would pull each back to the same basin). IPOP: the
   // population grows by restart_growth per restart. The tracker keeps the best over all restarts.

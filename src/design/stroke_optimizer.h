@@ -1,4 +1,4 @@
-// Issue 12: the stroke optimiser. pagmo2 (CMA-ES or differential evolution on parallel
+// The stroke optimiser. pagmo2 (CMA-ES or differential evolution on parallel
 // thread islands) searches the unit box of a StrokeSpace; NLopt (COBYLA with the limits as
 // constraints, or BOBYQA on the penalised objective) polishes the best point. Every point is
 // judged by running the analytic model (simulateAnalytic) on its trajectory.

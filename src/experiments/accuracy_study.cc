@@ -10,15 +10,10 @@
 #include "results/columns.h"
 #include "mujoco_model/mujoco_simulation.h"
 #include "results/atomic_file.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 namespace {
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 double rmsDiff(const TimeSeries& a, const TimeSeries& b) {
   if (!a.has(col::kPhi) || !b.has(col::kPhi)) return NAN;
@@ -129,7 +124,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
       int runs = 0;
       const RunResult r = timed([&](int) { return analytic(s); }, opt.repeats, wall, mean, runs);
       const bool dflt = tol == defaults_a.rel_tol && s.abs_tol == defaults_a.abs_tol;
-      st.rows.push_back(makeRow("analytic", "adaptive", "rel_tol=" + num(tol), tol, dflt, r, wall, mean, 1, ref_a));
+      st.rows.push_back(makeRow("analytic", "adaptive", "rel_tol=" + formatG(tol), tol, dflt, r, wall, mean, 1, ref_a));
     }
     const std::vector<double> hs = opt.quick ? std::vector<double>{1e-3}
                                              : std::vector<double>{1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6};
@@ -140,7 +135,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
       double wall = 0, mean = 0;
       int runs = 0;
       const RunResult r = timed([&](int) { return analytic(s); }, opt.repeats, wall, mean, runs);
-      st.rows.push_back(makeRow("analytic", "fixed RK4", "fixed_dt_s=" + num(h), h, false, r, wall, mean, 1, ref_a));
+      st.rows.push_back(makeRow("analytic", "fixed RK4", "fixed_dt_s=" + formatG(h), h, false, r, wall, mean, 1, ref_a));
     }
 
     // --- MuJoCo: timestep x integrator, then one family at a time around the defaults ------------
@@ -212,7 +207,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
       const Ensemble e_2h = ensemble(withStep(ref_m, 2 * h_ref));
       const Ensemble e_def = ensemble(c.mujoco);
       st.mujoco.present = e_ref.ok > 0;
-      st.mujoco.setting = "implicit timestep_s=" + num(h_ref) + " (w_n kept), mean of " + std::to_string(K) +
+      st.mujoco.setting = "implicit timestep_s=" + formatG(h_ref) + " (w_n kept), mean of " + std::to_string(K) +
                           " runs with dT_s + 0.." + std::to_string(K - 1) + " us";
       st.mujoco.phi_net_deg = e_ref.mean;
       st.mujoco.noise_deg = e_ref.sd;
@@ -257,7 +252,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
           const std::string integ = name(in);
           MujocoSettings s = withStep(c.mujoco, h);
           s.integrator = in;
-          add(std::string("timestep/") + integ, std::string("integrator=") + integ + " timestep_s=" + num(h), h, s);
+          add(std::string("timestep/") + integ, std::string("integrator=") + integ + " timestep_s=" + formatG(h), h, s);
         }
       if (!opt.quick) {
         for (const MujocoSolver so : {MujocoSolver::kNewton, MujocoSolver::kCG, MujocoSolver::kPGS}) {
@@ -270,7 +265,7 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
           MujocoSettings s = c.mujoco;
           s.iterations = it;
           s.tolerance = tol;
-          add("iterations", "iterations=" + std::to_string(it) + " tolerance=" + num(tol), tol, s);
+          add("iterations", "iterations=" + std::to_string(it) + " tolerance=" + formatG(tol), tol, s);
         }
         for (const MujocoCone co : {MujocoCone::kElliptic, MujocoCone::kPyramidal}) {
           const std::string cone = name(co);

@@ -1,4 +1,4 @@
-// Work-precision study (`tailsim accuracy EXPERIMENT.yaml --out DIR`, issue 6): what each solver
+// Work-precision study (`tailsim accuracy EXPERIMENT.yaml --out DIR`): what each solver
 // setting of each model buys in accuracy and costs in time, against a converged reference of
 // the same model.
 #pragma once

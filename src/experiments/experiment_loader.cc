@@ -18,6 +18,8 @@
 #include "experiments/model_registry.h"
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
+#include "results/number_text.h"
+#include "settings/units.h"
 
 #include <algorithm>
 #include <cctype>
@@ -41,13 +43,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kRadPerDeg = M_PI / 180.0;
-
-std::string fmtG(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 std::string joinList(std::initializer_list<const char*> names) {
   std::string s;
@@ -182,7 +177,7 @@ Sweep parseSweep(const std::string* file, const YAML::Node& n, const std::string
   }
   const double start = a[0], stop = a[1], step = a[2];
   if (step == 0.0) fail(rl, "range: step must not be 0");
-  if ((stop - start) * step < 0.0) fail(rl, "range: step " + fmtG(step) + " moves away from stop " + fmtG(stop));
+  if ((stop - start) * step < 0.0) fail(rl, "range: step " + formatG(step) + " moves away from stop " + formatG(stop));
   // stop is included within 1e-9 |step|.
   const double count = std::floor((stop - start) / step + 1e-9) + 1.0;
   if (count > static_cast<double>(kMaxSweepValues))
@@ -196,7 +191,7 @@ Sweep parseSweep(const std::string* file, const YAML::Node& n, const std::string
     SweepValue sv;
     sv.from_range = true;
     sv.number = v;
-    sv.text = fmtG(v);
+    sv.text = formatG(v);
     sv.mark = n.Mark();
     if (!seen.insert(sv.text).second)
       fail(rl, "range: values " + sv.text + " are not distinct at %g precision; list them with sweep: [...]");
@@ -325,21 +320,21 @@ class Reader {
   }
   double positive(const Item& it) const {
     const double v = number(it);
-    if (!(v > 0.0)) fail(it, "must be > 0, got " + fmtG(v));
+    if (!(v > 0.0)) fail(it, "must be > 0, got " + formatG(v));
     return v;
   }
   double nonNegative(const Item& it) const {
     const double v = number(it);
-    if (v < 0.0) fail(it, "must be >= 0, got " + fmtG(v));
+    if (v < 0.0) fail(it, "must be >= 0, got " + formatG(v));
     return v;
   }
   int integer(const Item& it, long lo, long hi = std::numeric_limits<int>::max()) const {
     const double v = number(it);
-    if (v != std::floor(v)) fail(it, "expected an integer, got " + fmtG(v));
+    if (v != std::floor(v)) fail(it, "expected an integer, got " + formatG(v));
     if (v < static_cast<double>(lo) || v > static_cast<double>(hi))
       fail(it, hi == std::numeric_limits<int>::max()
-                   ? "must be >= " + std::to_string(lo) + ", got " + fmtG(v)
-                   : "must be in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + fmtG(v));
+                   ? "must be >= " + std::to_string(lo) + ", got " + formatG(v)
+                   : "must be in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + formatG(v));
     return static_cast<int>(v);
   }
   bool boolean(const Item& it) const {
@@ -448,7 +443,7 @@ class YamlFields {
     const Item* it = get(f);
     if (!it) return;
     const double v = r_.number(*it);
-    if (ranges_ && !l.ok(v)) r_.fail(*it, "must " + l.text() + ", got " + fmtG(v));
+    if (ranges_ && !l.ok(v)) r_.fail(*it, "must " + l.text() + ", got " + formatG(v));
     x = v * f.scale;
   }
   void integer(const settings::Field& f, int& x, const settings::Limits& l, const settings::IntSet& only = {}) {
@@ -607,7 +602,7 @@ void checkMasses(const RobotParams& p, const Origins& origin, const Loc& fallbac
     if (m >= limits::kMinMassKg && m <= limits::kMaxMassKg) return;
     const auto it = origin.find(key);
     fail(it == origin.end() ? fallback : it->second,
-         "must lie in [" + fmtG(limits::kMinMassKg) + ", " + fmtG(limits::kMaxMassKg) + "] kg, got " + fmtG(m) +
+         "must lie in [" + formatG(limits::kMinMassKg) + ", " + formatG(limits::kMaxMassKg) + "] kg, got " + formatG(m) +
              " (docs/experiment-format.md \"Limits\")");
   };
   check(p.quadruped.mass_kg, "quadruped.mass_kg");
@@ -623,7 +618,7 @@ struct RobotFile {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Reading a YAML file within bounds (issue 16, finding 8): the file is read whole (at most
+// Reading a YAML file within bounds: the file is read whole (at most
 // kMaxYamlBytes), then walked once as parser events before any node is built. The walk refuses,
 // at the offending line:col, nesting deeper than kMaxYamlDepth, more than kMaxYamlNodes nodes
 // counting every alias as the nodes it stands for (an alias "bomb" expands exponentially), an
@@ -904,7 +899,7 @@ std::string builtinRobotFile(const std::string& name, const Loc& at) {
 double boundedDeg(const Reader& r, const Item& it, double max_abs) {
   const double v = r.number(it);
   if (!(std::abs(v) <= max_abs))
-    r.fail(it, "must lie in [-" + fmtG(max_abs) + ", " + fmtG(max_abs) + "] deg, got " + fmtG(v) +
+    r.fail(it, "must lie in [-" + formatG(max_abs) + ", " + formatG(max_abs) + "] deg, got " + formatG(v) +
                    " (docs/experiment-format.md \"Limits\")");
   return v;
 }
@@ -942,13 +937,13 @@ std::vector<SplineParams> readSplineTrajectory(const Reader& r, const Item& item
     if (v.size() < 2 || v.size() > static_cast<std::size_t>(limits::kMaxSplineKnots))
       r.fail(lists[i], "needs 2.." + std::to_string(limits::kMaxSplineKnots) + " knots (start, interior knots, end), got " +
                            std::to_string(v.size()));
-    for (const Item& x : v) joints[i].knots_rad.push_back(boundedDeg(r, x, limits::kMaxAbsTheta0Deg) * kRadPerDeg);
+    for (const Item& x : v) joints[i].knots_rad.push_back(boundedDeg(r, x, limits::kMaxAbsTheta0Deg) * units::kRadPerDeg);
   }
   const std::vector<Item> dT = r.perJoint(r.need(t, "dT_s"), n);
   for (int i = 0; i < n; ++i) {
     joints[i].dT_s = r.positive(dT[i]);
     if (joints[i].dT_s < limits::kMinDT_s)
-      r.fail(dT[i], "must be >= " + fmtG(limits::kMinDT_s) + " s, got " + fmtG(joints[i].dT_s) +
+      r.fail(dT[i], "must be >= " + formatG(limits::kMinDT_s) + " s, got " + formatG(joints[i].dT_s) +
                         " (docs/experiment-format.md \"Limits\")");
   }
   if (const Item* t0 = t.get("t0_s")) {
@@ -979,9 +974,9 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
     const std::vector<Item> v = r.perJoint(*w, n);
     for (int i = 0; i < n; ++i) {
       const double x = r.number(v[i]);
-      if (!(x > 0.0 && x < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(x));
+      if (!(x > 0.0 && x < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + formatG(x));
       if (!(x >= limits::kMinWss && x <= limits::kMaxWss))
-        r.fail(v[i], "must lie in [" + fmtG(limits::kMinWss) + ", " + fmtG(limits::kMaxWss) + "], got " + fmtG(x) +
+        r.fail(v[i], "must lie in [" + formatG(limits::kMinWss) + ", " + formatG(limits::kMaxWss) + "], got " + formatG(x) +
                          " (docs/experiment-format.md \"Limits\")");
       joints[i].w_ss = x;
       locs[i].w_ss = r.loc(v[i]);
@@ -1003,7 +998,7 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
     if (!dps && !radps) tailsim::fail(r.locAt(t.self, "thetadot_max_dps"), "rule: eq25 needs thetadot_max_dps or thetadot_max_radps");
     if (dps && radps) r.fail(*radps, "give thetadot_max_dps or thetadot_max_radps, not both");
     const Item& w = dps ? *dps : *radps;
-    const double wmax = r.positive(w) * (dps ? kRadPerDeg : 1.0);
+    const double wmax = r.positive(w) * (dps ? units::kRadPerDeg : 1.0);
     for (int i = 0; i < n; ++i) {
       try {
         joints[i] = equalPeakSpeedParams(n, wmax, joints[i].w_ss, joints[i].t0_s);  // Eq. (25)
@@ -1012,7 +1007,7 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
       }
       locs[i].dT = r.loc(w);
       if (!(joints[i].dT_s >= limits::kMinDT_s))
-        r.fail(w, "gives dT_s = " + fmtG(joints[i].dT_s) + " s (Eq. 25), shorter than " + fmtG(limits::kMinDT_s) +
+        r.fail(w, "gives dT_s = " + formatG(joints[i].dT_s) + " s (Eq. 25), shorter than " + formatG(limits::kMinDT_s) +
                       " s (docs/experiment-format.md \"Limits\")");
     }
   } else {
@@ -1020,10 +1015,10 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
       if (const Item* x = t.get(k)) r.fail(*x, "only used with rule: eq25");
     if (const Item* th0 = t.get("theta0_deg")) {
       const std::vector<Item> v = r.perJoint(*th0, n);
-      for (int i = 0; i < n; ++i) joints[i].theta0_rad = boundedDeg(r, v[i], limits::kMaxAbsTheta0Deg) * kRadPerDeg;
+      for (int i = 0; i < n; ++i) joints[i].theta0_rad = boundedDeg(r, v[i], limits::kMaxAbsTheta0Deg) * units::kRadPerDeg;
     }
     const std::vector<Item> dth = r.perJoint(r.need(t, "dtheta_deg"), n);
-    for (int i = 0; i < n; ++i) joints[i].dtheta_rad = boundedDeg(r, dth[i], limits::kMaxAbsDthetaDeg) * kRadPerDeg;
+    for (int i = 0; i < n; ++i) joints[i].dtheta_rad = boundedDeg(r, dth[i], limits::kMaxAbsDthetaDeg) * units::kRadPerDeg;
     const Item* dT = t.get("dT_s");
     const Item* peak = t.get("peak_speed_dps");
     if (!dT && !peak) tailsim::fail(r.locAt(t.self, "dT_s"), "give dT_s or peak_speed_dps");
@@ -1034,18 +1029,18 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
         joints[i].dT_s = r.number(v[i]);
         locs[i].dT = r.loc(v[i]);
         if (joints[i].dT_s > 0.0 && joints[i].dT_s < limits::kMinDT_s)
-          r.fail(v[i], "must be >= " + fmtG(limits::kMinDT_s) + " s, got " + fmtG(joints[i].dT_s) +
+          r.fail(v[i], "must be >= " + formatG(limits::kMinDT_s) + " s, got " + formatG(joints[i].dT_s) +
                            " (docs/experiment-format.md \"Limits\")");
       }
     } else {
       const std::vector<Item> v = r.perJoint(*peak, n);
       for (int i = 0; i < n; ++i) {
-        const double pk = r.positive(v[i]) * kRadPerDeg;
+        const double pk = r.positive(v[i]) * units::kRadPerDeg;
         joints[i].dT_s = 2.0 * std::abs(joints[i].dtheta_rad) / pk;  // peak speed 2 |dtheta| / dT (Eq. 23)
         if (!(joints[i].dT_s > 0.0)) r.fail(v[i], "dtheta_deg = 0 gives dT_s = 0; give dT_s instead");
         if (joints[i].dT_s < limits::kMinDT_s)
-          r.fail(v[i], "gives dT_s = 2 |dtheta| / peak speed = " + fmtG(joints[i].dT_s) + " s, shorter than " +
-                           fmtG(limits::kMinDT_s) + " s (docs/experiment-format.md \"Limits\")");
+          r.fail(v[i], "gives dT_s = 2 |dtheta| / peak speed = " + formatG(joints[i].dT_s) + " s, shorter than " +
+                           formatG(limits::kMinDT_s) + " s (docs/experiment-format.md \"Limits\")");
         locs[i].dT = r.loc(v[i]);
       }
     }
@@ -1071,7 +1066,7 @@ PoseSpec readPose(const Reader& r, const Item& item, int n) {
       for (int i = 0; i < n; ++i) out[i] = r.number(v[i]) * scale;
     }
   };
-  read("theta_deg", kRadPerDeg, p.theta_rad);
+  read("theta_deg", units::kRadPerDeg, p.theta_rad);
   read("thetadot_radps", 1.0, p.thetadot_radps);
   read("thetaddot_radps2", 1.0, p.thetaddot_radps2);
   return p;
@@ -1096,9 +1091,9 @@ MujocoSettings readMujoco(const Reader& r, const Item& item) {
   if (const Item* x = m.get("solimp")) {
     const std::vector<Item> v = r.list(*x);
     for (int i : {0, 1, 3})
-      if (!(s.solimp[i] > 0.0 && s.solimp[i] < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + fmtG(s.solimp[i]));
-    if (!(s.solimp[2] > 0.0)) r.fail(v[2], "width must be > 0, got " + fmtG(s.solimp[2]));
-    if (!(s.solimp[4] >= 1.0)) r.fail(v[4], "power must be >= 1, got " + fmtG(s.solimp[4]));
+      if (!(s.solimp[i] > 0.0 && s.solimp[i] < 1.0)) r.fail(v[i], "must lie in (0, 1), got " + formatG(s.solimp[i]));
+    if (!(s.solimp[2] > 0.0)) r.fail(v[2], "width must be > 0, got " + formatG(s.solimp[2]));
+    if (!(s.solimp[4] >= 1.0)) r.fail(v[4], "power must be >= 1, got " + formatG(s.solimp[4]));
   }
   return s;
 }
@@ -1111,7 +1106,7 @@ OutputSettings readOutput(const Reader& r, const Item& item, double tail_end_s) 
   const double t_end = o.duration_s > 0 ? o.duration_s : tail_end_s + o.settle_s;
   if (tail_end_s >= 0 && o.sample_dt_s > t_end) {
     const Item* at = m.get("sample_dt_s") ? m.get("sample_dt_s") : m.get("duration_s") ? m.get("duration_s") : &item;
-    r.fail(*at, "sample_dt_s = " + fmtG(o.sample_dt_s) + " s is longer than the run (" + fmtG(t_end) +
+    r.fail(*at, "sample_dt_s = " + formatG(o.sample_dt_s) + " s is longer than the run (" + formatG(t_end) +
                     " s): the time series needs at least 2 rows");
   }
   return o;
@@ -1134,9 +1129,9 @@ RenderSettings readRender(const Reader& r, const Item& item, double run_end_s) {
     const double frames = renderFrameCount(span, s);
     if (!(frames <= kRenderMaxFrames)) {
       const Item* at = m.get("duration_s") ? m.get("duration_s") : m.get("slowmo") ? m.get("slowmo") : m.get("fps") ? m.get("fps") : &item;
-      r.fail(*at, "the video would have " + fmtG(frames) + " frames (" + fmtG(span) + " s simulated x fps " +
-                      std::to_string(s.fps) + " x slowmo " + fmtG(s.slowmo) + "), more than " +
-                      fmtG(kRenderMaxFrames) + ": lower fps, slowmo or render.duration_s");
+      r.fail(*at, "the video would have " + formatG(frames) + " frames (" + formatG(span) + " s simulated x fps " +
+                      std::to_string(s.fps) + " x slowmo " + formatG(s.slowmo) + "), more than " +
+                      formatG(kRenderMaxFrames) + ": lower fps, slowmo or render.duration_s");
     }
   }
   return s;
@@ -1322,7 +1317,7 @@ Experiment readExperiment(Loader& L, const std::string* file, const YAML::Node& 
   double total = 1.0;
   for (const Sweep& s : sweeps) total *= static_cast<double>(s.values.size());
   if (total > static_cast<double>(kMaxCases))
-    fail(Loc{file, doc.Mark(), ""}, "the sweeps make " + fmtG(total) + " cases, more than " + std::to_string(kMaxCases));
+    fail(Loc{file, doc.Mark(), ""}, "the sweeps make " + formatG(total) + " cases, more than " + std::to_string(kMaxCases));
 
   // Case-name labels: the leaf key, or the dotted key where two swept leaves share a name.
   std::vector<std::string> label;

@@ -788,7 +788,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     if ((opt.only_case.empty() || e.cases[i].name == opt.only_case) && (in_shard.empty() || in_shard[i]))
       todo_all.push_back(i);
   job.total = static_cast<int>(todo_all.size());
-  // Render prerequisites are checked before anything runs (issue 5).
+  // Render prerequisites are checked before anything runs.
   job.render = opt.render && !e.cases.empty() && e.cases.front().render.enabled;
   std::map<std::string, size_t> seen;  // folder -> case: unique by construction, checked
   for (size_t i = 0; i < e.cases.size(); ++i) {
@@ -1261,7 +1261,7 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
                         "thin or none; no further case was started, the finished ones are saved (run the same "
                         "command again to resume)";
       } catch (const std::exception& ex) {
-        // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
+        // A full disk fails every case after it: stop starting new ones.
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);
         const bool disk_full = sys && sys->code() == std::errc::no_space_on_device;
         if (disk_full) stop = true;

@@ -1,4 +1,4 @@
-// Video of one experiment case (issue 5): the MuJoCo model with the analytic model as a ghost.
+// Video of one experiment case: the MuJoCo model with the analytic model as a ghost.
 #pragma once
 
 #include <string>

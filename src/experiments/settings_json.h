@@ -1,4 +1,4 @@
-// The resolved case as JSON (issue 10, item 1): every parameter a run used, defaults included,
+// The resolved case as JSON: every parameter a run used, defaults included,
 // written and read through the settings declarations (settings/fields.h). result.json's "resolved".
 #pragma once
 

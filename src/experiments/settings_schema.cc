@@ -11,17 +11,12 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/model_registry.h"
 #include "results/work_limits.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 namespace {
 
 using json = nlohmann::json;
-
-std::string g(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 json sweepRef() { return {{"$ref", "#/$defs/sweep"}}; }
 // A value, or a sweep replacing it.
@@ -49,7 +44,7 @@ struct Describer {
     json v = {{"type", "number"}};
     limitsInto(v, l);
     const std::string t = l.text();
-    add(f, v, t.empty() ? "number" : "number, " + t.substr(t.find(' ') + 1), g(x));
+    add(f, v, t.empty() ? "number" : "number, " + t.substr(t.find(' ') + 1), formatG(x));
   }
   void integer(const settings::Field& f, int x, const settings::Limits& l, const settings::IntSet& only = {}) {
     json v = {{"type", "integer"}};
@@ -93,7 +88,7 @@ struct Describer {
     json item = orSweep({{"type", "number"}});
     json v = {{"type", "array"}, {"items", item}, {"minItems", N}, {"maxItems", N}};
     std::string d = "[";
-    for (std::size_t i = 0; i < N; ++i) d += (i ? ", " : "") + g(x[i]);
+    for (std::size_t i = 0; i < N; ++i) d += (i ? ", " : "") + formatG(x[i]);
     // An array cannot be swept as a whole; its elements can.
     json p = v;
     p["description"] = f.doc;

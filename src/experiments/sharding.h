@@ -1,4 +1,4 @@
-// Splitting a sweep into N shards for N processes or cluster jobs (issue 13): `tailsim run EXP
+// Splitting a sweep into N shards for N processes or cluster jobs: `tailsim run EXP
 // --shard K/N` runs the cases assigned to shard K, `tailsim merge` joins the shards' folders.
 #pragma once
 

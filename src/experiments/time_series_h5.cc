@@ -25,7 +25,7 @@ namespace {
 
 // libhdf5 (Debian's serial build) is loaded the first time a file is opened, not at process start:
 // linked, it brings curl, GnuTLS, Kerberos and LDAP (18 more shared libraries, ~5 ms of start-up
-// for every process; issue 13 item 2), and most runs write no HDF5 file. The functions are
+// for every process), and most runs write no HDF5 file. The functions are
 // resolved by name with dlsym; hdf5.h supplies their types only (its data-type macros name global
 // variables, read here through the same table). The handle is never closed.
 #define TAILSIM_HDF5_FUNCTIONS(X) \

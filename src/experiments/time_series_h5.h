@@ -28,7 +28,7 @@ namespace tailsim {
 std::string columnUnits(const std::string& column);
 
 // Whether libhdf5 is mapped into the process: it is loaded (dlopen) the first time a file is
-// opened, never at start-up (issue 13 item 2; tests/test_lazy_gl.cc).
+// opened, never at start-up (tests/test_lazy_gl.cc).
 bool hdf5Loaded();
 
 // Reads a published file (never written through this class).

@@ -6,15 +6,13 @@
 #include <limits>
 
 #include "results/work_limits.h"
+#include "results/number_text.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
-std::string g(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", v);
-  return b;
-}
+std::string g(double v) { return formatG(v, 3); }
 
 // The keys that set the simulated time, most likely culprit first.
 std::vector<std::string> timeKeys(const ExperimentCase& c) {
@@ -163,7 +161,7 @@ std::string jointSpeedWarning(const ExperimentCase& c) {
   double peak = 0;
   std::size_t at = 0;
   for (std::size_t i = 0; i < traj.joints.size(); ++i) {
-    const double w = std::abs(traj.joints[i].peakSpeed()) * 180.0 / M_PI;
+    const double w = units::degrees(std::abs(traj.joints[i].peakSpeed()));
     if (w > peak) {
       peak = w;
       at = i;

@@ -2,10 +2,11 @@
 //
 // Errors: compile errors come back from mj_loadXML in a caller-owned buffer and are thrown as
 // MujocoError with MuJoCo's text. Run-time trouble (NaN/Inf, singular inertia, full contact
-// buffers) is read from the per-mjData warning counters d->warning[i] (no global state).
-// MuJoCo 2.2's fatal-error hook (mju_user_error) is a process-wide global: we do NOT install a
-// handler, so a genuine mju_error (e.g. out of arena memory) still terminates the process as in
-// stock MuJoCo. mju_user_warning is likewise left alone; the counters carry the information.
+// buffers) is read from the per-mjData warning counters d->warning[i]. MuJoCo 2.2's two
+// process-wide hooks, mju_user_warning and mju_user_error, get tailsim's handlers, installed once
+// per process by installMujocoMessageHandlers (which every function here that loads a model or
+// makes data calls first): a warning's text goes to the calling thread's MujocoMessages, an error
+// (e.g. out of arena memory) is thrown as MujocoError instead of ending the process.
 #pragma once
 
 #include <memory>
@@ -30,8 +31,6 @@ struct MjDataDeleter {
 using ModelPtr = std::unique_ptr<mjModel, MjModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, MjDataDeleter>;
 
-// Compiles an MJCF document held in memory (through a private mjVFS, no temporary file).
-// Throws MujocoError with MuJoCo's compiler message on failure.
 // MuJoCo reports through two global hooks (mju_user_warning, mju_user_error); without them it
 // appends to MUJOCO_LOG.TXT in the current directory (and exits on an error). tailsim installs its
 // own handlers once per process (thread-safe, before the first model is loaded): a warning goes
@@ -54,6 +53,8 @@ class MujocoMessages {
   MujocoMessages* outer_;
 };
 
+// Compiles an MJCF document held in memory (through a private mjVFS, no temporary file).
+// Throws MujocoError with MuJoCo's compiler message on failure.
 ModelPtr loadModelFromXml(const std::string& xml);
 // Loads an MJCF file from disk (throws MujocoError naming the file).
 ModelPtr loadModelFromFile(const std::string& path);
@@ -62,7 +63,9 @@ DataPtr makeData(const mjModel* m);
 
 // Total of d->warning[i].number over all warning types.
 int warningCount(const mjData* d);
-// "" if no warning occurred, else e.g. "mjWARN_BADQACC x3 (first at t=0.1234 s); ...".
+// "" if no warning occurred, else each warning type that occurred with its count and the info
+// MuJoCo attached to its last occurrence (d->warning[i].lastinfo, e.g. the index of the bad DOF):
+// "mjWARN_BADQACC x3 (info 7); mjWARN_CONTACTFULL x1 (info 100)".
 std::string describeWarnings(const mjData* d);
 
 // Id lookups that throw MujocoError naming the missing element.

@@ -24,13 +24,13 @@ using MujocoSampleObserver = std::function<void(double t_s, const mjModel* m, co
 
 // Called once per output sample with the same state as MujocoSampleObserver plus the body's
 // unwrapped yaw phi (the phi_deg column, in radians): a trajectory decided while the run goes
-// (issue 12, maneuvers: controllers/heading_controller.h) replaces `reference` (the tail's current
+// (maneuvers: controllers/heading_controller.h) replaces `reference` (the tail's current
 // reference trajectory, absolute times) and returns true; false keeps it. The new reference takes
 // effect from the next step; it should continue the old one at t_s (no step in theta_ref).
 using MujocoTrajectoryHook =
     std::function<bool(double t_s, double phi_rad, const mjModel* m, const mjData* d, TailTrajectory& reference)>;
 
-// The settled initial states of the MuJoCo models of one run (issue 13 item 4). Every case starts with
+// The settled initial states of the MuJoCo models of one run. Every case starts with
 // the same pre-roll (settings.settle_s with the tail held at theta(0)); cases that share the model
 // (the generated MJCF), the settle-relevant settings and the tail's reference at t = 0 share its
 // end state, so it is simulated once and copied. The copy is the whole MuJoCo state the next step

@@ -13,6 +13,8 @@
 #include "analytic_model/system_loads.h"
 #include "results/columns.h"
 #include "experiments/model_registry.h"
+#include "results/number_text.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -21,16 +23,9 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kPi = 3.14159265358979323846;
 const std::vector<std::string> kModels = modelNames();
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-std::string signedDeg(double v) { return fmt("%+.3f", v) + " deg"; }
+std::string signedDeg(double v) { return formatNumber("%+.3f", v) + " deg"; }
 
 ModelVerdict na(const std::string& model, const std::string& why) { return {model, Verdict::kNotAvailable, why}; }
 
@@ -73,7 +68,7 @@ std::vector<size_t> byMagnitude(const SweepAxis& a) {
 
 std::string listValues(const std::vector<double>& y, const char* f = "%.2f") {
   std::string s;
-  for (size_t i = 0; i < y.size(); ++i) s += (i ? ", " : "") + (std::isfinite(y[i]) ? fmt(f, y[i]) : "NaN");
+  for (size_t i = 0; i < y.size(); ++i) s += (i ? ", " : "") + (std::isfinite(y[i]) ? formatNumber(f, y[i]) : "NaN");
   return s;
 }
 
@@ -98,11 +93,11 @@ void oneAxisTrend(Finding& f, const ExperimentResults* r, const std::string& lea
     if (t.zero_plateaus)
       d += "; " + std::to_string(t.zero_plateaus) + " step(s) skipped where phi_net = 0 on both sides";
     if (t.holds)
-      d = "smallest step " + fmt("%.3f", t.min_step) + " deg (" + a->values[order[t.worst]] + " -> " +
+      d = "smallest step " + formatNumber("%.3f", t.min_step) + " deg (" + a->values[order[t.worst]] + " -> " +
           a->values[order[t.worst + 1]] + "); " + d;
     else
       d = what + " fails between " + leaf + " = " + a->values[order[t.worst]] + " and " + a->values[order[t.worst + 1]] +
-          " (phi_net " + fmt("%.3f", y[t.worst]) + " -> " + fmt("%.3f", y[t.worst + 1]) + " deg); " + d;
+          " (phi_net " + formatNumber("%.3f", y[t.worst]) + " -> " + formatNumber("%.3f", y[t.worst + 1]) + " deg); " + d;
     f.verdicts.push_back({m, t.holds ? Verdict::kYes : Verdict::kNo, d});
   }
 }
@@ -132,14 +127,14 @@ void twoAxisTrend(Finding& f, const ExperimentResults* r, const std::string& alo
       plateaus += t.zero_plateaus;
       if (t.holds) ++held;
       else
-        failures += (failures.empty() ? "" : "; ") + at + " (phi_net " + fmt("%.3f", y[t.worst]) + " -> " +
-                    fmt("%.3f", y[t.worst + 1]) + " deg)";
+        failures += (failures.empty() ? "" : "; ") + at + " (phi_net " + formatNumber("%.3f", y[t.worst]) + " -> " +
+                    formatNumber("%.3f", y[t.worst + 1]) + " deg)";
       if (t.min_step < min_step) min_step = t.min_step, where_min = at;
     }
     const int n = static_cast<int>(across->values.size());
     std::string d = "holds at " + std::to_string(held) + " of " + std::to_string(n) + " values of " + across_leaf;
     if (incomplete) d += " (" + std::to_string(incomplete) + " incomplete: failed or missing runs)";
-    if (std::isfinite(min_step)) d += "; smallest step in the claimed direction " + fmt("%.3f", min_step) + " deg at " + where_min;
+    if (std::isfinite(min_step)) d += "; smallest step in the claimed direction " + formatNumber("%.3f", min_step) + " deg at " + where_min;
     if (plateaus)
       d += "; " + std::to_string(plateaus) + " step(s) skipped where phi_net = 0 on both sides (static friction never "
            "broken)";
@@ -182,7 +177,7 @@ Finding splitCycle(const std::vector<ExperimentResults>& all) {
       continue;
     }
     const SplitCycleParams& j1 = rc->joints.front();
-    const double dT = j1.dT_s, dth = j1.dtheta_rad * 180 / kPi, w = j1.w_ss, th0 = j1.theta0_rad * 180 / kPi;
+    const double dT = j1.dT_s, dth = units::degrees(j1.dtheta_rad), w = j1.w_ss, th0 = units::degrees(j1.theta0_rad);
     const double t0 = j1.t0_s;
     TimeSeries s;
     try {
@@ -204,11 +199,11 @@ Finding splitCycle(const std::vector<ExperimentResults>& all) {
     const double th_err = std::max(std::fabs(th_start - th0), std::fabs(th_end - (th0 + dth)));
     const bool ok = peak_err <= 0.01 && t_err <= std::max(2.0 * dt, 0.02 * dT) && th_err <= 0.5;
     f.verdicts.push_back({m, ok ? Verdict::kYes : Verdict::kNo,
-                          "peak " + fmt("%.1f", peak) + " deg/s at t = " + fmt("%.4f", t[ip]) + " s (expected " +
-                              fmt("%.1f", want_peak) + " deg/s at " + fmt("%.4f", want_t) + " s; tolerance 1 %, " +
-                              fmt("%.4f", std::max(2.0 * dt, 0.02 * dT)) + " s); theta " + fmt("%.2f", th_start) +
-                              " -> " + fmt("%.2f", th_end) + " deg (expected " + fmt("%.2f", th0) + " -> " +
-                              fmt("%.2f", th0 + dth) + ", tolerance 0.5 deg)"});
+                          "peak " + formatNumber("%.1f", peak) + " deg/s at t = " + formatNumber("%.4f", t[ip]) + " s (expected " +
+                              formatNumber("%.1f", want_peak) + " deg/s at " + formatNumber("%.4f", want_t) + " s; tolerance 1 %, " +
+                              formatNumber("%.4f", std::max(2.0 * dt, 0.02 * dT)) + " s); theta " + formatNumber("%.2f", th_start) +
+                              " -> " + formatNumber("%.2f", th_end) + " deg (expected " + formatNumber("%.2f", th0) + " -> " +
+                              formatNumber("%.2f", th0 + dth) + ", tolerance 0.5 deg)"});
   }
   return f;
 }
@@ -250,13 +245,13 @@ Finding fig07Phases(const std::vector<ExperimentResults>& all) {
     const bool a = first_pos_mz < mz.size() && mz[first_pos_mz] > 0 && w[imax] > 0;
     const bool bc = w[imin] < 0 && imin > imax;
     const bool d = std::fabs(w.back()) < 0.01;
-    const std::string tneg = first_neg_mz < mz.size() ? fmt("%.3f", t[first_neg_mz]) + " s" : std::string("never");
+    const std::string tneg = first_neg_mz < mz.size() ? formatNumber("%.3f", t[first_neg_mz]) + " s" : std::string("never");
     f.verdicts.push_back({m, a && bc && d ? Verdict::kYes : Verdict::kNo,
                           std::string("A ") + (a ? "yes" : "no") + " (M_zT > 0 until " + tneg + ", phidot peaks at " +
-                              fmt("%+.1f", w[imax]) + " deg/s at " + fmt("%.3f", t[imax]) + " s); B-C " +
-                              (bc ? "yes" : "no") + " (phidot reaches " + fmt("%+.1f", w[imin]) + " deg/s at " +
-                              fmt("%.3f", t[imin]) + " s); D " + (d ? "yes" : "no") + " (phidot at the end " +
-                              fmt("%+.2g", w.back()) + " deg/s, t = " + fmt("%.3f", t.back()) + " s)"});
+                              formatNumber("%+.1f", w[imax]) + " deg/s at " + formatNumber("%.3f", t[imax]) + " s); B-C " +
+                              (bc ? "yes" : "no") + " (phidot reaches " + formatNumber("%+.1f", w[imin]) + " deg/s at " +
+                              formatNumber("%.3f", t[imin]) + " s); D " + (d ? "yes" : "no") + " (phidot at the end " +
+                              formatNumber("%+.2g", w.back()) + " deg/s, t = " + formatNumber("%.3f", t.back()) + " s)"});
   }
   return f;
 }
@@ -296,7 +291,7 @@ Finding eq25(const std::vector<ExperimentResults>& all) {
         d += (d.empty() ? "" : "; ") + ("n=" + a->values[i] + ": " + unresolved(*r));
         continue;
       }
-      const double vmax = 2.0 * std::fabs(rc->joints.front().dtheta_rad) / rc->joints.front().dT_s * 180 / kPi;
+      const double vmax = units::degrees(2.0 * std::fabs(rc->joints.front().dtheta_rad) / rc->joints.front().dT_s);
       const double want = 360.0 / (n + 1);  // |dtheta|; theta goes +want/2 -> -want/2
       double dth1 = kNaN, peak1 = kNaN;
       for (int j = 1; j <= n; ++j) {
@@ -308,13 +303,13 @@ Finding eq25(const std::vector<ExperimentResults>& all) {
         worst_speed = std::max(worst_speed, std::fabs(pk - vmax) / vmax);
         if (j == 1) dth1 = a1 - a0, peak1 = pk;
       }
-      d += (d.empty() ? "" : "; ") + ("n=" + std::to_string(n) + ": dtheta " + fmt("%.2f", dth1) + " deg, dT " +
-                                      fmt("%.3f", 2.0 * std::fabs(dth1) / peak1) + " s");
+      d += (d.empty() ? "" : "; ") + ("n=" + std::to_string(n) + ": dtheta " + formatNumber("%.2f", dth1) + " deg, dT " +
+                                      formatNumber("%.3f", 2.0 * std::fabs(dth1) / peak1) + " s");
     }
     ok = ok && worst_angle <= 0.5 && worst_speed <= 0.01;
     f.verdicts.push_back({m, ok ? Verdict::kYes : Verdict::kNo,
-                          d + " (worst joint angle error " + fmt("%.3f", worst_angle) + " deg, worst peak-speed error " +
-                              fmt("%.2f", 100 * worst_speed) + " %; tolerance 0.5 deg, 1 %)"});
+                          d + " (worst joint angle error " + formatNumber("%.3f", worst_angle) + " deg, worst peak-speed error " +
+                              formatNumber("%.2f", 100 * worst_speed) + " %; tolerance 0.5 deg, 1 %)"});
   }
   return f;
 }
@@ -354,7 +349,7 @@ std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
         if (!c) throw std::runtime_error("missing");
         const TimeSeries s = r->series(*c, m);
         if (!s.has(col::kMzTTan) || !s.has(col::kMzTCen) || s.numRows() == 0) { cols = false; break; }
-        th.push_back(a->number(i) * kPi / 180);
+        th.push_back(units::radians(a->number(i)));
         const ExperimentCase* rc = r->resolvedCase(*c);
         if (!rc) why_no_eq24 = unresolved(*r);
         else if (rc->robot.numLinks() != 1 || rc->pose.theta_rad.size() != 1)
@@ -387,16 +382,16 @@ std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
       return b;
     };
     const size_t it = argmaxAbs(tan), ic = argmaxAbs(cen);
-    const double th_t = th[it] * 180 / kPi, th_c = th[ic] * 180 / kPi;
+    const double th_t = units::degrees(th[it]), th_c = units::degrees(th[ic]);
     // |cen| is symmetric: both ends count; tolerate ties within 1e-9 relative.
     const bool cen_ok = std::fabs(std::fabs(th_c) - 90) < 1e-6 ||
                         std::fabs(std::fabs(cen[ic]) - std::max(std::fabs(cen.front()), std::fabs(cen.back()))) <=
                             1e-9 * std::fabs(cen[ic]);
     const bool tan_ok = std::fabs(th_t) < 1e-6;
     peaks.verdicts.push_back({m, tan_ok && cen_ok ? Verdict::kYes : Verdict::kNo,
-                              "max |M_zT,tan| = " + fmt("%.4g", std::fabs(tan[it])) + " N m at theta = " +
-                                  fmt("%.1f", th_t) + " deg; max |M_zT,cen| = " + fmt("%.4g", std::fabs(cen[ic])) +
-                                  " N m at theta = " + fmt("%.1f", th_c) + " deg (grid " + a->values.front() + " .. " +
+                              "max |M_zT,tan| = " + formatNumber("%.4g", std::fabs(tan[it])) + " N m at theta = " +
+                                  formatNumber("%.1f", th_t) + " deg; max |M_zT,cen| = " + formatNumber("%.4g", std::fabs(cen[ic])) +
+                                  " N m at theta = " + formatNumber("%.1f", th_c) + " deg (grid " + a->values.front() + " .. " +
                                   a->values.back() + " deg)"});
     if (!why_no_eq24.empty() || want.size() != th.size()) {
       eq.verdicts.push_back(na(m, why_no_eq24));
@@ -413,9 +408,9 @@ std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
     }
     const double rel = err / scale;
     eq.verdicts.push_back({m, rel <= 1e-6 ? Verdict::kYes : Verdict::kNo,
-                           "max deviation from Eq. (24) " + fmt("%.3g", err) + " N m = " + fmt("%.2g", rel) +
-                               " of the largest term (I_eff = " + fmt("%.5g", Ieff) + " kg m^2, d_Q2B = " +
-                               fmt("%.4g", d_Q2B) + " m; " + std::to_string(th.size()) + " poses" +
+                           "max deviation from Eq. (24) " + formatNumber("%.3g", err) + " N m = " + formatNumber("%.2g", rel) +
+                               " of the largest term (I_eff = " + formatNumber("%.5g", Ieff) + " kg m^2, d_Q2B = " +
+                               formatNumber("%.4g", d_Q2B) + " m; " + std::to_string(th.size()) + " poses" +
                                (have_total ? ", tangential, centripetal and total" : ", tangential and centripetal") +
                                "; tolerance 1e-6)"});
   }
@@ -478,7 +473,7 @@ Finding argmax60(const std::vector<ExperimentResults>& all) {
       ++counted;
       if (std::fabs(th->number(b) - 60) < 1e-9) ++at60;
       list += (list.empty() ? "" : ", ") + ("d_Q2B " + d->values[j] + ": " + th->values[b] + " deg (" +
-                                            fmt("%.2f", y[b]) + ")");
+                                            formatNumber("%.2f", y[b]) + ")");
     }
     if (!counted) { f.verdicts.push_back({m, Verdict::kNo, "no complete theta0 row"}); continue; }
     f.verdicts.push_back({m, 2 * at60 > counted ? Verdict::kYes : Verdict::kNo,
@@ -515,9 +510,9 @@ Finding lfVariation(const std::vector<ExperimentResults>& all) {
     for (const auto& [x, c] : lf)
       if (std::fabs(x - median) / median >= worst) worst = std::fabs(x - median) / median, wc = c;
     f.verdicts.push_back({m, worst < 0.03 ? Verdict::kYes : Verdict::kNo,
-                          "max variation " + fmt("%.2f", 100 * worst) + " % (at " + (wc ? wc->name : "?") +
-                              "); median L_F " + fmt("%.2f", 1e3 * median) + " mm, range " + fmt("%.2f", 1e3 * v.front()) +
-                              " .. " + fmt("%.2f", 1e3 * v.back()) + " mm over " + std::to_string(n) + " poses" +
+                          "max variation " + formatNumber("%.2f", 100 * worst) + " % (at " + (wc ? wc->name : "?") +
+                              "); median L_F " + formatNumber("%.2f", 1e3 * median) + " mm, range " + formatNumber("%.2f", 1e3 * v.front()) +
+                              " .. " + formatNumber("%.2f", 1e3 * v.back()) + " mm over " + std::to_string(n) + " poses" +
                               (n < r->cases.size() ? " (" + std::to_string(r->cases.size() - n) + " missing)" : "")});
   }
   return f;

@@ -13,6 +13,7 @@
 #include "plotting/result_folder.h"
 #include "plotting/style.h"
 #include "results/atomic_file.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 
@@ -46,9 +47,7 @@ const std::vector<std::string>& stepNames() {
 
 std::string fmt(const char* f, double x) {
   if (!std::isfinite(x)) return "n/a";
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
+  return formatNumber(f, x);
 }
 
 double median(std::vector<double> v) {

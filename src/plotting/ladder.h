@@ -1,4 +1,4 @@
-// The gap ladder (issue 11 item 2; docs/per-foot-model.md "The gap ladder"): from a result folder
+// The gap ladder (docs/per-foot-model.md "The gap ladder"): from a result folder
 // of configs/ladder/ experiments (each figure's cases run with analytic.coupling swept over
 // paper/exact and effects.friction over stiction/continuous, models analytic, perfoot, mujoco),
 // every case's phi_net on six rungs

@@ -15,6 +15,7 @@
 #include "plotting/gnuplot.h"
 #include "plotting/style.h"
 #include "experiments/model_registry.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 
@@ -25,9 +26,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  std::string s = buf;
+  std::string s = formatNumber(f, v);
   // "-0.0" -> "0.0": a value that rounds to zero has no sign.
   if (s.size() > 1 && s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
   return s;

@@ -11,6 +11,7 @@
 #include "plotting/style.h"
 #include "plotting/sweep_summary.h"
 #include "results/atomic_file.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 
@@ -18,13 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
-std::string num(double v, const char* f = "%+.3f") { return std::isfinite(v) ? fmt(f, v) : std::string("n/a"); }
+std::string num(double v, const char* f = "%+.3f") { return std::isfinite(v) ? formatNumber(f, v) : std::string("n/a"); }
 
 // Table cells must not contain a bare '|'.
 std::string cell(std::string s) {
@@ -146,7 +141,7 @@ void experimentSection(std::ostringstream& o, const ExperimentResults& r, const 
         if (std::isfinite(it->second.wall_time_s)) wall += it->second.wall_time_s;
       }
     o << (m == r.models.front() ? " " : "; ") << m << " (" << ok << " ok"
-      << (failed ? ", " + std::to_string(failed) + " FAILED" : "") << ", " << fmt("%.3g", wall)
+      << (failed ? ", " + std::to_string(failed) + " FAILED" : "") << ", " << formatNumber("%.3g", wall)
       << " s wall time in the simulations)";
   }
   o << ".\n\n";

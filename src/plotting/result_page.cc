@@ -20,6 +20,7 @@
 #include "rendering/replay.h"
 #include "results/atomic_file.h"
 #include "results/columns.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 
@@ -58,9 +59,7 @@ size_t utf8Length(const std::string& s, size_t i) {
 
 std::string num(double v) {
   if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v == 0.0 ? 0.0 : v);
-  return buf;
+  return formatG(v == 0.0 ? 0.0 : v, 9);
 }
 
 std::string numArray(const std::vector<double>& v) {

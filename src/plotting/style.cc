@@ -11,6 +11,7 @@
 #include "experiments/model_registry.h"
 #include "plotting/gnuplot.h"
 #include "plotting/result_folder.h"
+#include "results/number_text.h"
 
 namespace tailsim {
 
@@ -171,9 +172,7 @@ std::string convert(const std::string& s, bool enhanced) {
 }
 
 std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  std::string s = buf;
+  const std::string s = formatG(v);
   return s == "-0" ? "0" : s;
 }
 

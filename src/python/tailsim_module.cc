@@ -1,4 +1,4 @@
-// The Python module `tailsim` (issue 14, item 2; docs/python.md): the experiments layer seen from
+// The Python module `tailsim` (docs/python.md): the experiments layer seen from
 // Python. Every input goes through the YAML loader (experiments/experiment_loader.h): a file by its
 // path (run), or keyword arguments shaped like the sections of an experiment file, written as the
 // YAML text of one experiment (simulate). So keys, units, ranges, defaults and error messages are

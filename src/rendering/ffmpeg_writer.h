@@ -1,4 +1,4 @@
-// ffmpeg child processes fed raw RGB frames on stdin (issue 5). Outputs are written whole or
+// ffmpeg child processes fed raw RGB frames on stdin. Outputs are written whole or
 // not at all: ffmpeg writes to a temporary name beside the target, which is renamed over the
 // target only when ffmpeg exits cleanly; on any failure or exception the child is killed and
 // the temporary file removed.

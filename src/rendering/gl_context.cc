@@ -21,7 +21,7 @@ std::mutex& glSetupMutex() {
 
 // libOSMesa (software OpenGL: Mesa's llvmpipe, which pulls in LLVM, z3 and ICU) is loaded the first
 // time a context is made, not at process start: a run that renders nothing starts without it
-// (issue 13: ~14 ms of dynamic loading saved per process). RTLD_GLOBAL makes its GL entry points
+// (~14 ms of dynamic loading saved per process). RTLD_GLOBAL makes its GL entry points
 // visible to MuJoCo's loader (mjr_makeContext looks up OSMesaGetProcAddress in the process).
 // The handle is never closed: MuJoCo keeps the GL function pointers for the life of the process.
 struct OsMesaApi {

@@ -32,7 +32,7 @@ struct RenderSettings {
   bool shadows = false, reflections = false;
   int msaa = 4;               // offscreen multisamples (0 = off)
   bool ghost = true;          // translucent analytic-model ghost
-  // Added for issue 5 (rendering): the encoder.
+  // The encoder.
   std::string ffmpeg = "ffmpeg";  // executable: looked up on PATH unless it contains a '/'
   int crf = 20;                   // libx264 constant rate factor (lower = better, bigger)
   std::string preset = "ultrafast";  // libx264 preset (ultrafast: least CPU next to llvmpipe)

@@ -2,6 +2,7 @@
 
 #include "mujoco_model/mjcf_generator.h"
 #include "results/columns.h"
+#include "settings/units.h"
 
 #include <mujoco/mujoco.h>
 
@@ -44,12 +45,11 @@ PlanarState PlanarStateSampler::at(double t) const {
     w = (t - tv[i0]) / (tv[i1] - tv[i0]);
   }
   auto lerp = [&](const std::vector<double>& v) { return (1.0 - w) * v[i0] + w * v[i1]; };
-  const double deg = M_PI / 180.0;
   PlanarState s;
   s.x = lerp(*x_);
   s.y = lerp(*y_);
-  s.phi = lerp(*phi_) * deg;
-  for (const auto* th : theta_) s.theta.push_back(lerp(*th) * deg);
+  s.phi = lerp(*phi_) * units::kRadPerDeg;
+  for (const auto* th : theta_) s.theta.push_back(lerp(*th) * units::kRadPerDeg);
   return s;
 }
 

@@ -1,4 +1,4 @@
-// Replaying time series for video (issue 5): the renderer does not run physics. It samples the
+// Replaying time series for video: the renderer does not run physics. It samples the
 // models' TimeSeries (columns t_s, x_m, y_m, phi_deg, theta<i>_deg) at each frame's time, poses
 // the MuJoCo model from the MuJoCo series and a "ghost" from the analytic series with the
 // paper's planar kinematics (Eqs. 1-3).

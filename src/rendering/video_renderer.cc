@@ -27,6 +27,8 @@
 #include "rendering/replay.h"
 #include "results/palette.h"
 #include "results/work_limits.h"
+#include "results/number_text.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -35,12 +37,6 @@ namespace {
 namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------- checks
-
-std::string fmtG(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 // The declared limits of every render setting (render_settings.h), the same the loader applies.
 void checkSettings(const RenderSettings& s) {
@@ -399,7 +395,7 @@ void setupFigure(RenderRig& r, double t0, double t1, int height) {
     const int pts = std::clamp(r.layout2d.inset.width / 2, 50, mjMAXLINEPNT);
     for (int k = 0; k < pts; ++k) {
       const double t = t0 + (t1 - t0) * k / (pts - 1);
-      const double phi = (*smp)->at(t).phi * 180.0 / M_PI;
+      const double phi = units::degrees((*smp)->at(t).phi);
       f.linedata[line][2 * k] = static_cast<float>(t);
       f.linedata[line][2 * k + 1] = static_cast<float>(phi);
       lo = std::min(lo, phi), hi = std::max(hi, phi);
@@ -458,7 +454,7 @@ void setupRig(RenderRig& r, const RenderInputs& in, const RenderSettings& s) {
   r.look_offset[1] = 0.5 * (e.lo[1] + e.hi[1]);
   // 10 % margin: the robot keeps clear of the title strip and the frame's edges.
   const double half_w = 0.5 * (e.hi[0] - e.lo[0]) * 1.1 + 0.01, half_h = 0.5 * (e.hi[1] - e.lo[1]) * 1.1 + 0.01;
-  const double tan_half = std::tan(0.5 * m->vis.global.fovy * M_PI / 180.0);
+  const double tan_half = std::tan(units::radians(0.5 * m->vis.global.fovy));
   mjv_defaultFreeCamera(m, &r.cam);
   r.cam.type = mjCAMERA_FREE;
   if (s.camera == RenderCamera::kTop) {
@@ -510,7 +506,6 @@ void drawPanel(RenderRig& r, const RenderInputs& in, const RenderSettings& s, do
                const std::optional<PlanarState>& ghost) {
   const FrameLayout& L = r.layout2d;
   const mjrContext& con = r.gl->context();
-  constexpr double kRad2Deg = 180.0 / M_PI;
   char buf[256];
   mjr_rectangle(L.panel, 0.10f, 0.10f, 0.12f, 1.0f);
   mjr_rectangle(L.title, 0.10f, 0.10f, 0.12f, 1.0f);
@@ -523,14 +518,14 @@ void drawPanel(RenderRig& r, const RenderInputs& in, const RenderSettings& s, do
   // The phases of Eq. 20 exist only for split-cycle strokes (a spline has no t1 or t2).
   if (in.trajectory && splitCycleStrokes(*in.trajectory))
     text += std::string("\ntail ") + tailPhaseName(tailPhase(*in.trajectory, t));
-  std::snprintf(buf, sizeof buf, "\nheading change %+.1f deg", (st.phi - r.phi0) * kRad2Deg);
+  std::snprintf(buf, sizeof buf, "\nheading change %+.1f deg", (st.phi - r.phi0) * units::kDegPerRad);
   text += buf;
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.panel, text.c_str(), nullptr, &con);
   // Colour key: one label per model in its colour, with its phi now.
-  std::snprintf(buf, sizeof buf, "%s (solid)  %+.2f deg", in.solid_label.c_str(), st.phi * kRad2Deg);
+  std::snprintf(buf, sizeof buf, "%s (solid)  %+.2f deg", in.solid_label.c_str(), st.phi * units::kDegPerRad);
   mjr_label(L.key[0], mjFONT_NORMAL, buf, kMujocoRgb.r, kMujocoRgb.g, kMujocoRgb.b, 1.0f, 1, 1, 1, &con);
   if (ghost) {
-    std::snprintf(buf, sizeof buf, "%s (outline)  %+.2f deg", in.outline_label.c_str(), ghost->phi * kRad2Deg);
+    std::snprintf(buf, sizeof buf, "%s (outline)  %+.2f deg", in.outline_label.c_str(), ghost->phi * units::kDegPerRad);
     mjr_label(L.key[1], mjFONT_NORMAL, buf, kAnalyticRgb.r, kAnalyticRgb.g, kAnalyticRgb.b, 1.0f, 1, 1, 1, &con);
   }
   r.figure->selection = static_cast<float>(t);
@@ -587,7 +582,7 @@ FrameTimes frameTimes(const TimeSeries& mujoco, const RenderSettings& s) {
   if (s.duration_s > 0.0) f.t_end = std::min(f.t_end, f.t_start + s.duration_s);
   const double frames = renderFrameCount(f.t_end - f.t_start, s);
   if (!(frames >= 1.0 && frames <= kRenderMaxFrames))
-    throw std::runtime_error("render settings: the video would have " + fmtG(frames) + " frames, more than " +
+    throw std::runtime_error("render settings: the video would have " + formatG(frames) + " frames, more than " +
                              std::to_string(static_cast<long>(kRenderMaxFrames)) + " (lower fps, slowmo or duration_s)");
   f.frames = static_cast<long>(frames);
   return f;

@@ -1,4 +1,4 @@
-// Headless videos of a case (issue 5): OSMesa off-screen MuJoCo rendering piped into ffmpeg.
+// Headless videos of a case: OSMesa off-screen MuJoCo rendering piped into ffmpeg.
 // Rendering replays the models' time series; it runs no physics. See docs/rendering.md.
 #pragma once
 

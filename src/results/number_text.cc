@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 
 namespace tailsim {
@@ -94,6 +95,18 @@ char* formatG12(char* p, double v) {
     for (int i = 0; i < nz; ++i) *p++ = d[i];
   }
   return p;
+}
+
+std::string formatNumber(const char* f, double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, v);
+  return b;
+}
+
+std::string formatG(double v, int digits) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
 }
 
 }  // namespace tailsim

@@ -6,7 +6,7 @@
 
 namespace tailsim {
 
-// Which rows of the time series a case keeps (issue 13).
+// Which rows of the time series a case keeps.
 enum class TimeSeriesOutput {
   kFull,  // every sample (today's behaviour)
   kThin,  // the rows of thinRows() (results/thin_series.h): a 10-sample grid plus events and extremes

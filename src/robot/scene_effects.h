@@ -1,4 +1,4 @@
-// Which physical effects a scene simulates (issue 6). Both models read this.
+// Which physical effects a scene simulates. Both models read this.
 #pragma once
 
 #include "settings/fields.h"
@@ -17,7 +17,7 @@ enum class FootLoadModel {
   kConstant,     // L_F frozen at its value for the initial tail pose
 };
 
-// Effects a scene asks for (issue 6). Defaults reproduce the paper.
+// Effects a scene asks for. Defaults reproduce the paper.
 struct Effects {
   FrictionLaw friction = FrictionLaw::kStiction;
   bool translation = true;          // false: x, y locked

@@ -1,4 +1,4 @@
-// Declaring a settings struct's fields once (issue 10, item 4).
+// Declaring a settings struct's fields once.
 //
 // Every settings struct has, next to it, a field list
 //     template <class V, class S> settings::For<S, T> declareFields(V& v, S& s) { v.number(...); ... }

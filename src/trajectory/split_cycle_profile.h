@@ -1,6 +1,6 @@
 // Split-cycle joint trajectories (paper Sec. 3.3, Eqs. 20-23) and the equal-peak-speed rule
-// of Sec. 4.7 (Eq. 25). A joint profile may also be a clamped cubic spline (issue 12's smooth
-// stroke family): JointProfile is either; SplitCycleProfile is its historical name.
+// of Sec. 4.7 (Eq. 25). A joint profile may also be a clamped cubic spline (the optimiser's
+// smooth stroke family): JointProfile is either; SplitCycleProfile is its historical name.
 #pragma once
 
 #include <vector>

@@ -1,6 +1,6 @@
 // `tailsim optimize` as a module loaded at run time (dlopen by src/app/main.cc): pagmo2 (with TBB and
 // Boost.Serialization) costs ~4,000 page faults and ~75 ms of static initialisation per process, which
-// every `tailsim run` would pay if the program linked it (issue 13: start fast).
+// every `tailsim run` would pay if the program linked it (so every other command starts fast).
 #include <cmath>
 #include <cstdio>
 #include <cstring>
