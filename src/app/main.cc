@@ -22,6 +22,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 
+#include "app/commands.h"
 #include "experiments/accuracy_study.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
@@ -374,6 +375,8 @@ int main(int argc, char** argv) {
   maneuver->add_flag("--video", man_video, "also render the closed-loop turn (renders/<name>.mp4)");
   maneuver->add_flag("--quiet", man_quiet, "no progress lines");
 
+  int robot_exit = -1;
+  addRobotCommand(app, robot_exit);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version
@@ -407,6 +410,7 @@ int main(int argc, char** argv) {
     }
     return kExitUsage;
   }
+  if (robot_exit >= 0) return robot_exit;
 
   try {
     if (*run) {

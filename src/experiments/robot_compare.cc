@@ -1,0 +1,80 @@
+#include "experiments/robot_compare.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "experiments/model_registry.h"
+
+namespace tailsim {
+
+namespace {
+std::string f3(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", v);
+  return b;
+}
+}  // namespace
+
+std::vector<TailLink> tailFor(const DerivedRobot& r, const RobotTailChoice& c) {
+  const double L = c.length_m > 0.0 ? c.length_m : r.quadruped.l_F_m;
+  const int n = std::max(1, c.links);
+  const double m = c.mass_fraction * r.quadruped.mass_kg / n, l = L / n;
+  // Each link a uniform slender rod about its COM: m l^2 / 12.
+  return std::vector<TailLink>(static_cast<std::size_t>(n), TailLink{m, m * l * l / 12.0, l, 0.5 * l});
+}
+
+RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailChoice& choice) {
+  RobotComparison c;
+  c.robot = deriveRobot(spec);
+  c.tail = tailFor(c.robot, choice);
+  const int n = static_cast<int>(c.tail.size());
+
+  ExperimentCase& k = c.planar;
+  k.experiment = "robot";
+  k.name = "base";
+  k.robot.quadruped = c.robot.quadruped;
+  k.robot.tail = c.tail;
+  k.robot.friction.mu_s = k.robot.friction.mu_d = c.robot.mu;
+  k.robot.gravity_mps2 = c.robot.gravity_mps2;
+  for (int i = 0; i < n; ++i)
+    k.joints.push_back(equalPeakSpeedParams(n, choice.thetadot_max_dps * M_PI / 180.0, 0.25));  // Eq. (25)
+  k.mujoco.body_height_m = k.robot.quadruped.com_height_m;
+  k.output.settle_s = choice.settle_after_s;
+
+  c.articulated = runArticulated(c.robot, spec.mount, c.tail, k.trajectory(), k.mujoco, choice.stand_s,
+                                 choice.settle_after_s);
+  ModelRow art{"mujoco (articulated)", c.articulated.ok, c.articulated.phi_net_deg, c.articulated.warnings};
+  if (!c.articulated.ok) art.warnings.insert(art.warnings.begin(), c.articulated.error);
+  art.warnings.push_back("tilt: " + f3(c.articulated.stand_end_tilt_deg) + " deg after standing " +
+                         f3(choice.stand_s) + " s with the tail, at most " + f3(c.articulated.max_tilt_deg) +
+                         " deg during the stroke; " + std::to_string(c.articulated.feet_in_contact) + " feet on the floor");
+  c.rows.push_back(art);
+  for (const char* name : {"mujoco", "perfoot", "analytic"}) {
+    const ModelEntry* e = findModel(name);
+    if (!e) continue;
+    k.models = {name};
+    const RunResult res = e->run(k, nullptr);
+    ModelRow row{std::string(name) == "mujoco" ? "mujoco (rigid box)" : name, res.summary.ok, res.summary.phi_net_deg,
+                 res.summary.warnings};
+    if (!res.summary.ok) row.warnings.insert(row.warnings.begin(), res.summary.error);
+    c.rows.push_back(row);
+  }
+  return c;
+}
+
+std::string describeComparison(const RobotComparison& c) {
+  std::ostringstream o;
+  const TailLink& l = c.tail.front();
+  o << "tail: " << c.tail.size() << " link(s) of " << f3(l.mass_kg) << " kg, " << f3(l.length_m)
+    << " m; Eq. 25 stroke, mu = " << f3(c.robot.mu) << "\n\n";
+  o << "| model | phi_net [deg] | warnings |\n|---|---|---|\n";
+  for (const ModelRow& r : c.rows) {
+    std::string w;
+    for (const std::string& x : r.warnings) w += (w.empty() ? "" : "; ") + x;
+    o << "| " << r.model << " | " << (r.ok ? f3(r.phi_net_deg) : std::string("failed")) << " | " << w << " |\n";
+  }
+  return o.str();
+}
+
+}  // namespace tailsim
