@@ -238,4 +238,20 @@ TEST(RobotImport, FeetAndPlanarNumbersOfARigidBox) {
   EXPECT_THROW(deriveRobot(s), RobotImportError);
 }
 
+// `tailsim robot FILE.yaml`: a robot given by its size prints the values derived from its box.
+TEST(RobotImport, YamlRobotPrintsItsValues) {
+  Scratch t;
+  const std::string f = t.write("box.yaml",
+                                "quadruped: {mass_kg: 12, size_m: [0.5, 0.3, 0.2], foot_inset_m: 0.03}\n"
+                                "friction: {mu_s: 0.5, mu_d: 0.4}\ngravity_mps2: 9.81\n"
+                                "tails:\n  1: {mass_kg: 1.2, izz_kgm2: 0.025, length_m: 0.5}\n");
+  const std::string out = describeYamlRobot(f);
+  std::printf("%s", out.c_str());
+  EXPECT_NE(out.find("quadruped.izz_kgm2       0.34 "), std::string::npos) << out;
+  EXPECT_NE(out.find("quadruped.l_F_m          0.44 "), std::string::npos) << out;
+  EXPECT_NE(out.find("quadruped.com_height_m   0.1 "), std::string::npos) << out;
+  t.write("exp.yaml", "name: e\nrobot: box.yaml\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\nquadruped: {mass_kg: 24}\n");
+  EXPECT_NE(describeYamlRobot((t.dir / "exp.yaml").string()).find("quadruped.mass_kg        24 "), std::string::npos);
+}
+
 }  // namespace

@@ -12,7 +12,6 @@
 #include "mujoco_model/robot_import.h"
 
 namespace tailsim {
-
 void addRobotCommand(CLI::App& app, int& exit_code) {
   struct Options {
     std::string file, keyframe, mount_body;
@@ -25,7 +24,8 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "robot", "stand a MuJoCo model (MJCF or URDF) and print the planar models' parameters derived from it");
-  cmd->add_option("file", o->file, "the robot's MJCF (or URDF) file; its scene file works too")
+  cmd->add_option("file", o->file,
+                  "the robot's MJCF (or URDF) file, its scene file, or a YAML robot file or experiment")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--keyframe", o->keyframe, "stance: this keyframe (default: the model's `home`)");
@@ -51,6 +51,12 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->callback([o, &exit_code] {
     try {
+      const std::string ext = o->file.size() >= 5 ? o->file.substr(o->file.rfind('.') == std::string::npos ? 0 : o->file.rfind('.')) : "";
+      if (ext == ".yaml" || ext == ".yml") {
+        std::fputs(describeYamlRobot(o->file).c_str(), stdout);
+        exit_code = 0;
+        return;
+      }
       RobotModelSpec spec;
       spec.file = o->file;
       spec.keyframe = o->keyframe;

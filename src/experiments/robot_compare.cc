@@ -4,7 +4,11 @@
 #include <cstdio>
 #include <sstream>
 
+#include "experiments/experiment_loader.h"
 #include "experiments/model_registry.h"
+#include "experiments/yaml_file.h"
+
+#include <yaml-cpp/yaml.h>
 
 namespace tailsim {
 
@@ -61,6 +65,44 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
     c.rows.push_back(row);
   }
   return c;
+}
+
+std::string describeYamlRobot(const std::string& path) {
+  const YAML::Node doc = loadBoundedYaml(path);
+  RobotParams p;
+  std::string source;
+  if (doc.IsMap() && (doc["name"] || doc["experiments"])) {
+    const std::vector<Experiment> e = loadExperimentSuite(path);
+    const ExperimentCase& c = e.front().cases.front();
+    p = c.robot;
+    source = "robot file " + c.robot_file + " with the overrides of experiment " + e.front().name + " (case " + c.name + ")";
+  } else {
+    const RobotFileData r = loadRobotFile(path);
+    p = r.base;
+    source = "robot file " + r.file;
+  }
+  const QuadrupedParams& q = p.quadruped;
+  const struct {
+    const char* key;
+    double v;
+    const char* unit;
+  } rows[] = {{"quadruped.mass_kg", q.mass_kg, "kg"},
+              {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2"},
+              {"quadruped.d_Q2C_m", q.d_Q2C_m, "m"},
+              {"quadruped.d_Q2B_m", q.d_Q2B_m, "m"},
+              {"quadruped.l_F_m", q.l_F_m, "m"},
+              {"quadruped.w_F_m", q.w_F_m, "m"},
+              {"quadruped.com_height_m", q.com_height_m, "m"},
+              {"friction.mu_s", p.friction.mu_s, "-"},
+              {"friction.mu_d", p.friction.mu_d, "-"},
+              {"gravity_mps2", p.gravity_mps2, "m/s^2"}};
+  std::string out = "robot: " + source + "\n\n";
+  for (const auto& r : rows) {
+    char line[128];
+    std::snprintf(line, sizeof line, "%-24s %-14.9g %s\n", r.key, r.v, r.unit);
+    out += line;
+  }
+  return out + "\n(a quadruped given by size_m has these values derived from its box: docs/experiment-format.md)\n";
 }
 
 std::string describeComparison(const RobotComparison& c) {

@@ -43,6 +43,10 @@ std::vector<TailLink> tailFor(const DerivedRobot& r, const RobotTailChoice& c);
 // robot cannot be stood; a model that fails is a row with ok = false.
 RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailChoice& choice);
 
+// `tailsim robot FILE.yaml`: the planar robot of a YAML robot file or experiment (its first case),
+// value by value with units. Throws ConfigError.
+std::string describeYamlRobot(const std::string& path);
+
 // The comparison as a Markdown table plus each run's warnings.
 std::string describeComparison(const RobotComparison& c);
 
