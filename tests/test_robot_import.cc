@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 
+#include "experiments/experiment_loader.h"
 #include "experiments/robot_compare.h"
 #include "mujoco_model/robot_import.h"
 
@@ -252,6 +253,35 @@ TEST(RobotImport, YamlRobotPrintsItsValues) {
   EXPECT_NE(out.find("quadruped.com_height_m   0.1 "), std::string::npos) << out;
   t.write("exp.yaml", "name: e\nrobot: box.yaml\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\nquadruped: {mass_kg: 24}\n");
   EXPECT_NE(describeYamlRobot((t.dir / "exp.yaml").string()).find("quadruped.mass_kg        24 "), std::string::npos);
+}
+
+// --write-robot: the derived values as a tailsim robot file, read back exactly by the loader (so
+// an experiment on it runs the planar models on them and records them in each result.json).
+TEST(RobotImport, DerivedRobotFileLoadsBackExactly) {
+  Scratch t;
+  std::string xml = boxRobot("");
+  xml.replace(xml.find("</worldbody>"), 12,
+              "</worldbody>\n<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
+  RobotModelSpec s;
+  s.file = t.write("box.xml", xml);
+  s.mount.pos_m = {-0.25, 0.0, 0.0};
+  s.settle_s = 0.3;
+  const DerivedRobot r = deriveRobot(s);
+  RobotTailChoice c;
+  const std::string path = t.write("box_robot.yaml", derivedRobotFile(r, c));
+  const RobotFileData f = loadRobotFile(path);
+  const QuadrupedParams& q = f.base.quadruped;
+  EXPECT_EQ(q.mass_kg, r.quadruped.mass_kg);
+  EXPECT_EQ(q.izz_kgm2, r.quadruped.izz_kgm2);
+  EXPECT_EQ(q.d_Q2C_m, r.quadruped.d_Q2C_m);
+  EXPECT_EQ(q.d_Q2B_m, r.quadruped.d_Q2B_m);
+  EXPECT_EQ(q.l_F_m, r.quadruped.l_F_m);
+  EXPECT_EQ(q.w_F_m, r.quadruped.w_F_m);
+  EXPECT_EQ(q.com_height_m, r.quadruped.com_height_m);
+  EXPECT_EQ(f.base.friction.mu_s, r.mu);
+  ASSERT_EQ(f.tails.size(), 6u);
+  EXPECT_NEAR(f.tails.at(1).mass_kg, 0.1 * r.quadruped.mass_kg, 1e-12);
+  EXPECT_NEAR(f.tails.at(3).length_m * 3, r.quadruped.l_F_m, 1e-12);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "experiments/robot_compare.h"
+#include "results/atomic_file.h"
 #include "mujoco_model/robot_import.h"
 
 namespace tailsim {
@@ -19,6 +20,7 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
     std::vector<double> mount_pos;
     double mount_yaw_deg = 0.0, mu = -1.0, settle_s = 1.0;
     bool compare = false;
+    std::string write_robot;
     RobotTailChoice tail;
   };
   auto o = std::make_shared<Options>();
@@ -41,6 +43,8 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--settle-s", o->settle_s, "standing time before measuring [s]")->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--compare", o->compare,
                 "also run the four models with a tail: MuJoCo articulated, MuJoCo rigid box, perfoot, analytic");
+  cmd->add_option("--write-robot", o->write_robot,
+                  "write a tailsim robot file of the derived values (tails.1..6 from the --tail-* options) for experiments");
   cmd->add_option("--tail-mass-frac", o->tail.mass_fraction, "--compare: tail mass / robot mass")
       ->check(CLI::Range(0.001, 1.0))
       ->capture_default_str();
@@ -79,8 +83,15 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
         const RobotComparison c = compareRobotModels(spec, o->tail);
         std::fputs(describeDerivedRobot(c.robot).c_str(), stdout);
         std::fputs(("\n" + describeComparison(c)).c_str(), stdout);
+        if (!o->write_robot.empty() && !writeUserFile(o->write_robot, derivedRobotFile(c.robot, o->tail)))
+          std::printf("wrote %s\n", o->write_robot.c_str());
       } else {
-        std::fputs(describeDerivedRobot(deriveRobot(spec)).c_str(), stdout);
+        const DerivedRobot r = deriveRobot(spec);
+        std::fputs(describeDerivedRobot(r).c_str(), stdout);
+        if (!o->write_robot.empty()) {
+          if (!writeUserFile(o->write_robot, derivedRobotFile(r, o->tail)))
+            std::printf("wrote %s\n", o->write_robot.c_str());
+        }
       }
       exit_code = 0;
     } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "experiments/experiment_loader.h"
@@ -65,6 +66,37 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
     c.rows.push_back(row);
   }
   return c;
+}
+
+std::string derivedRobotFile(const DerivedRobot& r, const RobotTailChoice& c) {
+  auto g = [](double v) {  // the shortest text that reads back as v
+    char b[40];
+    for (int prec = 6; prec <= 17; ++prec) {
+      std::snprintf(b, sizeof b, "%.*g", prec, v);
+      if (std::strtod(b, nullptr) == v) break;
+    }
+    return std::string(b);
+  };
+  const QuadrupedParams& q = r.quadruped;
+  std::string t = "# Written by `tailsim robot` from " + r.model.source + "\n# stance: " + r.stance +
+                  "\n# feet (FL, FR, RR, RL):";
+  for (const std::string& f : r.feet) t += " " + f;
+  t += "\n# tail base: body '" + r.mount_body + "' (d_Q2B_m); docs/your-robot.md\n";
+  t += "quadruped:\n  mass_kg: " + g(q.mass_kg) + "\n  izz_kgm2: " + g(q.izz_kgm2) + "\n  d_Q2C_m: " + g(q.d_Q2C_m) +
+       "\n  d_Q2B_m: " + g(q.d_Q2B_m) + "\n  l_F_m: " + g(q.l_F_m) + "\n  w_F_m: " + g(q.w_F_m) +
+       "\n  com_height_m: " + g(q.com_height_m) + "\n";
+  t += "friction: {mu_s: " + g(r.mu) + ", mu_d: " + g(r.mu) + "}\n";
+  t += "gravity_mps2: " + g(r.gravity_mps2) + "\n";
+  RobotTailChoice k = c;
+  t += "# tails.n: the link of an n-link tail of " + g(100 * c.mass_fraction) + " % of the robot's mass, " +
+       (c.length_m > 0 ? g(c.length_m) + " m" : std::string("one body length (l_F)")) + " in all\ntails:\n";
+  for (int n = 1; n <= 6; ++n) {
+    k.links = n;
+    const TailLink l = tailFor(r, k).front();
+    t += "  " + std::to_string(n) + ": {mass_kg: " + g(l.mass_kg) + ", izz_kgm2: " + g(l.izz_kgm2) +
+         ", length_m: " + g(l.length_m) + "}\n";
+  }
+  return t;
 }
 
 std::string describeYamlRobot(const std::string& path) {

@@ -47,6 +47,11 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
 // value by value with units. Throws ConfigError.
 std::string describeYamlRobot(const std::string& path);
 
+// A tailsim robot file (docs/experiment-format.md "Robot file") holding the derived parameters,
+// mu_s = mu_d = the derived mu, and tails.1..6 from tailFor (the choice's mass and length split
+// over n links): `tailsim robot FILE --write-robot OUT.yaml`, for experiments.
+std::string derivedRobotFile(const DerivedRobot& r, const RobotTailChoice& c);
+
 // The comparison as a Markdown table plus each run's warnings.
 std::string describeComparison(const RobotComparison& c);
 

@@ -541,8 +541,11 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   const auto b = planar(base);
   q.d_Q2B_m = -b[0];
   r.lateral_mount_m = b[1];
-  if (q.d_Q2B_m < 0.0)
-    r.notes.push_back("the tail base is in front of the COM (d_Q2B_m < 0): check tail.mount (pos_m, yaw_deg)");
+  const bool mountGiven = !spec.mount.body.empty() || spec.mount.pos_m != std::array<double, 3>{};
+  if (!mountGiven)
+    r.notes.push_back("no tail mount given: d_Q2B_m is that of the root body's origin (--mount-pos X,Y,Z sets the tail base)");
+  else if (q.d_Q2B_m < 0.0)
+    r.notes.push_back("the tail base is in front of the COM (d_Q2B_m < 0): check the mount (pos_m, yaw_deg)");
 
   // Friction: the contacts' own (MuJoCo mixes the foot's and the floor's: priority, else the larger).
   int nmu = 0;
