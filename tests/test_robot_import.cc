@@ -285,3 +285,53 @@ TEST(RobotImport, DerivedRobotFileLoadsBackExactly) {
 }
 
 }  // namespace
+
+// The articulated run's sign conventions (tail mount, joint axis, stroke direction, heading): ANYmal C
+// with its legs locked at the stance by joint equality constraints is a rigid robot on its own feet,
+// so it must turn the way the rigid box of its derived parameters turns, and by about as much (mu 0.3,
+// where both slip). The same file with the base turned 180 deg about z (facing +x instead of -x)
+// must give the same phi_net: the heading is measured from where the robot stood.
+TEST(RobotImport, AnymalWithLockedLegsTurnsLikeTheRigidBoxWhicheverWayItFaces) {
+  REQUIRE_MENAGERIE(dir);
+  Scratch t;
+  RobotModelSpec s = anymalSpec(dir);
+  std::string xml;
+  {
+    std::ifstream in(s.file);
+    std::string line;
+    while (std::getline(in, line)) xml += line + "\n";
+  }
+  std::string eq = "<equality>\n";
+  for (const char* leg : {"LF", "RF", "LH", "RH"})
+    for (const char* j : {"_HAA", "_HFE", "_KFE"}) {
+      const std::string name = std::string(leg) + j;
+      const auto a = s.joint_angles_rad.find(name);
+      char line[160];
+      std::snprintf(line, sizeof line, "<joint joint1=\"%s\" polycoef=\"%.17g 0 0 0 0\" solref=\"0.002 1\"/>\n",
+                    name.c_str(), a == s.joint_angles_rad.end() ? 0.0 : a->second);
+      eq += line;
+    }
+  xml.replace(xml.find("<actuator>"), 0, eq + "</equality>\n");
+  const std::string facingMinusX = "<body name=\"base\" pos=\"0 0 0.62\" quat=\"0 0 0 1\"";
+  ASSERT_NE(xml.find(facingMinusX), std::string::npos);
+  s.file = t.write("anymal_locked.xml", xml);
+  s.mount.pos_m = {-0.35, 0.0, 0.0};
+  s.mu = 0.3;
+  RobotTailChoice tail;  // 10 %, l_F, 1 link, Eq. 25 at 600 deg/s
+  const RobotComparison c = compareRobotModels(s, tail);
+  std::printf("%s", describeComparison(c).c_str());
+  ASSERT_TRUE(c.articulated.ok) << c.articulated.error;
+  const ModelRow& box = c.rows.at(1);
+  ASSERT_EQ(box.model, "mujoco (rigid box)");
+  ASSERT_TRUE(box.ok);
+  EXPECT_GT(box.phi_net_deg, 1.0);  // it slips at mu 0.3
+  EXPECT_NEAR(c.articulated.phi_net_deg, box.phi_net_deg, 0.25 * box.phi_net_deg);
+  EXPECT_LT(c.articulated.max_tilt_deg, 1.0);  // the legs are locked
+
+  xml.replace(xml.find(facingMinusX), facingMinusX.size(), "<body name=\"base\" pos=\"0 0 0.62\" quat=\"1 0 0 0\"");
+  s.file = t.write("anymal_locked_facing_x.xml", xml);
+  const ArticulatedRun turned = runArticulated(deriveRobot(s), s.mount, c.tail, c.planar.trajectory(),
+                                               c.planar.mujoco, tail.stand_s, tail.settle_after_s);
+  ASSERT_TRUE(turned.ok) << turned.error;
+  EXPECT_NEAR(turned.phi_net_deg, c.articulated.phi_net_deg, 0.02);
+}
