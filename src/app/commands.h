@@ -44,5 +44,8 @@ void addAccuracyCommand(CLI::App& app, int& exit_code);
 void addSchemaCommand(CLI::App& app, int& exit_code);
 void addOptimizeCommand(CLI::App& app, int& exit_code);
 void addManeuverCommand(CLI::App& app, int& exit_code);
+// `tailsim robot FILE`: the planar models' parameters derived from a MuJoCo model (MJCF or URDF),
+// each with its unit and source (docs/your-robot.md).
+void addRobotCommand(CLI::App& app, int& exit_code);
 
 }  // namespace tailsim

@@ -1,0 +1,154 @@
+#include "experiments/robot_compare.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "experiments/experiment_loader.h"
+#include "experiments/model_registry.h"
+#include "experiments/yaml_file.h"
+
+#include <yaml-cpp/yaml.h>
+
+namespace tailsim {
+
+namespace {
+std::string f3(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3f", v);
+  return b;
+}
+}  // namespace
+
+std::vector<TailLink> tailFor(const DerivedRobot& r, const RobotTailChoice& c) {
+  const double L = c.length_m > 0.0 ? c.length_m : r.quadruped.l_F_m;
+  const int n = std::max(1, c.links);
+  const double m = c.mass_fraction * r.quadruped.mass_kg / n, l = L / n;
+  // Each link a uniform slender rod about its COM: m l^2 / 12.
+  return std::vector<TailLink>(static_cast<std::size_t>(n), TailLink{m, m * l * l / 12.0, l, 0.5 * l});
+}
+
+RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailChoice& choice) {
+  RobotComparison c;
+  c.robot = deriveRobot(spec);
+  c.tail = tailFor(c.robot, choice);
+  const int n = static_cast<int>(c.tail.size());
+
+  ExperimentCase& k = c.planar;
+  k.experiment = "robot";
+  k.name = "base";
+  k.robot.quadruped = c.robot.quadruped;
+  k.robot.tail = c.tail;
+  k.robot.friction.mu_s = k.robot.friction.mu_d = c.robot.mu;
+  k.robot.gravity_mps2 = c.robot.gravity_mps2;
+  for (int i = 0; i < n; ++i)
+    k.joints.push_back(equalPeakSpeedParams(n, choice.thetadot_max_dps * M_PI / 180.0, 0.25));  // Eq. (25)
+  k.mujoco.body_height_m = k.robot.quadruped.com_height_m;
+  k.output.settle_s = choice.settle_after_s;
+
+  c.articulated = runArticulated(c.robot, spec.mount, c.tail, k.trajectory(), k.mujoco, choice.stand_s,
+                                 choice.settle_after_s);
+  ModelRow art{"mujoco (articulated)", c.articulated.ok, c.articulated.phi_net_deg, c.articulated.warnings};
+  if (!c.articulated.ok) art.warnings.insert(art.warnings.begin(), c.articulated.error);
+  art.warnings.push_back("tilt: " + f3(c.articulated.stand_end_tilt_deg) + " deg after standing " +
+                         f3(choice.stand_s) + " s with the tail, at most " + f3(c.articulated.max_tilt_deg) +
+                         " deg during the stroke; " + std::to_string(c.articulated.feet_in_contact) + " feet on the floor");
+  c.rows.push_back(art);
+  for (const char* name : {"mujoco", "perfoot", "analytic"}) {
+    const ModelEntry* e = findModel(name);
+    if (!e) continue;
+    k.models = {name};
+    const RunResult res = e->run(k, nullptr);
+    ModelRow row{std::string(name) == "mujoco" ? "mujoco (rigid box)" : name, res.summary.ok, res.summary.phi_net_deg,
+                 res.summary.warnings};
+    if (!res.summary.ok) row.warnings.insert(row.warnings.begin(), res.summary.error);
+    c.rows.push_back(row);
+  }
+  return c;
+}
+
+std::string derivedRobotFile(const DerivedRobot& r, const RobotTailChoice& c) {
+  auto g = [](double v) {  // the shortest text that reads back as v
+    char b[40];
+    for (int prec = 6; prec <= 17; ++prec) {
+      std::snprintf(b, sizeof b, "%.*g", prec, v);
+      if (std::strtod(b, nullptr) == v) break;
+    }
+    return std::string(b);
+  };
+  const QuadrupedParams& q = r.quadruped;
+  std::string t = "# Written by `tailsim robot` from " + r.model.source + "\n# stance: " + r.stance +
+                  "\n# feet (FL, FR, RR, RL):";
+  for (const std::string& f : r.feet) t += " " + f;
+  t += "\n# tail base: body '" + r.mount_body + "' (d_Q2B_m); docs/your-robot.md\n";
+  t += "quadruped:\n  mass_kg: " + g(q.mass_kg) + "\n  izz_kgm2: " + g(q.izz_kgm2) + "\n  d_Q2C_m: " + g(q.d_Q2C_m) +
+       "\n  d_Q2B_m: " + g(q.d_Q2B_m) + "\n  l_F_m: " + g(q.l_F_m) + "\n  w_F_m: " + g(q.w_F_m) +
+       "\n  com_height_m: " + g(q.com_height_m) + "\n";
+  t += "friction: {mu_s: " + g(r.mu) + ", mu_d: " + g(r.mu) + "}\n";
+  t += "gravity_mps2: " + g(r.gravity_mps2) + "\n";
+  RobotTailChoice k = c;
+  t += "# tails.n: the link of an n-link tail of " + g(100 * c.mass_fraction) + " % of the robot's mass, " +
+       (c.length_m > 0 ? g(c.length_m) + " m" : std::string("one body length (l_F)")) + " in all\ntails:\n";
+  for (int n = 1; n <= 6; ++n) {
+    k.links = n;
+    const TailLink l = tailFor(r, k).front();
+    t += "  " + std::to_string(n) + ": {mass_kg: " + g(l.mass_kg) + ", izz_kgm2: " + g(l.izz_kgm2) +
+         ", length_m: " + g(l.length_m) + "}\n";
+  }
+  return t;
+}
+
+std::string describeYamlRobot(const std::string& path) {
+  const YAML::Node doc = loadBoundedYaml(path);
+  RobotParams p;
+  std::string source;
+  if (doc.IsMap() && (doc["name"] || doc["experiments"])) {
+    const std::vector<Experiment> e = loadExperimentSuite(path);
+    const ExperimentCase& c = e.front().cases.front();
+    p = c.robot;
+    source = "robot file " + c.robot_file + " with the overrides of experiment " + e.front().name + " (case " + c.name + ")";
+  } else {
+    const RobotFileData r = loadRobotFile(path);
+    p = r.base;
+    source = "robot file " + r.file;
+  }
+  const QuadrupedParams& q = p.quadruped;
+  const struct {
+    const char* key;
+    double v;
+    const char* unit;
+  } rows[] = {{"quadruped.mass_kg", q.mass_kg, "kg"},
+              {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2"},
+              {"quadruped.d_Q2C_m", q.d_Q2C_m, "m"},
+              {"quadruped.d_Q2B_m", q.d_Q2B_m, "m"},
+              {"quadruped.l_F_m", q.l_F_m, "m"},
+              {"quadruped.w_F_m", q.w_F_m, "m"},
+              {"quadruped.com_height_m", q.com_height_m, "m"},
+              {"friction.mu_s", p.friction.mu_s, "-"},
+              {"friction.mu_d", p.friction.mu_d, "-"},
+              {"gravity_mps2", p.gravity_mps2, "m/s^2"}};
+  std::string out = "robot: " + source + "\n\n";
+  for (const auto& r : rows) {
+    char line[128];
+    std::snprintf(line, sizeof line, "%-24s %-14.9g %s\n", r.key, r.v, r.unit);
+    out += line;
+  }
+  return out + "\n(a quadruped given by size_m has these values derived from its box: docs/experiment-format.md)\n";
+}
+
+std::string describeComparison(const RobotComparison& c) {
+  std::ostringstream o;
+  const TailLink& l = c.tail.front();
+  o << "tail: " << c.tail.size() << " link(s) of " << f3(l.mass_kg) << " kg, " << f3(l.length_m)
+    << " m; Eq. 25 stroke, mu = " << f3(c.robot.mu) << "\n\n";
+  o << "| model | phi_net [deg] | warnings |\n|---|---|---|\n";
+  for (const ModelRow& r : c.rows) {
+    std::string w;
+    for (const std::string& x : r.warnings) w += (w.empty() ? "" : "; ") + x;
+    o << "| " << r.model << " | " << (r.ok ? f3(r.phi_net_deg) : std::string("failed")) << " | " << w << " |\n";
+  }
+  return o.str();
+}
+
+}  // namespace tailsim

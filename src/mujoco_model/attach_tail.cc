@@ -1,0 +1,214 @@
+#include "mujoco_model/attach_tail.h"
+
+#include <tinyxml2.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+
+#include "controllers/tail_controller.h"
+#include "mujoco_model/mjcf_generator.h"
+
+namespace tailsim {
+namespace {
+
+using tinyxml2::XMLElement;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTailRadius = 0.012;  // visual capsule radius [m]
+
+std::string nums(std::initializer_list<double> v) {
+  std::string s;
+  char b[40];
+  for (double x : v) {
+    std::snprintf(b, sizeof b, "%.17g", x);
+    s += (s.empty() ? "" : " ") + std::string(b);
+  }
+  return s;
+}
+
+XMLElement* findBody(XMLElement* e, const std::string& name) {
+  for (XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    if (std::string(c->Name()) == "body" && c->Attribute("name") && name == c->Attribute("name")) return c;
+    if (XMLElement* f = findBody(c, name)) return f;
+  }
+  return nullptr;
+}
+
+double tiltDeg(const mjData* d, int body) {
+  return std::acos(std::max(-1.0, std::min(1.0, d->xmat[9 * body + 8]))) * 180.0 / kPi;
+}
+
+}  // namespace
+
+std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                       const MujocoSettings& s) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(r.model.xml.c_str()) != tinyxml2::XML_SUCCESS) throw RobotImportError("attachTail: the model does not parse");
+  XMLElement* root = doc.RootElement();
+  while (XMLElement* k = root->FirstChildElement("keyframe")) root->DeleteChild(k);
+  const std::string bodyName = mount.body.empty() ? r.root_body : mount.body;
+  XMLElement* parent = findBody(root->FirstChildElement("worldbody"), bodyName);
+  if (!parent) throw RobotImportError(r.model.source + ": tail mount: no body named '" + bodyName + "'");
+  // Tail frame: the mount body's frame turned about z so that x points backward (yaw + 180 deg).
+  const double a = 0.5 * (mount.yaw_rad + kPi);
+  XMLElement* link = nullptr;
+  XMLElement* at = parent;
+  RobotParams p;
+  p.tail = tail;
+  const ServoGains gains = tailServoGains(p, s);
+  for (std::size_t i = 0; i < tail.size(); ++i) {
+    const TailLink& l = tail[i];
+    link = doc.NewElement("body");
+    at->InsertEndChild(link);
+    link->SetAttribute("name", mjcf::tailBodyName(static_cast<int>(i + 1)).c_str());
+    if (i == 0) {
+      link->SetAttribute("pos", nums({mount.pos_m[0], mount.pos_m[1], mount.pos_m[2]}).c_str());
+      link->SetAttribute("quat", nums({std::cos(a), 0.0, 0.0, std::sin(a)}).c_str());
+    } else {
+      link->SetAttribute("pos", nums({tail[i - 1].length_m, 0.0, 0.0}).c_str());
+    }
+    XMLElement* in = doc.NewElement("inertial");
+    link->InsertEndChild(in);
+    in->SetAttribute("pos", nums({l.com_offset_m, 0.0, 0.0}).c_str());
+    in->SetAttribute("mass", nums({l.mass_kg}).c_str());
+    const std::array<double, 3> I = tailLinkDiagInertia(l);
+    in->SetAttribute("diaginertia", nums({I[0], I[1], I[2]}).c_str());
+    XMLElement* j = doc.NewElement("joint");
+    link->InsertEndChild(j);
+    j->SetAttribute("name", mjcf::tailJointName(static_cast<int>(i + 1)).c_str());
+    j->SetAttribute("type", "hinge");
+    j->SetAttribute("axis", "0 0 1");
+    j->SetAttribute("limited", "false");
+    j->SetAttribute("damping", "0");
+    j->SetAttribute("armature", "0");
+    j->SetAttribute("frictionloss", "0");
+    XMLElement* g = doc.NewElement("geom");
+    link->InsertEndChild(g);
+    g->SetAttribute("name", ("tail_geom" + std::to_string(i + 1)).c_str());
+    g->SetAttribute("type", "capsule");
+    g->SetAttribute("fromto", nums({0.0, 0.0, 0.0, l.length_m, 0.0, 0.0}).c_str());
+    g->SetAttribute("size", nums({kTailRadius}).c_str());
+    g->SetAttribute("contype", 0);
+    g->SetAttribute("conaffinity", 0);
+    g->SetAttribute("mass", 0);
+    g->SetAttribute("group", 1);
+    g->SetAttribute("rgba", "0.85 0.45 0.1 1");
+    at = link;
+  }
+  XMLElement* act = root->FirstChildElement("actuator");
+  if (!act) {
+    act = doc.NewElement("actuator");
+    root->InsertEndChild(act);
+  }
+  for (std::size_t i = 0; i < tail.size(); ++i) {
+    XMLElement* g = doc.NewElement("general");
+    act->InsertEndChild(g);
+    g->SetAttribute("name", mjcf::tailActuatorName(static_cast<int>(i + 1)).c_str());
+    g->SetAttribute("joint", mjcf::tailJointName(static_cast<int>(i + 1)).c_str());
+    g->SetAttribute("ctrllimited", "false");
+    g->SetAttribute("forcelimited", "false");
+    g->SetAttribute("gainprm", nums({gains.kp[i]}).c_str());
+    g->SetAttribute("biasprm", nums({0.0, -gains.kp[i], -gains.kv[i]}).c_str());
+    g->SetAttribute("biastype", "affine");
+    g->SetAttribute("gaintype", "fixed");
+  }
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
+}
+
+ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                              const TailTrajectory& trajectory, const MujocoSettings& s_in, double stand_s,
+                              double settle_after_s) {
+  ArticulatedRun out;
+  MujocoMessages messages;
+  // The servo gains at the model's own timestep.
+  MujocoSettings s = s_in;
+  {
+    ModelPtr probe = loadModelFromXml(r.model.xml);
+    s.timestep_s = probe->opt.timestep;
+  }
+  ModelPtr mp = loadModelFromXml(attachTail(r, mount, tail, s));
+  mjModel* m = mp.get();
+  DataPtr dp = makeData(m);
+  mjData* d = dp.get();
+  const int n = static_cast<int>(tail.size());
+  for (const auto& [name, q] : r.settled_qpos) {
+    const int j = jointId(m, name);
+    for (std::size_t k = 0; k < q.size(); ++k) d->qpos[m->jnt_qposadr[j] + k] = q[k];
+  }
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
+    const char* jn = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * a]);
+    const auto t = jn ? r.hold_target_rad.find(jn) : r.hold_target_rad.end();
+    if (t != r.hold_target_rad.end()) d->ctrl[a] = t->second;
+  }
+  std::vector<int> qadr, vadr, act, pdq, pdv;
+  std::vector<double> pdTarget;
+  for (int i = 1; i <= n; ++i) {
+    const int j = jointId(m, mjcf::tailJointName(i));
+    qadr.push_back(m->jnt_qposadr[j]);
+    vadr.push_back(m->jnt_dofadr[j]);
+    act.push_back(actuatorId(m, mjcf::tailActuatorName(i)));
+  }
+  for (const std::string& name : r.pd_joints) {
+    const int j = jointId(m, name);
+    pdq.push_back(m->jnt_qposadr[j]);
+    pdv.push_back(m->jnt_dofadr[j]);
+    pdTarget.push_back(r.hold_target_rad.at(name));
+  }
+  std::vector<JointState> ref0;
+  trajectory.evaluate(0.0, ref0);
+  for (int i = 0; i < n; ++i) d->qpos[qadr[i]] = ref0[i].theta;
+  TailController ctrl(m, trajectory, qadr, vadr, act, {s.velocity_feedforward, s.inverse_dynamics_feedforward});
+  mj_forward(m, d);
+  const int body = bodyId(m, r.root_body);
+  if (r.mu_given) {
+    for (const auto& [bodyName, k] : r.foot_geoms) m->geom_friction[3 * (m->body_geomadr[bodyId(m, bodyName)] + k)] = r.mu;
+    m->geom_friction[3 * geomId(m, r.model.floor_geom)] = r.mu;
+  }
+  auto step = [&](double t_ref) {
+    mj_step1(m, d);
+    for (std::size_t k = 0; k < pdq.size(); ++k)
+      d->qfrc_applied[pdv[k]] = kStancePdKp * (pdTarget[k] - d->qpos[pdq[k]]) - kStancePdKv * d->qvel[pdv[k]];
+    ctrl.apply(m, d, t_ref, false);
+    mj_step2(m, d);
+  };
+  const double dt = m->opt.timestep;
+  const long standSteps = std::lround(stand_s / dt);
+  for (long k = 0; k < standSteps && out.ok; ++k) {
+    step(0.0);
+    out.stand_max_tilt_deg = std::max(out.stand_max_tilt_deg, tiltDeg(d, body));
+    if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings while standing: " + describeWarnings(d);
+  }
+  out.stand_s = stand_s;
+  out.stand_end_tilt_deg = tiltDeg(d, body);
+  for (const auto& [bodyName, k] : r.foot_geoms) {
+    const int g = m->body_geomadr[bodyId(m, bodyName)] + k;
+    bool touching = false;
+    for (int i = 0; i < d->ncon; ++i) touching = touching || d->contact[i].geom1 == g || d->contact[i].geom2 == g;
+    out.feet_in_contact += touching;
+  }
+  auto yaw = [&] { return std::atan2(d->xmat[9 * body + 3], d->xmat[9 * body]); };
+  const double yaw0 = yaw();
+  double phi = 0.0, prev = yaw0;
+  const double t_end = trajectory.endTime() + settle_after_s;
+  const long runSteps = std::lround(t_end / dt);
+  for (long k = 0; k < runSteps && out.ok; ++k) {
+    step((k + 1) * dt);
+    const double y = yaw();
+    phi += std::remainder(y - prev, 2 * kPi);
+    prev = y;
+    out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
+    if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
+  }
+  out.run_s = t_end;
+  out.phi_net_deg = phi * 180.0 / kPi;
+  if (out.stand_max_tilt_deg >= 1.0)
+    out.warnings.push_back("the body tilted " + std::to_string(out.stand_max_tilt_deg) + " deg while standing with the tail");
+  if (!messages.text().empty()) out.warnings.push_back(messages.text());
+  return out;
+}
+
+}  // namespace tailsim

@@ -1,0 +1,42 @@
+// A generated planar tail attached to a user's MuJoCo robot (robot_import.h), and the articulated
+// run: the robot stands in its stance with the tail, then the tail follows its trajectory under
+// tailsim's servos (controllers/tail_controller.h) while the legs stay held (docs/your-robot.md).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mujoco_model/mujoco_settings.h"
+#include "mujoco_model/robot_import.h"
+#include "robot/robot_params.h"
+#include "trajectory/split_cycle_profile.h"
+
+namespace tailsim {
+
+// The robot's MJCF (r.model.xml) with the tail under the mount body: links tail_link1..n (hinges
+// about the mount body's z, theta = 0 straight back along the planar frame's -x), each link's
+// COM, mass and I_zz as given, visual capsules that do not collide, and one PD servo per joint
+// (tail_motor<i>, gains tailServoGains at the model's own timestep). The model's keyframes are
+// removed (their qpos has no tail); the stance is set by joint name from r.settled_qpos. A mu the
+// user gave (r.mu_given) becomes the sliding friction of the feet and the floor.
+std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                       const MujocoSettings& s);
+
+struct ArticulatedRun {
+  bool ok = true;
+  std::string error;
+  double stand_max_tilt_deg = 0.0;  // largest body tilt while standing with the tail held [deg]
+  double stand_end_tilt_deg = 0.0;  // body tilt at the end of standing (the stroke's start) [deg]
+  double max_tilt_deg = 0.0;        // largest body tilt during the stroke and after [deg]
+  double phi_net_deg = 0.0;         // heading change of the root body from the stroke's start [deg]
+  double stand_s = 0.0, run_s = 0.0;
+  int feet_in_contact = 0;          // foot geoms touching the floor at the stroke's start
+  std::vector<std::string> warnings;
+};
+
+// Stands stand_s with the tail held at theta(0), then runs the stroke and settle_after_s more.
+ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                              const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
+                              double settle_after_s);
+
+}  // namespace tailsim

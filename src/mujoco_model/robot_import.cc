@@ -1,0 +1,629 @@
+#include "mujoco_model/robot_import.h"
+
+#include <tinyxml2.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+namespace tailsim {
+namespace {
+
+namespace fs = std::filesystem;
+using tinyxml2::XMLDocument;
+using tinyxml2::XMLElement;
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string g6(double v) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+[[noreturn]] void fail(const std::string& file, const std::string& what) { throw RobotImportError(file + ": " + what); }
+
+void loadXmlFile(XMLDocument& doc, const std::string& file) {
+  if (doc.LoadFile(file.c_str()) != tinyxml2::XML_SUCCESS)
+    fail(file, std::string("cannot read it as XML: ") + (doc.ErrorStr() ? doc.ErrorStr() : "unknown error"));
+}
+
+// Every element below `e` (depth first, document order), `e` itself excluded.
+void forEachElement(XMLElement* e, const std::function<void(XMLElement*)>& f) {
+  for (XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    f(c);
+    forEachElement(c, f);
+  }
+}
+
+// <include file="..."/> replaced by the children of the included file's <mujoco> (recursively, each
+// file relative to the file that names it), as MuJoCo's own parser does.
+void inlineIncludes(XMLDocument& doc, XMLElement* root, const fs::path& dir, int depth) {
+  if (depth > 8) fail(dir.string(), "includes nested more than 8 deep");
+  std::vector<XMLElement*> includes;
+  forEachElement(root, [&](XMLElement* e) {
+    if (std::string(e->Name()) == "include") includes.push_back(e);
+  });
+  for (XMLElement* inc : includes) {
+    const char* f = inc->Attribute("file");
+    if (!f) fail(dir.string(), "an <include> without file=");
+    const fs::path p = fs::path(f).is_absolute() ? fs::path(f) : dir / f;
+    XMLDocument sub;
+    loadXmlFile(sub, p.string());
+    XMLElement* subRoot = sub.RootElement();
+    if (!subRoot || std::string(subRoot->Name()) != "mujoco") fail(p.string(), "an included file must be <mujoco>");
+    inlineIncludes(sub, subRoot, p.parent_path(), depth + 1);
+    tinyxml2::XMLNode* parent = inc->Parent();
+    tinyxml2::XMLNode* after = inc;
+    for (XMLElement* c = subRoot->FirstChildElement(); c; c = c->NextSiblingElement()) {
+      tinyxml2::XMLNode* copy = c->DeepClone(&doc);
+      parent->InsertAfterChild(after, copy);
+      after = copy;
+    }
+    parent->DeleteChild(inc);
+  }
+}
+
+// The default classes of an MJCF model and the attribute a geom gets from them (MuJoCo's rules:
+// the geom's class, else the nearest enclosing body's childclass, else "main"; a class inherits
+// from the classes that enclose it).
+class Defaults {
+ public:
+  explicit Defaults(XMLElement* root) {
+    for (XMLElement* d = root->FirstChildElement("default"); d; d = d->NextSiblingElement("default")) add(d, true);
+  }
+  const char* geomAttr(XMLElement* geom, const char* name) const {
+    if (const char* v = geom->Attribute(name)) return v;
+    std::string cls = "main";
+    if (const char* c = geom->Attribute("class")) {
+      cls = c;
+    } else {
+      for (tinyxml2::XMLNode* p = geom->Parent(); p; p = p->Parent()) {
+        XMLElement* b = p->ToElement();
+        if (b && std::string(b->Name()) == "body" && b->Attribute("childclass")) {
+          cls = b->Attribute("childclass");
+          break;
+        }
+      }
+    }
+    const auto it = classes_.find(cls);
+    for (XMLElement* d = it == classes_.end() ? nullptr : it->second; d;) {
+      if (XMLElement* gd = d->FirstChildElement("geom"))
+        if (const char* v = gd->Attribute(name)) return v;
+      XMLElement* up = d->Parent() ? d->Parent()->ToElement() : nullptr;
+      d = up && std::string(up->Name()) == "default" ? up : nullptr;
+    }
+    return nullptr;
+  }
+
+ private:
+  void add(XMLElement* d, bool top) {
+    const char* c = d->Attribute("class");
+    classes_[c ? c : (top ? "main" : "")] = d;
+    for (XMLElement* k = d->FirstChildElement("default"); k; k = k->NextSiblingElement("default")) add(k, false);
+  }
+  std::map<std::string, XMLElement*> classes_;
+};
+
+std::string stemOf(const std::string& file) { return fs::path(file).stem().string(); }
+
+bool isFile(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_regular_file(p, ec);
+}
+
+// URDF: MuJoCo reads it (visual elements discarded, as its URDF reader does by default) and writes
+// it back as MJCF; the returned text then goes through the MJCF steps.
+std::string urdfToMjcf(const std::string& file) {
+  installMujocoMessageHandlers();
+  char err[1000] = "";
+  ModelPtr m(mj_loadXML(file.c_str(), nullptr, err, sizeof err));
+  if (!m) fail(file, std::string("MuJoCo cannot load this URDF: ") + err);
+  char tmpl[] = "/tmp/tailsim-urdf-XXXXXX.xml";
+  const int fd = mkstemps(tmpl, 4);
+  if (fd < 0) fail(file, "cannot create a temporary file for the converted URDF");
+  ::close(fd);
+  const bool ok = mj_saveLastXML(tmpl, m.get(), err, sizeof err);
+  std::ifstream in(tmpl);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::remove(tmpl);
+  if (!ok) fail(file, std::string("MuJoCo cannot write this URDF as MJCF: ") + err);
+  return ss.str();
+}
+
+}  // namespace
+
+PreparedModel prepareRobotModel(const std::string& file_in) {
+  PreparedModel out;
+  out.source = fs::absolute(file_in).lexically_normal().string();
+  const std::string& file = out.source;
+  if (!isFile(file)) fail(file, "model file not found");
+  const fs::path dir = fs::path(file).parent_path();
+
+  XMLDocument doc;
+  loadXmlFile(doc, file);
+  if (!doc.RootElement()) fail(file, "empty XML file");
+  if (std::string(doc.RootElement()->Name()) == "robot") {
+    out.from_urdf = true;
+    const std::string mjcf = urdfToMjcf(file);
+    doc.Clear();
+    if (doc.Parse(mjcf.c_str()) != tinyxml2::XML_SUCCESS) fail(file, "MuJoCo's MJCF of this URDF does not parse");
+    out.notes.push_back("URDF read by MuJoCo's URDF reader (visual elements discarded) and written back as MJCF");
+  } else if (std::string(doc.RootElement()->Name()) != "mujoco") {
+    fail(file, "neither MJCF (<mujoco>) nor URDF (<robot>)");
+  }
+  XMLElement* root = doc.RootElement();
+  inlineIncludes(doc, root, dir, 0);
+
+  // Asset folders made absolute, so the compiled text finds the files the user's file names.
+  XMLElement* compiler = root->FirstChildElement("compiler");
+  if (!compiler) {
+    compiler = doc.NewElement("compiler");
+    root->InsertFirstChild(compiler);
+  }
+  auto absDir = [&](const char* attr) {
+    const char* v = compiler->Attribute(attr);
+    const fs::path p = v ? fs::path(v) : fs::path();
+    const fs::path a = p.is_absolute() ? p : (dir / p).lexically_normal();
+    std::string text = a.string();
+    if (text.empty() || text.back() != '/') text += '/';
+    compiler->SetAttribute(attr, text.c_str());
+    return a;
+  };
+  const char* assetdir = compiler->Attribute("assetdir");
+  const fs::path meshdir = compiler->Attribute("meshdir") || !assetdir ? absDir("meshdir") : absDir("assetdir");
+  const fs::path texturedir =
+      compiler->Attribute("texturedir") || !assetdir ? absDir("texturedir") : fs::path(compiler->Attribute("assetdir"));
+  if (assetdir) absDir("assetdir");
+  const bool inertiaFromGeom = compiler->Attribute("inertiafromgeom") &&
+                               std::string(compiler->Attribute("inertiafromgeom")) == "true";
+
+  // Missing mesh and texture files.
+  std::map<std::string, std::string> missingMesh;     // mesh name -> the missing file
+  std::set<std::string> missingTexture;
+  std::vector<XMLElement*> dropAssets;
+  for (XMLElement* asset = root->FirstChildElement("asset"); asset; asset = asset->NextSiblingElement("asset")) {
+    for (XMLElement* e = asset->FirstChildElement(); e; e = e->NextSiblingElement()) {
+      const std::string tag = e->Name();
+      if (tag != "mesh" && tag != "texture" && tag != "hfield" && tag != "skin") continue;
+      const fs::path base = tag == "texture" ? texturedir : meshdir;
+      std::vector<std::string> files;
+      for (const char* a : {"file", "fileright", "fileleft", "fileup", "filedown", "filefront", "fileback"})
+        if (const char* f = e->Attribute(a)) files.push_back(f);
+      for (const std::string& f : files) {
+        const fs::path p = fs::path(f).is_absolute() ? fs::path(f) : base / f;
+        if (isFile(p)) continue;
+        const std::string name = e->Attribute("name") ? e->Attribute("name") : stemOf(f);
+        if (tag == "mesh") missingMesh[name] = p.string();
+        else if (tag == "texture") missingTexture.insert(name);
+        else fail(file, "<" + tag + "> '" + name + "': file " + p.string() + " is missing");
+        dropAssets.push_back(e);
+        break;
+      }
+    }
+  }
+  if (!missingTexture.empty()) {
+    std::vector<XMLElement*> materials;
+    forEachElement(root, [&](XMLElement* e) {
+      if (std::string(e->Name()) == "material" && e->Attribute("texture") && missingTexture.count(e->Attribute("texture")))
+        materials.push_back(e);
+    });
+    for (XMLElement* m : materials) m->DeleteAttribute("texture");
+  }
+
+  // Geoms that use a missing mesh: dropped when they cannot collide; otherwise an error.
+  const Defaults defaults(root);
+  XMLElement* world = root->FirstChildElement("worldbody");
+  if (!world) fail(file, "no <worldbody>");
+  std::vector<XMLElement*> geoms;
+  forEachElement(world, [&](XMLElement* e) {
+    if (std::string(e->Name()) == "geom") geoms.push_back(e);
+  });
+  std::vector<std::string> colliding;
+  std::vector<XMLElement*> dropGeoms;
+  bool hasPlane = false;
+  for (XMLElement* gm : geoms) {
+    const char* type = defaults.geomAttr(gm, "type");
+    if (type && std::string(type) == "plane") {
+      hasPlane = true;
+      if (out.floor_geom.empty()) out.floor_geom = gm->Attribute("name") ? gm->Attribute("name") : "";
+    }
+    const char* mesh = defaults.geomAttr(gm, "mesh");
+    if (!mesh || !missingMesh.count(mesh)) continue;
+    const char* ct = defaults.geomAttr(gm, "contype");
+    const char* ca = defaults.geomAttr(gm, "conaffinity");
+    const bool collides = (ct ? std::atoi(ct) : 1) != 0 || (ca ? std::atoi(ca) : 1) != 0;
+    XMLElement* body = gm->Parent() ? gm->Parent()->ToElement() : nullptr;
+    const std::string bodyName = body && body->Attribute("name") ? body->Attribute("name") : "world";
+    const std::string geomName =
+        gm->Attribute("name") ? "'" + std::string(gm->Attribute("name")) + "'" : "(unnamed, mesh '" + std::string(mesh) + "')";
+    if (collides) {
+      colliding.push_back("geom " + geomName + " in body '" + bodyName + "' collides but its mesh file " +
+                          missingMesh[mesh] + " is missing");
+      continue;
+    }
+    const bool massFromGeoms = inertiaFromGeom || (body && !body->FirstChildElement("inertial"));
+    if (massFromGeoms && std::string(body ? body->Name() : "") == "body")
+      fail(file, "geom " + geomName + " in body '" + bodyName + "' has a missing mesh file " + missingMesh[mesh] +
+                     " and the body's mass and inertia come from its geoms (no <inertial>): supply the file");
+    dropGeoms.push_back(gm);
+  }
+  if (!colliding.empty()) {
+    std::string msg = std::to_string(colliding.size()) + " colliding geom" + (colliding.size() > 1 ? "s have" : " has") +
+                      " a missing mesh file: ";
+    for (std::size_t i = 0; i < colliding.size() && i < 5; ++i) msg += (i ? "; " : "") + colliding[i];
+    if (colliding.size() > 5) msg += "; and " + std::to_string(colliding.size() - 5) + " more";
+    fail(file, msg + ". Supply the mesh files (meshdir " + meshdir.string() +
+                   "), or make such geoms visual-only (contype=\"0\" conaffinity=\"0\")");
+  }
+  for (XMLElement* gm : dropGeoms) gm->Parent()->DeleteChild(gm);
+  for (XMLElement* a : dropAssets) a->Parent()->DeleteChild(a);
+  out.dropped_geoms = static_cast<int>(dropGeoms.size());
+  out.dropped_textures = static_cast<int>(missingTexture.size());
+  if (out.dropped_geoms || out.dropped_textures)
+    out.notes.push_back("dropped " + std::to_string(out.dropped_geoms) + " non-colliding geom" +
+                        (out.dropped_geoms == 1 ? "" : "s") + " whose mesh file is missing and " +
+                        std::to_string(out.dropped_textures) + " texture" + (out.dropped_textures == 1 ? "" : "s") +
+                        " whose file is missing (their materials keep their colour)");
+
+  // Every joint named (the stance is carried by name into a model with a tail).
+  int unnamed = 0;
+  forEachElement(world, [&](XMLElement* e) {
+    const std::string tag = e->Name();
+    if ((tag == "joint" || tag == "freejoint") && !e->Attribute("name"))
+      e->SetAttribute("name", ("tailsim_joint" + std::to_string(++unnamed)).c_str());
+  });
+
+  // A floor when the model has none (a robot file without its scene).
+  if (!hasPlane || out.floor_geom.empty()) {
+    if (hasPlane) {
+      // The model's plane has no name: name it.
+      for (XMLElement* gm : geoms) {
+        const char* type = defaults.geomAttr(gm, "type");
+        if (type && std::string(type) == "plane") {
+          gm->SetAttribute("name", "tailsim_floor");
+          break;
+        }
+      }
+    } else {
+      XMLElement* floor = doc.NewElement("geom");
+      floor->SetAttribute("name", "tailsim_floor");
+      floor->SetAttribute("type", "plane");
+      floor->SetAttribute("size", "0 0 1");
+      world->InsertFirstChild(floor);
+      out.notes.push_back("added a floor (plane, MuJoCo's default friction 1): the model has none");
+    }
+    out.floor_geom = "tailsim_floor";
+  }
+
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  out.xml = printer.CStr();
+  return out;
+}
+
+namespace {
+
+// Lowest z of a geom's surface (spheres, capsules, cylinders, boxes exactly; others by bounding sphere).
+double lowestZ(const mjModel* m, const mjData* d, int g) {
+  const double* p = d->geom_xpos + 3 * g;
+  const double* R = d->geom_xmat + 9 * g;  // row-major; column k = geom axis k in world
+  const double* s = m->geom_size + 3 * g;
+  switch (m->geom_type[g]) {
+    case mjGEOM_SPHERE: return p[2] - s[0];
+    case mjGEOM_CAPSULE: return p[2] - std::abs(R[8]) * s[1] - s[0];
+    case mjGEOM_CYLINDER: return p[2] - std::abs(R[8]) * s[1] - s[0] * std::sqrt(std::max(0.0, 1.0 - R[8] * R[8]));
+    case mjGEOM_BOX: return p[2] - std::abs(R[6]) * s[0] - std::abs(R[7]) * s[1] - std::abs(R[8]) * s[2];
+    default: return p[2] - m->geom_rbound[g];
+  }
+}
+
+struct Stance {
+  std::vector<double> qpos;                  // nq
+  std::vector<std::pair<int, double>> held;  // (joint id, target angle) of every actuated hinge/slide
+  std::string words;
+};
+
+// The stance: a keyframe (named, or `home`) or qpos0, with the spec's joint angles over it.
+Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string& file) {
+  Stance s;
+  s.qpos.assign(m->qpos0, m->qpos0 + m->nq);
+  std::string key = spec.keyframe;
+  if (key.empty() && mj_name2id(m, mjOBJ_KEY, "home") >= 0) key = "home";
+  if (!key.empty()) {
+    const int k = mj_name2id(m, mjOBJ_KEY, key.c_str());
+    if (k < 0) {
+      std::string names;
+      for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
+      fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")");
+    }
+    s.qpos.assign(m->key_qpos + k * m->nq, m->key_qpos + (k + 1) * m->nq);
+    s.words = "keyframe '" + key + "'";
+  } else if (spec.joint_angles_rad.empty()) {
+    fail(file, "no stance: the model has no `home` keyframe; name a keyframe or give the joint angles of its "
+               "standing pose (docs/your-robot.md)");
+  } else {
+    s.words = "the model's reference pose (qpos0)";
+  }
+  for (const auto& [name, angle] : spec.joint_angles_rad) {
+    const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    if (j < 0) fail(file, "stance: no joint named '" + name + "'");
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
+      fail(file, "stance: joint '" + name + "' is not a hinge or slide");
+    s.qpos[m->jnt_qposadr[j]] = angle;
+  }
+  if (!spec.joint_angles_rad.empty())
+    s.words += " with " + std::to_string(spec.joint_angles_rad.size()) + " joint angle" +
+               (spec.joint_angles_rad.size() == 1 ? "" : "s") + " given";
+  return s;
+}
+
+int rootBody(const mjModel* m, const std::string& file) {
+  for (int j = 0; j < m->njnt; ++j)
+    if (m->jnt_type[j] == mjJNT_FREE) return m->jnt_bodyid[j];
+  fail(file, "no free joint: a standing robot needs a floating base (<freejoint/>)");
+}
+
+}  // namespace
+
+DerivedRobot deriveRobot(const RobotModelSpec& spec) {
+  DerivedRobot r;
+  r.model = prepareRobotModel(spec.file);
+  const std::string& file = r.model.source;
+  MujocoMessages messages;
+  ModelPtr mp = loadModelFromXml(r.model.xml);
+  mjModel* m = mp.get();
+  DataPtr dp = makeData(m);
+  mjData* d = dp.get();
+  r.gravity_mps2 = -m->opt.gravity[2];
+  if (!(r.gravity_mps2 > 0.0)) fail(file, "gravity must point down (-z) to stand the robot");
+
+  const int root = rootBody(m, file);
+  r.root_body = mj_id2name(m, mjOBJ_BODY, root) ? mj_id2name(m, mjOBJ_BODY, root) : "";
+  const Stance stance = stanceOf(m, spec, file);
+  r.stance = stance.words;
+
+  // Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
+  // ctrl; a joint without one is held by a PD tailsim adds through qfrc_applied.
+  std::vector<int> heldByActuator(m->njnt, 0);
+  std::vector<double> ctrl(m->nu, 0.0);
+  int positionServos = 0;
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
+    const int j = m->actuator_trnid[2 * a];
+    const bool position = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
+    if (!position) continue;
+    ctrl[a] = stance.qpos[m->jnt_qposadr[j]];
+    heldByActuator[j] = 1;
+    ++positionServos;
+  }
+  std::vector<int> pd;  // joints held by tailsim's PD
+  for (int j = 0; j < m->njnt; ++j)
+    if ((m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) && !heldByActuator[j]) pd.push_back(j);
+  constexpr double kPdKp = kStancePdKp, kPdKv = kStancePdKv;
+  r.stance += ", legs held by " + std::to_string(positionServos) + " position actuator" + (positionServos == 1 ? "" : "s") +
+              " of the model" + (pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(pd.size()) + " joints");
+
+  // Lifted (or lowered) until the lowest colliding geom is 1 mm above the floor, then settled.
+  mju_copy(d->qpos, stance.qpos.data(), m->nq);
+  mj_kinematics(m, d);
+  const int floor = mj_name2id(m, mjOBJ_GEOM, r.model.floor_geom.c_str());
+  const double floorZ = floor >= 0 ? d->geom_xpos[3 * floor + 2] : 0.0;
+  double low = 1e300;
+  for (int g = 0; g < m->ngeom; ++g)
+    if (m->geom_bodyid[g] != 0 && m->body_rootid[m->geom_bodyid[g]] == root && (m->geom_contype[g] || m->geom_conaffinity[g])) low = std::min(low, lowestZ(m, d, g));
+  const int freeq = m->jnt_qposadr[m->body_jntadr[root]];
+  const double lift = floorZ + 1e-3 - low;
+  d->qpos[freeq + 2] += lift;
+  r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
+                    g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(spec.settle_s) + " s");
+  mju_copy(d->ctrl, ctrl.data(), m->nu);
+  const int steps = static_cast<int>(std::ceil(spec.settle_s / m->opt.timestep));
+  for (int i = 0; i < steps; ++i) {
+    for (int j : pd) {
+      const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
+      d->qfrc_applied[va] = kPdKp * (stance.qpos[qa] - d->qpos[qa]) - kPdKv * d->qvel[va];
+    }
+    mj_step(m, d);
+  }
+  mj_forward(m, d);
+  if (warningCount(d) > 0) fail(file, "MuJoCo warnings while standing: " + describeWarnings(d));
+  const double* Rroot = d->xmat + 9 * root;
+  r.tilt_deg = std::acos(std::clamp(Rroot[8], -1.0, 1.0)) * 180.0 / kPi;
+
+  // Feet: the named geoms, or the robot's geoms touching the floor.
+  std::vector<int> feet;
+  if (!spec.feet.empty()) {
+    for (const std::string& n : spec.feet) {
+      const int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
+      if (g < 0) fail(file, "feet: no geom named '" + n + "'");
+      feet.push_back(g);
+    }
+  } else {
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
+      const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
+      if (other < 0 || c.dist > 1e-3) continue;
+      if (std::find(feet.begin(), feet.end(), other) == feet.end()) feet.push_back(other);
+    }
+  }
+  auto geomName = [&](int g) {
+    const char* n = mj_id2name(m, mjOBJ_GEOM, g);
+    return n ? std::string(n) : "geom #" + std::to_string(g) + " of body '" +
+                                    std::string(mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) ? mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) : "?") + "'";
+  };
+  if (feet.size() < 3 || feet.size() > 4) {
+    std::string names;
+    for (int g : feet) names += (names.empty() ? "" : ", ") + geomName(g);
+    fail(file, "after standing " + g6(spec.settle_s) + " s in " + r.stance + ", the robot touches the floor with " +
+                   std::to_string(feet.size()) + " geom" + (feet.size() == 1 ? "" : "s") +
+                   (names.empty() ? "" : " (" + names + ")") +
+                   "; a quadruped stands on 3 or 4 feet: check the stance (tilt " + g6(r.tilt_deg) +
+                   " deg) or name the feet with feet: [...]");
+  }
+  if (feet.size() != 4) fail(file, "the planar models need 4 feet; the robot stands on " + std::to_string(feet.size()));
+
+  // Robot bodies: the root body's tree (not the world, nor other bodies of a scene).
+  auto robotBody = [&](int b) { return b > 0 && m->body_rootid[b] == root; };
+  double M = 0.0, c[3] = {0, 0, 0};
+  for (int b = 1; b < m->nbody; ++b) {
+    if (!robotBody(b)) continue;
+    M += m->body_mass[b];
+    for (int k = 0; k < 3; ++k) c[k] += m->body_mass[b] * d->xipos[3 * b + k];
+  }
+  for (double& x : c) x /= M;
+  double izz = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    if (!robotBody(b)) continue;
+    const double* R = d->ximat + 9 * b;
+    const double* I = m->body_inertia + 3 * b;
+    const double dx = d->xipos[3 * b] - c[0], dy = d->xipos[3 * b + 1] - c[1];
+    izz += R[6] * R[6] * I[0] + R[7] * R[7] * I[1] + R[8] * R[8] * I[2] + m->body_mass[b] * (dx * dx + dy * dy);
+  }
+  r.mujoco_subtreemass_kg = m->body_subtreemass[root];
+  for (int b = 1; b < m->nbody; ++b)
+    if (robotBody(b)) r.mujoco_cinert_izz_kgm2 += d->cinert[10 * b + 2];
+
+  // The planar frame: the mount body's x axis turned by the mount yaw, projected on the floor.
+  const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
+  if (mount < 0) fail(file, "tail mount: no body named '" + spec.mount.body + "'");
+  r.mount_body = mj_id2name(m, mjOBJ_BODY, mount) ? mj_id2name(m, mjOBJ_BODY, mount) : "";
+  const double* Rm = d->xmat + 9 * mount;
+  const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
+  const double ex[2] = {std::cos(psi), std::sin(psi)}, ey[2] = {-std::sin(psi), std::cos(psi)};
+  auto planar = [&](const double* p) {
+    const double dx = p[0] - c[0], dy = p[1] - c[1];
+    return std::array<double, 2>{dx * ex[0] + dy * ex[1], dx * ey[0] + dy * ey[1]};
+  };
+  std::vector<std::array<double, 2>> fp;
+  for (int g : feet) fp.push_back(planar(d->geom_xpos + 3 * g));
+  double mu_sum = 0.0, mx = 0.0, my = 0.0;
+  for (const auto& p : fp) mx += p[0] / 4, my += p[1] / 4;
+  // FL, FR, RR, RL: front = x above the centroid, left = y above it.
+  std::vector<int> order(4, -1);
+  for (int i = 0; i < 4; ++i) {
+    const bool front = fp[i][0] > mx, left = fp[i][1] > my;
+    const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
+    if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
+                                         std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")");
+    order[slot] = i;
+  }
+  for (int s = 0; s < 4; ++s) {
+    const int g = feet[order[s]], b = m->geom_bodyid[g];
+    r.feet.push_back(geomName(g));
+    r.foot_geoms.emplace_back(mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "", g - m->body_geomadr[b]);
+  }
+  const auto& FL = fp[order[0]];
+  const auto& FR = fp[order[1]];
+  const auto& RR = fp[order[2]];
+  const auto& RL = fp[order[3]];
+  QuadrupedParams& q = r.quadruped;
+  q.mass_kg = M;
+  q.izz_kgm2 = izz;
+  q.l_F_m = 0.5 * (FL[0] + FR[0]) - 0.5 * (RL[0] + RR[0]);
+  q.w_F_m = 0.5 * (FL[1] + RL[1]) - 0.5 * (FR[1] + RR[1]);
+  q.d_Q2C_m = mx;
+  r.lateral_com_to_feet_m = my;
+  double footZ = 0.0;
+  for (int g : feet) footZ += lowestZ(m, d, g) / 4;
+  q.com_height_m = c[2] - footZ;
+  double base[3];
+  mju_rotVecMat(base, spec.mount.pos_m.data(), d->xmat + 9 * mount);
+  for (int k = 0; k < 3; ++k) base[k] += d->xpos[3 * mount + k];
+  const auto b = planar(base);
+  q.d_Q2B_m = -b[0];
+  r.lateral_mount_m = b[1];
+  const bool mountGiven = !spec.mount.body.empty() || spec.mount.pos_m != std::array<double, 3>{};
+  if (!mountGiven)
+    r.notes.push_back("no tail mount given: d_Q2B_m is that of the root body's origin (--mount-pos X,Y,Z sets the tail base)");
+  else if (q.d_Q2B_m < 0.0)
+    r.notes.push_back("the tail base is in front of the COM (d_Q2B_m < 0): check the mount (pos_m, yaw_deg)");
+
+  // Friction: the contacts' own (MuJoCo mixes the foot's and the floor's: priority, else the larger).
+  int nmu = 0;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& ct = d->contact[i];
+    if (std::find(feet.begin(), feet.end(), ct.geom1) != feet.end() || std::find(feet.begin(), feet.end(), ct.geom2) != feet.end()) {
+      mu_sum += ct.friction[0];
+      ++nmu;
+    }
+  }
+  std::string muSource;
+  if (spec.mu >= 0.0) {
+    r.mu = spec.mu;
+    r.mu_given = true;
+    muSource = "given (overrides the foot contacts)";
+  } else if (nmu > 0) {
+    r.mu = mu_sum / nmu;
+    muSource = "MuJoCo's foot-floor contacts (friction[0], " + std::to_string(nmu) + " contacts)";
+  } else {
+    r.mu = 0.0;
+    for (int g : feet) r.mu += m->geom_friction[3 * g] / feet.size();
+    muSource = "the foot geoms' friction (no contact after standing)";
+  }
+
+  const std::string stood = " (stance after standing " + g6(spec.settle_s) + " s)";
+  const std::string frame = "planar frame: body '" + r.mount_body + "' x" +
+                            (spec.mount.yaw_rad != 0.0 ? " turned by " + g6(spec.mount.yaw_rad * 180 / kPi) + " deg" : "");
+  r.values = {
+      {"quadruped.mass_kg", q.mass_kg, "kg", "sum of the model's body masses (MuJoCo body_subtreemass of '" + r.root_body + "': " + g6(r.mujoco_subtreemass_kg) + ")"},
+      {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2", "composite I_zz about the COM, legs held" + stood + "; MuJoCo cinert sum " + g6(r.mujoco_cinert_izz_kgm2)},
+      {"quadruped.d_Q2C_m", q.d_Q2C_m, "m", "x of the foot centroid from the COM, " + frame},
+      {"quadruped.d_Q2B_m", q.d_Q2B_m, "m", "tail base (body '" + r.mount_body + "' + pos_m) behind the COM, " + frame},
+      {"quadruped.l_F_m", q.l_F_m, "m", "front feet x - rear feet x (means of each pair)"},
+      {"quadruped.w_F_m", q.w_F_m, "m", "left feet y - right feet y (means of each pair)"},
+      {"quadruped.com_height_m", q.com_height_m, "m", "COM above the feet's lowest points" + stood},
+      {"friction.mu_s = mu_d", r.mu, "-", muSource},
+      {"gravity_mps2", r.gravity_mps2, "m/s^2", "the model's option gravity"},
+  };
+  if (std::abs(r.lateral_com_to_feet_m) > 1e-3)
+    r.notes.push_back("the foot centroid is " + g6(1e3 * r.lateral_com_to_feet_m) +
+                      " mm to the side of the COM; the planar models take 0");
+  if (std::abs(r.lateral_mount_m) > 1e-3)
+    r.notes.push_back("the tail base is " + g6(1e3 * r.lateral_mount_m) + " mm to the side of the COM; the planar models take 0");
+  const double asym = std::abs((FL[0] - RL[0]) - (FR[0] - RR[0]));
+  if (asym > 1e-3) r.notes.push_back("left and right foot spacings differ by " + g6(1e3 * asym) + " mm; l_F_m is their mean");
+  r.notes.push_back("tilt after standing: " + g6(r.tilt_deg) + " deg");
+  if (!messages.text().empty()) r.notes.push_back(messages.text());
+  for (int j = 0; j < m->njnt; ++j) {
+    const int n = m->jnt_type[j] == mjJNT_FREE ? 7 : m->jnt_type[j] == mjJNT_BALL ? 4 : 1;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (!name) continue;
+    r.settled_qpos[name].assign(d->qpos + m->jnt_qposadr[j], d->qpos + m->jnt_qposadr[j] + n);
+    if (m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) {
+      r.hold_target_rad[name] = stance.qpos[m->jnt_qposadr[j]];
+      if (!heldByActuator[j]) r.pd_joints.push_back(name);
+    }
+  }
+  return r;
+}
+
+std::string describeDerivedRobot(const DerivedRobot& r) {
+  std::ostringstream o;
+  o << "robot: " << r.model.source << (r.model.from_urdf ? " (URDF)" : "") << "\n";
+  o << "stance: " << r.stance << "\n";
+  o << "feet (FL, FR, RR, RL): ";
+  for (std::size_t i = 0; i < r.feet.size(); ++i) o << (i ? ", " : "") << r.feet[i];
+  o << "\n\n";
+  std::size_t w = 0;
+  for (const DerivedValue& v : r.values) w = std::max(w, v.key.size());
+  for (const DerivedValue& v : r.values) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%-*s  %-14.9g %-7s ", static_cast<int>(w), v.key.c_str(), v.value, v.unit.c_str());
+    o << line << v.source << "\n";
+  }
+  o << "\n";
+  for (const std::string& n : r.model.notes) o << "note: " << n << "\n";
+  for (const std::string& n : r.notes) o << "note: " << n << "\n";
+  return o.str();
+}
+
+}  // namespace tailsim

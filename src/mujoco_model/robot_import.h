@@ -1,0 +1,106 @@
+// A user's quadruped from its MuJoCo model file (MJCF, or URDF through MuJoCo's own URDF reader):
+// loaded as written, geoms whose mesh or texture file is missing dropped when they cannot collide,
+// stood on the floor in a stance held by the model's own actuators, and the planar models'
+// parameters derived from it (docs/your-robot.md).
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mujoco_model/mujoco_handles.h"
+#include "robot/robot_params.h"
+
+namespace tailsim {
+
+// Where the tail goes: under body `body`, at pos_m in that body's frame. The planar robot frame's
+// forward axis is the mount body's x axis turned by yaw_rad about z (0: the body's x is forward);
+// the straight tail points backward along it.
+struct TailMount {
+  std::string body;                   // "": the robot's root body (the one with the free joint)
+  std::array<double, 3> pos_m{};      // [m]
+  double yaw_rad = 0.0;               // [rad]
+};
+
+// What the user says about the model besides its file.
+struct RobotModelSpec {
+  std::string file;                                // MJCF or URDF (absolute or relative to the working dir)
+  std::string keyframe;                            // "": the model's `home` key when it has one
+  std::map<std::string, double> joint_angles_rad;  // stance by joint name (over the keyframe, or qpos0)
+  std::vector<std::string> feet;                   // foot geom names; empty: those touching the floor
+  double mu = -1.0;                                // < 0: from the foot contacts
+  TailMount mount;
+  double settle_s = 1.0;                           // standing time before the robot is measured [s]
+};
+
+// The user's file as tailsim compiles it: includes inlined, asset folders absolute, missing-file
+// geoms and textures dropped, a floor added when the model has none.
+struct PreparedModel {
+  std::string xml;             // MJCF text
+  std::string source;          // the file it came from (absolute)
+  bool from_urdf = false;
+  int dropped_geoms = 0;       // non-colliding geoms whose mesh file is missing
+  int dropped_textures = 0;    // textures whose file is missing (their materials keep their colour)
+  std::string floor_geom;      // the floor's geom name
+  std::vector<std::string> notes;  // one line each, for the user
+};
+
+// Throws ConfigError-like std::runtime_error (RobotImportError) naming the file, the geom and the
+// missing file when a colliding geom's mesh is missing, or a body whose mass came from a dropped geom.
+PreparedModel prepareRobotModel(const std::string& file);
+
+class RobotImportError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// One derived value, as `tailsim robot` prints it.
+struct DerivedValue {
+  std::string key;     // e.g. "quadruped.izz_kgm2"
+  double value = 0.0;
+  std::string unit;
+  std::string source;  // where it came from
+};
+
+// The robot standing in its stance, and the planar models' parameters derived from it.
+struct DerivedRobot {
+  PreparedModel model;
+  QuadrupedParams quadruped;
+  double mu = 0.0;                      // foot-floor friction (contacts' mu, or the spec's)
+  bool mu_given = false;                // the spec's mu: the articulated run sets it on the feet and floor
+  double gravity_mps2 = 9.81;
+  std::vector<std::string> feet;        // foot geom names, ordered FL, FR, RR, RL (planar frame)
+  std::string root_body, mount_body;
+  std::string stance;                   // how the stance was set, in words
+  double tilt_deg = 0.0;                // root body tilt after settling [deg]
+  double lateral_com_to_feet_m = 0.0;   // y of the foot centroid in the planar frame (the planar models take 0) [m]
+  double lateral_mount_m = 0.0;         // y of the tail base in the planar frame [m]
+  // MuJoCo's own figures, for checking: body_subtreemass of the root body and the z-z entry of the
+  // composite inertia (the sum of d->cinert over the robot's bodies, about their common COM).
+  double mujoco_subtreemass_kg = 0.0;
+  double mujoco_cinert_izz_kgm2 = 0.0;
+  std::vector<DerivedValue> values;
+  std::vector<std::string> notes;
+  // The stood robot, for a model that adds to it (attach_tail.h): qpos by joint name (every joint
+  // is named by prepareRobotModel), the held joints' targets, and the joints held by tailsim's PD.
+  std::map<std::string, std::vector<double>> settled_qpos;
+  std::map<std::string, double> hold_target_rad;
+  std::vector<std::string> pd_joints;
+  // Each foot as (body name, index of the geom among its body's geoms): unnamed geoms found again
+  // in a model with more bodies.
+  std::vector<std::pair<std::string, int>> foot_geoms;
+};
+
+// The PD tailsim adds on a joint that no position actuator of the model holds (qfrc_applied).
+inline constexpr double kStancePdKp = 200.0;  // [N m/rad]
+inline constexpr double kStancePdKv = 5.0;    // [N m s/rad]
+
+// Loads, stands (settle_s with the legs held) and measures the robot. Throws RobotImportError with
+// a message for the user (no stance, not on 3-4 feet, ...), MujocoError when MuJoCo refuses the file.
+DerivedRobot deriveRobot(const RobotModelSpec& spec);
+
+// The table `tailsim robot` prints: every derived value with its unit and source, then the notes.
+std::string describeDerivedRobot(const DerivedRobot& r);
+
+}  // namespace tailsim
