@@ -502,10 +502,10 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
     throw std::invalid_argument("trajectory has " + std::to_string(trajectory.joints.size()) +
                                 " joints but the tail has " + std::to_string(n) + " links");
   if (!(output.sample_dt_s > 0.0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
-  const double duration = output.duration_s > 0.0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  const double duration = output.runEnd(trajectory.endTime());
   if (!(duration >= 0.0) || !std::isfinite(duration)) throw std::invalid_argument("bad simulation duration");
   // Work bounds, checked as doubles before they become counts (no float-to-integer overflow).
-  const double rows = std::floor(duration / output.sample_dt_s + 1e-9) + 1;
+  const double rows = output.rows(duration);
   if (!(rows <= limits::kMaxRowsPerRun))
     throw std::invalid_argument("the run (" + std::to_string(duration) + " s / output.sample_dt_s " +
                                 std::to_string(output.sample_dt_s) + " s) would write more than " +
