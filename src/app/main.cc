@@ -29,7 +29,7 @@
 #include "experiments/settings_schema.h"
 #include "experiments/render_case.h"
 #include "experiments/sharding.h"
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "plotting/ladder.h"
 #include "plotting/accuracy_plot.h"
 #include "plotting/figure_sheet.h"

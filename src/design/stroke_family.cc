@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 namespace tailsim {
 namespace {

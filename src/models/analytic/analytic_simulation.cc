@@ -1,4 +1,4 @@
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 
 #include "results/columns.h"
 
@@ -13,11 +13,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "analytic_model/analytic_model.h"
-#include "analytic_model/analytic_recorder.h"
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/step_control.h"
-#include "analytic_model/support_check.h"
+#include "models/analytic/analytic_model.h"
+#include "models/analytic/analytic_recorder.h"
+#include "models/planar/foot_loads.h"
+#include "models/planar/step_control.h"
+#include "models/planar/support_check.h"
 #include "results/work_limits.h"
 
 namespace tailsim {

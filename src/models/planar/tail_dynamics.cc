@@ -1,4 +1,4 @@
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 #include <cmath>
 #include <stdexcept>

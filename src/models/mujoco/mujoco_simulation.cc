@@ -1,4 +1,4 @@
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 #include "results/columns.h"
 
@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "controllers/tail_controller.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "results/sha256.h"
 #include "results/work_limits.h"
 #include "robot/friction_law.h"

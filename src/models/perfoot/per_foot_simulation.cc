@@ -9,12 +9,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/per_foot_model.h"
-#include "analytic_model/row_columns.h"
-#include "analytic_model/step_control.h"
-#include "analytic_model/stick_slip.h"
-#include "analytic_model/support_check.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/perfoot/per_foot_model.h"
+#include "models/planar/row_columns.h"
+#include "models/planar/step_control.h"
+#include "models/planar/stick_slip.h"
+#include "models/planar/support_check.h"
 #include "results/columns.h"
 #include "results/thin_series.h"
 #include "robot/friction_law.h"
