@@ -1,5 +1,5 @@
 #!/bin/sh
-# Regenerates the models in mjcf/ from the generator (src/mujoco_model/mjcf_generator.cc):
+# Regenerates the models in mjcf/ from the generator (src/models/mujoco/mjcf_generator.cc):
 #   tail_n<N>.xml                    the single-file model tailsim simulates (= a result folder's mjcf/<hash>.xml)
 #   tailsim_n<N>.xml, scene_n<N>.xml the same robot in MuJoCo Menagerie form (mjcf/README.md)
 # for the paper robot with an N = 1..6 link tail. Tests MujocoModel.MjcfFilesAreUpToDate and

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 
 namespace tailsim::testing {
 

@@ -26,11 +26,11 @@
 
 #include <mujoco/mujoco.h>
 
-#include "analytic_model/per_foot_model.h"
+#include "models/perfoot/per_foot_model.h"
 #include "experiments/experiment_loader.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 

@@ -11,7 +11,7 @@
 
 #include "analytic_test_util.h"
 #include "experiments/experiment_runner.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 using namespace tailsim::testing;

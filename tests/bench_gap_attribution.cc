@@ -33,9 +33,9 @@
 #include <string>
 #include <vector>
 
-#include "analytic_model/per_foot_model.h"
+#include "models/perfoot/per_foot_model.h"
 #include "experiments/experiment_loader.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "results/atomic_file.h"
 #include "results/columns.h"
 

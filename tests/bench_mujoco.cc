@@ -9,9 +9,9 @@
 #include <cmath>
 #include <vector>
 
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "../tests/analytic_test_util.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 

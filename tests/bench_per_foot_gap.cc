@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/per_foot_model.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/perfoot/per_foot_model.h"
 #include "analytic_test_util.h"
 #include "experiments/experiment_loader.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 using namespace tailsim::testing;

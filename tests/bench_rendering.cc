@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "rendering/video_renderer.h"
 
 namespace tailsim {

@@ -32,9 +32,9 @@
 #include <string>
 #include <vector>
 
-#include "analytic_model/per_foot_model.h"
-#include "mujoco_model/mujoco_settings.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/perfoot/per_foot_model.h"
+#include "models/mujoco/mujoco_settings.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "random_robots.h"
 
 using namespace tailsim;

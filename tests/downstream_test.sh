@@ -20,7 +20,7 @@ want=$("$bin/tailsim" run "$src/configs/default.yaml" --out "$tmp/ref" --quiet >
 # (1) install + find_package
 cmake --install "$bin" --prefix "$tmp/prefix" >"$tmp/install.log" 2>&1 || fail "cmake --install: $(tail -5 "$tmp/install.log")"
 for f in bin/tailsim lib/cmake/tailsim/tailsimConfig.cmake lib/cmake/tailsim/tailsimConfigVersion.cmake \
-         include/tailsim/analytic_model/analytic_simulation.h include/tailsim/tailsim_version.h \
+         include/tailsim/models/analytic/analytic_simulation.h include/tailsim/tailsim_version.h \
          include/tailsim/controllers/tail_controller.h share/tailsim/robots/paper_quadruped.yaml; do
   [ -e "$tmp/prefix/$f" ] || fail "not installed: $f"
 done

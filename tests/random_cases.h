@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "analytic_model/stick_slip.h"
+#include "models/planar/stick_slip.h"
 #include "analytic_test_util.h"
 
 namespace tailsim::testing {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "analytic_model/analytic_model.h"
+#include "models/analytic/analytic_model.h"
 #include "analytic_test_util.h"
 #include "random_cases.h"
 

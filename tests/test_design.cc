@@ -16,8 +16,8 @@
 #include <regex>
 #include <string>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/tail_dynamics.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/planar/tail_dynamics.h"
 #include "design/optimize_config.h"
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"

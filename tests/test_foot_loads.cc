@@ -3,8 +3,8 @@
 
 #include <algorithm>
 
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/system_loads.h"
+#include "models/planar/foot_loads.h"
+#include "models/planar/system_loads.h"
 #include "analytic_test_util.h"
 
 using namespace tailsim;

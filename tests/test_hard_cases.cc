@@ -7,7 +7,7 @@
 #include <random>
 
 #include "analytic_test_util.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 using namespace tailsim::testing;

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "analytic_model/per_foot_model.h"
+#include "models/perfoot/per_foot_model.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"

@@ -15,8 +15,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "trajectory/split_cycle_profile.h"
 
 using namespace tailsim;

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "analytic_test_util.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 using namespace tailsim::testing;

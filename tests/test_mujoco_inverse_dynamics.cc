@@ -1,14 +1,14 @@
 // Cross-check of the two models' tail dynamics: MuJoCo's inverse dynamics of the generated model
 // (base held still, gravity and contacts off) equals the analytic recursive Newton-Euler tail
-// base load of Eqs. (5)-(8) (analytic_model/tail_dynamics.h) at random tail states.
+// base load of Eqs. (5)-(8) (models/planar/tail_dynamics.h) at random tail states.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "analytic_model/tail_dynamics.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/planar/tail_dynamics.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
 
 using namespace tailsim;
 

@@ -11,8 +11,8 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 using namespace tailsim;
 

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "random_robots.h"
 
 using namespace tailsim;

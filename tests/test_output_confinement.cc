@@ -10,7 +10,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "rendering/ffmpeg_writer.h"
 
 using namespace tailsim;

@@ -10,10 +10,10 @@
 #include <cmath>
 #include <cstdio>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/system_loads.h"
-#include "analytic_model/tail_dynamics.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/planar/foot_loads.h"
+#include "models/planar/system_loads.h"
+#include "models/planar/tail_dynamics.h"
 #include "experiments/experiment_loader.h"
 
 using namespace tailsim;

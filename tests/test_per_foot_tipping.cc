@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "analytic_model/per_foot_model.h"
+#include "models/perfoot/per_foot_model.h"
 #include "analytic_test_util.h"
 #include "random_cases.h"
 

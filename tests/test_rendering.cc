@@ -18,10 +18,10 @@
 #include <thread>
 #include <vector>
 
-#include "mujoco_model/mjcf_generator.h"
-#include "analytic_model/analytic_simulation.h"
-#include "mujoco_model/mujoco_handles.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/mujoco/mujoco_handles.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/replay.h"
 #include "rendering/video_renderer.h"

@@ -12,7 +12,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/robot_compare.h"
-#include "mujoco_model/robot_import.h"
+#include "models/mujoco/robot_import.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;

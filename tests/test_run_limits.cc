@@ -12,7 +12,7 @@
 
 #include "analytic_test_util.h"
 #include "random_cases.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "results/work_limits.h"
 
 namespace tailsim {

@@ -1,6 +1,6 @@
 // The friction and stick/slip event logic of the analytic model on its own (stick_slip.h):
 // sliding friction loads, which DOF switches, and locating a switch inside a step.
-#include "analytic_model/stick_slip.h"
+#include "models/planar/stick_slip.h"
 
 #include <gtest/gtest.h>
 

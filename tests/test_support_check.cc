@@ -5,11 +5,11 @@
 #include <cmath>
 #include <random>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/per_foot_model.h"
-#include "analytic_model/support_check.h"
-#include "analytic_model/system_loads.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/planar/foot_loads.h"
+#include "models/perfoot/per_foot_model.h"
+#include "models/planar/support_check.h"
+#include "models/planar/system_loads.h"
 #include "analytic_test_util.h"
 
 using namespace tailsim;

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "analytic_model/system_loads.h"
+#include "models/planar/system_loads.h"
 #include "analytic_test_util.h"
 
 using namespace tailsim;

@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analytic_model/per_foot_model.h"
+#include "models/perfoot/per_foot_model.h"
 #include "analytic_test_util.h"
 #include "random_cases.h"
 #include "experiments/experiment_loader.h"

@@ -13,7 +13,7 @@
 #include "analytic_test_util.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "plotting/findings.h"
 #include "plotting/plots.h"
 #include "plotting/report.h"

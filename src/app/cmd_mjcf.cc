@@ -8,7 +8,7 @@
 #include "app/commands.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "results/atomic_file.h"
 #include "results/sha256.h"
 

@@ -10,7 +10,7 @@
 #include "app/commands.h"
 #include "experiments/robot_compare.h"
 #include "results/atomic_file.h"
-#include "mujoco_model/robot_import.h"
+#include "models/mujoco/robot_import.h"
 
 namespace tailsim {
 void addRobotCommand(CLI::App& app, int& exit_code) {

@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 #include "design/design_yaml.h"
 #include "experiments/render_case.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
 

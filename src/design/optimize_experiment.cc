@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/per_foot_model.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/perfoot/per_foot_model.h"
 #include "experiments/experiment_loader.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
 

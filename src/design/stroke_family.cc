@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 namespace tailsim {
 namespace {
@@ -88,21 +88,9 @@ std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& jo
 
 void jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& kin,
                   std::vector<double>& tau) {
-  // Eqs. (5)-(7) from the tip to the base, as tailBaseLoad, keeping every joint's moment.
   tailKinematics(links, joints, kin);
-  const TailKinematics& k = kin;
-  const int n = static_cast<int>(links.size());
-  tau.resize(static_cast<std::size_t>(n));
-  Vec2 F_next = Vec2::Zero();
-  double M_next = 0.0;
-  for (int i = n - 1; i >= 0; --i) {
-    const Vec2 F = F_next + links[i].mass_kg * k.a_L[i];
-    double M = M_next + links[i].izz_kgm2 * k.alpha[i] - cross2(k.p_J[i] - k.p_L[i], F);
-    if (i + 1 < n) M += cross2(k.p_J[i + 1] - k.p_L[i], F_next);
-    F_next = F;
-    M_next = M;
-    tau[static_cast<std::size_t>(i)] = M;
-  }
+  tau.resize(links.size());
+  tailBaseLoad(links, kin, kin.a_L, tau.data());
 }
 
 std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints) {

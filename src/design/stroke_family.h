@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 

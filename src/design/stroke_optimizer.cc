@@ -18,7 +18,7 @@
 #include <pagmo/problem.hpp>
 #include <stdexcept>
 
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 #include "results/work_limits.h"
 
 namespace tailsim {

@@ -6,9 +6,9 @@
 #include <functional>
 #include <sstream>
 
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 #include "results/columns.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "results/atomic_file.h"
 #include "results/number_text.h"
 

@@ -10,8 +10,8 @@ TailTrajectory ExperimentCase::trajectory() const {
 }
 
 double ExperimentCase::simDuration() const {
-  if (output.duration_s > 0.0) return output.duration_s;
-  return trajectory().endTime() + output.settle_s;
+  if (output.duration_s > 0.0) return output.duration_s;  // no trajectory to build
+  return output.runEnd(trajectory().endTime());
 }
 
 std::vector<std::string> sectionKeys() {

@@ -9,9 +9,9 @@
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 #include "robot/scene_effects.h"
-#include "analytic_model/analytic_settings.h"
-#include "analytic_model/per_foot_model.h"
-#include "mujoco_model/mujoco_settings.h"
+#include "models/analytic/analytic_settings.h"
+#include "models/perfoot/per_foot_model.h"
+#include "models/mujoco/mujoco_settings.h"
 #include "rendering/render_settings.h"
 #include "results/output_settings.h"
 

@@ -1103,7 +1103,7 @@ OutputSettings readOutput(const Reader& r, const Item& item, double tail_end_s) 
   OutputSettings o;
   const MapView m = readDeclared(r, item, o);
   // The time series needs at least 2 rows (t = 0 and the end); a longer spacing is a mistake.
-  const double t_end = o.duration_s > 0 ? o.duration_s : tail_end_s + o.settle_s;
+  const double t_end = o.runEnd(tail_end_s);
   if (tail_end_s >= 0 && o.sample_dt_s > t_end) {
     const Item* at = m.get("sample_dt_s") ? m.get("sample_dt_s") : m.get("duration_s") ? m.get("duration_s") : &item;
     r.fail(*at, "sample_dt_s = " + formatG(o.sample_dt_s) + " s is longer than the run (" + formatG(t_end) +
@@ -1291,9 +1291,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     } else if constexpr (std::is_same_v<T, OutputSettings>) {
       if (x) v = readOutput(r, *x, c.kind == CaseKind::kSimulate ? c.trajectory().endTime() : -1.0);
     } else if constexpr (std::is_same_v<T, RenderSettings>) {
-      const double run_end = c.kind != CaseKind::kSimulate ? -1.0
-                             : c.output.duration_s > 0     ? c.output.duration_s
-                                                           : c.trajectory().endTime() + c.output.settle_s;
+      const double run_end = c.kind != CaseKind::kSimulate ? -1.0 : c.simDuration();
       if (x) v = readRender(r, *x, run_end);
     } else if (x) {
       readDeclared(r, *x, v);

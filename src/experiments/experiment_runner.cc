@@ -32,7 +32,7 @@
 #include <system_error>
 #include <thread>
 
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 #include "experiments/folder_inputs.h"
 #include "experiments/model_registry.h"
 #include "experiments/render_case.h"
@@ -40,8 +40,8 @@
 #include "experiments/results_table.h"
 #include "experiments/time_series_h5.h"
 #include "experiments/work_estimate.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "results/atomic_file.h"
 #include "results/columns.h"
 #include "results/sha256.h"

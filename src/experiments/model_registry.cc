@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "analytic_model/analytic_recorder.h"
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/per_foot_model.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/analytic/analytic_recorder.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/perfoot/per_foot_model.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "experiments/work_estimate.h"
 #include "results/columns.h"
 #include "results/palette.h"

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "experiments/experiment_config.h"
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 #include "results/time_series.h"
 
 namespace tailsim {

@@ -4,7 +4,7 @@
 
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {

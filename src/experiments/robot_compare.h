@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "experiments/experiment_config.h"
-#include "mujoco_model/attach_tail.h"
-#include "mujoco_model/robot_import.h"
+#include "models/mujoco/attach_tail.h"
+#include "models/mujoco/robot_import.h"
 
 namespace tailsim {
 

@@ -105,7 +105,7 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
   if (c.kind != CaseKind::kSimulate) return w;
   const int n = c.robot.numLinks();
   w.sim_time_s = c.simDuration();
-  w.rows = std::floor(w.sim_time_s / c.output.sample_dt_s) + 1;
+  w.rows = c.output.rows(w.sim_time_s);
   double cols = 0;
   bool shown = false;
   for (const ModelEntry& m : modelRegistry()) {

@@ -10,7 +10,7 @@
 #include <optional>
 #include <sstream>
 
-#include "analytic_model/system_loads.h"
+#include "models/planar/system_loads.h"
 #include "results/columns.h"
 #include "experiments/model_registry.h"
 #include "results/number_text.h"

@@ -12,8 +12,8 @@
 #include <stdexcept>
 
 #include "experiments/model_registry.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "plotting/figure_sheet.h"
 #include "plotting/result_folder.h"
 #include "plotting/result_page_assets.h"

@@ -1,6 +1,6 @@
 #include "rendering/replay.h"
 
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "results/columns.h"
 #include "settings/units.h"
 

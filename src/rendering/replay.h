@@ -57,7 +57,7 @@ bool splitCycleStrokes(const TailTrajectory& traj);
 const char* tailPhaseName(TailPhase p);
 
 // Where the planar state goes in a MuJoCo model's qpos, found by joint name (mj_name2id with the
-// generator's names, src/mujoco_model/mjcf_generator.h), not by assuming an order: the root joint
+// generator's names, src/models/mujoco/mjcf_generator.h), not by assuming an order: the root joint
 // "root" is a free joint (translation on) or a ball joint (translation off; x, y stay fixed);
 // the tail joints "tail_joint<i>" are hinges about z.
 struct MujocoReplayLayout {

@@ -19,9 +19,9 @@
 #include <stdexcept>
 #include <vector>
 
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "results/columns.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/gl_context.h"
 #include "rendering/replay.h"

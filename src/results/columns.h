@@ -47,7 +47,7 @@ inline std::string trackErr(int i) { return "track_err" + std::to_string(i) + "_
 std::vector<std::string> shared(int links);
 
 // MuJoCo's own columns, in order (the planar models' come from their column tables,
-// analytic_model/row_columns.h).
+// models/planar/row_columns.h).
 inline std::vector<std::string> mujocoOnly(int links) {
   std::vector<std::string> c;
   for (int k = 1; k <= 4; ++k) {
@@ -58,7 +58,7 @@ inline std::vector<std::string> mujocoOnly(int links) {
   return c;
 }
 
-// The per-foot model's own (analytic_model/per_foot_model.h): foot k's friction force (world)
+// The per-foot model's own (models/perfoot/per_foot_model.h): foot k's friction force (world)
 // and normal load, k = 1 front-left .. 4 rear-left, and the load factor of the held wrench.
 inline std::string footFx(int k) { return "F" + std::to_string(k) + "x_N"; }
 inline std::string footFy(int k) { return "F" + std::to_string(k) + "y_N"; }

@@ -2,6 +2,8 @@
 // of the sampled rows are kept, and where (docs/experiment-format.md "Time-series output").
 #pragma once
 
+#include <cmath>
+
 #include "settings/fields.h"
 
 namespace tailsim {
@@ -38,6 +40,13 @@ struct OutputSettings {
 
   // Whether the case gets its own folder DIR/cases/<dir>/ (CSV time series kept).
   bool caseFolder() const { return time_series != TimeSeriesOutput::kNone && time_series_file == TimeSeriesFile::kCsv; }
+
+  // The run's length and rows, one rule for every model, the loader and the work estimate: a run
+  // whose tail stops at tail_end_s ends at duration_s, or settle_s after the tail stops; its rows
+  // are the grid 0, dt, 2 dt, ... up to t_end (a sample within 1e-9 dt of t_end counts), as a
+  // double, so that a caller checks it against limits::kMaxRowsPerRun before it becomes a count.
+  double runEnd(double tail_end_s) const { return duration_s > 0.0 ? duration_s : tail_end_s + settle_s; }
+  double rows(double t_end) const { return std::floor(t_end / sample_dt_s + 1e-9) + 1; }
 };
 
 // The YAML/JSON keys of OutputSettings (settings/fields.h), declared once.

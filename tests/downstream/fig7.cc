@@ -1,5 +1,5 @@
 // Downstream use of tailsim::analytic: the paper's Fig. 7 case, built from the parameter structs.
-#include <tailsim/analytic_model/analytic_simulation.h>
+#include <tailsim/models/analytic/analytic_simulation.h>
 
 #include <cmath>
 #include <cstdio>

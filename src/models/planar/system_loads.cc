@@ -1,4 +1,4 @@
-#include "analytic_model/system_loads.h"
+#include "models/planar/system_loads.h"
 
 #include <stdexcept>
 

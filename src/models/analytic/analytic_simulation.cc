@@ -1,4 +1,4 @@
-#include "analytic_model/analytic_simulation.h"
+#include "models/analytic/analytic_simulation.h"
 
 #include "results/columns.h"
 
@@ -13,11 +13,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "analytic_model/analytic_model.h"
-#include "analytic_model/analytic_recorder.h"
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/step_control.h"
-#include "analytic_model/support_check.h"
+#include "models/analytic/analytic_model.h"
+#include "models/analytic/analytic_recorder.h"
+#include "models/planar/foot_loads.h"
+#include "models/planar/step_control.h"
+#include "models/planar/support_check.h"
 #include "results/work_limits.h"
 
 namespace tailsim {
@@ -100,14 +100,14 @@ RunPlan planRun(const TailTrajectory& trajectory, const AnalyticSettings& settin
   if (!(settings.fixed_dt_s > 0)) throw std::invalid_argument("analytic.fixed_dt_s must be > 0");
   if (!(output.sample_dt_s > 0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
   RunPlan plan;
-  const double t_end = output.duration_s > 0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  const double t_end = output.runEnd(trajectory.endTime());
   plan.t_end = t_end;
   if (output.sample_dt_s > t_end)
     throw std::invalid_argument("output.sample_dt_s = " + std::to_string(output.sample_dt_s) +
                                 " s is longer than the run (" + std::to_string(t_end) +
                                 " s): the time series needs at least 2 rows");
   // Checked as a double before it becomes a count (no float-to-integer overflow).
-  const double rows = std::floor(t_end / output.sample_dt_s + 1e-9) + 1;
+  const double rows = output.rows(t_end);
   if (!(rows <= limits::kMaxRowsPerRun))
     throw std::invalid_argument("the run (" + std::to_string(t_end) + " s / output.sample_dt_s " +
                                 std::to_string(output.sample_dt_s) + " s) would write more than " +

@@ -8,7 +8,7 @@
 
 #include <mujoco/mujoco.h>
 
-#include "mujoco_model/mujoco_settings.h"
+#include "models/mujoco/mujoco_settings.h"
 #include "results/output_settings.h"
 #include "results/time_series.h"
 #include "robot/robot_params.h"

@@ -6,8 +6,8 @@
 #include <memory>
 #include <vector>
 
-#include "analytic_model/analytic_model.h"
-#include "analytic_model/row_columns.h"
+#include "models/analytic/analytic_model.h"
+#include "models/planar/row_columns.h"
 #include "results/thin_series.h"
 #include "results/time_series.h"
 

@@ -1,4 +1,4 @@
-#include "analytic_model/analytic_recorder.h"
+#include "models/analytic/analytic_recorder.h"
 
 #include <cmath>
 #include <limits>

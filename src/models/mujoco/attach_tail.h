@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_model/mujoco_settings.h"
-#include "mujoco_model/robot_import.h"
+#include "models/mujoco/mujoco_settings.h"
+#include "models/mujoco/robot_import.h"
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_model/mujoco_settings.h"
+#include "models/mujoco/mujoco_settings.h"
 #include "robot/robot_params.h"
 #include "robot/scene_effects.h"
 

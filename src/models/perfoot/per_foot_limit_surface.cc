@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "analytic_model/per_foot_model.h"
+#include "models/perfoot/per_foot_model.h"
 
 namespace tailsim {
 

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 namespace tailsim {
 

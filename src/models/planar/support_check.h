@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 namespace tailsim {
 

@@ -1,4 +1,4 @@
-#include "analytic_model/foot_loads.h"
+#include "models/planar/foot_loads.h"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // tail state only, not on x, y or phi: the paper's model is body-frame invariant.
 #pragma once
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 namespace tailsim {
 

@@ -55,8 +55,11 @@ struct TailLoad {
 // Recursive Newton-Euler from link n to link 1 (Eqs. 5-7).
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin);
 // The same with the link COM accelerations a_L given (e.g. kin.a_L_acc: the load of the joint
-// accelerations alone); positions and angular accelerations from kin.
-TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin, const std::vector<Vec2>& a_L);
+// accelerations alone); positions and angular accelerations from kin. With `joint_moments` (one
+// value per link), also every joint's moment M_J,i: the torque joint i's motor gives, the tail
+// base held still (the one recursion of the tail's loads).
+TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& kin, const std::vector<Vec2>& a_L,
+                      double* joint_moments = nullptr);
 TailLoad tailBaseLoad(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
 
 // Distance from the tail base to link i's COM (used for the Sec. 4.7 check).

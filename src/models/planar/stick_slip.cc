@@ -1,4 +1,4 @@
-#include "analytic_model/stick_slip.h"
+#include "models/planar/stick_slip.h"
 
 #include <algorithm>
 #include <cmath>

@@ -9,9 +9,9 @@
 #include <limits>
 #include <vector>
 
-#include "analytic_model/analytic_settings.h"
-#include "analytic_model/stick_slip.h"
-#include "analytic_model/system_loads.h"
+#include "models/analytic/analytic_settings.h"
+#include "models/planar/stick_slip.h"
+#include "models/planar/system_loads.h"
 #include "robot/scene_effects.h"
 #include "trajectory/split_cycle_profile.h"
 

@@ -1,4 +1,4 @@
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -60,7 +60,8 @@ TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& 
   return tailBaseLoad(links, k, k.a_L);
 }
 
-TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& k, const std::vector<Vec2>& a_L) {
+TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& k, const std::vector<Vec2>& a_L,
+                      double* joint_moments) {
   const int n = static_cast<int>(links.size());
   Vec2 F_next = Vec2::Zero();  // F_J,i+1
   double M_next = 0.0;         // M_J,i+1
@@ -71,6 +72,7 @@ TailLoad tailBaseLoad(const std::vector<TailLink>& links, const TailKinematics& 
     if (i + 1 < n) M += cross2(k.p_J[i + 1] - k.p_L[i], F_next);
     F_next = F;
     M_next = M;
+    if (joint_moments) joint_moments[i] = M;
   }
   TailLoad load;
   load.F_J1_B = F_next;

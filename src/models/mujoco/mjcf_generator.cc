@@ -1,4 +1,4 @@
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 
 #include <tinyxml2.h>
 

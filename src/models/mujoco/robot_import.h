@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "robot/robot_params.h"
 
 namespace tailsim {

@@ -5,10 +5,10 @@
 
 #include <vector>
 
-#include "analytic_model/analytic_settings.h"
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/stick_slip.h"  // breakawayCoefficient
-#include "analytic_model/system_loads.h"
+#include "models/analytic/analytic_settings.h"
+#include "models/planar/foot_loads.h"
+#include "models/planar/stick_slip.h"  // breakawayCoefficient
+#include "models/planar/system_loads.h"
 #include "results/output_settings.h"
 #include "results/time_series.h"
 #include "robot/scene_effects.h"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "analytic_model/foot_loads.h"
+#include "models/planar/foot_loads.h"
 #include "results/output_settings.h"
 #include "results/time_series.h"
 #include "results/work_limits.h"

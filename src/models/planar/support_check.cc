@@ -1,4 +1,4 @@
-#include "analytic_model/support_check.h"
+#include "models/planar/support_check.h"
 
 #include <algorithm>
 #include <array>
@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "analytic_model/foot_loads.h"
-#include "analytic_model/system_loads.h"
+#include "models/planar/foot_loads.h"
+#include "models/planar/system_loads.h"
 
 namespace tailsim {
 namespace {

@@ -1,4 +1,4 @@
-#include "mujoco_model/mujoco_simulation.h"
+#include "models/mujoco/mujoco_simulation.h"
 
 #include "results/columns.h"
 
@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "controllers/tail_controller.h"
-#include "mujoco_model/mjcf_generator.h"
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/mujoco_handles.h"
 #include "results/sha256.h"
 #include "results/work_limits.h"
 #include "robot/friction_law.h"
@@ -494,18 +494,25 @@ long MujocoSettleCache::settleSteps() const {
   return impl_->settle_steps;
 }
 
-RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
-                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
-                         MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
+namespace {
+
+// The run's length and rows, checked before any work (std::invalid_argument).
+struct MujocoPlan {
+  double duration = 0;  // simulated seconds after the pre-roll
+  long rows = 0;        // output rows
+};
+
+MujocoPlan planMujocoRun(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+                         const OutputSettings& output) {
   const int n = robot.numLinks();
   if (static_cast<int>(trajectory.joints.size()) != n)
     throw std::invalid_argument("trajectory has " + std::to_string(trajectory.joints.size()) +
                                 " joints but the tail has " + std::to_string(n) + " links");
   if (!(output.sample_dt_s > 0.0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
-  const double duration = output.duration_s > 0.0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  const double duration = output.runEnd(trajectory.endTime());
   if (!(duration >= 0.0) || !std::isfinite(duration)) throw std::invalid_argument("bad simulation duration");
   // Work bounds, checked as doubles before they become counts (no float-to-integer overflow).
-  const double rows = std::floor(duration / output.sample_dt_s + 1e-9) + 1;
+  const double rows = output.rows(duration);
   if (!(rows <= limits::kMaxRowsPerRun))
     throw std::invalid_argument("the run (" + std::to_string(duration) + " s / output.sample_dt_s " +
                                 std::to_string(output.sample_dt_s) + " s) would write more than " +
@@ -516,276 +523,348 @@ RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& traject
                                 std::to_string(settings.settle_s) + " s + " + std::to_string(duration) +
                                 " s) / timestep_s " + std::to_string(settings.timestep_s) + " s), more than " +
                                 std::to_string(static_cast<long>(limits::kMaxMujocoSteps)));
+  return {duration, static_cast<long>(rows)};
+}
 
-  const std::string xml = generateMjcf(robot, settings, effects);  // validates robot + settings
-  const MujocoMessages messages;  // MuJoCo's warnings go into this run's error text, not MUJOCO_LOG.TXT
-  ModelPtr model = loadModelFromXml(xml);
-  mjModel* m = model.get();
-  DataPtr data = makeData(m);
-  mjData* d = data.get();
-  const Layout L = makeLayout(m, n, effects.translation);
-  const ServoGains gains = tailServoGains(robot, settings);
-  const bool continuous = effects.friction == FrictionLaw::kContinuous && effects.ground_contact;
-  const bool rk4 = settings.integrator == MujocoIntegrator::kRK4;
+// One MuJoCo run, in named stages in the manner of mj_forward: build (the constructor: MJCF,
+// model, data, columns, start pose), settle (the pre-roll or its cached end state), stepLoop (the
+// steps, with the output rows sampled on the grid as it passes, sampleRows), judge (the summary
+// and the warnings of a doubtful result). The stages share the run's state below.
+class MujocoRun {
+ public:
+  MujocoRun(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+            const Effects& effects, const OutputSettings& output, const MujocoPlan& plan)
+      : robot_(robot),
+        settings_(settings),
+        effects_(effects),
+        output_(output),
+        plan_(plan),
+        n_(robot.numLinks()),
+        xml_(generateMjcf(robot, settings, effects)),  // validates robot + settings
+        model_(loadModelFromXml(xml_)),
+        m_(model_.get()),
+        data_(makeData(m_)),
+        d_(data_.get()),
+        L_(makeLayout(m_, n_, effects.translation)),
+        gains_(tailServoGains(robot, settings)),
+        continuous_(effects.friction == FrictionLaw::kContinuous && effects.ground_contact),
+        rk4_(settings.integrator == MujocoIntegrator::kRK4),
+        sum_(result_.summary),
+        ts_(result_.series),
+        cols_(makeColumns(ts_, n_)),
+        row_(ts_.numColumns(), 0.0),
+        ctrl_(m_, trajectory, L_.tail_qposadr, L_.tail_dofadr, L_.tail_act,
+              {settings.velocity_feedforward, settings.inverse_dynamics_feedforward}),
+        qvel_s_(m_->nv),
+        qacc_s_(m_->nv),
+        standing_(settings, effects, L_.quad_body),
+        weight_N_(mj_getTotalmass(m_) * robot.gravity_mps2) {
+    sum_.model = "mujoco";
+    // Initial state: home keyframe, tail at theta(0), then settle on the feet.
+    mj_resetDataKeyframe(m_, d_, mj_name2id(m_, mjOBJ_KEY, mjcf::kHomeKey));
+    trajectory.evaluate(0.0, ref0_);
+    for (int i = 0; i < n_; ++i) d_->qpos[L_.tail_qposadr[i]] = ref0_[i].theta;
+    mj_forward(m_, d_);
+  }
 
-  RunResult result;
-  RunSummary& sum = result.summary;
-  sum.model = "mujoco";
-  TimeSeries& ts = result.series;
-  const Columns cols = makeColumns(ts, n);
-  std::vector<double> row(ts.numColumns(), 0.0);
+  // Pre-roll (or its cached end state): the quadruped settles on its feet, the tail held at
+  // theta(0). False: the run failed while settling.
+  bool settle(MujocoSettleCache* settle_cache) {
+    const std::string key =
+        settle_cache ? settleKey(xml_, settings_, effects_, robot_.friction, ref0_) : std::string();
+    const std::shared_ptr<const SettledState> cached = settle_cache ? settle_cache->impl().find(key) : nullptr;
+    if (cached) {
+      restoreSettled(*cached, m_, d_, standing_);
+    } else {
+      long settle_steps = 0;
+      while (d_->time < settings_.settle_s - 0.5 * settings_.timestep_s && sum_.ok) {
+        const double t_state = d_->time - settings_.settle_s;
+        step(0.0, false, nullptr);
+        ++settle_steps;
+        if (warningCount(d_) > 0)
+          fail(instabilityMessage(d_, d_->time - settings_.settle_s, settings_, gains_) + " (settling)");
+        else if (!standing_.update(d_, t_state))
+          fail(standing_.why() + " (while settling with the tail held at theta(0))");
+      }
+      if (settle_cache) settle_cache->impl().miss(settle_steps);
+      if (!sum_.ok) return false;
+      d_->time = 0.0;
+      for (int v = 0; v < m_->nv; ++v) d_->qvel[v] = 0.0;
+      if (settle_cache && messages_.text().empty()) settle_cache->impl().keep(key, saveSettled(m_, d_, standing_));
+    }
+    mj_forward(m_, d_);
+    return true;
+  }
 
-  // Initial state: home keyframe, tail at theta(0), then settle on the feet.
-  mj_resetDataKeyframe(m, d, mj_name2id(m, mjOBJ_KEY, mjcf::kHomeKey));
-  std::vector<JointState> ref0;
-  trajectory.evaluate(0.0, ref0);
-  for (int i = 0; i < n; ++i) d->qpos[L.tail_qposadr[i]] = ref0[i].theta;
-  TailController ctrl(m, trajectory, L.tail_qposadr, L.tail_dofadr, L.tail_act,
-                      {settings.velocity_feedforward, settings.inverse_dynamics_feedforward});
-  mj_forward(m, d);
+  // The run from t = 0 to its end. Row k is the state at the start of the first step with
+  // t >= t_k (exact when the timestep divides sample_dt; otherwise up to one timestep late,
+  // labelled t_k).
+  void stepLoop(const MujocoSampleObserver& observer, const MujocoTrajectoryHook& hook) {
+    const double h = settings_.timestep_s;
+    const double eps = 1e-6 * h;
+    const double duration = plan_.duration;
+    long k = 0;
+    std::vector<mjtNum> qpos_t(m_->nq), qvel_t(m_->nv), qacc_t(m_->nv);
+    ImpulseAverager averager(output_.sample_dt_s, h, plan_.rows, cols_, ts_);
+    phi_ = yaw_prev_ = phi0_ = yawOf(d_, L_.quad_body);
+    const auto wall0 = std::chrono::steady_clock::now();
+    // Runs to the end of the simulated time even when the output grid ends earlier (a spacing that
+    // does not divide the duration): the summary is the state at the end, not the last row.
+    while (k < plan_.rows || d_->time < duration - eps) {
+      const double t = d_->time;
+      const bool sample = k < plan_.rows && t >= k * output_.sample_dt_s - eps;
+      const bool averaged = t < duration - eps;  // the step lies inside the run: its impulse counts
+      if (sample) {
+        if (observer) observer(k * output_.sample_dt_s, m_, d_);
+        if (hook) {
+          mj_kinematics(m_, d_);  // xmat of this state (the yaw so far is one step old)
+          const double phi_now = phi_ + wrapPi(yawOf(d_, L_.quad_body) - yaw_prev_);
+          TailTrajectory next = ctrl_.trajectory();
+          if (hook(k * output_.sample_dt_s, phi_now - phi0_, m_, d_, next)) ctrl_.setTrajectory(std::move(next));
+        }
+        std::copy(d_->qpos, d_->qpos + m_->nq, qpos_t.begin());
+        std::copy(d_->qvel, d_->qvel + m_->nv, qvel_t.begin());
+      }
+      if (rk4_ && sample) {
+        // RK4 overwrites the intermediate fields: evaluate the sample state first.
+        if (continuous_) updateFootFriction(m_, d_, L_, robot_.friction);
+        mj_forward(m_, d_);
+        ctrl_.apply(m_, d_, t, true);
+        const double yaw = yawOf(d_, L_.quad_body);
+        phi_ += wrapPi(yaw - yaw_prev_);
+        yaw_prev_ = yaw;
+        std::copy(d_->qacc, d_->qacc + m_->nv, qacc_t.begin());
+        loads_ = computeLoads(m_, d_, L_, qvel_t, qacc_t, scratch_);
+        sampleRows(k, t, eps, qpos_t, qvel_t, qacc_t, averager);
+        mj_step(m_, d_);
+      } else if (rk4_) {
+        step(t, true, &loads_);
+      } else {
+        std::copy(d_->qvel, d_->qvel + m_->nv, qvel_s_.begin());
+        step(t, true, nullptr);
+      }
+      ++steps_;
+      if (steps_ > settings_.max_steps) {
+        fail("step budget of " + std::to_string(settings_.max_steps) +
+             " MuJoCo steps exhausted at t=" + std::to_string(t) + " s (docs/experiment-format.md \"Limits\")");
+        break;
+      }
+      if (warningCount(d_) > 0 || !std::isfinite(d_->qacc[L_.root_dofadr]) || !std::isfinite(ctrl_.lastError(0))) {
+        fail(instabilityMessage(d_, t, settings_, gains_));
+        break;
+      }
+      if (!standing_.update(d_, t)) {
+        fellOver(t);
+        break;
+      }
+      if (!rk4_) {  // unwrapped every step, so a coarse output grid cannot alias a fast spin
+        const double yaw = yawOf(d_, L_.quad_body);  // xmat of time t
+        phi_ += wrapPi(yaw - yaw_prev_);
+        yaw_prev_ = yaw;
+        // The acceleration the integrator applied (implicit: (M - h D)^-1 f, not d->qacc's explicit one).
+        for (int v = 0; v < m_->nv; ++v) qacc_s_[v] = (d_->qvel[v] - qvel_s_[v]) / h;
+        loads_ = computeLoads(m_, d_, L_, qvel_s_, qacc_s_, scratch_);
+      }
+      if (sample && !rk4_) sampleRows(k, t, eps, qpos_t, qvel_s_, qacc_s_, averager);
+      if (averaged) {
+        averager.addStep(t, loads_);
+        peak_normal_N_ =
+            std::max(peak_normal_N_, loads_[kFn1] + loads_[kFn1 + 1] + loads_[kFn1 + 2] + loads_[kFn1 + 3]);
+      }
+    }
+    averager.finish();
+    sum_.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    sum_.solver_steps = steps_;
+  }
 
-  auto fail = [&](const std::string& why) {
-    sum.ok = false;
-    sum.error = why + (messages.text().empty() ? "" : " [" + messages.text() + "]");
-  };
-  std::vector<mjtNum> qvel_s(m->nv), qacc_s(m->nv), scratch;
-  Loads loads{};
+  // The summary of the run that ended, and the warnings of a result that is computed but doubtful.
+  RunResult judge() {
+    mj_kinematics(m_, d_);  // xmat of the final state
+    phi_ += wrapPi(yawOf(d_, L_.quad_body) - yaw_prev_);
+    sum_.phi_net_deg = (phi_ - phi0_) * kRad2Deg;
+    sum_.extra["final_x_m"] = d_->xpos[3 * L_.quad_body];  // as the x_m, y_m columns: the quadruped COM
+    sum_.extra["final_y_m"] = d_->xpos[3 * L_.quad_body + 1];
+    const std::vector<double>& tcol = ts_.values(cols_.t);
+    const std::vector<double>& pd = ts_.values(cols_.phidot);
+    const double thr = settings_.stop_phidot_radps * kRad2Deg;
+    sum_.t_stop_s = 0.0;
+    for (size_t r = pd.size(); r-- > 0;) {
+      if (std::abs(pd[r]) >= thr) {
+        sum_.t_stop_s = r + 1 < pd.size() ? tcol[r + 1] : tcol[r];
+        break;
+      }
+    }
+    const TrackingStats st = ctrl_.stats();
+    for (int i = 0; i < n_; ++i) {
+      sum_.extra["tracking_max_deg_j" + std::to_string(i + 1)] = st.max_abs_rad[i] * kRad2Deg;
+      sum_.extra["tracking_rms_deg_j" + std::to_string(i + 1)] = st.rms_rad[i] * kRad2Deg;
+    }
+    sum_.extra["mujoco_warnings"] = warningCount(d_);
+    sum_.extra["kp_j1"] = gains_.kp[0];
+    standing_.report(sum_.extra);
+    reportContact();
+    // Contact fidelity (docs/mujoco-model.md "Contact fidelity"): feet that leave the ground while the
+    // body slides, and impulsive normal forces, mean MuJoCo's soft contact, not Coulomb friction,
+    // shaped the result.
+    if (standing_.enforced() && sum_.ok) {
+      const double airborne = sum_.extra["airborne_fraction"], peak = sum_.extra["peak_normal_force_over_mg"];
+      std::ostringstream os;
+      os.precision(3);
+      if (airborne > limits::kMaxAirborneFraction)
+        os << "all four feet carry no load in " << 100.0 * airborne << " % of the steps (limit "
+           << 100.0 * limits::kMaxAirborneFraction << " %): MuJoCo's soft contact chatters while the body slides";
+      if (peak > limits::kMaxPeakNormalForceOverMg)
+        os << (os.str().empty() ? "" : "; ") << "the summed foot normal force peaks at " << peak
+           << " m g (limit " << limits::kMaxPeakNormalForceOverMg << " m g): impulsive contact";
+      if (!os.str().empty()) {
+        os << "; phi_net depends on the contact softness (mujoco.solref), see docs/mujoco-model.md \"Contact fidelity\"";
+        sum_.warnings.push_back(os.str());
+      }
+    }
+    // At rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
+    {
+      mjtNum v6[6];
+      mj_objectVelocity(m_, d_, mjOBJ_BODY, L_.quad_body, v6, 0);  // (angular, linear), world axes
+      const double phidot_dps = std::abs(v6[2]) * kRad2Deg, speed = std::hypot(v6[3], v6[4]);
+      sum_.extra["final_phidot_dps"] = v6[2] * kRad2Deg;
+      sum_.extra["final_speed_mps"] = speed;
+      sum_.at_rest = phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps;
+      if (!sum_.at_rest && sum_.ok) {
+        std::ostringstream os;
+        os.precision(4);
+        os << "the body is still moving when the run ends at t = " << plan_.duration << " s (|phi_dot| " << phidot_dps
+           << " deg/s, speed " << speed << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
+           << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
+        sum_.warnings.push_back(os.str());
+      }
+    }
+    // The servo follows the reference only as well as the step allows (a coarse timestep_s lowers
+    // the gains: kp ~ (servo_wn_dt / timestep_s)^2): a large tracking error means a different motion.
+    double worst = 0.0;
+    int worst_j = 0;
+    for (int i = 0; i < n_; ++i)
+      if (st.max_abs_rad[i] * kRad2Deg > worst) worst = st.max_abs_rad[i] * kRad2Deg, worst_j = i + 1;
+    if (worst > limits::kMaxTrackingErrorDeg && sum_.ok) {
+      std::ostringstream os;
+      os.precision(3);
+      os << "the tail servo is off its reference by up to " << worst << " deg (joint " << worst_j << "; limit "
+         << limits::kMaxTrackingErrorDeg << " deg): the simulated tail motion differs from the trajectory, "
+         << "lower mujoco.timestep_s (" << settings_.timestep_s << " s)";
+      sum_.warnings.push_back(os.str());
+    }
+    if (!sum_.ok) sum_.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+    return result_;
+  }
+
+  // The result of a run that failed while settling.
+  RunResult failed() {
+    sum_.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+    standing_.report(sum_.extra);
+    reportContact();
+    sum_.extra["mujoco_warnings"] = warningCount(d_);
+    return result_;
+  }
+
+ private:
   // One step. RK4 with `rk4_loads`: also the loads of the state the step starts from (RK4 overwrites
   // the intermediate fields, so they are taken before it; the step's impulse is then h times them).
-  auto step = [&](double t_ref, bool record, Loads* rk4_loads) {
-    if (continuous) updateFootFriction(m, d, L, robot.friction);
-    if (rk4) {
-      mj_forward(m, d);  // M, bias at this state for the feed-forward; ctrl is held over the RK4 step
-      ctrl.apply(m, d, t_ref, record);
+  void step(double t_ref, bool record, Loads* rk4_loads) {
+    if (continuous_) updateFootFriction(m_, d_, L_, robot_.friction);
+    if (rk4_) {
+      mj_forward(m_, d_);  // M, bias at this state for the feed-forward; ctrl is held over the RK4 step
+      ctrl_.apply(m_, d_, t_ref, record);
       if (rk4_loads) {
-        std::copy(d->qvel, d->qvel + m->nv, qvel_s.begin());
-        std::copy(d->qacc, d->qacc + m->nv, qacc_s.begin());
-        *rk4_loads = computeLoads(m, d, L, qvel_s, qacc_s, scratch);
+        std::copy(d_->qvel, d_->qvel + m_->nv, qvel_s_.begin());
+        std::copy(d_->qacc, d_->qacc + m_->nv, qacc_s_.begin());
+        *rk4_loads = computeLoads(m_, d_, L_, qvel_s_, qacc_s_, scratch_);
       }
-      mj_step(m, d);
+      mj_step(m_, d_);
     } else {
-      mj_step1(m, d);
-      ctrl.apply(m, d, t_ref, record);
-      mj_step2(m, d);
+      mj_step1(m_, d_);
+      ctrl_.apply(m_, d_, t_ref, record);
+      mj_step2(m_, d_);
     }
-  };
+  }
 
-  StandingMonitor standing(settings, effects, L.quad_body);
+  // The rows of the grid times the step starting at t reaches (the state sampled before it).
+  void sampleRows(long& k, double t, double eps, const std::vector<mjtNum>& qpos, const std::vector<mjtNum>& qvel,
+                  const std::vector<mjtNum>& qacc, ImpulseAverager& averager) {
+    while (k < plan_.rows && t >= k * output_.sample_dt_s - eps) {
+      fillRow(m_, d_, L_, cols_, ctrl_, qpos, qvel, qacc, loads_, k * output_.sample_dt_s, phi_, row_);
+      averager.addRow(k, row_);
+      ++k;
+    }
+  }
+
+  // The body tipped past max_tilt_deg at t. A diverging integration (timestep too large for the
+  // servo gains) also throws the body over, usually a few steps before MuJoCo's own warning. Look
+  // 0.05 s further: if MuJoCo then warns, the cause is the step, not the robot's balance.
+  void fellOver(double t) {
+    const long look = std::max(1L, std::lround(0.05 / settings_.timestep_s));
+    bool unstable = false;
+    double t_bad = t;
+    for (long i = 0; i < look && !unstable; ++i) {
+      mj_step(m_, d_);  // (MuJoCo resets d, time included, when it finds a bad acceleration)
+      t_bad += settings_.timestep_s;
+      unstable = warningCount(d_) > 0 || !std::isfinite(d_->qacc[L_.root_dofadr]);
+    }
+    std::ostringstream tilt;
+    tilt << " (the body had tilted past max_tilt_deg at t=" << t << " s as it diverged)";
+    fail(unstable ? instabilityMessage(d_, t_bad, settings_, gains_) + tilt.str() : standing_.why());
+  }
+
+  void fail(const std::string& why) {
+    sum_.ok = false;
+    sum_.error = why + (messages_.text().empty() ? "" : " [" + messages_.text() + "]");
+  }
+
   // Peak of the summed foot normal force over the run's steps (each step's force, not the 1 ms
   // averages), in units of the robot's weight m g (m = every body, g = robot.gravity_mps2).
-  const double weight_N = mj_getTotalmass(m) * robot.gravity_mps2;
-  double peak_normal_N = 0.0;
-  auto reportContact = [&]() {
-    sum.extra["peak_normal_force_over_mg"] = weight_N > 0.0 ? peak_normal_N / weight_N : 0.0;
-  };
-  auto failed = [&]() {  // the run's result when it fails
-    sum.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
-    standing.report(sum.extra);
-    reportContact();
-    sum.extra["mujoco_warnings"] = warningCount(d);
-    return result;
-  };
-  // Pre-roll (or its cached end state): the quadruped settles on its feet, the tail held at theta(0).
-  const std::string key = settle_cache ? settleKey(xml, settings, effects, robot.friction, ref0) : std::string();
-  const std::shared_ptr<const SettledState> cached = settle_cache ? settle_cache->impl().find(key) : nullptr;
-  if (cached) {
-    restoreSettled(*cached, m, d, standing);
-  } else {
-    long settle_steps = 0;
-    while (d->time < settings.settle_s - 0.5 * settings.timestep_s && sum.ok) {
-      const double t_state = d->time - settings.settle_s;
-      step(0.0, false, nullptr);
-      ++settle_steps;
-      if (warningCount(d) > 0) fail(instabilityMessage(d, d->time - settings.settle_s, settings, gains) + " (settling)");
-      else if (!standing.update(d, t_state)) fail(standing.why() + " (while settling with the tail held at theta(0))");
-    }
-    if (settle_cache) settle_cache->impl().miss(settle_steps);
-    if (!sum.ok) return failed();
-    d->time = 0.0;
-    for (int v = 0; v < m->nv; ++v) d->qvel[v] = 0.0;
-    if (settle_cache && messages.text().empty()) settle_cache->impl().keep(key, saveSettled(m, d, standing));
+  void reportContact() {
+    sum_.extra["peak_normal_force_over_mg"] = weight_N_ > 0.0 ? peak_normal_N_ / weight_N_ : 0.0;
   }
-  mj_forward(m, d);
 
-  // Main loop. Row k is the state at the start of the first step with t >= t_k (exact when the
-  // timestep divides sample_dt; otherwise up to one timestep late, labelled t_k).
-  const double h = settings.timestep_s;
-  const long num_samples = static_cast<long>(rows);
-  const double eps = 1e-6 * h;
-  long k = 0;
-  std::vector<mjtNum> qpos_t(m->nq), qvel_t(m->nv), qacc_t(m->nv);
-  ImpulseAverager averager(output.sample_dt_s, h, num_samples, cols, ts);
-  double phi = yawOf(d, L.quad_body), yaw_prev = phi, phi0 = phi;
-  long steps = 0;
-  const auto wall0 = std::chrono::steady_clock::now();
-  // Runs to the end of the simulated time even when the output grid ends earlier (a spacing that
-  // does not divide the duration): the summary is the state at the end, not the last row.
-  while (k < num_samples || d->time < duration - eps) {
-    const double t = d->time;
-    const bool sample = k < num_samples && t >= k * output.sample_dt_s - eps;
-    const bool averaged = t < duration - eps;  // the step lies inside the run: its impulse counts
-    if (sample) {
-      if (observer) observer(k * output.sample_dt_s, m, d);
-      if (hook) {
-        mj_kinematics(m, d);  // xmat of this state (the yaw so far is one step old)
-        const double phi_now = phi + wrapPi(yawOf(d, L.quad_body) - yaw_prev);
-        TailTrajectory next = ctrl.trajectory();
-        if (hook(k * output.sample_dt_s, phi_now - phi0, m, d, next)) ctrl.setTrajectory(std::move(next));
-      }
-      std::copy(d->qpos, d->qpos + m->nq, qpos_t.begin());
-      std::copy(d->qvel, d->qvel + m->nv, qvel_t.begin());
-    }
-    if (rk4 && sample) {
-      // RK4 overwrites the intermediate fields: evaluate the sample state first.
-      if (continuous) updateFootFriction(m, d, L, robot.friction);
-      mj_forward(m, d);
-      ctrl.apply(m, d, t, true);
-      const double yaw = yawOf(d, L.quad_body);
-      phi += wrapPi(yaw - yaw_prev);
-      yaw_prev = yaw;
-      std::copy(d->qacc, d->qacc + m->nv, qacc_t.begin());
-      loads = computeLoads(m, d, L, qvel_t, qacc_t, scratch);
-      while (k < num_samples && t >= k * output.sample_dt_s - eps) {
-        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_t, qacc_t, loads, k * output.sample_dt_s, phi, row);
-        averager.addRow(k, row);
-        ++k;
-      }
-      mj_step(m, d);
-    } else if (rk4) {
-      step(t, true, &loads);
-    } else {
-      std::copy(d->qvel, d->qvel + m->nv, qvel_s.begin());
-      step(t, true, nullptr);
-    }
-    ++steps;
-    if (steps > settings.max_steps) {
-      fail("step budget of " + std::to_string(settings.max_steps) +
-           " MuJoCo steps exhausted at t=" + std::to_string(t) + " s (docs/experiment-format.md \"Limits\")");
-      break;
-    }
-    if (warningCount(d) > 0 || !std::isfinite(d->qacc[L.root_dofadr]) || !std::isfinite(ctrl.lastError(0))) {
-      fail(instabilityMessage(d, t, settings, gains));
-      break;
-    }
-    if (!standing.update(d, t)) {
-      // A diverging integration (timestep too large for the servo gains) also throws the body
-      // over, usually a few steps before MuJoCo's own warning. Look 0.05 s further: if MuJoCo then
-      // warns, the cause is the step, not the robot's balance.
-      const long look = std::max(1L, std::lround(0.05 / h));
-      bool unstable = false;
-      double t_bad = t;
-      for (long i = 0; i < look && !unstable; ++i) {
-        mj_step(m, d);  // (MuJoCo resets d, time included, when it finds a bad acceleration)
-        t_bad += h;
-        unstable = warningCount(d) > 0 || !std::isfinite(d->qacc[L.root_dofadr]);
-      }
-      std::ostringstream tilt;
-      tilt << " (the body had tilted past max_tilt_deg at t=" << t << " s as it diverged)";
-      fail(unstable ? instabilityMessage(d, t_bad, settings, gains) + tilt.str() : standing.why());
-      break;
-    }
-    if (!rk4) {  // unwrapped every step, so a coarse output grid cannot alias a fast spin
-      const double yaw = yawOf(d, L.quad_body);  // xmat of time t
-      phi += wrapPi(yaw - yaw_prev);
-      yaw_prev = yaw;
-    }
-    if (!rk4) {
-      // The acceleration the integrator applied (implicit: (M - h D)^-1 f, not d->qacc's explicit one).
-      for (int v = 0; v < m->nv; ++v) qacc_s[v] = (d->qvel[v] - qvel_s[v]) / h;
-      loads = computeLoads(m, d, L, qvel_s, qacc_s, scratch);
-    }
-    if (sample && !rk4) {
-      while (k < num_samples && t >= k * output.sample_dt_s - eps) {
-        fillRow(m, d, L, cols, ctrl, qpos_t, qvel_s, qacc_s, loads, k * output.sample_dt_s, phi, row);
-        averager.addRow(k, row);
-        ++k;
-      }
-    }
-    if (averaged) {
-      averager.addStep(t, loads);
-      peak_normal_N = std::max(peak_normal_N, loads[kFn1] + loads[kFn1 + 1] + loads[kFn1 + 2] + loads[kFn1 + 3]);
-    }
-  }
-  averager.finish();
-  sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  sum.solver_steps = steps;
+  const RobotParams& robot_;
+  const MujocoSettings& settings_;
+  const Effects& effects_;
+  const OutputSettings& output_;
+  const MujocoPlan plan_;
+  const int n_;
+  const std::string xml_;
+  const MujocoMessages messages_;  // MuJoCo's warnings go into this run's error text, not MUJOCO_LOG.TXT
+  ModelPtr model_;
+  mjModel* m_;
+  DataPtr data_;
+  mjData* d_;
+  const Layout L_;
+  const ServoGains gains_;
+  const bool continuous_, rk4_;
+  RunResult result_;
+  RunSummary& sum_;
+  TimeSeries& ts_;
+  const Columns cols_;
+  std::vector<double> row_;
+  std::vector<JointState> ref0_;  // the joints at t = 0
+  TailController ctrl_;
+  std::vector<mjtNum> qvel_s_, qacc_s_, scratch_;
+  Loads loads_{};
+  StandingMonitor standing_;
+  const double weight_N_;
+  double peak_normal_N_ = 0.0;
+  double phi_ = 0.0, yaw_prev_ = 0.0, phi0_ = 0.0;  // the unwrapped yaw, the last yaw read, the yaw at t = 0
+  long steps_ = 0;
+};
 
-  // Summary.
-  mj_kinematics(m, d);  // xmat of the final state
-  phi += wrapPi(yawOf(d, L.quad_body) - yaw_prev);
-  sum.phi_net_deg = (phi - phi0) * kRad2Deg;
-  sum.extra["final_x_m"] = d->xpos[3 * L.quad_body];  // as the x_m, y_m columns: the quadruped COM
-  sum.extra["final_y_m"] = d->xpos[3 * L.quad_body + 1];
-  const std::vector<double>& tcol = ts.values(cols.t);
-  const std::vector<double>& pd = ts.values(cols.phidot);
-  const double thr = settings.stop_phidot_radps * kRad2Deg;
-  sum.t_stop_s = 0.0;
-  for (size_t r = pd.size(); r-- > 0;) {
-    if (std::abs(pd[r]) >= thr) {
-      sum.t_stop_s = r + 1 < pd.size() ? tcol[r + 1] : tcol[r];
-      break;
-    }
-  }
-  const TrackingStats st = ctrl.stats();
-  for (int i = 0; i < n; ++i) {
-    sum.extra["tracking_max_deg_j" + std::to_string(i + 1)] = st.max_abs_rad[i] * kRad2Deg;
-    sum.extra["tracking_rms_deg_j" + std::to_string(i + 1)] = st.rms_rad[i] * kRad2Deg;
-  }
-  sum.extra["mujoco_warnings"] = warningCount(d);
-  sum.extra["kp_j1"] = gains.kp[0];
-  standing.report(sum.extra);
-  reportContact();
-  // Contact fidelity (docs/mujoco-model.md "Contact fidelity"): feet that leave the ground while the
-  // body slides, and impulsive normal forces, mean MuJoCo's soft contact, not Coulomb friction,
-  // shaped the result.
-  if (standing.enforced() && sum.ok) {
-    const double airborne = sum.extra["airborne_fraction"], peak = sum.extra["peak_normal_force_over_mg"];
-    std::ostringstream os;
-    os.precision(3);
-    if (airborne > limits::kMaxAirborneFraction)
-      os << "all four feet carry no load in " << 100.0 * airborne << " % of the steps (limit "
-         << 100.0 * limits::kMaxAirborneFraction << " %): MuJoCo's soft contact chatters while the body slides";
-    if (peak > limits::kMaxPeakNormalForceOverMg)
-      os << (os.str().empty() ? "" : "; ") << "the summed foot normal force peaks at " << peak
-         << " m g (limit " << limits::kMaxPeakNormalForceOverMg << " m g): impulsive contact";
-    if (!os.str().empty()) {
-      os << "; phi_net depends on the contact softness (mujoco.solref), see docs/mujoco-model.md \"Contact fidelity\"";
-      sum.warnings.push_back(os.str());
-    }
-  }
-  // At rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
-  {
-    mjtNum v6[6];
-    mj_objectVelocity(m, d, mjOBJ_BODY, L.quad_body, v6, 0);  // (angular, linear), world axes
-    const double phidot_dps = std::abs(v6[2]) * kRad2Deg, speed = std::hypot(v6[3], v6[4]);
-    sum.extra["final_phidot_dps"] = v6[2] * kRad2Deg;
-    sum.extra["final_speed_mps"] = speed;
-    sum.at_rest = phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps;
-    if (!sum.at_rest && sum.ok) {
-      std::ostringstream os;
-      os.precision(4);
-      os << "the body is still moving when the run ends at t = " << duration << " s (|phi_dot| " << phidot_dps
-         << " deg/s, speed " << speed << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
-         << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
-      sum.warnings.push_back(os.str());
-    }
-  }
-  // The servo follows the reference only as well as the step allows (a coarse timestep_s lowers
-  // the gains: kp ~ (servo_wn_dt / timestep_s)^2): a large tracking error means a different motion.
-  double worst = 0.0;
-  int worst_j = 0;
-  for (int i = 0; i < n; ++i)
-    if (st.max_abs_rad[i] * kRad2Deg > worst) worst = st.max_abs_rad[i] * kRad2Deg, worst_j = i + 1;
-  if (worst > limits::kMaxTrackingErrorDeg && sum.ok) {
-    std::ostringstream os;
-    os.precision(3);
-    os << "the tail servo is off its reference by up to " << worst << " deg (joint " << worst_j << "; limit "
-       << limits::kMaxTrackingErrorDeg << " deg): the simulated tail motion differs from the trajectory, "
-       << "lower mujoco.timestep_s (" << settings.timestep_s << " s)";
-    sum.warnings.push_back(os.str());
-  }
-  if (!sum.ok) sum.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
-  return result;
+}  // namespace
+
+RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
+                         MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
+  const MujocoPlan plan = planMujocoRun(robot, trajectory, settings, output);
+  MujocoRun run(robot, trajectory, settings, effects, output, plan);
+  if (!run.settle(settle_cache)) return run.failed();
+  run.stepLoop(observer, hook);
+  return run.judge();
 }
 
 }  // namespace tailsim

@@ -1,4 +1,4 @@
-#include "analytic_model/analytic_model.h"
+#include "models/analytic/analytic_model.h"
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "analytic_model/foot_loads.h"
+#include "models/planar/foot_loads.h"
 #include "numerics/sin_cos.h"
 
 namespace tailsim {

@@ -11,7 +11,7 @@
 #include <cmath>
 #include <utility>
 
-#include "analytic_model/tail_dynamics.h"
+#include "models/planar/tail_dynamics.h"
 #include "robot/robot_params.h"
 #include "robot/scene_effects.h"
 

@@ -1,4 +1,4 @@
-#include "mujoco_model/mujoco_handles.h"
+#include "models/mujoco/mujoco_handles.h"
 
 #include <cstdio>
 #include <cstring>

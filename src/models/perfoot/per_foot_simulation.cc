@@ -9,12 +9,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "analytic_model/analytic_simulation.h"
-#include "analytic_model/per_foot_model.h"
-#include "analytic_model/row_columns.h"
-#include "analytic_model/step_control.h"
-#include "analytic_model/stick_slip.h"
-#include "analytic_model/support_check.h"
+#include "models/analytic/analytic_simulation.h"
+#include "models/perfoot/per_foot_model.h"
+#include "models/planar/row_columns.h"
+#include "models/planar/step_control.h"
+#include "models/planar/stick_slip.h"
+#include "models/planar/support_check.h"
 #include "results/columns.h"
 #include "results/thin_series.h"
 #include "robot/friction_law.h"
@@ -595,9 +595,9 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   for (double v : settings.initial_velocity)
     if (!std::isfinite(v)) throw std::invalid_argument("perfoot initial_velocity must be finite");
   if (!(output.sample_dt_s > 0)) throw std::invalid_argument("output.sample_dt_s must be > 0");
-  const double t_end = output.duration_s > 0 ? output.duration_s : trajectory.endTime() + output.settle_s;
+  const double t_end = output.runEnd(trajectory.endTime());
   if (output.sample_dt_s > t_end) throw std::invalid_argument("output.sample_dt_s is longer than the run");
-  const double rows = std::floor(t_end / output.sample_dt_s + 1e-9) + 1;
+  const double rows = output.rows(t_end);
   if (!(rows <= limits::kMaxRowsPerRun)) throw std::invalid_argument("the run would write too many rows");
 
   const auto wall0 = std::chrono::steady_clock::now();

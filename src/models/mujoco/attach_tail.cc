@@ -1,4 +1,4 @@
-#include "mujoco_model/attach_tail.h"
+#include "models/mujoco/attach_tail.h"
 
 #include <tinyxml2.h>
 
@@ -7,7 +7,7 @@
 #include <functional>
 
 #include "controllers/tail_controller.h"
-#include "mujoco_model/mjcf_generator.h"
+#include "models/mujoco/mjcf_generator.h"
 
 namespace tailsim {
 namespace {

@@ -1,4 +1,4 @@
-#include "mujoco_model/robot_import.h"
+#include "models/mujoco/robot_import.h"
 
 #include <tinyxml2.h>
 #include <unistd.h>
