@@ -385,3 +385,35 @@ TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
   EXPECT_NEAR(r.quadruped.l_F_m, 0.4, 1e-3);
   EXPECT_NEAR(r.quadruped.w_F_m, 0.24, 1e-9);
 }
+
+// Standing with the tail: the tilt that counts is the one from the robot's own settled stance. A
+// rigid box robot whose front feet are 40 mm shorter stands pitched by atan(0.04 / 0.4) = 5.7 deg
+// with or without a tail; holding the tail must not tilt it further, and no tilt warning is given.
+TEST(RobotImport, TiltWithTheTailIsMeasuredFromTheStance) {
+  Scratch t;
+  std::string xml = boxRobot("");
+  for (const char* front : {"pos=\"0.2 0.12 -0.28\"", "pos=\"0.2 -0.12 -0.28\""}) {
+    std::string shorter = front;
+    shorter.replace(shorter.find("-0.28"), 5, "-0.24");
+    xml.replace(xml.find(front), std::string(front).size(), shorter);
+  }
+  xml.replace(xml.find("</worldbody>"), 12,
+              "</worldbody>\n<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
+  RobotModelSpec s;
+  s.file = t.write("pitched_box.xml", xml);
+  s.mount.pos_m = {-0.25, 0.0, 0.0};
+  s.settle_s = 0.3;
+  RobotTailChoice tail;
+  tail.stand_s = 0.5;
+  const RobotComparison c = compareRobotModels(s, tail);
+  const ArticulatedRun& a = c.articulated;
+  ASSERT_TRUE(a.ok) << a.error;
+  const double pitch = std::atan(0.04 / 0.4) / kDeg;
+  EXPECT_NEAR(a.stance_tilt_deg, pitch, 0.1);
+  EXPECT_NEAR(a.stand_end_tilt_deg, pitch, 0.3);
+  EXPECT_LT(a.stand_end_rel_tilt_deg, 0.3);
+  EXPECT_LT(a.stand_max_rel_tilt_deg, 0.3);
+  for (const std::string& w : a.warnings) EXPECT_EQ(w.find("tilted"), std::string::npos) << w;
+  std::printf("stance %.3f, after standing %.3f abs / %.3f from the stance, stroke max %.3f / %.3f deg\n",
+              a.stance_tilt_deg, a.stand_end_tilt_deg, a.stand_end_rel_tilt_deg, a.max_tilt_deg, a.max_rel_tilt_deg);
+}
