@@ -335,3 +335,85 @@ TEST(RobotImport, AnymalWithLockedLegsTurnsLikeTheRigidBoxWhicheverWayItFaces) {
   ASSERT_TRUE(turned.ok) << turned.error;
   EXPECT_NEAR(turned.phi_net_deg, c.articulated.phi_net_deg, 0.02);
 }
+
+// A URDF robot: MuJoCo 2.2's URDF reader would fuse the root link into the world (no free joint);
+// tailsim keeps it a body (fusestatic off) and gives it the free joint. A 10 kg box base and four
+// 0.5 kg legs, two on revolute joints (held by tailsim's PD), two on fixed joints (their own bodies).
+TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
+  Scratch t;
+  std::string legs;
+  const struct {
+    const char* name;
+    double x, y;
+    const char* type;
+  } leg[] = {{"FL", 0.2, 0.12, "revolute"}, {"FR", 0.2, -0.12, "revolute"}, {"RR", -0.2, -0.12, "fixed"},
+             {"RL", -0.2, 0.12, "fixed"}};
+  for (const auto& l : leg) {
+    char b[1200];
+    std::snprintf(b, sizeof b,
+                  "<link name=\"%s\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/>"
+                  "<inertia ixx=\"0.002\" iyy=\"0.002\" izz=\"0.0003\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
+                  "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
+                  "<joint name=\"%s_j\" type=\"%s\"><parent link=\"base\"/><child link=\"%s\"/>"
+                  "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
+                  "<limit lower=\"-1\" upper=\"1\" effort=\"50\" velocity=\"10\"/></joint>\n",
+                  l.name, l.name, l.type, l.name, l.x, l.y);
+    legs += b;
+  }
+  const std::string urdf = std::string(R"(<robot name="boxbot">
+  <link name="base">
+    <inertial><origin xyz="0.01 0 0"/><mass value="10"/>
+      <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><mesh filename="package://boxbot/meshes/shell.stl"/></geometry></visual>
+    <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision>
+  </link>
+)") + legs + "</robot>\n";
+  RobotModelSpec s;
+  s.file = t.write("boxbot.urdf", urdf);
+  s.joint_angles_rad = {{"FL_j", 0.0}, {"FR_j", 0.0}};
+  const DerivedRobot r = deriveRobot(s);
+  std::printf("%s", describeDerivedRobot(r).c_str());
+  EXPECT_TRUE(r.model.from_urdf);
+  EXPECT_EQ(r.root_body, "base");
+  EXPECT_EQ(r.pd_joints.size(), 2u);
+  expectMujocoFigures(r, 10.0 + 4 * 0.5);
+  // By hand: I_zz of the base and legs about the COM (x_c = 0.1 / 12), legs upright.
+  const double xc = (10 * 0.01 + 0.5 * (0.2 + 0.2 - 0.2 - 0.2)) / 12.0;
+  double izz = 0.25 + 10 * (0.01 - xc) * (0.01 - xc) + 4 * 0.0003;
+  for (const auto& l : leg) izz += 0.5 * ((l.x - xc) * (l.x - xc) + l.y * l.y);
+  EXPECT_NEAR(r.quadruped.izz_kgm2, izz, 1e-4 * izz);
+  EXPECT_NEAR(r.quadruped.l_F_m, 0.4, 1e-3);
+  EXPECT_NEAR(r.quadruped.w_F_m, 0.24, 1e-9);
+}
+
+// Standing with the tail: the tilt that counts is the one from the robot's own settled stance. A
+// rigid box robot whose front feet are 40 mm shorter stands pitched by atan(0.04 / 0.4) = 5.7 deg
+// with or without a tail; holding the tail must not tilt it further, and no tilt warning is given.
+TEST(RobotImport, TiltWithTheTailIsMeasuredFromTheStance) {
+  Scratch t;
+  std::string xml = boxRobot("");
+  for (const char* front : {"pos=\"0.2 0.12 -0.28\"", "pos=\"0.2 -0.12 -0.28\""}) {
+    std::string shorter = front;
+    shorter.replace(shorter.find("-0.28"), 5, "-0.24");
+    xml.replace(xml.find(front), std::string(front).size(), shorter);
+  }
+  xml.replace(xml.find("</worldbody>"), 12,
+              "</worldbody>\n<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
+  RobotModelSpec s;
+  s.file = t.write("pitched_box.xml", xml);
+  s.mount.pos_m = {-0.25, 0.0, 0.0};
+  s.settle_s = 0.3;
+  RobotTailChoice tail;
+  tail.stand_s = 0.5;
+  const RobotComparison c = compareRobotModels(s, tail);
+  const ArticulatedRun& a = c.articulated;
+  ASSERT_TRUE(a.ok) << a.error;
+  const double pitch = std::atan(0.04 / 0.4) / kDeg;
+  EXPECT_NEAR(a.stance_tilt_deg, pitch, 0.1);
+  EXPECT_NEAR(a.stand_end_tilt_deg, pitch, 0.3);
+  EXPECT_LT(a.stand_end_rel_tilt_deg, 0.3);
+  EXPECT_LT(a.stand_max_rel_tilt_deg, 0.3);
+  for (const std::string& w : a.warnings) EXPECT_EQ(w.find("tilted"), std::string::npos) << w;
+  std::printf("stance %.3f, after standing %.3f abs / %.3f from the stance, stroke max %.3f / %.3f deg\n",
+              a.stance_tilt_deg, a.stand_end_tilt_deg, a.stand_end_rel_tilt_deg, a.max_tilt_deg, a.max_rel_tilt_deg);
+}

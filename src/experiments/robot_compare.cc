@@ -51,9 +51,12 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
                                  choice.settle_after_s);
   ModelRow art{"mujoco (articulated)", c.articulated.ok, c.articulated.phi_net_deg, c.articulated.warnings};
   if (!c.articulated.ok) art.warnings.insert(art.warnings.begin(), c.articulated.error);
-  art.warnings.push_back("tilt: " + f3(c.articulated.stand_end_tilt_deg) + " deg after standing " +
-                         f3(choice.stand_s) + " s with the tail, at most " + f3(c.articulated.max_tilt_deg) +
-                         " deg during the stroke; " + std::to_string(c.articulated.feet_in_contact) + " feet on the floor");
+  const ArticulatedRun& a = c.articulated;
+  art.warnings.push_back("tilt (absolute / from the stance): stance " + f3(a.stance_tilt_deg) + " deg; after standing " +
+                         f3(choice.stand_s) + " s with the tail " + f3(a.stand_end_tilt_deg) + " / " +
+                         f3(a.stand_end_rel_tilt_deg) + " deg (at most " + f3(a.stand_max_tilt_deg) + " / " +
+                         f3(a.stand_max_rel_tilt_deg) + "); during the stroke at most " + f3(a.max_tilt_deg) + " / " +
+                         f3(a.max_rel_tilt_deg) + " deg; " + std::to_string(a.feet_in_contact) + " feet on the floor");
   c.rows.push_back(art);
   for (const char* name : {"mujoco", "perfoot", "analytic"}) {
     const ModelEntry* e = findModel(name);

@@ -2,6 +2,7 @@
 
 #include <tinyxml2.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -35,8 +36,19 @@ XMLElement* findBody(XMLElement* e, const std::string& name) {
   return nullptr;
 }
 
-double tiltDeg(const mjData* d, int body) {
-  return std::acos(std::max(-1.0, std::min(1.0, d->xmat[9 * body + 8]))) * 180.0 / kPi;
+double angleDeg(double cosine) { return std::acos(std::max(-1.0, std::min(1.0, cosine))) * 180.0 / kPi; }
+
+// The body's z axis in the world (column 2 of its row-major xmat).
+std::array<double, 3> bodyZ(const mjData* d, int body) {
+  const double* R = d->xmat + 9 * body;
+  return {R[2], R[5], R[8]};
+}
+
+double tiltDeg(const mjData* d, int body) { return angleDeg(d->xmat[9 * body + 8]); }
+
+double tiltFromDeg(const mjData* d, int body, const std::array<double, 3>& z0) {
+  const std::array<double, 3> z = bodyZ(d, body);
+  return angleDeg(z[0] * z0[0] + z[1] * z0[1] + z[2] * z0[2]);
 }
 
 }  // namespace
@@ -164,6 +176,8 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
   TailController ctrl(m, trajectory, qadr, vadr, act, {s.velocity_feedforward, s.inverse_dynamics_feedforward});
   mj_forward(m, d);
   const int body = bodyId(m, r.root_body);
+  const std::array<double, 3> stanceZ = bodyZ(d, body);
+  out.stance_tilt_deg = tiltDeg(d, body);
   if (r.mu_given) {
     for (const auto& [bodyName, k] : r.foot_geoms) m->geom_friction[3 * (m->body_geomadr[bodyId(m, bodyName)] + k)] = r.mu;
     m->geom_friction[3 * geomId(m, r.model.floor_geom)] = r.mu;
@@ -180,10 +194,12 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
   for (long k = 0; k < standSteps && out.ok; ++k) {
     step(0.0);
     out.stand_max_tilt_deg = std::max(out.stand_max_tilt_deg, tiltDeg(d, body));
+    out.stand_max_rel_tilt_deg = std::max(out.stand_max_rel_tilt_deg, tiltFromDeg(d, body, stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings while standing: " + describeWarnings(d);
   }
   out.stand_s = stand_s;
   out.stand_end_tilt_deg = tiltDeg(d, body);
+  out.stand_end_rel_tilt_deg = tiltFromDeg(d, body, stanceZ);
   for (const auto& [bodyName, k] : r.foot_geoms) {
     const int g = m->body_geomadr[bodyId(m, bodyName)] + k;
     bool touching = false;
@@ -201,12 +217,14 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
     phi += std::remainder(y - prev, 2 * kPi);
     prev = y;
     out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
+    out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
   }
   out.run_s = t_end;
   out.phi_net_deg = phi * 180.0 / kPi;
-  if (out.stand_max_tilt_deg >= 1.0)
-    out.warnings.push_back("the body tilted " + std::to_string(out.stand_max_tilt_deg) + " deg while standing with the tail");
+  if (out.stand_max_rel_tilt_deg >= 1.0)
+    out.warnings.push_back("the body tilted up to " + std::to_string(out.stand_max_rel_tilt_deg) + " deg from its stance (" +
+                           std::to_string(out.stand_max_tilt_deg) + " deg absolute) while standing with the tail");
   if (!messages.text().empty()) out.warnings.push_back(messages.text());
   return out;
 }

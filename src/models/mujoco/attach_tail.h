@@ -25,9 +25,15 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
 struct ArticulatedRun {
   bool ok = true;
   std::string error;
-  double stand_max_tilt_deg = 0.0;  // largest body tilt while standing with the tail held [deg]
-  double stand_end_tilt_deg = 0.0;  // body tilt at the end of standing (the stroke's start) [deg]
-  double max_tilt_deg = 0.0;        // largest body tilt during the stroke and after [deg]
+  // Tilt: the angle of the root body's z axis from the world's z (absolute), or from its own z in
+  // the settled stance the run starts from, before the tail's weight acts (from the stance).
+  double stance_tilt_deg = 0.0;         // the settled stance's own tilt [deg]
+  double stand_max_tilt_deg = 0.0;      // largest body tilt while standing with the tail held [deg]
+  double stand_end_tilt_deg = 0.0;      // body tilt at the end of standing (the stroke's start) [deg]
+  double stand_max_rel_tilt_deg = 0.0;  // largest tilt from the stance while standing with the tail [deg]
+  double stand_end_rel_tilt_deg = 0.0;  // tilt from the stance at the end of standing [deg]
+  double max_tilt_deg = 0.0;            // largest body tilt during the stroke and after [deg]
+  double max_rel_tilt_deg = 0.0;        // largest tilt from the stance during the stroke and after [deg]
   double phi_net_deg = 0.0;         // heading change of the root body from the stroke's start [deg]
   double stand_s = 0.0, run_s = 0.0;
   int feet_in_contact = 0;          // foot geoms touching the floor at the stroke's start

@@ -119,24 +119,79 @@ bool isFile(const fs::path& p) {
   return fs::is_regular_file(p, ec);
 }
 
-// URDF: MuJoCo reads it (visual elements discarded, as its URDF reader does by default) and writes
-// it back as MJCF; the returned text then goes through the MJCF steps.
+// A temporary file named like /tmp/tailsim-<what>-XXXXXX<suffix>, removed with the object.
+class TempFile {
+ public:
+  TempFile(const std::string& what, const std::string& suffix, const std::string& for_file) {
+    std::string t = "/tmp/tailsim-" + what + "-XXXXXX" + suffix;
+    std::vector<char> buf(t.begin(), t.end());
+    buf.push_back('\0');
+    const int fd = mkstemps(buf.data(), static_cast<int>(suffix.size()));
+    if (fd < 0) fail(for_file, "cannot create a temporary file in /tmp");
+    ::close(fd);
+    path_ = buf.data();
+  }
+  ~TempFile() { std::remove(path_.c_str()); }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// URDF: MuJoCo reads it and writes it back as MJCF; the returned text then goes through the MJCF
+// steps. MuJoCo's URDF reader fuses bodies without joints into their parents (compiler fusestatic),
+// the root link into the world: the URDF is given MuJoCo's extension element
+// <mujoco><compiler fusestatic="false"/></mujoco> so that the root link stays a body, and that body
+// gets the free joint a standing robot needs (unless the URDF gives it one, a floating joint from a
+// link with nothing else). Visual elements are discarded (the reader's default); mesh and texture
+// folders are made absolute, the text being read from /tmp.
 std::string urdfToMjcf(const std::string& file) {
+  XMLDocument urdf;
+  loadXmlFile(urdf, file);
+  XMLElement* robot = urdf.RootElement();
+  XMLElement* ext = robot->FirstChildElement("mujoco");
+  if (!ext) {
+    ext = urdf.NewElement("mujoco");
+    robot->InsertFirstChild(ext);
+  }
+  XMLElement* compiler = ext->FirstChildElement("compiler");
+  if (!compiler) {
+    compiler = urdf.NewElement("compiler");
+    ext->InsertFirstChild(compiler);
+  }
+  compiler->SetAttribute("fusestatic", "false");
+  const fs::path dir = fs::path(file).parent_path();
+  for (const char* attr : {"meshdir", "texturedir"}) {
+    const char* v = compiler->Attribute(attr);
+    const fs::path p = v ? fs::path(v) : fs::path();
+    std::string a = (p.is_absolute() ? p : (dir / p).lexically_normal()).string();
+    if (a.empty() || a.back() != '/') a += "/";
+    compiler->SetAttribute(attr, a.c_str());
+  }
+  TempFile in("urdf", ".urdf", file);
+  if (urdf.SaveFile(in.path().c_str()) != tinyxml2::XML_SUCCESS) fail(file, "cannot write a temporary copy of the URDF");
+
   installMujocoMessageHandlers();
   char err[1000] = "";
-  ModelPtr m(mj_loadXML(file.c_str(), nullptr, err, sizeof err));
+  ModelPtr m(mj_loadXML(in.path().c_str(), nullptr, err, sizeof err));
   if (!m) fail(file, std::string("MuJoCo cannot load this URDF: ") + err);
-  char tmpl[] = "/tmp/tailsim-urdf-XXXXXX.xml";
-  const int fd = mkstemps(tmpl, 4);
-  if (fd < 0) fail(file, "cannot create a temporary file for the converted URDF");
-  ::close(fd);
-  const bool ok = mj_saveLastXML(tmpl, m.get(), err, sizeof err);
-  std::ifstream in(tmpl);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::remove(tmpl);
+  TempFile out("urdf", ".xml", file);
+  const bool ok = mj_saveLastXML(out.path().c_str(), m.get(), err, sizeof err);
   if (!ok) fail(file, std::string("MuJoCo cannot write this URDF as MJCF: ") + err);
-  return ss.str();
+  XMLDocument mjcf;
+  loadXmlFile(mjcf, out.path());
+  XMLElement* world = mjcf.RootElement() ? mjcf.RootElement()->FirstChildElement("worldbody") : nullptr;
+  XMLElement* base = world ? world->FirstChildElement("body") : nullptr;
+  if (!base) fail(file, "MuJoCo's MJCF of this URDF has no body: the URDF has no link with mass");
+  if (base->NextSiblingElement("body"))
+    fail(file, "the URDF has more than one root link (MuJoCo's MJCF has several bodies in the world)");
+  const bool hasJoint = base->FirstChildElement("freejoint") || base->FirstChildElement("joint");
+  if (!hasJoint) base->InsertFirstChild(mjcf.NewElement("freejoint"));
+  tinyxml2::XMLPrinter printer;
+  mjcf.Print(&printer);
+  return printer.CStr();
 }
 
 }  // namespace
@@ -156,7 +211,8 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
     const std::string mjcf = urdfToMjcf(file);
     doc.Clear();
     if (doc.Parse(mjcf.c_str()) != tinyxml2::XML_SUCCESS) fail(file, "MuJoCo's MJCF of this URDF does not parse");
-    out.notes.push_back("URDF read by MuJoCo's URDF reader (visual elements discarded) and written back as MJCF");
+    out.notes.push_back("URDF read by MuJoCo's URDF reader (fusestatic off, visual elements discarded), written "
+                        "back as MJCF, its root link given a free joint");
   } else if (std::string(doc.RootElement()->Name()) != "mujoco") {
     fail(file, "neither MJCF (<mujoco>) nor URDF (<robot>)");
   }
