@@ -85,6 +85,20 @@ TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepRenderingIsBounded) {
   EXPECT_EQ(errorOf(write("small.yaml", sweep + "render: {width: 640, height: 480}\n")), "(no error)");
 }
 
+// A video replays whichever model ran: an analytic-only sweep's rendering is bounded
+// the same way (this file, models [analytic], was accepted and started 981 renders of 8192 x 8192).
+TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepRenderingIsBoundedForEveryModel) {
+  for (const std::string models : {"[analytic]", "[analytic, perfoot]"}) {
+    const std::string f =
+        write("rend_a.yaml", "name: r\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: {range: [0.01, 0.99, "
+                             "0.001]}}\nmodels: " + models + "\noutput: {time_series: none}\n"
+                             "render: {width: 8192, height: 8192, fps: 240, slowmo: 160, msaa: 4}\n");
+    const std::string e = errorOf(f);
+    EXPECT_EQ(e.rfind(f + ":1:1: the 981 cases would render about ", 0), 0u) << models << ": " << e;
+    EXPECT_NE(e.find("more than the limit 1e+12"), std::string::npos) << models << ": " << e;
+  }
+}
+
 // The solver steps of a whole sweep are bounded too.
 TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepStepsAreBounded) {
   const std::string f = write("steps.yaml",

@@ -68,11 +68,12 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
   if (has(c.models, "mujoco")) {
     cols = std::max(cols, mujocoColumns(n));
     w.mujoco_steps = (c.mujoco.settle_s + w.sim_time_s) / c.mujoco.timestep_s;
-    if (c.render.enabled) {
-      const double shown = c.render.duration_s > 0 ? std::min(c.render.duration_s, w.sim_time_s) : w.sim_time_s;
-      w.render_frames = std::floor(shown * c.render.fps * c.render.slowmo) + 1;
-      w.render_samples = w.render_frames * c.render.width * c.render.height * std::max(1, c.render.msaa);
-    }
+  }
+  // A video replays the time series of whichever models ran, so it counts for every model set.
+  if (c.render.enabled) {
+    const double shown = c.render.duration_s > 0 ? std::min(c.render.duration_s, w.sim_time_s) : w.sim_time_s;
+    w.render_frames = std::floor(shown * c.render.fps * c.render.slowmo) + 1;
+    w.render_samples = w.render_frames * c.render.width * c.render.height * std::max(1, c.render.msaa);
   }
   w.csv_bytes = w.rows * cols * limits::kCsvBytesPerValue;
   return w;
