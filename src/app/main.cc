@@ -508,6 +508,7 @@ int main(int argc, char** argv) {
     if (*accuracy) {
       const Experiment e = loadExperiment(exp_path);
       fs::create_directories(acc_out);
+      checkAccuracyTables(acc_out);
       AccuracyOptions ao;
       ao.repeats = acc_repeats;
       ao.quick = acc_quick;
