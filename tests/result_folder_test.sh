@@ -485,6 +485,8 @@ YAML
   if [ $rc -eq 0 ]; then echo "SKIP: the run fit in 1.2 GB here"; exit 0; fi
   grep -q "bad_alloc" "$W/err" && { cat "$W/err"; fail "out of memory reported as raw std::bad_alloc"; }
   grep -q "out of memory while running" "$W/err" || { cat "$W/err"; fail "out of memory: no message in tailsim's words"; }
+  # with the memory a running case holds (6 links: 39 columns x 8e5 rows x 8 B = 250 MB)
+  grep -q "at least about 250 MB for this one" "$W/err" || { cat "$W/err"; fail "out of memory: no MB figure"; }
   echo "out of memory: $(head -c 150 "$W/err")"
   ;;
 hdf5-damaged-manifest)

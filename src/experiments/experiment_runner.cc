@@ -1271,12 +1271,17 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
         // Out of memory: every case holds its series in memory while it runs; start no more.
         stop = true;
         std::lock_guard<std::mutex> lock(mu);
-        if (first_error.empty())
-          first_error = "case " + t.job->e->cases[t.i].name +
-                        ": out of memory while running it (each running case holds its time series in memory, one "
-                        "case per thread): use fewer --threads, raise output.sample_dt_s or set output.time_series: "
-                        "thin or none; no further case was started, the finished ones are saved (run the same "
-                        "command again to resume)";
+        if (first_error.empty()) {
+          // Its series as held while it runs: rows x columns x 8 B a value, per model (a lower bound).
+          const ExperimentCase& c = t.job->e->cases[t.i];
+          char mb[32];
+          std::snprintf(mb, sizeof mb, "%.0f",
+                        estimateWork(c).csv_bytes / limits::kCsvBytesPerValue * 8.0 * static_cast<double>(c.models.size()) / 1e6);
+          first_error = "case " + c.name + ": out of memory while running it (each running case holds its time series in "
+                        "memory, at least about " + mb + " MB for this one, one case per thread): use fewer --threads, "
+                        "raise output.sample_dt_s or set output.time_series: thin or none; no further case was started, "
+                        "the finished ones are saved (run the same command again to resume)";
+        }
       } catch (const std::exception& ex) {
         // A full disk fails every case after it: stop starting new ones (issue 16, finding 4).
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);
