@@ -485,7 +485,56 @@ YAML
   if [ $rc -eq 0 ]; then echo "SKIP: the run fit in 1.2 GB here"; exit 0; fi
   grep -q "bad_alloc" "$W/err" && { cat "$W/err"; fail "out of memory reported as raw std::bad_alloc"; }
   grep -q "out of memory while running" "$W/err" || { cat "$W/err"; fail "out of memory: no message in tailsim's words"; }
+  # with the memory a running case holds (6 links: 39 columns x 8e5 rows x 8 B = 250 MB)
+  grep -q "at least about 250 MB for this one" "$W/err" || { cat "$W/err"; fail "out of memory: no MB figure"; }
   echo "out of memory: $(head -c 150 "$W/err")"
+  ;;
+hdf5-damaged-manifest)
+  # A damaged .h5 whose manifest line matches it (a shard copied from another machine carries a
+  # manifest that names whatever it holds): libhdf5 crashed inside H5Ocopy (SIGSEGV; seeds 2, 11, 17
+  # of 24 for merge, 11 and 15 for a resume). Now the copy runs in a child process: a crash there is
+  # an error naming the file, rc 1, and tailsim itself never dies.
+  sweep s 0.1  # 10 cases
+  damage() {  # damage DIR SEED: 10 random bytes into DIR/time_series.h5, then DIR's manifest names it as it is
+    python3 - "$@" <<'PY'
+import hashlib, os, random, sys
+d, seed = sys.argv[1], int(sys.argv[2])
+p = os.path.join(d, 'time_series.h5'); r = random.Random(seed); b = bytearray(open(p, 'rb').read())
+for _ in range(10): b[r.randrange(len(b))] = r.randrange(256)
+open(p, 'wb').write(b)
+m = os.path.join(d, '.tailsim-manifest'); out = []
+for line in open(m):
+    h, n = line.rstrip('\n').split('  ', 1)
+    f = os.path.join(d, n)
+    if os.path.isfile(f): h = hashlib.sha256(open(f, 'rb').read()).hexdigest()
+    out.append(h + '  ' + n + '\n')
+open(m, 'w').write(''.join(out))
+PY
+  }
+  "$TAILSIM" run "$W/s.yaml" --out "$W/sh1" --shard 1/2 --quiet > /dev/null || fail "shard 1"
+  "$TAILSIM" run "$W/s.yaml" --out "$W/sh2" --shard 2/2 --quiet > /dev/null || fail "shard 2"
+  "$TAILSIM" run "$W/s.yaml" --out "$W/clean" --quiet > /dev/null || fail "clean run"
+  refused=0
+  for seed in $(seq 1 24); do
+    rm -rf "$W/shx" "$W/m" && cp -r "$W/sh1" "$W/shx" && damage "$W/shx" "$seed"
+    rc=0
+    timeout 60 "$TAILSIM" merge "$W/shx" "$W/sh2" --out "$W/m" > /dev/null 2> "$W/e" || rc=$?
+    no_crash $rc "$W/e" "merge of a damaged shard with a matching manifest (seed $seed)"
+    [ -z "$(ls -d "$W"/m.merge.tmp.* 2>/dev/null)" ] || fail "merge (seed $seed) left its staging folder"
+    if grep -q "libhdf5 crashed" "$W/e"; then
+      refused=$((refused + 1))
+      grep -q "shx/time_series.h5 (shard .*shx) is damaged" "$W/e" || { cat "$W/e"; fail "seed $seed: the error does not name the file and shard"; }
+    fi
+    rm -rf "$W/z" && cp -r "$W/clean" "$W/z" && damage "$W/z" "$seed" && sed -i 2d "$W/z/cases.jsonl"
+    rc=0
+    timeout 60 "$TAILSIM" run "$W/s.yaml" --out "$W/z" --quiet > /dev/null 2> "$W/e" || rc=$?
+    no_crash $rc "$W/e" "resume of a damaged time_series.h5 with a matching manifest (seed $seed)"
+    if grep -q "libhdf5 crashed" "$W/e"; then
+      refused=$((refused + 1))
+      grep -q "z/time_series.h5 or a part in .*is damaged" "$W/e" || { cat "$W/e"; fail "seed $seed: the resume's error does not name the file"; }
+    fi
+  done
+  echo "damaged .h5 with a matching manifest, 24 seeds, merge and resume: no crash ($refused libhdf5 crashes reported as errors)"
   ;;
 *) echo "unknown CLASS $CLASS"; exit 2 ;;
 esac

@@ -391,6 +391,30 @@ TEST_F(UnboundedWorkRefusedAtLoad, OptimizeRunsAreEstimatedAndBounded) {
   EXPECT_EQ(optimizeRunEstimate(ok), 60.0);
 }
 
+// A run's cost is the base's: with a 1e-7 s fixed analytic step (6e6 steps, 3.4 s a run) 20,200 runs
+// (about 19 hours) were accepted and started; the steps are estimated (runs x steps a run) and bounded.
+TEST_F(UnboundedWorkRefusedAtLoad, OptimizeStepsAreEstimatedAndBounded) {
+  std::ofstream(dir_ / "slow.yaml") << "name: s\nrobot: " << kSourceDir
+                                     << "/configs/robots/paper_quadruped.yaml\ntail: {links: 1}\n"
+                                        "trajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\nmodels: [analytic]\n"
+                                        "analytic: {solver: fixed, fixed_dt_s: 1e-7}\n";
+  const std::string slow = write("slow_opt.yaml", "name: slow\nkind: optimize\nbase: slow.yaml\noptimize:\n"
+                                                  "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                                  "  islands: 2\n  population: 100\n  generations: 100\n  seeds: [1]\n");
+  const std::string e = errorOf([&] { loadOptimizeSpec(slow); });
+  EXPECT_NE(e.find("slow_opt.yaml:5:3: optimize: the search would take about "), std::string::npos) << e;
+  EXPECT_NE(e.find(" analytic solver steps (about "), std::string::npos) << e;
+  EXPECT_NE(e.find(" runs x at least "), std::string::npos) << e;
+  EXPECT_NE(e.find("more than the limit 1e+11"), std::string::npos) << e;
+  // The same search on the default (adaptive) step loads.
+  EXPECT_EQ(errorOf([&] {
+              loadOptimizeSpec(write("fast_opt.yaml", "name: fast\nkind: optimize\nbase: base.yaml\noptimize:\n"
+                                                      "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                                      "  islands: 2\n  population: 100\n  generations: 100\n  seeds: [1]\n"));
+            }),
+            "(no error)");
+}
+
 // The longest MuJoCo run of a maneuver (the closed loop, max_strokes cycles) is estimated at load.
 TEST_F(UnboundedWorkRefusedAtLoad, ManeuverRunsAreEstimatedAndBounded) {
   const std::string e = errorOf([&] {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "experiments/experiment_loader.h"
+#include "experiments/keyword_args.h"
 #include "experiments/settings_json.h"
 
 namespace tailsim {
@@ -317,7 +318,7 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
           "          foot_loads: constant, load_decomposition: false}\n"
           "output: {sample_dt_s: 0.002, duration_s: 1.5, settle_s: 0.2}\n"
           "render: {width: 320, height: 240, fps: 60, slowmo: 2, duration_s: 0.5, camera: perspective,\n"
-          "         shadows: true, reflections: true, msaa: 4, ghost: false, ffmpeg: /usr/bin/ffmpeg,\n"
+          "         shadows: true, reflections: true, msaa: 4, ghost: false,\n"
           "         crf: 30, preset: slow}\n"));
   const ExperimentCase c = loadExperiment(p).cases.at(0);
   EXPECT_DOUBLE_EQ(c.robot.friction.mu_s, 0.3);
@@ -378,7 +379,6 @@ TEST_F(LoaderTest, AllSectionsAreRead) {
   EXPECT_TRUE(c.render.reflections);
   EXPECT_EQ(c.render.msaa, 4);
   EXPECT_FALSE(c.render.ghost);
-  EXPECT_EQ(c.render.ffmpeg, "/usr/bin/ffmpeg");
   EXPECT_EQ(c.render.crf, 30);
   EXPECT_EQ(c.render.preset, "slow");
 
@@ -887,6 +887,31 @@ TEST_F(LoaderTest, ContinuousThresholdsOnlyWithThatLaw) {
       "exp.yaml", head + "effects: {friction: continuous}\n"
                          "friction: {phidot_s_radps: 0.1, phidot_d_radps: 1, v_s_mps: 0.02, v_d_mps: 0.2}\n")).cases.at(0);
   EXPECT_DOUBLE_EQ(c.robot.friction.v_d_mps, 0.2);
+}
+
+
+// No input names a program to run: `render.ffmpeg` was a file key, and an experiment with
+// `ffmpeg: ./evil.sh` (or a result folder's experiment.yaml, or tailsim.simulate(render=...)) ran that
+// program. The encoder is ffmpeg on PATH, the user's choice; the key is refused at file:line:col.
+using NoInputTextReachesAnInterpreterUnescaped = LoaderTest;
+TEST_F(NoInputTextReachesAnInterpreterUnescaped, NoFileNamesAProgramToRun) {
+  for (const char* v : {"./evil.sh", "/bin/sh", "sh", "ffmpeg"})
+    expectError(exp(std::string(kTraj) + "render: {width: 64, height: 48, ffmpeg: " + v + "}\n"), 5, "render.ffmpeg",
+                "unknown key");
+  EXPECT_EQ(loadExperiment(write("ok.yaml", exp(std::string(kTraj) + "render: {width: 64, height: 48}\n")))
+                .cases.at(0)
+                .render.ffmpeg,
+            "ffmpeg");
+  // The Python keyword path builds its text for the same loader: refused there too.
+  const std::string text = simulateExperimentText(
+      "paper", nlohmann::ordered_json{{"dtheta_deg", -90}, {"dT_s", 0.25}}, "analytic",
+      nlohmann::ordered_json{{"render", {{"ffmpeg", "/tmp/evil.sh"}}}});
+  try {
+    loadExperimentText(text, "<tailsim.simulate>");
+    ADD_FAILURE() << "render.ffmpeg accepted from tailsim.simulate";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("render.ffmpeg: unknown key"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -4,17 +4,20 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <thread>
 
+#include "experiments/accuracy_study.h"
 #include "experiments/experiment_runner.h"
 #include "results/atomic_file.h"
 #include "tailsim_version.h"
@@ -385,6 +388,67 @@ TEST(ExperimentRunner, Finding11_KilledRunTemporariesAreCleaned) {
   EXPECT_EQ(runExperiment(e, o).resumed, 2);
   for (const auto& p : stale) EXPECT_FALSE(fs::exists(p)) << p;
   for (const auto& p : kept) EXPECT_TRUE(fs::exists(p)) << p;
+}
+
+// A user's file at the path of a case's HDF5 part (time_series.h5.d/<case dir>.h5) was overwritten by the
+// case's part and then deleted by the join, without a word: it is refused before any work, unchanged,
+// whatever it is (a regular file, a symlink, a FIFO). tailsim's own parts still resume.
+TEST(UserFiles, AFileAtAPartsPathIsRefused) {
+  const fs::path dir = tempDir("a1");
+  std::ofstream(dir / "h5.yaml") << "name: h5\nrobot: paper\ntail: {links: 1}\n"
+                                 << "trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: {sweep: [0.2, 0.3]}}\n"
+                                 << "models: [analytic]\noutput: {time_series: thin, time_series_file: hdf5}\n";
+  const Experiment e = loadExperiment((dir / "h5.yaml").string());
+  RunOptions o;
+  o.out_dir = (dir / "out").string();
+  o.progress = false;
+  const fs::path parts = dir / "out" / "time_series.h5.d", mine = parts / "w_ss=0.3.h5";
+  for (const std::string kind : {"file", "symlink", "fifo"}) {
+    fs::remove_all(dir / "out");
+    fs::create_directories(parts);
+    std::ofstream(dir / "target") << "mine";
+    if (kind == "file") std::ofstream(mine) << "mine";
+    if (kind == "symlink") fs::create_symlink(dir / "target", mine);
+    if (kind == "fifo") ASSERT_EQ(::mkfifo(mine.c_str(), 0644), 0);
+    try {
+      runExperiment(e, o);
+      ADD_FAILURE() << kind << ": a user's file at a part's path was not refused";
+    } catch (const std::runtime_error& err) {
+      EXPECT_NE(std::string(err.what()).find(mine.string() + " was not written by tailsim"), std::string::npos)
+          << kind << ": " << err.what();
+    }
+    EXPECT_TRUE(fs::exists(fs::symlink_status(mine))) << kind;
+    EXPECT_FALSE(fs::exists(dir / "out" / "summary.json")) << kind << ": work done before the refusal";
+    std::ifstream t(kind == "file" ? mine : dir / "target");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(t), {}), "mine") << kind;
+  }
+  // Without the user's file the same folder runs, and resumes.
+  fs::remove_all(dir / "out");
+  EXPECT_EQ(runExperiment(e, o).ran, 2);
+  EXPECT_EQ(runExperiment(e, o).resumed, 2);
+}
+
+// `tailsim accuracy --out DIR` wrote accuracy.md and accuracy.csv over the user's files: refused
+// (checkAccuracyTables, before the study; writeAccuracyTables itself), unchanged; its own replaced.
+TEST(UserFiles, AccuracyTablesReplaceOnlyTailsimsOwn) {
+  const fs::path dir = tempDir("a4");
+  for (const std::string name : {"accuracy.md", "accuracy.csv"}) {
+    std::ofstream(dir / name) << "mine";
+    EXPECT_THROW(checkAccuracyTables(dir.string()), std::runtime_error) << name;
+    try {
+      writeAccuracyTables({}, dir.string());
+      ADD_FAILURE() << "the user's " << name << " was replaced";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find((dir / name).string() + " was not written by tailsim"), std::string::npos)
+          << e.what();
+    }
+    std::ifstream in(dir / name);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "mine") << name;
+    fs::remove(dir / name);
+  }
+  writeAccuracyTables({}, dir.string());
+  checkAccuracyTables(dir.string());
+  writeAccuracyTables({}, dir.string());  // over its own
 }
 
 // A user's file named like a temporary of a dead process but without tailsim's infix

@@ -85,6 +85,20 @@ TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepRenderingIsBounded) {
   EXPECT_EQ(errorOf(write("small.yaml", sweep + "render: {width: 640, height: 480}\n")), "(no error)");
 }
 
+// A video replays whichever model ran: an analytic-only sweep's rendering is bounded
+// the same way (this file, models [analytic], was accepted and started 981 renders of 8192 x 8192).
+TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepRenderingIsBoundedForEveryModel) {
+  for (const std::string models : {"[analytic]", "[analytic, perfoot]"}) {
+    const std::string f =
+        write("rend_a.yaml", "name: r\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25, w_ss: {range: [0.01, 0.99, "
+                             "0.001]}}\nmodels: " + models + "\noutput: {time_series: none}\n"
+                             "render: {width: 8192, height: 8192, fps: 240, slowmo: 160, msaa: 4}\n");
+    const std::string e = errorOf(f);
+    EXPECT_EQ(e.rfind(f + ":1:1: the 981 cases would render about ", 0), 0u) << models << ": " << e;
+    EXPECT_NE(e.find("more than the limit 1e+12"), std::string::npos) << models << ": " << e;
+  }
+}
+
 // The solver steps of a whole sweep are bounded too.
 TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepStepsAreBounded) {
   const std::string f = write("steps.yaml",
@@ -95,6 +109,29 @@ TEST_F(UnboundedWorkRefusedAtLoad, WholeSweepStepsAreBounded) {
   const std::string e = errorOf(f);
   EXPECT_EQ(e.rfind(f + ":1:1: the 2501 cases would take about ", 0), 0u) << e;
   EXPECT_NE(e.find("solver steps in all"), std::string::npos) << e;
+}
+
+// A suite's members are bounded together: each below the whole-experiment limits, two of them over
+// (a 60-member suite of 98,010-case experiments, 5.9 million cases, loaded for over a minute and
+// 1.4 GB before anything was said).
+TEST_F(UnboundedWorkRefusedAtLoad, SuiteMembersAreBoundedTogether) {
+  auto member = [&](const std::string& name) {
+    return write(name + ".yaml", "name: " + name + "\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\nmodels: [mujoco]\n"
+                                 "output: {duration_s: 100, sample_dt_s: 0.01, time_series: none}\n"
+                                 "mujoco: {timestep_s: 0.00002}\nquadruped: {d_Q2B_m: {range: [0.1, 0.148, 0.00004]}}\n");
+  };
+  EXPECT_EQ(errorOf(member("m1")), "(no error)");  // about 6e9 steps: within 1e10 alone
+  member("m2");
+  const std::string suite = write("suite.yaml", "experiments: [m1.yaml, m2.yaml]\n");
+  std::string e = "(no error)";
+  try {
+    loadExperimentSuite(suite);
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_EQ(e.rfind(suite + ":1:24: experiments[1]: the suite's ", 0), 0u) << e;
+  EXPECT_NE(e.find(" cases up to this experiment would take about "), std::string::npos) << e;
+  EXPECT_NE(e.find("more than the limit 1e+10"), std::string::npos) << e;
 }
 
 // threads is bounded before any work (the CLI's --threads and tailsim.run(threads=...) alike).

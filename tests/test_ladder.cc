@@ -165,3 +165,42 @@ TEST(GapLadder, AFolderWithoutTheLadderAxesIsRefused) {
   }
   fs::remove_all(dir);
 }
+
+// ladder.md and ladder.csv were written over the user's own files of those names: refused before
+// anything is written, naming the file; tailsim's own (and an earlier tailsim's, by its first line)
+// are replaced.
+TEST(UserFiles, LadderTablesReplaceOnlyTailsimsOwn) {
+  const fs::path out = tempDir("userfiles");
+  RunOptions o;
+  o.out_dir = out.string();
+  o.progress = false;
+  o.threads = 2;
+  runExperiment(loadExperiment(std::string(TAILSIM_SOURCE_DIR) + "/configs/ladder/fig07_loading.yaml"), o);
+  for (const std::string name : {"ladder.md", "ladder.csv"}) {
+    std::ofstream(out / name) << "mine";
+    try {
+      writeLadder(out.string());
+      ADD_FAILURE() << "the user's " << name << " was replaced";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find((out / name).string() + " was not written by tailsim"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(slurp(out / name), "mine");
+    EXPECT_FALSE(fs::exists(out / "plots" / "ladder_fig07_loading.png")) << "written before the refusal";
+    fs::remove(out / name);
+  }
+  writeLadder(out.string());
+  writeLadder(out.string());  // over its own files
+  const std::string md = slurp(out / "ladder.md");
+  {  // an earlier tailsim's ladder.md: not in the manifest, recognised by its first line
+    std::istringstream in(slurp(out / ".tailsim-manifest"));
+    std::string keep;
+    for (std::string l; std::getline(in, l);)
+      if (l.size() < 11 || l.compare(l.size() - 11, 11, "  ladder.md") != 0) keep += l + "\n";
+    std::ofstream(out / ".tailsim-manifest", std::ios::trunc) << keep;
+  }
+  std::ofstream(out / "ladder.md", std::ios::trunc) << "# The gap ladder\n\nolder\n";
+  writeLadder(out.string());
+  EXPECT_EQ(slurp(out / "ladder.md"), md);
+  fs::remove_all(out);
+}

@@ -181,7 +181,7 @@ TEST(ResumeKey, EveryDeclaredFieldIsInTheKey) {
 }
 
 // The loader refuses, at file:line:col, every render value the renderer would refuse (the same
-// declared limits): fps above 240, odd or tiny sizes, msaa, crf, preset, empty ffmpeg.
+// declared limits): fps above 240, odd or tiny sizes, msaa, crf, preset.
 TEST(DeclaredLimits, LoaderRefusesWhatTheRendererRefuses) {
   const fs::path dir = tempDir("render");
   const std::string f = (dir / "e.yaml").string();
@@ -192,7 +192,6 @@ TEST(DeclaredLimits, LoaderRefusesWhatTheRendererRefuses) {
            {"{msaa: 5}", "render.msaa"},
            {"{crf: 52}", "render.crf"},
            {"{preset: quick}", "render.preset"},
-           {"{ffmpeg: ''}", "render.ffmpeg"},
            {"{camera: side}", "render.camera"},
            {"{slowmo: 0}", "render.slowmo"}}) {
     const std::string err = loadError(dir, std::string(kBase) + "render: " + yaml + "\n");

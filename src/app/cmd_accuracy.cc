@@ -29,6 +29,7 @@ void addAccuracyCommand(CLI::App& app, int& exit_code) {
   accuracy->callback([a, &exit_code] {
     const Experiment e = loadExperiment(a->exp_path);
     std::filesystem::create_directories(a->out);
+    checkAccuracyTables(a->out);
     AccuracyOptions ao;
     ao.repeats = a->repeats;
     ao.quick = a->quick;

@@ -11,6 +11,7 @@
 
 #include "design/design_yaml.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/work_estimate.h"
 #include "results/work_limits.h"
 
 namespace tailsim {
@@ -189,6 +190,15 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
                     (os.enumerate_directions ? " x 2^n patterns" : "") + ", more than the limit " +
                     fmtG(limits::kMaxOptimizeRuns) +
                     " (docs/design-a-tail-stroke.md \"Limits\"): lower generations, population, islands, restarts or seeds");
+  // A run's cost is the base's: its analytic steps (a fixed or bounded step may make a run seconds long).
+  if (const double runs = optimizeRunEstimate(s), per_run = std::max(1.0, estimateWork(s.base).solverSteps());
+      !(runs * per_run <= limits::kMaxOptimizeSteps))
+    r.fail(opt, "the search would take about " + fmtG(runs * per_run) + " analytic solver steps (about " + fmtG(runs) +
+                    " runs x at least " + fmtG(per_run) +
+                    " steps a run, as the base experiment's stroke and analytic settings take), more than the limit " +
+                    fmtG(limits::kMaxOptimizeSteps) +
+                    " (docs/design-a-tail-stroke.md \"Limits\"): lower generations, population, islands, restarts or "
+                    "seeds, or give the base a coarser analytic step (analytic.fixed_dt_s, analytic.max_step_s)");
   if (torque && L.torque_max_Nm == 0.0) {  // torque_max_Nm: base -- the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");

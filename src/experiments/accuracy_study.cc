@@ -285,6 +285,14 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
   return out;
 }
 
+namespace {
+// A table an earlier tailsim wrote before folders had a manifest: recognised by its first line.
+EarlierOwnFile earlierAccuracyTable(const std::string& name) {
+  const std::string head = name == "accuracy.csv" ? "case,model,family,setting,value,is_default," : "# Work-precision study\n";
+  return [head](const std::string& text) { return text.compare(0, head.size(), head) == 0; };
+}
+}  // namespace
+
 void writeAccuracyTables(const std::vector<AccuracyStudy>& studies, const std::string& dir) {
   std::ostringstream csv, md;
   csv << "case,model,family,setting,value,is_default,ok,phi_net_deg,err_phi_net_deg,rms_err_phi_deg,wall_s,steps,"
@@ -335,8 +343,12 @@ void writeAccuracyTables(const std::vector<AccuracyStudy>& studies, const std::s
       md << b;
     }
   }
-  writeFileAtomic(dir + "/accuracy.csv", csv.str());
-  writeFileAtomic(dir + "/accuracy.md", md.str());
+  writeOwnedFile(dir, "accuracy.csv", csv.str(), earlierAccuracyTable("accuracy.csv"));
+  writeOwnedFile(dir, "accuracy.md", md.str(), earlierAccuracyTable("accuracy.md"));
+}
+
+void checkAccuracyTables(const std::string& dir) {
+  for (const char* name : {"accuracy.csv", "accuracy.md"}) checkOwnedFile(dir, name, std::nullopt, earlierAccuracyTable(name));
 }
 
 }  // namespace tailsim

@@ -54,7 +54,11 @@ struct AccuracyOptions {
 // Every case of `e` (kind: simulate), both models unless options.mujoco is false.
 std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyOptions& options);
 
-// DIR/accuracy.csv and DIR/accuracy.md (tables, defaults marked, references and their error).
+// Throws std::runtime_error naming the file when DIR/accuracy.csv or DIR/accuracy.md is there but not
+// tailsim's (its .tailsim-manifest does not name it as it is): checked before the study runs.
+void checkAccuracyTables(const std::string& dir);
+// DIR/accuracy.csv and DIR/accuracy.md (tables, defaults marked, references and their error), each
+// only over a file of tailsim's (writeOwnedFile).
 void writeAccuracyTables(const std::vector<AccuracyStudy>& studies, const std::string& dir);
 
 }  // namespace tailsim

@@ -1356,7 +1356,7 @@ Experiment readExperiment(Loader& L, const std::string* file, const YAML::Node& 
 }
 
 void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::vector<std::string>& stack,
-               std::vector<Experiment>& out, std::map<std::string, std::string>& names) {
+               std::vector<Experiment>& out, std::map<std::string, std::string>& names, WorkTotal& total) {
   const Reader r(file, nullptr);
   const MapView m = r.map(r.root(doc), {"experiments", "description"});
   if (const Item* d = m.get("description")) r.string(*d);
@@ -1380,12 +1380,20 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
       if (stack.size() >= kMaxSuiteDepth)
         r.fail(entry, "suites are nested more than " + std::to_string(kMaxSuiteDepth) +
                           " deep (a suite listing a suite listing a suite ...)");
-      readSuite(L, path, sub, stack, out, names);
+      readSuite(L, path, sub, stack, out, names, total);
       continue;
     }
     Experiment e = readExperiment(L, path, sub);
     const auto [it, fresh] = names.emplace(e.name, *path);
     if (!fresh) r.fail(entry, "experiment name '" + e.name + "' is already used by " + it->second);
+    // The members together, bounded as one experiment's work (and at most kMaxSuiteCases cases), as they load.
+    total += totalWork(e.cases);
+    if (total.cases > static_cast<double>(kMaxSuiteCases))
+      r.fail(entry, "the suite's experiments up to this one make " + fmtG(total.cases) + " cases, more than " +
+                        std::to_string(kMaxSuiteCases) + " (docs/experiment-format.md \"Limits\"): split the suite");
+    if (const std::string x = workTotalExcess(total, "suite's " + fmtG(total.cases) + " cases up to this experiment");
+        !x.empty())
+      r.fail(entry, x);
     out.push_back(std::move(e));
   }
   stack.pop_back();
@@ -1528,7 +1536,8 @@ std::vector<Experiment> loadExperimentSuite(const std::string& path) {
   }
   std::vector<std::string> stack;
   std::map<std::string, std::string> names;
-  readSuite(L, file, doc, stack, out, names);
+  WorkTotal total;
+  readSuite(L, file, doc, stack, out, names, total);
   return out;
 }
 

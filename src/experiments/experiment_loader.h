@@ -62,6 +62,9 @@ std::string experimentNameProblem(const std::string& name, std::size_t max_chars
 // At most this many values per sweep/range and this many cases per experiment.
 constexpr std::size_t kMaxSweepValues = 10000;
 constexpr std::size_t kMaxCases = 100000;
+// A suite's members together (each within kMaxCases; their steps, bytes and render samples are bounded
+// together by the whole-experiment limits too).
+constexpr std::size_t kMaxSuiteCases = 10 * kMaxCases;
 
 // Bounds on any YAML file the loader reads (hostile input must fail fast with file:line:col, never
 // crash or run for minutes): its size, the nesting of lists and maps, the number of values, lists

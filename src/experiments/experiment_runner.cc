@@ -335,6 +335,19 @@ bool h5PartIntact(const Job& job, size_t i) {
   }
 }
 
+// A file at case i's part path that tailsim never wrote there (time_series.h5.d's manifest has no line
+// for its name: tailsim names a part before it takes its name) is the user's: refused, not replaced. A
+// part of tailsim's changed since (damaged) has its line: its case runs again and replaces it.
+void refuseUserPart(const Job& job, size_t i) {
+  const fs::path p = h5PartPath(job, i);
+  std::error_code ec;
+  if (!fs::exists(fs::symlink_status(p, ec))) return;
+  const std::optional<std::string> m = readResultFile((job.root / kH5Parts / ".tailsim-manifest").string());
+  if (m && m->find("  " + job.dirs[i] + ".h5\n") != std::string::npos) return;
+  throw std::runtime_error(p.string() + " was not written by tailsim: not replaced; move it out of " +
+                           (job.root / kH5Parts).string() + " or choose another --out");
+}
+
 bool keepsSeries(const ExperimentCase& c) { return c.output.time_series != TimeSeriesOutput::kNone; }
 bool inH5(const ExperimentCase& c) { return keepsSeries(c) && c.output.time_series_file == TimeSeriesFile::kHdf5; }
 
@@ -903,6 +916,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       continue;
     }
     job.h5_from[i] = kH5None;
+    if (inH5(c)) refuseUserPart(job, i);
     job.todo.push_back(i);
   }
   if (!job.other_builds.empty()) {
@@ -1013,11 +1027,12 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     }
   }
   if (job.render) renderCase(c, runs, (job.root / "renders").string());
-  if (part) {  // on disk, and named with its content, before the journal says the case is finished
-    part->publish();
-    const std::optional<std::string> text = readResultFile(h5PartPath(job, i).string());
-    if (!text) throw std::runtime_error("cannot read back " + h5PartPath(job, i).string());
-    recordInManifest((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *text);
+  if (part) {  // on disk, and named with its content before it takes its name, before the journal line
+    part->publish([&](const std::string& temp) {
+      const std::optional<std::string> hash = sha256OfFile(temp);
+      if (!hash) throw std::runtime_error("cannot read back " + temp);
+      recordHashInManifest((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *hash);
+    });
   }
   std::string line = j.dump();
   if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
@@ -1091,15 +1106,21 @@ void publishTimeSeriesH5(Job& job) {
     long long bytes = kH5FileBytes + kH5LinkBytes * static_cast<long long>(from_published.size() + from_parts.size());
     if (!from_published.empty()) bytes += static_cast<long long>(fs::file_size(job.published->path(), ec));
     for (size_t i : from_parts) bytes += static_cast<long long>(fs::file_size(h5PartPath(job, i), ec));
-    TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes);
-    for (size_t i : from_published) out.copyCase(*job.published, job.dirs[i]);
-    for (size_t i : from_parts) {
-      const TimeSeriesH5Reader part(h5PartPath(job, i).string());
-      if (!part.ok()) throw std::runtime_error("cannot read " + h5PartPath(job, i).string());
-      out.copyCase(part, job.dirs[i]);
-    }
-    job.published.reset();  // (closed before the rename replaces it)
-    out.publish();
+    // In a child process: a damaged file (its manifest line matching) crashes libhdf5, not tailsim.
+    const std::string what = (from_published.empty() ? std::string() : job.published->path() + " or ") + "a part in " +
+                             parts.string();
+    runHdf5Isolated(what, [&] {
+      TimeSeriesH5Writer out((job.root / "time_series.h5").string(), H5Storage::kDisk, bytes);
+      for (size_t i : from_published) out.copyCase(*job.published, job.dirs[i]);
+      for (size_t i : from_parts) {
+        const TimeSeriesH5Reader part(h5PartPath(job, i).string());
+        if (!part.ok()) throw std::runtime_error("cannot read " + h5PartPath(job, i).string());
+        out.copyCase(part, job.dirs[i]);
+      }
+      job.published.reset();  // (closed before the rename replaces it)
+      out.publish();
+    });
+    job.published.reset();  // (the child replaced it)
   }
   const std::optional<std::string> hash = sha256OfFile((job.root / "time_series.h5").string());
   if (!hash) throw std::runtime_error("cannot read back " + (job.root / "time_series.h5").string());
@@ -1254,12 +1275,17 @@ RunStats runJobs(std::vector<Job>& jobs, const RunOptions& opt, const std::strin
         // Out of memory: every case holds its series in memory while it runs; start no more.
         stop = true;
         std::lock_guard<std::mutex> lock(mu);
-        if (first_error.empty())
-          first_error = "case " + t.job->e->cases[t.i].name +
-                        ": out of memory while running it (each running case holds its time series in memory, one "
-                        "case per thread): use fewer --threads, raise output.sample_dt_s or set output.time_series: "
-                        "thin or none; no further case was started, the finished ones are saved (run the same "
-                        "command again to resume)";
+        if (first_error.empty()) {
+          // Its series as held while it runs: rows x columns x 8 B a value, per model (a lower bound).
+          const ExperimentCase& c = t.job->e->cases[t.i];
+          char mb[32];
+          std::snprintf(mb, sizeof mb, "%.0f",
+                        estimateWork(c).csv_bytes / limits::kCsvBytesPerValue * 8.0 * static_cast<double>(c.models.size()) / 1e6);
+          first_error = "case " + c.name + ": out of memory while running it (each running case holds its time series in "
+                        "memory, at least about " + mb + " MB for this one, one case per thread): use fewer --threads, "
+                        "raise output.sample_dt_s or set output.time_series: thin or none; no further case was started, "
+                        "the finished ones are saved (run the same command again to resume)";
+        }
       } catch (const std::exception& ex) {
         // A full disk fails every case after it: stop starting new ones.
         const auto* sys = dynamic_cast<const std::system_error*>(&ex);

@@ -284,7 +284,8 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
         if (rel.filename() == "time_series.h5") {  // every shard's case groups (the first shard's win)
           requireIntactH5(it->path(), d);  // libhdf5 crashes on some damaged files
           fs::create_directories(dst.parent_path());
-          mergeTimeSeriesH5(it->path().string(), dst.string());
+          runHdf5Isolated(it->path().string() + " (shard " + d + ")",
+                          [&] { mergeTimeSeriesH5(it->path().string(), dst.string()); });
           merged_h5.insert(dst);
           continue;
         }

@@ -14,6 +14,7 @@
 // (H5Handle); Debian's libhdf5 is built thread-safe, and each writer also serializes its own calls.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -81,7 +82,9 @@ class TimeSeriesH5Writer {
   // Copies /<case_dir> (all its models) from a published file (H5Ocopy).
   void copyCase(const TimeSeriesH5Reader& from, const std::string& case_dir);
   // Closes the file, flushes it to disk and renames it over final_path (the rename is flushed too).
-  void publish();
+  // before_rename (if given) is called with the temporary file's path once it is whole on disk,
+  // before the rename (to name it in a manifest first: a stop in between leaves no unnamed file).
+  void publish(const std::function<void(const std::string& temp_path)>& before_rename = nullptr);
 
  private:
   void writeLocked(const std::string& case_dir, const std::string& case_name, const std::string& key,
@@ -94,6 +97,14 @@ class TimeSeriesH5Writer {
   int reserve_fd_ = -1;
   bool published_ = false;
 };
+
+// Runs f, which reads HDF5 files written elsewhere or earlier, in a child process: libhdf5 crashes
+// (SIGSEGV) on some damaged files whatever their manifest line says (a shard received from another
+// machine has a manifest that matches whatever it holds). A crash is then std::runtime_error
+// "<what> is damaged: libhdf5 crashed reading it (...)", never tailsim's; f's exceptions come back with
+// their message (a std::system_error with its error code, so a full disk is still ENOSPC). f's effects
+// on memory stay in the child: it may only write files. Call it with no other thread using libhdf5.
+void runHdf5Isolated(const std::string& what, const std::function<void()>& f);
 
 // Copies every case group of `src` that `dst` lacks into `dst` (created when absent): joins the
 // files of shard folders (tailsim merge). Throws std::runtime_error.

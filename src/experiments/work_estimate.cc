@@ -173,37 +173,55 @@ std::string jointSpeedWarning(const ExperimentCase& c) {
          "docs/experiment-format.md \"Limits\"): the result describes a stroke no robot makes";
 }
 
-WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
-  WorkExcess x;
-  double steps = 0, bytes = 0, samples = 0, frames = 0;
+WorkTotal totalWork(const std::vector<ExperimentCase>& cases) {
+  WorkTotal t;
+  t.cases = static_cast<double>(cases.size());
   for (const ExperimentCase& c : cases) {
     if (c.kind != CaseKind::kSimulate) continue;
     const WorkEstimate w = estimateWork(c);
-    steps += w.solverSteps();
-    samples += w.render_samples;
-    frames += w.render_frames;
+    t.steps += w.solverSteps();
+    t.samples += w.render_samples;
+    t.frames += w.render_frames;
     const double share = c.output.time_series == TimeSeriesOutput::kNone   ? 0.0
                          : c.output.time_series == TimeSeriesOutput::kThin ? 0.1
                                                                             : 1.0;
-    bytes += share * w.csv_bytes * static_cast<double>(c.models.size());
+    t.bytes += share * w.csv_bytes * static_cast<double>(c.models.size());
   }
+  return t;
+}
+
+WorkTotal& operator+=(WorkTotal& a, const WorkTotal& b) {
+  a.cases += b.cases;
+  a.steps += b.steps;
+  a.bytes += b.bytes;
+  a.samples += b.samples;
+  a.frames += b.frames;
+  return a;
+}
+
+std::string workTotalExcess(const WorkTotal& w, const std::string& n) {
   const std::string see = " (docs/experiment-format.md \"Limits\")";
-  const std::string n = std::to_string(cases.size()) + (cases.size() == 1 ? " case" : " cases");
-  if (!(steps <= limits::kMaxExperimentSteps))
-    x.what = "the " + n + " would take about " + g(steps) + " solver steps in all (every model's steps, " +
-             "summed over the cases), more than the limit " + g(limits::kMaxExperimentSteps) + see +
-             ": sweep fewer values or split the experiment";
-  else if (!(bytes <= limits::kMaxExperimentBytes))
-    x.what = "the " + n + " would write about " + g(bytes) + " bytes of time series in all (rows x columns x " +
-             g(limits::kCsvBytesPerValue) + " B per model run, summed over the cases), more than the limit " +
-             g(limits::kMaxExperimentBytes) + see + ": set output.time_series: thin or none, raise output.sample_dt_s, " +
-             "or sweep fewer values";
-  else if (!(samples <= limits::kMaxExperimentRenderSamples))
-    x.what = "the " + n + " would render about " + g(frames) + " video frames, " + g(samples) +
-             " samples in all (frames x render.width x render.height x render.msaa, summed over the cases), more "
-             "than the limit " + g(limits::kMaxExperimentRenderSamples) + " (about 14 hours of rendering)" + see +
-             ": lower render.width, render.height, render.msaa, render.fps or render.slowmo, set render.duration_s, "
-             "or sweep fewer values";
+  if (!(w.steps <= limits::kMaxExperimentSteps))
+    return "the " + n + " would take about " + g(w.steps) + " solver steps in all (every model's steps, " +
+           "summed over the cases), more than the limit " + g(limits::kMaxExperimentSteps) + see +
+           ": sweep fewer values or split the experiment";
+  if (!(w.bytes <= limits::kMaxExperimentBytes))
+    return "the " + n + " would write about " + g(w.bytes) + " bytes of time series in all (rows x columns x " +
+           g(limits::kCsvBytesPerValue) + " B per model run, summed over the cases), more than the limit " +
+           g(limits::kMaxExperimentBytes) + see + ": set output.time_series: thin or none, raise output.sample_dt_s, " +
+           "or sweep fewer values";
+  if (!(w.samples <= limits::kMaxExperimentRenderSamples))
+    return "the " + n + " would render about " + g(w.frames) + " video frames, " + g(w.samples) +
+           " samples in all (frames x render.width x render.height x render.msaa, summed over the cases), more "
+           "than the limit " + g(limits::kMaxExperimentRenderSamples) + " (about 14 hours of rendering)" + see +
+           ": lower render.width, render.height, render.msaa, render.fps or render.slowmo, set render.duration_s, "
+           "or sweep fewer values";
+  return "";
+}
+
+WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases) {
+  WorkExcess x;
+  x.what = workTotalExcess(totalWork(cases), std::to_string(cases.size()) + (cases.size() == 1 ? " case" : " cases"));
   return x;
 }
 

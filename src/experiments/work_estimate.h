@@ -58,4 +58,14 @@ std::string jointSpeedWarning(const ExperimentCase& c);
 // (the sweeps as a whole are the culprit).
 WorkExcess checkExperimentWork(const std::vector<ExperimentCase>& cases);
 
+// Those sums, to bound the members of a suite together (a suite of N members could ask N times
+// what one experiment may): `cases` counts every case.
+struct WorkTotal {
+  double cases = 0, steps = 0, bytes = 0, samples = 0, frames = 0;
+};
+WorkTotal totalWork(const std::vector<ExperimentCase>& cases);
+WorkTotal& operator+=(WorkTotal& a, const WorkTotal& b);
+// What exceeds the whole-experiment limits ("" when within); `n` names the cases ("the <n> would ...").
+std::string workTotalExcess(const WorkTotal& w, const std::string& n);
+
 }  // namespace tailsim

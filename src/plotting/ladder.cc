@@ -270,6 +270,13 @@ std::vector<LadderCase> loadLadder(const std::string& dir) {
 
 std::vector<std::string> writeLadder(const std::string& dir) {
   const std::vector<LadderCase> cs = loadLadder(dir);
+  // ladder.csv and ladder.md only over tailsim's own (an earlier tailsim's without a manifest: by their first line)
+  const auto earlier = [](const char* head) {
+    return [h = std::string(head)](const std::string& text) { return text.compare(0, h.size(), h) == 0; };
+  };
+  const EarlierOwnFile earlier_csv = earlier("experiment,case,"), earlier_md = earlier("# The gap ladder\n");
+  checkOwnedFile(dir, "ladder.csv", std::nullopt, earlier_csv);  // before anything is written
+  checkOwnedFile(dir, "ladder.md", std::nullopt, earlier_md);
   std::vector<std::string> files;
   const std::string plots = (std::filesystem::path(dir) / "plots").string();
   std::filesystem::create_directories(plots);
@@ -289,7 +296,7 @@ std::vector<std::string> writeLadder(const std::string& dir) {
     csv << "," << fmt("%.9g", c.paper_adams) << "\n";
   }
   const std::string csv_path = (std::filesystem::path(dir) / "ladder.csv").string();
-  writeFileAtomic(csv_path, csv.str());
+  writeOwnedFile(dir, "ladder.csv", csv.str(), earlier_csv);
   files.push_back(csv_path);
 
   std::ostringstream o;
@@ -378,7 +385,7 @@ std::vector<std::string> writeLadder(const std::string& dir) {
     tableOf(o, sub);
   }
   const std::string md = (std::filesystem::path(dir) / "ladder.md").string();
-  writeFileAtomic(md, o.str());
+  writeOwnedFile(dir, "ladder.md", o.str(), earlier_md);
   files.insert(files.begin(), md);
   return files;
 }

@@ -32,8 +32,9 @@ struct RenderSettings {
   bool shadows = false, reflections = false;
   int msaa = 4;               // offscreen multisamples (0 = off)
   bool ghost = true;          // translucent analytic-model ghost
-  // The encoder.
-  std::string ffmpeg = "ffmpeg";  // executable: looked up on PATH unless it contains a '/'
+  // The encoder executable, looked up on PATH unless it contains a '/'. Not a declared field: no
+  // experiment file, result folder or Python call names a program to run; only C++ callers set it.
+  std::string ffmpeg = "ffmpeg";
   int crf = 20;                   // libx264 constant rate factor (lower = better, bigger)
   std::string preset = "ultrafast";  // libx264 preset (ultrafast: least CPU next to llvmpipe)
 };
@@ -76,8 +77,6 @@ settings::For<S, RenderSettings> declareFields(V& v, S& s) {
   v.boolean(Field{"reflections", "floor reflections (1.4x the cost)"}, s.reflections);
   v.integer(Field{"msaa", "offscreen multisamples; 0 = off"}, s.msaa, Limits::closed(0, kRenderMaxMsaa));
   v.boolean(Field{"ghost", "translucent analytic-model ghost"}, s.ghost);
-  v.text(Field{"ffmpeg", "encoder executable: looked up on PATH unless it contains a '/'"}, s.ffmpeg,
-         settings::TextRule{true, {}});
   v.integer(Field{"crf", "libx264 constant rate factor (lower = better, bigger)"}, s.crf,
             Limits::closed(kRenderMinCrf, kRenderMaxCrf));
   v.text(Field{"preset", "libx264 preset (ultrafast: least CPU next to llvmpipe)"}, s.preset,

@@ -52,11 +52,11 @@ std::string requireFfmpeg(const RenderSettings& s) {
   if (exe.empty()) {
     if (s.ffmpeg.find('/') != std::string::npos)
       throw std::runtime_error("rendering: ffmpeg not found at " + s.ffmpeg +
-                               " (render.ffmpeg); install ffmpeg (scripts/setup.sh) or fix the path");
+                               "; install ffmpeg (scripts/setup.sh) or fix the path");
     const char* path = std::getenv("PATH");
     throw std::runtime_error("rendering: '" + s.ffmpeg + "' not found on PATH (" + (path ? path : "unset") +
-                             "); install ffmpeg (scripts/setup.sh installs the Debian package) or set "
-                             "render.ffmpeg to its full path");
+                             "); install ffmpeg (scripts/setup.sh installs the Debian package) or put its "
+                             "folder on PATH");
   }
   return exe;
 }
