@@ -22,6 +22,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 
+#include "app/commands.h"
 #include "experiments/accuracy_study.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
@@ -168,11 +169,12 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
           const std::string q = poseQuantity(pose_results ? &*pose_results : nullptr, c.name, model);
           std::printf(" %s: %s", model.c_str(), q.empty() ? "ok" : q.c_str());
         } else if (r["phi_net_deg"].is_number())
-          std::printf(" %s: phi_net %+.3f deg (%.2f ms)", model.c_str(), r["phi_net_deg"].get<double>(),
+          std::printf(" %s: phi_net %s deg (%.2f ms)", model.c_str(), readRunRecord(r).phiText().c_str(),
                       1e3 * r.value("wall_time_s", 0.0));
         else std::printf(" %s: ok", model.c_str());
       }
       std::printf("\n");
+      if (j.contains("verdict") && j["verdict"].is_string()) std::printf("    verdict: %s\n", j["verdict"].get<std::string>().c_str());
       for (const auto& [model, r] : j["runs"].items())
         if (r.contains("warnings") && r["warnings"].is_array())
           for (const auto& w : r["warnings"])
@@ -343,6 +345,8 @@ int main(int argc, char** argv) {
   auto* ladder = app.add_subcommand("ladder", "write DIR/ladder.md: the gap ladder of a configs/ladder/ result folder");
   ladder->add_option("dir", result_dir, "result folder")->required()->check(CLI::ExistingDirectory);
 
+  int trust_exit = -1;
+  addTrustCommand(app, trust_exit);
   std::string acc_out;
   bool acc_quick = false, acc_no_mujoco = false;
   int acc_repeats = 3;
@@ -408,6 +412,7 @@ int main(int argc, char** argv) {
     return kExitUsage;
   }
 
+  if (trust_exit >= 0) return trust_exit;
   try {
     if (*run) {
       ShardSpec shard{};
