@@ -74,7 +74,7 @@ std::vector<std::string> writeTrust(const std::vector<TrustStudy>& studies, cons
       const double err = r.group == "reference" ? kNaN : errOf(r, ref);
       if (!std::isfinite(err)) continue;
       groups[r.group].push_back({1e3 * r.wall_s, std::max(err, 1e-4)});
-      if (studies.size() == 1) {
+      if (studies.size() == 1 && r.group != "jitter") {  // the jitter points sit on the default's
         const std::string short_setting = r.group == "default" ? std::string("default") : r.setting;
         labels.push_back("set label " + gpQuote(gpText(short_setting)) + " at " + fmt("%.6g", 1e3 * r.wall_s) + ", " +
                          fmt("%.6g", std::max(err, 1e-4)) + " offset 1, 0.6 font ',9'");
@@ -87,7 +87,8 @@ std::vector<std::string> writeTrust(const std::vector<TrustStudy>& studies, cons
        << gpTitle(gpText("What the MuJoCo answer depends on and what it costs: " + e.name +
                          (studies.size() == 1 ? ", case " + studies[0].case_name : "")),
                   1400)
-       << "\nset key top right box opaque\n";
+       << "\nset rmargin at screen 0.72\nset key at screen 0.73, graph 1 left top Left reverse nobox samplen 2"
+       << "\nset offsets graph 0.05, graph 0.35, graph 0.3, graph 0.3\n";
   for (const std::string& l : labels) body << l << "\n";
   // The default run's own uncertainty, as a horizontal line (single case).
   std::vector<std::string> parts;
@@ -103,7 +104,7 @@ std::vector<std::string> writeTrust(const std::vector<TrustStudy>& studies, cons
     if (const TrustRow* d = studies[0].row("default"); d && std::isfinite(d->uncertainty_deg))
       parts.push_back(fmt("%.9g", std::max(d->uncertainty_deg, 1e-4)) +
                       " with lines dt 2 lw 2 lc rgb 'gray40' title " +
-                      gpQuote(gpText("the default run's own uncertainty (phi_net_uncertainty_deg)")));
+                      gpQuote(gpText("default's own uncertainty")));
   if (!parts.empty()) {
     body << "plot ";
     for (size_t i = 0; i < parts.size(); ++i) body << (i ? ", \\\n     " : "") << parts[i];
