@@ -32,6 +32,7 @@ void addTrustCommand(CLI::App& app, int& exit_code) {
       const Experiment e = loadExperiment(o->experiment);  // every error before any work
       TrustOptions opt;
       opt.only_case = o->only_case;
+      requireCase({e}, o->experiment, o->only_case);  // before the folder is made
       const FolderLock lock(o->out);
       refuseRunResults(o->out, "trust");
       claimDesignFolder(o->out, trustOutputs());
