@@ -17,7 +17,11 @@
 //    airborne_fraction), and the median share;
 //  * peak Fn / m g: median and max of summary extra peak_normal_force_over_mg;
 //  * falls: the rule fails (tips over, unstable) where the reference stands, and the other way round;
-//  * steps, wall: median mj_step calls (pre-roll included) and wall time per run.
+//  * steps, wall: median mj_step calls (pre-roll and the uncertainty's check run included) and
+//    wall time per run;
+//  * U bounds err: runs whose phi_net_uncertainty_deg >= |phi_net - phi_net,ref|; U median: the
+//    uncertainty / max(|phi_net|, 0.5 deg); U flagged: runs warned as uncertain; err > 3 %
+//    flagged: of the runs more than 3 % off the reference, those warned.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -44,7 +48,7 @@ namespace {
 
 struct Run {
   bool ok = false;
-  double phi_deg = NAN, airborne = NAN, peak = NAN, wall_s = NAN;
+  double phi_deg = NAN, airborne = NAN, peak = NAN, wall_s = NAN, u_deg = NAN, tilt_deg = NAN;
   long steps = 0;
 };
 
@@ -71,6 +75,7 @@ void today(const RobotParams&, const TailTrajectory&, MujocoSettings& s) {
   s.foot_shape = MujocoFootShape::kSphere;
   s.foot_radius_m = 0.01;
   s.settle_s = 0.1;
+  s.uncertainty = false;
 }
 
 // Finer step with the servo's natural frequency kept.
@@ -82,6 +87,7 @@ void refine(MujocoSettings& s, double factor) {
 // A rule's converged reference: its own contact, a finer step, stiff friction and noslip.
 void toReference(MujocoSettings& s, double factor) {
   refine(s, factor);
+  s.uncertainty = false;
   s.impratio = std::max(s.impratio, 100.0);
   s.noslip_iterations = std::max(s.noslip_iterations, 3);
 }
@@ -186,12 +192,16 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
     out.phi_deg = res.summary.phi_net_deg;
     out.wall_s = res.summary.wall_time_s;
     out.steps = res.summary.solver_steps + static_cast<long>(std::lround(s.settle_s / s.timestep_s));
+    if (const auto u = res.summary.extra.find("uncertainty_solver_steps"); u != res.summary.extra.end())
+      out.steps += static_cast<long>(u->second) + static_cast<long>(std::lround(s.settle_s / (2 * s.timestep_s)));
     auto x = [&](const char* k) {
       const auto it = res.summary.extra.find(k);
       return it == res.summary.extra.end() ? NAN : it->second;
     };
     out.airborne = x("airborne_fraction");
     out.peak = x("peak_normal_force_over_mg");
+    out.u_deg = x("phi_net_uncertainty_deg");
+    out.tilt_deg = x("max_tilt_deg");
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "run threw: %s\n", ex.what());
   }
@@ -307,7 +317,7 @@ int main(int argc, char** argv) {
   if (!csv_path.empty()) {
     csv.open(csv_path);
     csv << "rule,case,ok,phi_deg,phi_jitter_deg,ref_ok,ref_phi_deg,ref_jitter_deg,today_ref_phi_deg,ref16_phi_deg,perfoot_phi_deg,airborne,"
-           "peak_over_mg,steps,wall_s,"
+           "peak_over_mg,steps,wall_s,u_deg,max_tilt_deg,"
            "description\n";
   }
 
@@ -334,18 +344,22 @@ int main(int argc, char** argv) {
   std::printf("| rule | compared | err median | err p90 | err max | vs today ref median | vs today ref p90 | "
               "vs per-foot median | vs per-foot p90 | jitter p90 | ref jitter p90 | ref h/8 vs h/16 median / p90 (n) | sign flips | airborne > 1 %% | "
               "airborne median | peak Fn/mg median | peak Fn/mg max | falls only here / only in ref | steps median | "
-              "wall median [ms] |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "wall median [ms] | U bounds err | U median | U flagged | err > 3 %% flagged |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& nm : names) {
     const Rule& rule = all.at(nm);
     std::vector<double> err, errT, errP, jit, rjit, conv, air, peak, steps, wall;
     int flips = 0, air1 = 0, falls_here = 0, falls_ref = 0, compared = 0;
+    int u_have = 0, u_bound = 0, u_flag = 0, big = 0, big_flag = 0;
+    std::vector<double> u_rel;
     for (int k = 0; k < N; ++k) {
       const RandomRobotCase& c = cases[k];
       MujocoSettings s = baseSettings(c.robot);
       rule(c.robot, c.trajectory, s);
       const Run r = runOnce(c.robot, c.trajectory, s);
-      const Run j = runOnce(c.robot, jittered(c.trajectory, 1e-6), s);
+      MujocoSettings sj = s;
+      sj.uncertainty = false;  // the jitter run needs phi_net only
+      const Run j = runOnce(c.robot, jittered(c.trajectory, 1e-6), sj);
       const Run f = refRun(rule, k, 8.0, 0.0);
       const Run fj = refRun(rule, k, 8.0, 1e-6);
       const Run ft = refRun(all.at("today"), k, 8.0, 0.0);
@@ -356,7 +370,7 @@ int main(int argc, char** argv) {
       if (csv.is_open())
         csv << '"' << nm << "\"," << k << ',' << r.ok << ',' << r.phi_deg << ',' << j.phi_deg << ',' << f.ok << ','
             << f.phi_deg << ',' << fj.phi_deg << ',' << ft.phi_deg << ',' << f16.phi_deg << ',' << perfoot[k] << ',' << r.airborne << ','
-            << r.peak << ',' << r.steps << ',' << r.wall_s << ",\"" << describe(c) << "\"\n";
+            << r.peak << ',' << r.steps << ',' << r.wall_s << ',' << r.u_deg << ',' << r.tilt_deg << ",\"" << describe(c) << "\"\n";
       if (r.ok && !f.ok) ++falls_ref;
       if (!r.ok && f.ok) ++falls_here;
       if (!r.ok || !f.ok) continue;
@@ -368,18 +382,28 @@ int main(int argc, char** argv) {
       if (fj.ok) rjit.push_back(rel(fj.phi_deg, f.phi_deg));
       if (f16.ok) conv.push_back(rel(f.phi_deg, f16.phi_deg));
       if (std::abs(f.phi_deg) >= 0.5 && r.phi_deg * f.phi_deg < 0) ++flips;
+      if (std::isfinite(r.u_deg)) {
+        const double scale = std::max(std::abs(r.phi_deg), 0.5);
+        const bool flagged = r.u_deg > s.uncertainty_warn_share * scale;
+        ++u_have;
+        if (std::abs(r.phi_deg - f.phi_deg) <= r.u_deg) ++u_bound;
+        u_flag += flagged;
+        u_rel.push_back(r.u_deg / scale);
+        if (err.back() > 0.03) ++big, big_flag += flagged;
+      }
       air.push_back(r.airborne);
       if (r.airborne > 0.01) ++air1;
       peak.push_back(r.peak);
     }
     std::printf("| %s | %d | %.2f %% | %.2f %% | %.1f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% | %.2f %% / %.2f %% (%zu) "
-                "| %d | %d | %.1f %% | %.2f | %.1f | %d / %d | %.0f | %.1f |\n",
+                "| %d | %d | %.1f %% | %.2f | %.1f | %d / %d | %.0f | %.1f | %d / %d (%.1f %%) | %.2f %% | %d | %d / %d |\n",
                 nm.c_str(), compared, 100 * quantile(err, 0.5), 100 * quantile(err, 0.9), 100 * quantile(err, 1.0),
                 100 * quantile(errT, 0.5), 100 * quantile(errT, 0.9), 100 * quantile(errP, 0.5), 100 * quantile(errP, 0.9),
                 100 * quantile(jit, 0.9),
                 100 * quantile(rjit, 0.9), 100 * quantile(conv, 0.5), 100 * quantile(conv, 0.9), conv.size(), flips,
                 air1, 100 * quantile(air, 0.5), quantile(peak, 0.5), quantile(peak, 1.0), falls_here, falls_ref,
-                quantile(steps, 0.5), 1e3 * quantile(wall, 0.5));
+                quantile(steps, 0.5), 1e3 * quantile(wall, 0.5), u_bound, u_have,
+                u_have ? 100.0 * u_bound / u_have : NAN, 100 * quantile(u_rel, 0.5), u_flag, big_flag, big);
     std::fflush(stdout);
   }
   return 0;

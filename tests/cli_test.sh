@@ -227,6 +227,13 @@ run 2 "$tailsim" run "$src/configs/default.yaml" --out r --threads -1
 run 2 "$tailsim" accuracy "$src/configs/accuracy/fig07.yaml" --out r --repeats 0
 ok "--models selecting nothing exits 1 and writes nothing; bad --shard/--threads/--repeats exit 2"
 
+# tailsim trust: a case it does not have, or a folder of `tailsim run`, is refused before any work.
+run 1 "$tailsim" trust "$src/configs/examples/robot_12kg_n3.yaml" --out trust_nope --case nope
+grep -q "no case named 'nope'" err.txt || fail "trust --case nope: $(cat err.txt)"
+[ ! -e trust_nope ] || fail "trust --case nope made its folder"
+run 2 "$tailsim" trust "$src/configs/examples/robot_12kg_n3.yaml"
+ok "tailsim trust: an unknown --case exits 1 and makes no folder; no --out exits 2"
+
 # A run that renders nothing does not load OSMesa (LLVM, z3, ICU) at all.
 LD_DEBUG=libs "$tailsim" run "$src/configs/default.yaml" --out lazy_gl --quiet >out.txt 2>err.txt || fail "lazy-GL run: $(tail -3 err.txt)"
 grep -q "calling init: .*libyaml-cpp" err.txt || fail "LD_DEBUG=libs printed no library list: cannot check OSMesa"

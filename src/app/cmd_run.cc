@@ -127,11 +127,13 @@ void printCases(const std::vector<Experiment>& suite, const std::string& out, bo
           const std::string q = poseQuantity(pose_results ? &*pose_results : nullptr, c.name, model);
           std::printf(" %s: %s", model.c_str(), q.empty() ? "ok" : q.c_str());
         } else if (r["phi_net_deg"].is_number())
-          std::printf(" %s: phi_net %+.3f deg (%.2f ms)", model.c_str(), r["phi_net_deg"].get<double>(),
+          std::printf(" %s: phi_net %s deg (%.2f ms)", model.c_str(), readRunRecord(r).phiText().c_str(),
                       1e3 * r.value("wall_time_s", 0.0));
         else std::printf(" %s: ok", model.c_str());
       }
       std::printf("\n");
+      if (j.contains("verdict") && j["verdict"].is_string())
+        std::printf("    verdict: %s\n", j["verdict"].get<std::string>().c_str());
       for (const auto& [model, r] : j["runs"].items())
         if (r.contains("warnings") && r["warnings"].is_array())
           for (const auto& w : r["warnings"])

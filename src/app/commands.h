@@ -47,5 +47,7 @@ void addManeuverCommand(CLI::App& app, int& exit_code);
 // `tailsim robot FILE`: the planar models' parameters derived from a MuJoCo model (MJCF or URDF),
 // each with its unit and source (docs/your-robot.md).
 void addRobotCommand(CLI::App& app, int& exit_code);
+// `tailsim trust EXPERIMENT --out DIR`: the convergence and sensitivity study of one case (docs/accuracy.md).
+void addTrustCommand(CLI::App& app, int& exit_code);
 
 }  // namespace tailsim

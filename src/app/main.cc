@@ -7,6 +7,7 @@
 //   tailsim accuracy EXPERIMENT.yaml --out DIR work-precision study of both models
 //   tailsim optimize EXPERIMENT.yaml --out DIR best tail stroke (kind: optimize, docs/design-a-tail-stroke.md)
 //   tailsim maneuver EXPERIMENT.yaml --out DIR turn to a heading, open- and closed-loop (kind: maneuver)
+//   tailsim trust EXPERIMENT.yaml --out DIR  what the MuJoCo answer depends on (docs/accuracy.md)
 //   tailsim robot FILE                       the planar parameters of a MuJoCo robot (docs/your-robot.md)
 // Each subcommand is one file, src/app/cmd_<name>.cc (declared in commands.h).
 // Exit codes: see kExitCodes below (also printed by --help).
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
   addOptimizeCommand(app, exit_code);
   addManeuverCommand(app, exit_code);
   addRobotCommand(app, exit_code);
+  addTrustCommand(app, exit_code);
 
   try {
     app.parse(argc, argv);

@@ -38,6 +38,7 @@
 #include "experiments/render_case.h"
 #include "experiments/sharding.h"
 #include "experiments/results_table.h"
+#include "experiments/verdict.h"
 #include "experiments/time_series_h5.h"
 #include "experiments/work_estimate.h"
 #include "models/mujoco/mjcf_generator.h"
@@ -1007,6 +1008,11 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     j["runs"][r.summary.model] = summaryJson(r.summary);
     if (!r.summary.ok) ++failed_runs;
   }
+  {
+    std::vector<RunSummary> sums;
+    for (const RunResult& r : runs) sums.push_back(r.summary);
+    if (std::string v = caseVerdict(sums); !v.empty()) j["verdict"] = std::move(v);
+  }
   // The MJCF a model's run simulated, once per distinct model (mjcf/<hash>.xml); none when the
   // model could not be built (the run's error says why).
   const bool simulates_mjcf = std::any_of(c.models.begin(), c.models.end(), [](const std::string& m) {
@@ -1048,7 +1054,7 @@ void forEachEntry(const Job& job, const F& f) {
 }
 
 // One experiment's rows of a results table, read from its job's entries (after writeSummary: the
-// part a table reads, {name, sweep, runs}, and the extras' names collected).
+// part a table reads, {name, sweep, runs, verdict}, and the extras' names collected).
 ResultsCsvInput tableInput(const Job& job) {
   return {job.e->name, job.e->swept_keys, [&job](const std::function<void(const json&)>& f) { forEachEntry(job, f); },
           &job.extra_names};
@@ -1182,7 +1188,7 @@ void writeSummary(Job& job) {
     first = false;
     // From here on the entry serves results tables only: keep what they read.
     json row = json::object();
-    for (const char* k : {"name", "sweep", "runs"})
+    for (const char* k : {"name", "sweep", "runs", "verdict"})
       if (auto it = entry.find(k); it != entry.end()) row[k] = std::move(*it);
     if (const auto runs = row.find("runs"); runs != row.end() && runs->is_object())
       for (const auto& [model, run] : runs->items())

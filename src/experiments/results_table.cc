@@ -58,6 +58,7 @@ std::string resultsCsv(const std::vector<ResultsCsvInput>& experiments) {
   std::string out = "experiment,case,model";
   for (const std::string& k : swept) out += "," + csvField(k);
   for (const char* f : kSummaryFields) out += std::string(",") + f;
+  out += ",verdict";  // the case's verdict across its models (experiments/verdict.h), on each of its rows
   for (const std::string& x : extras) out += "," + csvField(x);
   out += "\n";
   for (const ResultsCsvInput& s : experiments)
@@ -66,6 +67,7 @@ std::string resultsCsv(const std::vector<ResultsCsvInput>& experiments) {
         out += csvField(cell(s.experiment)) + "," + csvField(cell(field(c, "name"))) + "," + csvField(model);
         for (const std::string& k : swept) out += "," + csvField(cell(field(field(c, "sweep"), k.c_str())));
         for (const char* f : kSummaryFields) out += "," + csvField(cell(field(run, f)));
+        out += "," + csvField(cell(field(c, "verdict")));
         for (const std::string& x : extras) out += "," + csvField(cell(field(field(run, "extra"), x.c_str())));
         out += "\n";
       }

@@ -97,7 +97,7 @@ void fig06Table(std::ostringstream& o, const std::vector<ExperimentResults>& res
     for (const CaseRecord& c : r->cases)
       for (const auto& [m, run] : c.runs)
         o << "| " << r->name << (r->cases.size() > 1 ? " " + c.name : "") << " | " << m << " | "
-          << (run.ok ? num(run.phi_net_deg) : "failed: " + cell(run.error)) << " | " << num(run.t_stop_s, "%.3f")
+          << (run.ok ? run.phiText() : "failed: " + cell(run.error)) << " | " << num(run.t_stop_s, "%.3f")
           << " | " << run.stick_slip_events << " | " << num(run.wall_time_s, "%.3f") << " |\n";
   o << "\n";
 }
@@ -160,6 +160,13 @@ void experimentSection(std::ostringstream& o, const ExperimentResults& r, const 
     list("Where the models differ", sum.disagree);
     list("Warnings (each once, with the number of runs)", sum.warnings);
   }
+  // The verdict across the models, once per case (experiments/verdict.h).
+  if (std::any_of(r.cases.begin(), r.cases.end(), [](const CaseRecord& c) { return !c.verdict.empty(); })) {
+    o << "\nVerdict across the models (docs/accuracy.md \"Verdict across the models\"):\n\n"
+      << "| case | verdict |\n|---|---|\n";
+    for (const CaseRecord& c : r.cases)
+      if (!c.verdict.empty()) o << "| " << cell(c.name) << " | " << cell(c.verdict) << " |\n";
+  }
   // One-axis phi_net table (small sweeps): the numbers behind the line plots.
   if (r.kind != "pose" && r.axes.size() == 1 && r.cases.size() <= 20) {
     const SweepAxis& a = r.axes[0];
@@ -171,7 +178,10 @@ void experimentSection(std::ostringstream& o, const ExperimentResults& r, const 
     for (const std::string& v : a.values) {
       o << "| " << v;
       const CaseRecord* c = r.find({{a.key, v}});
-      for (const std::string& m : r.models) o << " | " << (c ? num(r.phiNet(*c, m)) : std::string("n/a"));
+      for (const std::string& m : r.models) {
+        const auto run = c ? c->runs.find(m) : std::map<std::string, RunRecord>::const_iterator();
+        o << " | " << (c && run != c->runs.end() ? run->second.phiText() : std::string("n/a"));
+      }
       o << " |\n";
     }
   }

@@ -91,27 +91,35 @@ double numberOr(const json& j, const char* key, double fallback) {
   return (it != j.end() && it->is_number()) ? it->get<double>() : fallback;
 }
 
+}  // namespace
+
+RunRecord readRunRecord(const json& j) {
+  RunRecord run;
+  run.ok = j.value("ok", true);
+  run.phi_net_deg = numberOr(j, "phi_net_deg", NAN);
+  run.t_stop_s = numberOr(j, "t_stop_s", NAN);
+  run.wall_time_s = numberOr(j, "wall_time_s", NAN);
+  run.stick_slip_events = static_cast<int>(numberOr(j, "stick_slip_events", 0));
+  if (auto x = j.find("extra"); x != j.end() && x->is_object())
+    run.phi_net_uncertainty_deg = numberOr(*x, "phi_net_uncertainty_deg", NAN);
+  if (j.contains("error") && j["error"].is_string()) run.error = j["error"].get<std::string>();
+  if (auto w = j.find("warnings"); w != j.end() && w->is_array())
+    for (const json& x : *w)
+      if (x.is_string()) run.warnings.push_back(x.get<std::string>());
+  return run;
+}
+
+namespace {
+
 CaseRecord parseCase(const json& c) {
   CaseRecord r;
   r.name = c.value("name", std::string("base"));
   r.dir = c.value("dir", caseDirName(r.name));  // recorded by the run; older folders: the same mapping
   if (auto s = c.find("sweep"); s != c.end() && s->is_object())
     for (auto it = s->begin(); it != s->end(); ++it) r.sweep[it.key()] = valueText(it.value());
+  if (auto v = c.find("verdict"); v != c.end() && v->is_string()) r.verdict = v->get<std::string>();
   if (auto runs = c.find("runs"); runs != c.end() && runs->is_object()) {
-    for (auto it = runs->begin(); it != runs->end(); ++it) {
-      const json& j = it.value();
-      RunRecord run;
-      run.ok = j.value("ok", true);
-      run.phi_net_deg = numberOr(j, "phi_net_deg", NAN);
-      run.t_stop_s = numberOr(j, "t_stop_s", NAN);
-      run.wall_time_s = numberOr(j, "wall_time_s", NAN);
-      run.stick_slip_events = static_cast<int>(numberOr(j, "stick_slip_events", 0));
-      if (j.contains("error") && j["error"].is_string()) run.error = j["error"].get<std::string>();
-      if (auto w = j.find("warnings"); w != j.end() && w->is_array())
-        for (const json& x : *w)
-          if (x.is_string()) run.warnings.push_back(x.get<std::string>());
-      r.runs[it.key()] = run;
-    }
+    for (auto it = runs->begin(); it != runs->end(); ++it) r.runs[it.key()] = readRunRecord(it.value());
   }
   return r;
 }
@@ -152,6 +160,19 @@ std::string ExperimentResults::seriesNote() const {
   return name + ": " + std::to_string(none) + " of " + std::to_string(cases.size()) +
          " cases have no time series (output.time_series: none); figures over time need output.time_series: full "
          "or thin, figures of phi_net over the swept values are drawn from results.csv";
+}
+
+std::string RunRecord::phiText() const {
+  if (!ok || !std::isfinite(phi_net_deg)) return "n/a";
+  char b[96];
+  if (std::isfinite(phi_net_uncertainty_deg))
+    std::snprintf(b, sizeof b, "%+.3f +- %.3f", phi_net_deg, phi_net_uncertainty_deg);
+  else
+    std::snprintf(b, sizeof b, "%+.3f", phi_net_deg);
+  const bool uncertain = std::any_of(warnings.begin(), warnings.end(), [](const std::string& w) {
+    return w.compare(0, sizeof kUncertainWarning - 1, kUncertainWarning) == 0;
+  });
+  return std::string(b) + (uncertain ? " (uncertain)" : "");
 }
 
 double ExperimentResults::phiNet(const CaseRecord& c, const std::string& model) const {

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,16 +23,24 @@ struct RunRecord {
   double phi_net_deg = NAN;
   double t_stop_s = NAN;
   double wall_time_s = NAN;
+  double phi_net_uncertainty_deg = NAN;  // MuJoCo's extra of that name; NaN when not estimated
   int stick_slip_events = 0;
   std::string error;
   std::vector<std::string> warnings;  // the run's warnings, as summary.json lists them
+  // The result as a reader should see it: "+6.123", "+6.123 +- 0.050", "+6.123 +- 2.300 (uncertain)"
+  // (uncertain: a warning says the uncertainty exceeds the share the run was given).
+  std::string phiText() const;
 };
+
+// A run as summary.json records it (a missing field takes RunRecord's default).
+RunRecord readRunRecord(const nlohmann::json& run);
 
 struct CaseRecord {
   std::string name;                           // "base" or "key=value,..."
   std::string dir;                            // folder under DIR/cases/
   std::map<std::string, std::string> sweep;   // swept key -> value as written
   std::map<std::string, RunRecord> runs;      // model -> run
+  std::string verdict;                        // across the models (experiments/verdict.h); empty: none
 };
 
 // One swept key with its distinct values in increasing order (numeric when all values parse).

@@ -50,6 +50,11 @@ struct RunSummary {
   std::map<std::string, double> extra;  // model-specific figures (e.g. tracking_rms_deg_j1)
 };
 
+// How a run's warning begins when its phi_net is not to be read as a plain number (the MuJoCo
+// run's own uncertainty exceeds its stated share, or its check run failed): readers (console,
+// report, verdict) mark such a result "uncertain".
+inline constexpr char kUncertainWarning[] = "phi_net is uncertain";
+
 struct RunResult {
   RunSummary summary;
   TimeSeries series;

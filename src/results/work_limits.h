@@ -68,5 +68,9 @@ constexpr double kMaxJointSpeedDps = 36000.0;  // [deg/s]
 // no foot loaded, and the peak summed foot normal force in units of the weight m g; above these warns.
 constexpr double kMaxAirborneFraction = 0.2;        // [1]
 constexpr double kMaxPeakNormalForceOverMg = 30.0;  // [1]
+// MuJoCo near fall (docs/mujoco-model.md "Tipping over"): a run that stands but whose body tilted
+// beyond this share of mujoco.max_tilt_deg rocked on two feet; whether it falls depends on the
+// contact and the step, so its phi_net is marked uncertain. Paper cases: at most 0.32 deg of 5.
+constexpr double kNearFallTiltShare = 0.5;  // [1]
 
 }  // namespace tailsim::limits

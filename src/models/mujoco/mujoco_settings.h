@@ -90,6 +90,12 @@ struct MujocoSettings {
   // chatter). 0 = that check off.
   double max_tilt_deg = 5.0;            // [deg]
   double max_all_feet_off_s = 0.1;      // [s]
+  // The run's own error estimate (docs/mujoco-model.md "Uncertainty of a run"): a second run at
+  // twice the timestep (servo w_n kept) gives phi_net_uncertainty_deg = 2 |phi_h - phi_2h| + 0.5 %
+  // of max(|phi_net|, 0.5 deg); it costs half the run's steps again. A result whose uncertainty
+  // exceeds uncertainty_warn_share of max(|phi_net|, 0.5 deg) carries a warning.
+  bool uncertainty = true;
+  double uncertainty_warn_share = 0.1;  // [1]
   // Step budget of the main loop: a run needing more mj_step calls fails (not a loader key).
   long max_steps = static_cast<long>(limits::kMaxMujocoSteps);
 };
@@ -140,6 +146,10 @@ settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
            Limits::nonNegative());
   v.number(Field{"max_all_feet_off_s", "tipping over: longest time with no foot loaded; 0 = off [s]"},
            s.max_all_feet_off_s, Limits::nonNegative());
+  v.boolean(Field{"uncertainty", "estimate phi_net_uncertainty_deg with a second run at 2 timestep_s"}, s.uncertainty);
+  v.number(Field{"uncertainty_warn_share",
+                 "warn when phi_net_uncertainty_deg exceeds this share of max(abs(phi_net), 0.5 deg)"},
+           s.uncertainty_warn_share, Limits::positive());
   v.internal(Field{"max_steps", "step budget (results/work_limits.h); not a YAML key"}, s.max_steps);
 }
 

@@ -721,6 +721,17 @@ class MujocoRun {
         sum_.warnings.push_back(os.str());
       }
     }
+    // Near fall: the body rocked onto two feet and came back; a converged run may see it fall.
+    if (standing_.enforced() && sum_.ok && settings_.max_tilt_deg > 0.0 &&
+        sum_.extra["max_tilt_deg"] > limits::kNearFallTiltShare * settings_.max_tilt_deg) {
+      std::ostringstream os;
+      os.precision(3);
+      os << kUncertainWarning << ": the robot nearly fell (body tilt up to " << sum_.extra["max_tilt_deg"]
+         << " deg, more than " << 100.0 * limits::kNearFallTiltShare << " % of max_tilt_deg = " << settings_.max_tilt_deg
+         << " deg): it rocked on two feet, and whether it falls depends on the contact and the step "
+         << "(docs/mujoco-model.md \"Tipping over\")";
+      sum_.warnings.push_back(os.str());
+    }
     // At rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
     {
       mjtNum v6[6];
@@ -855,16 +866,67 @@ class MujocoRun {
   long steps_ = 0;
 };
 
-}  // namespace
-
-RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
-                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
-                         MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
+// One MuJoCo run at `settings`, without the uncertainty estimate: the stages of a MujocoRun.
+RunResult runMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+                    const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
+                    MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
   const MujocoPlan plan = planMujocoRun(robot, trajectory, settings, output);
   MujocoRun run(robot, trajectory, settings, effects, output, plan);
   if (!run.settle(settle_cache)) return run.failed();
   run.stepLoop(observer, hook);
   return run.judge();
+}
+
+// The run's error estimate from a second run at twice the step (docs/mujoco-model.md "Uncertainty
+// of a run"): U = 2 |phi_h - phi_2h| + 0.5 % of max(|phi_h|, 0.5 deg), the factor and the floor
+// measured on the random-robot corpus (tests/bench_trust.cc). Adds phi_net_uncertainty_deg
+// (NaN when the check run failed) and uncertainty_solver_steps to the extras, and a warning when U
+// exceeds settings.uncertainty_warn_share of max(|phi_h|, 0.5 deg) or the check run failed.
+void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+                    const Effects& effects, const OutputSettings& output, RunResult& fine) {
+  MujocoSettings coarse = settings;
+  coarse.timestep_s *= 2.0;
+  if (coarse.kp == 0.0) coarse.servo_wn_dt *= 2.0;  // the same servo w_n
+  coarse.max_steps = std::max(1L, settings.max_steps / 2);
+  OutputSettings quiet = output;
+  quiet.time_series = TimeSeriesOutput::kNone;
+  const auto wall0 = std::chrono::steady_clock::now();
+  // Its own pre-roll, not the run's settle cache (whose hit and miss counts are the runs').
+  const RunResult check = runMujoco(robot, trajectory, coarse, effects, quiet, nullptr, nullptr, nullptr);
+  RunSummary& sum = fine.summary;
+  sum.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  sum.extra["uncertainty_solver_steps"] = static_cast<double>(check.summary.solver_steps);
+  const double floor_deg = 0.5, phi = sum.phi_net_deg;
+  const double scale = std::max(std::abs(phi), floor_deg);
+  std::ostringstream os;
+  os.precision(3);
+  if (!check.summary.ok) {
+    sum.extra["phi_net_uncertainty_deg"] = std::numeric_limits<double>::quiet_NaN();
+    os << kUncertainWarning << ": the check run at twice the timestep (" << coarse.timestep_s
+       << " s) failed (" << check.summary.error << "), so this result is not converged in the step";
+    sum.warnings.push_back(os.str());
+    return;
+  }
+  const double u = 2.0 * std::abs(phi - check.summary.phi_net_deg) + 0.005 * scale;
+  sum.extra["phi_net_uncertainty_deg"] = u;
+  if (u > settings.uncertainty_warn_share * scale) {
+    os << kUncertainWarning << ": +-" << u << " deg (" << 100.0 * u / scale << " % of max(|phi_net|, 0.5 deg); limit "
+       << 100.0 * settings.uncertainty_warn_share << " %, mujoco.uncertainty_warn_share); at twice the timestep "
+       << "phi_net is " << check.summary.phi_net_deg << " deg: lower mujoco.timestep_s or see `tailsim trust`";
+    sum.warnings.push_back(os.str());
+  }
+}
+
+}  // namespace
+
+RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
+                         const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
+                         MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
+  RunResult r = runMujoco(robot, trajectory, settings, effects, output, observer, settle_cache, hook);
+  // A run steered by a hook decides its reference as it goes: a second run would steer differently.
+  if (settings.uncertainty && r.summary.ok && !hook)
+    addUncertainty(robot, trajectory, settings, effects, output, r);
+  return r;
 }
 
 }  // namespace tailsim
