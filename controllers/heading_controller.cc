@@ -148,13 +148,24 @@ HeadingController::HeadingController(ManeuverSettings settings, YawMap map) : s_
   if (map_.full() == 0.0) throw std::invalid_argument("HeadingController: a full cycle does not turn the body");
 }
 
-std::optional<StrokeCommand> HeadingController::next(double phi_rad) const {
+double YawMap::yawAt(double sc) const {
+  if (scale.empty()) throw std::logic_error("empty yaw map");
+  if (sc <= scale.front()) return std::abs(yaw_rad.front());
+  for (std::size_t i = 1; i < scale.size(); ++i)
+    if (sc <= scale[i])
+      return std::abs(yaw_rad[i - 1]) +
+             (sc - scale[i - 1]) / (scale[i] - scale[i - 1]) * (std::abs(yaw_rad[i]) - std::abs(yaw_rad[i - 1]));
+  return std::abs(yaw_rad.back());
+}
+
+std::optional<StrokeCommand> HeadingController::next(double phi_rad, double yaw_factor) const {
   const double e = s_.heading() - phi_rad;
   if (std::abs(e) <= s_.tolerance()) return std::nullopt;
   StrokeCommand c;
   // A cycle of direction d turns d * full(): pick d so the turn has the error's sign.
   c.direction = (e > 0) == (map_.full() > 0) ? 1 : -1;
-  c.scale = std::abs(e) >= std::abs(map_.full()) ? 1.0 : map_.scaleFor(std::abs(e));
+  const double want = std::abs(e) / yaw_factor;
+  c.scale = want >= std::abs(map_.full()) ? 1.0 : map_.scaleFor(want);
   return c;
 }
 

@@ -112,13 +112,17 @@ struct YawMap {
   double full() const { return yaw_rad.back(); }
   // The scale whose |yaw| is |want| (linear interpolation; clamped to [scale.front(), 1]).
   double scaleFor(double want_abs_rad) const;
+  // |yaw| at a scale (linear interpolation; the first point's below it).
+  double yawAt(double scale) const;
 };
 
 class HeadingController {
  public:
   HeadingController(ManeuverSettings settings, YawMap map);
   // The next cycle for the measured heading change phi [rad], or none when within tolerance.
-  std::optional<StrokeCommand> next(double phi_rad) const;
+  // yaw_factor: how much of the map's yaw a partial cycle turned the body last (measured /
+  // predicted); the scale is chosen for the error divided by it.
+  std::optional<StrokeCommand> next(double phi_rad, double yaw_factor = 1.0) const;
   const ManeuverSettings& settings() const { return s_; }
   const YawMap& map() const { return map_; }
 

@@ -306,6 +306,24 @@ TEST(ManeuverStroke, ScaledMirroredAndRepositioned) {
   EXPECT_NEAR(js[0].theta, -(a.theta0_rad + a.dtheta_rad), 1e-15);
 }
 
+// A partial cycle that turned the body less than the analytic map predicts (MuJoCo's stiction
+// threshold differs: the optimised n = 1 stroke's 0.39 scale turned it 0.001 deg where the map said
+// 1.6, and the closed loop stalled 1.6 deg short): the next one is chosen for the error divided by
+// the measured/predicted factor.
+TEST(HeadingController, ScalesUpWhenPartialCyclesTurnLessThanTheMap) {
+  ManeuverSettings s;  // target 90 deg, tolerance 1 deg
+  YawMap map;
+  map.scale = {0.1, 0.5, 1.0};
+  map.yaw_rad = {1 * M_PI / 180, 5 * M_PI / 180, 10 * M_PI / 180};
+  EXPECT_NEAR(map.yawAt(0.3), 3 * M_PI / 180, 1e-15);
+  const HeadingController c(s, map);
+  const auto plain = c.next(87.0 * M_PI / 180);        // 3 deg to go: scale 0.3
+  const auto scaled = c.next(87.0 * M_PI / 180, 0.6);  // the map over-predicts: ask for 5 deg: scale 0.5
+  ASSERT_TRUE(plain && scaled);
+  EXPECT_NEAR(plain->scale, 0.3, 1e-12);
+  EXPECT_NEAR(scaled->scale, 0.5, 1e-12);
+}
+
 // `stroke_from` takes the fast stroke from an experiment file (a tailsim optimize best.yaml or any
 // one-case file); min_scale, when left out, is derived from the tolerance (its cycle turns the body
 // by the tolerance); the analytic plan lands on the target; the folder keeps the stroke file.

@@ -302,6 +302,7 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
   // and its last rest is over.
   std::vector<std::pair<double, TailTrajectory>> pending;
   std::vector<double> pose = cycleStartPose(s, n, 1);  // the pose the tail holds between cycles
+  double yaw_factor = 1.0;  // measured / predicted yaw of the partial cycles so far (HeadingController::next)
   double t_free = 0.0;  // the cycle's strokes and rests are over from this time
   double phi_prev = 0.0;
   bool done = false;
@@ -319,8 +320,19 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
     if (done || strokes.size() >= static_cast<std::size_t>(s.max_strokes)) return false;
     // Next cycle: the last one is over and the body is at rest (measured), or waited 1 s more.
     if (ts < t_free - 1e-9 || (rate > kRestRate && ts < t_free + 1.0)) return false;
-    if (!strokes.empty()) strokes.back().heading_after_rad = phi;
-    const std::optional<StrokeCommand> c = ctl.next(phi);
+    if (!strokes.empty()) {
+      strokes.back().heading_after_rad = phi;
+      // A partial cycle that turned the body less (or more) than the analytic map predicts: the
+      // next partial cycle asks for the error divided by that factor (MuJoCo's stiction threshold
+      // differs from the analytic model's, so a small stroke can turn it far less).
+      const StrokeRecord& last = strokes.back();
+      if (last.command.scale < 1.0) {
+        const double predicted = map.yawAt(last.command.scale);
+        const double measured = std::abs(last.heading_after_rad - last.heading_before_rad);
+        if (predicted > 0.0) yaw_factor = std::min(2.0, std::max(0.05, measured / predicted));
+      }
+    }
+    const std::optional<StrokeCommand> c = ctl.next(phi, yaw_factor);
     if (!c) {
       done = true;
       return false;
