@@ -34,6 +34,10 @@ struct ManeuverSettings {
   int max_strokes = 40;                   // cycles at most (open and closed loop)
   int map_points = 12;                    // analytic yaw-vs-scale map: points in [min_scale, 1]
   bool mujoco = true;                     // run MuJoCo open- and closed-loop (false: analytic plan only)
+  // Not a YAML key: the fast stroke's shape at full scale (maneuver.stroke_from: a split-cycle or
+  // spline trajectory, e.g. a `tailsim optimize` best.yaml). Empty: every joint from 0 to
+  // +-stroke_deg in stroke_dT_s (w_ss stroke_w_ss).
+  TailTrajectory stroke_shape;
 
   double heading() const { return units::radians(heading_deg); }  // [rad]
   double tolerance() const { return units::radians(tolerance_deg); }
@@ -68,16 +72,37 @@ struct StrokeCommand {
   int direction = 1;
 };
 
-// The fast stroke and the slow return of a cycle for an n-joint tail, starting at t_start (absolute
-// time); each is a split-cycle trajectory (every joint alike). The fast stroke ends at
-// t_start + scale * stroke_dT_s, the return starts rest_s after it.
+// The trajectory with every start time shifted so the earliest is 0 (durations and delays kept).
+TailTrajectory shiftedToZero(const TailTrajectory& t);
+
+// The smallest scale a fast stroke may have: its shortest joint duration at least an experiment's
+// shortest dT (limits::kMinDT_s).
+double minScaleFloor(const ManeuverSettings& s, int n_joints);
+
+// The fast stroke at full scale, direction +1, starting at t = 0: stroke_shape shifted to start at
+// 0, or (no shape) every joint from 0 to stroke_deg in stroke_dT_s.
+TailTrajectory fastStrokeShape(const ManeuverSettings& s, int n_joints);
+// Every joint's angle where a cycle of `direction` starts (and its return ends)  [rad]: the
+// shape's start pose, mirrored (negated) for direction -1.
+std::vector<double> cycleStartPose(const ManeuverSettings& s, int n_joints, int direction);
+
+// A cycle for an n-joint tail, starting at t_start (absolute time): the fast stroke (the shape
+// scaled: each joint's amplitude about its start angle and every duration and delay by `scale`, so
+// the peak speeds stay; mirrored for direction -1), and the slow return to the start pose in
+// return_dT_s (split-cycle, return_w_ss), rest_s after the fast stroke's end. When `from` (the pose
+// the tail is at) differs from the cycle's start pose, a slow move there (`pre`, like the return)
+// and rest_s come first. Every part is a trajectory in absolute time.
 struct CycleStrokes {
-  TailTrajectory fast, back;
+  TailTrajectory pre, fast, back;  // pre.joints empty: no move before the stroke
+  double rest_s = 0.0;
+  bool hasPre() const { return !pre.joints.empty(); }
   double fastEnd() const { return fast.endTime(); }
   double backEnd() const { return back.endTime(); }
+  double end() const { return back.endTime() + rest_s; }  // the cycle is over (after its last rest)
 };
-CycleStrokes cycleStrokes(const ManeuverSettings& s, int n_joints, const StrokeCommand& c, double t_start);
-// A cycle's whole duration: fast stroke, rest, return, rest.
+CycleStrokes cycleStrokes(const ManeuverSettings& s, int n_joints, const StrokeCommand& c, double t_start,
+                          const std::vector<double>* from = nullptr);
+// A cycle's whole duration without a move before it: fast stroke, rest, return, rest.
 double cycleDuration(const ManeuverSettings& s, double scale);
 
 // Yaw per cycle as a function of the scale (monotone in |yaw| after the map is built), for
@@ -88,13 +113,17 @@ struct YawMap {
   double full() const { return yaw_rad.back(); }
   // The scale whose |yaw| is |want| (linear interpolation; clamped to [scale.front(), 1]).
   double scaleFor(double want_abs_rad) const;
+  // |yaw| at a scale (linear interpolation; the first point's below it).
+  double yawAt(double scale) const;
 };
 
 class HeadingController {
  public:
   HeadingController(ManeuverSettings settings, YawMap map);
   // The next cycle for the measured heading change phi [rad], or none when within tolerance.
-  std::optional<StrokeCommand> next(double phi_rad) const;
+  // yaw_factor: how much of the map's yaw a partial cycle turned the body last (measured /
+  // predicted); the scale is chosen for the error divided by it.
+  std::optional<StrokeCommand> next(double phi_rad, double yaw_factor = 1.0) const;
   const ManeuverSettings& settings() const { return s_; }
   const YawMap& map() const { return map_; }
 

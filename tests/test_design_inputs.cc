@@ -73,7 +73,7 @@ class DesignInputs : public ::testing::Test {
   std::string optimizeFile(const std::string& name, const std::string& extra = "") {
     return write("opt.yaml", "name: " + yamlQuoted(name) +
                                  "\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n"
-                                 "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                 "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: none}\n"
                                  "  islands: 1\n  population: 6\n  generations: 2\n  polish: none\n  seeds: [1]\n  pareto_points: 2\n"
                                  "  mujoco_check: false\n" + extra);
   }
@@ -381,7 +381,7 @@ TEST_F(UnboundedWorkRefusedAtLoad, EnumeratedDirectionsAreBounded) {
 // 1e11 runs) are refused with the estimate, a small file loads.
 TEST_F(UnboundedWorkRefusedAtLoad, OptimizeRunsAreEstimatedAndBounded) {
   const std::string big = write("big.yaml", "name: big\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n"
-                                            "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                            "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: none}\n"
                                             "  islands: 64\n  population: 1000\n  generations: 10000\n");
   const std::string e = errorOf([&] { loadOptimizeSpec(big); });
   EXPECT_NE(e.find("big.yaml:5:3: optimize: the search would run the analytic model about 640064202 times"), std::string::npos) << e;
@@ -434,9 +434,9 @@ TEST_F(UnboundedWorkRefusedAtLoad, ImpossibleOptimizeLimitsAreRefused) {
   };
   std::string e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 1e-9}")); });
   EXPECT_NE(e.find("lim.yaml:6:11: optimize.limits: no stroke keeps these limits"), std::string::npos) << e;
-  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 1, dT_s: [0.05, 0.1]}")); });
+  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 1, dT_s: [0.05, 0.1], torque_max_Nm: none}")); });
   EXPECT_NE(e.find("peaks at 20 deg/s (limit 1)"), std::string::npos) << e;
-  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [10, 10.5], thetadot_max_dps: 600}")); });
+  e = errorOf([&] { loadOptimizeSpec(file("{theta_deg: [10, 10.5], thetadot_max_dps: 600, torque_max_Nm: none}")); });
   EXPECT_NE(e.find("needs a range of 1 deg (have 0.5)"), std::string::npos) << e;
   EXPECT_EQ(errorOf([&] { loadOptimizeSpec(file("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 1}")); }),
             "(no error)");

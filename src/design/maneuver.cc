@@ -11,10 +11,12 @@
 
 #include "models/analytic/analytic_simulation.h"
 #include "design/design_yaml.h"
+#include "design/optimize_experiment.h"
 #include "experiments/render_case.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
+#include "results/work_limits.h"
 
 namespace tailsim {
 namespace {
@@ -35,16 +37,7 @@ OutputSettings segmentOutput(const ExperimentCase& base, double duration_s) {
   return o;
 }
 
-// The trajectory of one stroke shifted to start at t = 0.
-TailTrajectory atZero(const TailTrajectory& t) {
-  TailTrajectory out;
-  for (const auto& j : t.joints) {
-    SplitCycleParams p = j.params();
-    p.t0_s = 0.0;
-    out.joints.emplace_back(p);
-  }
-  return out;
-}
+TailTrajectory atZero(const TailTrajectory& t) { return shiftedToZero(t); }
 
 // Columns kept in a maneuver's series (what plots and the video need).
 std::vector<std::string> keptColumns(int n) {
@@ -144,7 +137,7 @@ CycleYaw analyticCycleYaw(const ExperimentCase& base, const ManeuverSettings& s,
   const CycleStrokes c = cycleStrokes(s, n, {scale, 1}, 0.0);
   CycleYaw y;
   const RunResult a = simulateAnalytic(base.robot, atZero(c.fast), base.analytic, base.effects,
-                                       segmentOutput(base, c.fast.endTime() + s.rest_s));
+                                       segmentOutput(base, c.fast.endTime() - c.fast.startTime() + s.rest_s));
   const RunResult b = simulateAnalytic(base.robot, atZero(c.back), base.analytic, base.effects,
                                        segmentOutput(base, s.return_dT_s + s.rest_s));
   if (!a.summary.ok || !b.summary.ok) throw std::runtime_error("analytic cycle failed: " + a.summary.error + b.summary.error);
@@ -152,6 +145,18 @@ CycleYaw analyticCycleYaw(const ExperimentCase& base, const ManeuverSettings& s,
   y.back_rad = b.summary.phi_net_deg / kDegPerRad;
   y.at_rest = a.summary.at_rest && b.summary.at_rest;
   return y;
+}
+
+double derivedMinScale(const ExperimentCase& base, const ManeuverSettings& s, double floor) {
+  const double tol = s.tolerance();
+  if (std::abs(analyticCycleYaw(base, s, 1.0).total()) <= tol) return 1.0;
+  double lo = floor, hi = 1.0;
+  if (std::abs(analyticCycleYaw(base, s, lo).total()) >= tol) return lo;
+  for (int it = 0; it < 30 && hi - lo > 1e-4; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (std::abs(analyticCycleYaw(base, s, mid).total()) < tol ? lo : hi) = mid;
+  }
+  return lo;  // its cycle turns by at most the tolerance
 }
 
 YawMap analyticYawMap(const ExperimentCase& base, const ManeuverSettings& s) {
@@ -203,22 +208,30 @@ ManeuverRun runAnalyticOpenLoop(const ExperimentCase& base, const ManeuverSettin
   run.label = "analytic_open_loop";
   run.series = emptySeries(n);
   double t = 0, x = 0, y = 0, phi = 0;
+  std::vector<double> pose = cycleStartPose(s, n, 1);  // the tail starts at direction +1's start pose
   for (std::size_t k = 0; k < plan.size(); ++k) {
-    const CycleStrokes c = cycleStrokes(s, n, plan[k], 0.0);
+    const CycleStrokes c = cycleStrokes(s, n, plan[k], 0.0, &pose);
+    pose = cycleStartPose(s, n, plan[k].direction);
     StrokeRecord rec{t, plan[k], phi, phi};
+    const char* names[] = {" move to the start", " stroke", " return"};
     int part = 0;
-    for (const TailTrajectory* tr : {&c.fast, &c.back}) {
-      const double dur = (part == 0 ? c.fast.endTime() : s.return_dT_s) + s.rest_s;
+    for (const TailTrajectory* tr : {&c.pre, &c.fast, &c.back}) {
+      if (tr->joints.empty()) {
+        ++part;
+        continue;
+      }
+      const double dur = (part == 1 ? tr->endTime() - tr->startTime() : s.return_dT_s) + s.rest_s;
       const RunResult a = simulateAnalytic(base.robot, atZero(*tr), base.analytic, base.effects, segmentOutput(base, dur));
       if (!a.summary.ok) {
         run.ok = false;
-        run.error = a.summary.error;
+        run.error = "cycle " + std::to_string(k + 1) + names[part] + ": " + a.summary.error;
         break;
       }
       if (!a.summary.at_rest)
-        run.warnings.push_back("cycle " + std::to_string(k + 1) + (part ? " return" : " stroke") +
+        run.warnings.push_back("cycle " + std::to_string(k + 1) + names[part] +
                                ": the body is still moving when the next stroke starts (raise maneuver.rest_s)");
-      appendSegment(run.series, a.series, n, t, x, y, phi, k + 1 == plan.size() && part == 1);
+      for (const std::string& w : a.summary.warnings) run.warnings.push_back("cycle " + std::to_string(k + 1) + names[part] + ": " + w);
+      appendSegment(run.series, a.series, n, t, x, y, phi, k + 1 == plan.size() && part == 2);
       const std::size_t last = a.series.numRows() - 1;
       const double dx = a.series.at(last, a.series.column("x_m")) - a.series.at(0, a.series.column("x_m"));
       const double dy = a.series.at(last, a.series.column("y_m")) - a.series.at(0, a.series.column("y_m"));
@@ -244,14 +257,21 @@ ManeuverRun runMujocoOpenLoop(const ExperimentCase& base, const ManeuverSettings
   std::vector<std::pair<double, TailTrajectory>> schedule;
   std::vector<StrokeRecord> strokes;
   double t = 0;
+  std::vector<double> pose = cycleStartPose(s, n, 1);
   for (const StrokeCommand& c : plan) {
-    const CycleStrokes cs = cycleStrokes(s, n, c, t);
+    const CycleStrokes cs = cycleStrokes(s, n, c, t, &pose);
+    pose = cycleStartPose(s, n, c.direction);
     strokes.push_back({t, c, 0, 0});
-    schedule.emplace_back(t, cs.fast);
+    if (cs.hasPre()) {
+      schedule.emplace_back(t, cs.pre);
+      schedule.emplace_back(cs.pre.endTime(), cs.fast);  // holds its start pose until it starts
+    } else {
+      schedule.emplace_back(t, cs.fast);
+    }
     schedule.emplace_back(cs.fast.endTime(), cs.back);
-    t += cycleDuration(s, c.scale);
+    t = cs.end();
   }
-  if (schedule.empty()) schedule.emplace_back(0.0, cycleStrokes(s, n, {1.0, 1}, 1e9).fast);  // held at 0
+  if (schedule.empty()) schedule.emplace_back(0.0, cycleStrokes(s, n, {1.0, 1}, 1e9).fast);  // held at the start pose
   std::size_t next = 1;
   const double eps = 1e-9;
   const MujocoTrajectoryHook hook = [&](double ts, double, const mjModel*, const mjData*, TailTrajectory& ref) {
@@ -278,8 +298,11 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
   const int n = base.robot.numLinks();
   const HeadingController ctl(s, map);
   std::vector<StrokeRecord> strokes;
-  enum class Phase { kIdle, kFast, kBack } phase = Phase::kIdle;
-  CycleStrokes cur;
+  // The cycle's parts still to come: (switch time, reference); the next cycle once none is left
+  // and its last rest is over.
+  std::vector<std::pair<double, TailTrajectory>> pending;
+  std::vector<double> pose = cycleStartPose(s, n, 1);  // the pose the tail holds between cycles
+  double yaw_factor = 1.0;  // measured / predicted yaw of the partial cycles so far (HeadingController::next)
   double t_free = 0.0;  // the cycle's strokes and rests are over from this time
   double phi_prev = 0.0;
   bool done = false;
@@ -288,29 +311,46 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
   const MujocoTrajectoryHook hook = [&](double ts, double phi, const mjModel*, const mjData*, TailTrajectory& ref) {
     const double rate = std::abs(phi - phi_prev) / dt;
     phi_prev = phi;
-    if (phase == Phase::kFast && ts >= cur.fast.endTime() - 1e-9) {
-      phase = Phase::kBack;
-      ref = cur.back;
+    if (!pending.empty()) {
+      if (ts < pending.front().first - 1e-9) return false;
+      ref = std::move(pending.front().second);
+      pending.erase(pending.begin());
       return true;
     }
     if (done || strokes.size() >= static_cast<std::size_t>(s.max_strokes)) return false;
-    if (phase == Phase::kBack && ts >= t_free - 1e-9) phase = Phase::kIdle;
     // Next cycle: the last one is over and the body is at rest (measured), or waited 1 s more.
-    if (phase != Phase::kIdle || (rate > kRestRate && ts < t_free + 1.0)) return false;
-    if (!strokes.empty()) strokes.back().heading_after_rad = phi;
-    const std::optional<StrokeCommand> c = ctl.next(phi);
+    if (ts < t_free - 1e-9 || (rate > kRestRate && ts < t_free + 1.0)) return false;
+    if (!strokes.empty()) {
+      strokes.back().heading_after_rad = phi;
+      // A partial cycle that turned the body less (or more) than the analytic map predicts: the
+      // next partial cycle asks for the error divided by that factor (MuJoCo's stiction threshold
+      // differs from the analytic model's, so a small stroke can turn it far less).
+      const StrokeRecord& last = strokes.back();
+      if (last.command.scale < 1.0) {
+        const double predicted = map.yawAt(last.command.scale);
+        const double measured = std::abs(last.heading_after_rad - last.heading_before_rad);
+        if (predicted > 0.0) yaw_factor = std::min(2.0, std::max(0.05, measured / predicted));
+      }
+    }
+    const std::optional<StrokeCommand> c = ctl.next(phi, yaw_factor);
     if (!c) {
       done = true;
       return false;
     }
-    cur = cycleStrokes(s, n, *c, ts);
-    t_free = cur.back.endTime() + s.rest_s;
+    const CycleStrokes cur = cycleStrokes(s, n, *c, ts, &pose);
+    pose = cycleStartPose(s, n, c->direction);
+    t_free = cur.end();
     strokes.push_back({ts, *c, phi, phi});
-    phase = Phase::kFast;
-    ref = cur.fast;
+    if (cur.hasPre()) {
+      ref = cur.pre;
+      pending.emplace_back(cur.pre.endTime(), cur.fast);
+    } else {
+      ref = cur.fast;
+    }
+    pending.emplace_back(cur.fast.endTime(), cur.back);
     return true;
   };
-  // The reference starts held at 0 (a stroke that never starts within the run).
+  // The reference starts held at the start pose (a stroke that never starts within the run).
   const TailTrajectory hold = cycleStrokes(s, n, {1.0, 1}, 1e6).fast;
   const RunResult rm = simulateMujoco(base.robot, hold, base.mujoco, base.effects, segmentOutput(base, duration_s), nullptr,
                                       nullptr, hook);
@@ -324,10 +364,18 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
 
 ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress) {
   const auto w0 = std::chrono::steady_clock::now();
-  const ManeuverSettings& s = spec.settings;
+  ManeuverSettings s = spec.settings;
   const ExperimentCase& base = spec.base;
   ManeuverReport rep;
+  if (!spec.min_scale_given) s.min_scale = derivedMinScale(base, s, minScaleFloor(s, base.robot.numLinks()));
+  rep.min_scale = s.min_scale;
+  const int n = base.robot.numLinks();
   fs::create_directories(fs::path(out_dir) / "plots");
+  // The folder's own inputs: it runs again after a move (tailsim maneuver DIR/maneuver.yaml).
+  for (const auto& [name, text] : designFolderInputs(spec.source_file, "maneuver.yaml", spec.base_file, spec.stroke_file)) {
+    writeOwnedFile(out_dir, name, text);
+    rep.files.push_back(name);
+  }
   rep.full_cycle = analyticCycleYaw(base, s, 1.0);
   rep.map = analyticYawMap(base, s);
   rep.plan = planOpenLoop(base, s, rep.map);
@@ -336,8 +384,6 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
                  rep.full_cycle.fast_rad * kDegPerRad, rep.full_cycle.back_rad * kDegPerRad, rep.plan.size(),
                  rep.plan.empty() ? 0.0 : rep.plan.back().scale);
   rep.runs.push_back(runAnalyticOpenLoop(base, s, rep.plan));
-  double plan_time = 0;
-  for (const StrokeCommand& c : rep.plan) plan_time += cycleDuration(s, c.scale);
   if (s.mujoco) {
     rep.runs.push_back(runMujocoOpenLoop(base, s, rep.plan));
     if (progress) std::fprintf(stderr, "MuJoCo open loop done\n");
@@ -347,7 +393,6 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     rep.runs.push_back(runMujocoClosedLoop(base, s, rep.map, dur));
     if (progress) std::fprintf(stderr, "MuJoCo closed loop done\n");
   }
-  const int n = base.robot.numLinks();
 
   // maneuver.csv: heading of each run on the output grid (empty where a run has no row).
   {
@@ -377,8 +422,13 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     for (const ManeuverRun& r : rep.runs)
       for (std::size_t k = 0; k < r.strokes.size(); ++k) {
         const StrokeRecord& x = r.strokes[k];
+        // Joint 1's fast-stroke angle change and the fast stroke's duration.
+        const CycleStrokes cs = cycleStrokes(s, n, x.command, 0.0);
+        std::vector<JointState> a, b;
+        cs.fast.evaluate(-1.0, a);
+        cs.fast.evaluate(cs.fast.endTime() + 1.0, b);
         csv << r.label << "," << k + 1 << "," << g17(x.t_start_s) << "," << g17(x.command.scale) << "," << x.command.direction
-            << "," << g17(x.command.direction * x.command.scale * s.stroke_deg) << "," << g17(x.command.scale * s.stroke_dT_s)
+            << "," << g17((b[0].theta - a[0].theta) * kDegPerRad) << "," << g17(cs.fast.endTime() - cs.fast.startTime())
             << "," << g17(s.return_dT_s) << "," << g17(x.heading_before_rad * kDegPerRad) << ","
             << g17(x.heading_after_rad * kDegPerRad) << "," << g17((x.heading_after_rad - x.heading_before_rad) * kDegPerRad)
             << "\n";
@@ -409,7 +459,7 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     for (const ManeuverRun& r : rep.runs) {
       if (!r.strokes.empty()) {
         const StrokeRecord& x = r.strokes.back();
-        t_action = std::max(t_action, x.t_start_s + x.command.scale * s.stroke_dT_s + s.return_dT_s + s.rest_s);
+        t_action = std::max(t_action, x.t_start_s + cycleDuration(s, x.command.scale));
       }
       t_action = std::max(t_action, r.t_within_s);
     }
@@ -440,8 +490,12 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     runs[1].series = rep.runs[2].series;
     // The video's phase text follows the case trajectory: the first planned stroke.
     c.joints.clear();
+    c.splines.clear();
     if (!rep.plan.empty())
-      for (const auto& jp : cycleStrokes(s, n, rep.plan.front(), 0.0).fast.joints) c.joints.push_back(jp.params());
+      for (const auto& jp : cycleStrokes(s, n, rep.plan.front(), 0.0).fast.joints) {
+        if (jp.isSpline()) c.splines.push_back(jp.spline());
+        else c.joints.push_back(jp.params());
+      }
     renderCase(c, runs, (fs::path(out_dir) / "renders").string(), "open-loop plan (analytic)");
     rep.files.push_back("renders/" + spec.name + ".mp4");
   }
@@ -452,6 +506,9 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
   j["source"] = spec.source_file;
   j["base"] = spec.base_file;
   j["target_deg"] = s.heading_deg;
+  j["min_scale"] = s.min_scale;
+  j["min_scale_derived"] = !spec.min_scale_given;
+  j["stroke_from"] = spec.stroke_file.empty() ? (s.stroke_shape.joints.empty() ? "stroke_deg" : "base") : spec.stroke_file;
   j["tolerance_deg"] = s.tolerance_deg;
   j["analytic_cycle"] = {{"stroke_yaw_deg", rep.full_cycle.fast_rad * kDegPerRad},
                          {"return_yaw_deg", rep.full_cycle.back_rad * kDegPerRad},

@@ -20,9 +20,12 @@ struct ManeuverSpec {
   std::string name, description;
   std::string source_file;  // absolute path of the maneuver file
   std::string base_file;    // absolute path of the base experiment
-  ExperimentCase base;      // its one case (its trajectory is not used)
-  ManeuverSettings settings;
+  ExperimentCase base;      // its one case (its trajectory is the fast stroke with stroke_from: base)
+  ManeuverSettings settings;  // settings.stroke_shape: the stroke_from trajectory (empty: stroke_deg ...)
+  std::string stroke_file;  // stroke_from: FILE, absolute (empty: none or base)
+  bool min_scale_given = false;  // else runManeuver derives it from the tolerance (derivedMinScale)
 };
+
 
 // Throws ConfigError "<file>:<line>:<col>: maneuver.<key>: ..." before any work.
 ManeuverSpec loadManeuverSpec(const std::string& path);
@@ -35,6 +38,11 @@ struct CycleYaw {
   double total() const { return fast_rad + back_rad; }
 };
 CycleYaw analyticCycleYaw(const ExperimentCase& base, const ManeuverSettings& s, double scale);
+
+// The smallest stroke scale the controller needs: the one whose analytic cycle turns the body by
+// the tolerance (bisection; smaller cycles are never needed, larger ones cannot land within the
+// tolerance from just outside it), at least `floor`; 1 when even a full cycle turns less.
+double derivedMinScale(const ExperimentCase& base, const ManeuverSettings& s, double floor);
 
 // The yaw-vs-scale map on the analytic model (map_points scales in [min_scale, 1]; |yaw| made
 // monotone by a running maximum).
@@ -72,6 +80,7 @@ ManeuverRun runMujocoOpenLoop(const ExperimentCase& base, const ManeuverSettings
 ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map, double duration_s);
 
 struct ManeuverReport {
+  double min_scale = 0;  // used (given, or derived from the tolerance)
   YawMap map;
   CycleYaw full_cycle;
   std::vector<StrokeCommand> plan;

@@ -9,6 +9,7 @@
 
 #include "design/design_yaml.h"
 #include "design/maneuver.h"
+#include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
 
@@ -47,6 +48,16 @@ struct YamlFieldReader {
   }
 };
 
+// The case's trajectory set to t (split-cycle joints or spline joints).
+void setTrajectory(ExperimentCase& c, const TailTrajectory& t) {
+  c.joints.clear();
+  c.splines.clear();
+  for (const auto& j : t.joints) {
+    if (j.isSpline()) c.splines.push_back(j.spline());
+    else c.joints.push_back(j.params());
+  }
+}
+
 // The first of `keys` the section sets, else the section itself: where an error points.
 const Val& firstSet(const Val& section, const std::vector<std::pair<std::string, Val>>& m,
                     std::initializer_list<const char*> keys) {
@@ -65,31 +76,21 @@ void checkStrokes(const Reader& r, const Val& mv, const std::vector<std::pair<st
     if (w < limits::kMinWss || w > limits::kMaxWss)
       r.fail(firstSet(mv, m, {key}), "must lie in [" + fmtG(limits::kMinWss) + ", " + fmtG(limits::kMaxWss) +
                                          "] (as an experiment's trajectory.w_ss), got " + fmtG(w));
-  if (s.min_scale * s.stroke_dT_s < limits::kMinDT_s)
+  const int n = spec.base.robot.numLinks();
+  if (spec.min_scale_given && s.min_scale < minScaleFloor(s, n))
     r.fail(firstSet(mv, m, {"min_scale", "stroke_dT_s"}),
-           "the shortest stroke (min_scale x stroke_dT_s = " + fmtG(s.min_scale) + " x " + fmtG(s.stroke_dT_s) + " = " +
-               fmtG(s.min_scale * s.stroke_dT_s) + " s) is shorter than an experiment's trajectory.dT_s may be (" +
-               fmtG(limits::kMinDT_s) + " s): raise min_scale or stroke_dT_s");
+           "the shortest stroke (min_scale " + fmtG(s.min_scale) + " x the fast stroke's shortest joint duration) is shorter "
+           "than an experiment's trajectory.dT_s may be (" + fmtG(limits::kMinDT_s) + " s): min_scale must be at least " +
+               fmtG(minScaleFloor(s, n)) + " (or leave it out: derived from tolerance_deg)");
   if (s.return_dT_s < limits::kMinDT_s)
     r.fail(firstSet(mv, m, {"return_dT_s"}), "must be at least " + fmtG(limits::kMinDT_s) +
                                                  " s (as an experiment's trajectory.dT_s), got " + fmtG(s.return_dT_s));
-  const int n = spec.base.robot.numLinks();
-  auto atZero = [](const TailTrajectory& t) {
-    std::vector<SplitCycleParams> joints;
-    for (const auto& j : t.joints) {
-      SplitCycleParams p = j.params();
-      p.t0_s = 0.0;
-      joints.push_back(p);
-    }
-    return joints;
-  };
   // The analytic segments: each stroke run alone with the rest after it (analyticCycleYaw, the plan).
-  for (const double scale : {s.min_scale, 1.0}) {
+  for (const double scale : {spec.min_scale_given ? s.min_scale : minScaleFloor(s, n), 1.0}) {
     const CycleStrokes cs = cycleStrokes(s, n, {scale, 1}, 0.0);
     for (int part = 0; part < 2; ++part) {
       ExperimentCase c = spec.base;
-      c.splines.clear();
-      c.joints = atZero(part == 0 ? cs.fast : cs.back);
+      setTrajectory(c, shiftedToZero(part == 0 ? cs.fast : cs.back));
       c.models = {"analytic"};
       c.render.enabled = false;
       c.output.duration_s = (part == 0 ? cs.fast.endTime() : s.return_dT_s) + s.rest_s;
@@ -104,8 +105,7 @@ void checkStrokes(const Reader& r, const Val& mv, const std::vector<std::pair<st
   // The MuJoCo closed loop: at most max_strokes cycles (runManeuver's duration), one run.
   if (s.mujoco) {
     ExperimentCase c = spec.base;
-    c.splines.clear();
-    c.joints = atZero(cycleStrokes(s, n, {1.0, 1}, 0.0).fast);
+    setTrajectory(c, shiftedToZero(cycleStrokes(s, n, {1.0, 1}, 0.0).fast));
     c.models = {"mujoco"};
     c.render.enabled = false;
     c.output.duration_s = s.max_strokes * (cycleDuration(s, 1.0) + 0.2) + 0.5;
@@ -135,6 +135,7 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   std::vector<std::pair<std::string, Val>> m;
   {
     // Reader::map takes the allowed keys as an initializer list: check them here from the declaration.
+    kl.keys.push_back("stroke_from");  // not a declared number: a trajectory's source (below)
     for (const auto& kv : mv.node) {
       const std::string key = "maneuver." + kv.first.Scalar();
       if (!kv.first.IsScalar()) r.fail(kv.first.Mark(), "maneuver", "keys must be plain names");
@@ -149,12 +150,40 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   YamlFieldReader fr{r, m};
   declareFields(fr, s.settings);
   if (s.settings.min_scale > 1.0) r.fail(*Reader::get(m, "min_scale"), "must be <= 1");
+  s.min_scale_given = Reader::get(m, "min_scale") != nullptr;
+  const Val* from = Reader::get(m, "stroke_from");
+  if (from)
+    for (const char* k : {"stroke_deg", "stroke_dT_s", "stroke_w_ss"})
+      if (const Val* v = Reader::get(m, k))
+        r.fail(*v, std::string("not used with stroke_from (the fast stroke is that trajectory)"));
 
   const Experiment e = loadExperiment(s.base_file);
   if (e.cases.size() != 1)
     r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
   s.base = e.cases.front();
   if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
+  if (from) {
+    // stroke_from: base (the base experiment's trajectory) or the path of a one-case experiment
+    // file (relative to this file), e.g. a `tailsim optimize` best.yaml: its trajectory, split-cycle
+    // or spline, is the fast stroke at full scale.
+    const std::string v = r.text(*from);
+    TailTrajectory t;
+    if (v == "base") {
+      t = s.base.trajectory();
+    } else {
+      s.stroke_file = (fs::path(s.source_file).parent_path() / v).lexically_normal().string();
+      std::error_code ec;
+      if (!fs::is_regular_file(s.stroke_file, ec)) r.fail(*from, "no such experiment file: " + s.stroke_file);
+      const Experiment se = loadExperiment(s.stroke_file);
+      if (se.cases.size() != 1 || se.cases.front().kind != CaseKind::kSimulate)
+        r.fail(*from, s.stroke_file + " must be a one-case kind: simulate experiment (e.g. a tailsim optimize best.yaml)");
+      t = se.cases.front().trajectory();
+    }
+    if (static_cast<int>(t.joints.size()) != s.base.robot.numLinks())
+      r.fail(*from, "the stroke moves " + std::to_string(t.joints.size()) + " joints, the base's tail has " +
+                        std::to_string(s.base.robot.numLinks()));
+    s.settings.stroke_shape = shiftedToZero(t);
+  }
   checkStrokes(r, mv, m, s);
   return s;
 }

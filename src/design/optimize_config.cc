@@ -19,6 +19,52 @@ namespace {
 
 constexpr double kRadPerDeg = M_PI / 180.0;
 using namespace design_yaml;
+
+// The limits the design file leaves out, from the robot file's tail entries: every joint must give
+// it, and the strictest joint's value holds for all (the narrowest common angle range). A limit
+// neither gives is refused with what to add (torque: `none` keeps no torque limit).
+void resolveRobotLimits(const Reader& r, const Val& lv, const ExperimentCase& base, const Val* theta, const Val* speed,
+                        const Val* torque, StrokeLimits& L) {
+  const std::vector<TailLink>& tail = base.robot.tail;
+  const std::string n = std::to_string(tail.size());
+  const std::string where = base.robot_file.empty() ? std::string("the base experiment's tail")
+                                                    : "the robot file " + base.robot_file + " (its tails." + n + " entry)";
+  auto missing = [&](const char* key, const std::string& add) {
+    r.fail(lv.mark, lv.key + "." + key,
+           std::string("required key is missing: neither this file nor ") + where + " gives it. Add " + add);
+  };
+  if (!theta) {
+    double lo = -1e300, hi = 1e300;
+    for (const TailLink& k : tail) {
+      if (!k.hasRange()) missing("theta_deg", "theta_min_deg and theta_max_deg to the robot's tail entry, or "
+                                              "theta_deg: [low, high] here");
+      lo = std::max(lo, k.theta_min_rad);
+      hi = std::min(hi, k.theta_max_rad);
+    }
+    if (!(hi > lo)) r.fail(lv, "the robot's joints have no common angle range (give theta_deg here)");
+    L.theta_min_rad = lo;
+    L.theta_max_rad = hi;
+  }
+  if (!speed) {
+    double v = 1e300;
+    for (const TailLink& k : tail) {
+      if (!(k.thetadot_max_radps > 0.0))
+        missing("thetadot_max_dps", "thetadot_max_dps (the actuator's peak speed) to the robot's tail entry or here");
+      v = std::min(v, k.thetadot_max_radps);
+    }
+    L.thetadot_max_radps = v;
+  }
+  if (!torque) {
+    double v = 1e300;
+    for (const TailLink& k : tail) {
+      if (!(k.torque_max_Nm > 0.0))
+        missing("torque_max_Nm", "torque_max_Nm (the actuator's peak torque) to the robot's tail entry or here, or "
+                                 "torque_max_Nm: none here for no torque limit");
+      v = std::min(v, k.torque_max_Nm);
+    }
+    L.torque_max_Nm = v;
+  }
+}
 }  // namespace
 
 bool isOptimizeFile(const std::string& path) {
@@ -65,7 +111,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& base = file.base(r);  // the base experiment's own checks below point here
   const Val& opt = file.section(r);
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check"});
+                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -73,31 +119,61 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     if (sp.family != StrokeFamily::kSpline) r.fail(*k, "only used with family: spline");
     sp.knots = r.integer(*k, 0, kMaxKnots);
   }
+  // objective: phi_net (the analytic model's), or {quantity: ..., model: analytic | perfoot | mujoco,
+  // search: analytic | perfoot (mujoco only; default perfoot), candidates: K (mujoco only; default 8)}.
   if (const Val* v = Reader::get(o, "objective")) {
-    const std::string ob = r.choice(*v, {"phi_net", "phi_net_per_torque", "phi_net_per_energy"});
-    s.problem.objective = ob == "phi_net" ? StrokeObjective::kPhiNet
-                          : ob == "phi_net_per_torque" ? StrokeObjective::kPhiNetPerTorque
-                                                       : StrokeObjective::kPhiNetPerEnergy;
+    const Val* q = v;
+    if (v->node.IsMap()) {
+      const auto om = r.map(*v, {"quantity", "model", "search", "candidates"});
+      q = Reader::get(om, "quantity");
+      if (const Val* m = Reader::get(om, "model")) {
+        const std::string mn = r.choice(*m, {"analytic", "perfoot", "mujoco"});
+        s.objective_model = mn == "perfoot" ? ObjectiveModel::kPerFoot
+                            : mn == "mujoco" ? ObjectiveModel::kMujoco
+                                             : ObjectiveModel::kAnalytic;
+      }
+      s.problem.search_model =
+          s.objective_model == ObjectiveModel::kAnalytic ? ObjectiveModel::kAnalytic : ObjectiveModel::kPerFoot;
+      const Val* search = Reader::get(om, "search");
+      const Val* cand = Reader::get(om, "candidates");
+      if (s.objective_model != ObjectiveModel::kMujoco) {
+        if (search) r.fail(*search, "only used with model: mujoco (the model the candidates are searched on)");
+        if (cand) r.fail(*cand, "only used with model: mujoco (how many of the search's best MuJoCo re-ranks)");
+      } else {
+        if (search)
+          s.problem.search_model =
+              r.choice(*search, {"analytic", "perfoot"}) == "perfoot" ? ObjectiveModel::kPerFoot : ObjectiveModel::kAnalytic;
+        s.problem.keep_candidates = cand ? r.integer(*cand, 1, kMaxMujocoCandidates) : 8;
+      }
+    }
+    if (q) {
+      const std::string ob = r.choice(*q, {"phi_net", "phi_net_per_torque", "phi_net_per_energy"});
+      s.problem.objective = ob == "phi_net" ? StrokeObjective::kPhiNet
+                            : ob == "phi_net_per_torque" ? StrokeObjective::kPhiNetPerTorque
+                                                         : StrokeObjective::kPhiNetPerEnergy;
+    }
   }
   const Val& lv = need(o, opt, "limits");
   const auto l = r.map(lv, {"theta_deg", "thetadot_max_dps", "torque_max_Nm", "end", "dT_s", "w_ss", "start_delay_s"});
   StrokeLimits& L = sp.limits;
-  {
-    const Val& th = need(l, lv, "theta_deg");
-    const auto [a, b] = r.interval(th, -360.0, 360.0);
-    if (!(b > a)) r.fail(th, "the range must not be empty");
+  // The angle range, speed and torque limits: here, or the robot file's (its tail entry's
+  // theta_min_deg/theta_max_deg, thetadot_max_dps, torque_max_Nm; resolved once the base is read).
+  const Val* theta = Reader::get(l, "theta_deg");
+  if (theta) {
+    const auto [a, b] = r.interval(*theta, -360.0, 360.0);
+    if (!(b > a)) r.fail(*theta, "the range must not be empty");
     L.theta_min_rad = a * kRadPerDeg;
     L.theta_max_rad = b * kRadPerDeg;
   }
-  {
-    const Val& w = need(l, lv, "thetadot_max_dps");
-    L.thetadot_max_radps = r.inRange(w, 1.0, 36000.0) * kRadPerDeg;
-  }
+  const Val* speed = Reader::get(l, "thetadot_max_dps");
+  if (speed) L.thetadot_max_radps = r.inRange(*speed, 1.0, 36000.0) * kRadPerDeg;
   const Val* torque = Reader::get(l, "torque_max_Nm");
-  if (torque && !(torque->node.IsScalar() && torque->node.Scalar() == "base")) {
+  const bool torque_word = torque && torque->node.IsScalar() &&
+                           (torque->node.Scalar() == "base" || torque->node.Scalar() == "none");
+  if (torque && !torque_word) {
     L.torque_max_Nm = r.number(*torque);
     if (!(L.torque_max_Nm > 0.0))
-      r.fail(*torque, "must be > 0 or base (leave it out for no torque limit), got " + fmtG(L.torque_max_Nm));
+      r.fail(*torque, "must be > 0, base (the base stroke's peak) or none (no torque limit), got " + fmtG(L.torque_max_Nm));
   }
   if (const Val* e = Reader::get(l, "end")) {
     L.end = r.choice(*e, {"rest", "start"}) == "start" ? StrokeEnd::kAtStart : StrokeEnd::kAtRest;
@@ -162,7 +238,12 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     s.pareto_points = r.integer(*v, 0, kMaxParetoPoints);
     if (s.pareto_points == 1) r.fail(*v, "a front needs 0 (none) or at least 2 points");
   }
-  if (const Val* v = Reader::get(o, "mujoco_check")) s.mujoco_check = r.boolean(*v);
+  if (const Val* v = Reader::get(o, "min_turn_deg")) s.min_turn_deg = r.inRange(*v, 0.0, 90.0);
+  if (const Val* v = Reader::get(o, "mujoco_check")) {
+    s.mujoco_check = r.boolean(*v);
+    if (!s.mujoco_check && s.objective_model == ObjectiveModel::kMujoco)
+      r.fail(*v, "objective model: mujoco runs MuJoCo on the candidates: leave mujoco_check true");
+  }
 
   // The base experiment, through the loader (its errors name the base file).
   const Experiment e = loadExperiment(s.base_file);
@@ -199,7 +280,8 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
                     fmtG(limits::kMaxOptimizeSteps) +
                     " (docs/design-a-tail-stroke.md \"Limits\"): lower generations, population, islands, restarts or "
                     "seeds, or give the base a coarser analytic step (analytic.fixed_dt_s, analytic.max_step_s)");
-  if (torque && L.torque_max_Nm == 0.0) {  // torque_max_Nm: base -- the base stroke's own peak joint torque
+  resolveRobotLimits(r, lv, s.base, theta, speed, torque, L);
+  if (torque && torque->node.IsScalar() && torque->node.Scalar() == "base") {  // the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");
   }

@@ -30,6 +30,10 @@ struct OptimizeSpec {
   std::vector<std::uint64_t> seeds{1};  // one optimisation per seed; the best is the result
   int pareto_points = 0;                // > 0: phi_net vs peak torque front with this many points
   bool mujoco_check = true;             // re-simulate the optimum in MuJoCo
+  double min_turn_deg = 0.1;            // a best stroke turning the body less is no answer (exit 3, what would)
+  // The objective's model (objective: {model: ...}); with mujoco the search runs
+  // problem.search_model and MuJoCo re-ranks its best problem.keep_candidates points.
+  ObjectiveModel objective_model = ObjectiveModel::kAnalytic;
 };
 
 // Limits of the optimize section (documented in docs/design-a-tail-stroke.md; results/work_limits.h).
@@ -43,6 +47,7 @@ constexpr int kMaxKeptDirectionsLog2 = limits::kMaxKeptDirectionsLog2;
 constexpr int kMaxPolishEvaluations = limits::kMaxPolishEvaluations;
 constexpr int kMaxSeeds = limits::kMaxOptimizeSeeds;
 constexpr int kMaxParetoPoints = limits::kMaxParetoPoints;
+constexpr int kMaxMujocoCandidates = 50;
 
 // Analytic model runs the whole optimisation asks for at most (every seed and Pareto point; each
 // search: the start, islands x population x (generations + 1 + refine_generations) per restart,

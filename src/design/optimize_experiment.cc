@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <unistd.h>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <nlohmann/json.hpp>
@@ -15,6 +17,7 @@
 #include "models/analytic/analytic_simulation.h"
 #include "models/perfoot/per_foot_model.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/folder_inputs.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
@@ -113,7 +116,7 @@ std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& t
   YAML::Node doc = YAML::LoadFile(spec.base_file);
   doc["name"] = spec.name + kBestNameSuffix;
   doc["description"] = "Best stroke of " + spec.name + " (tailsim optimize, " + std::string(familyName(spec.problem.space.family)) + ")";
-  doc["robot"] = spec.base.robot_file;  // absolute: the file runs from any folder
+  doc["robot"] = "robot.yaml";  // the copy beside it in the folder (designFolderInputs)
   YAML::Node t(YAML::NodeType::Map);
   auto flowList = [] {
     YAML::Node l(YAML::NodeType::Sequence);
@@ -162,7 +165,91 @@ std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& t
   doc["models"] = models;
   YAML::Emitter e;
   e << doc;
-  return "# Written by tailsim optimize from " + spec.source_file + "\n" + std::string(e.c_str()) + "\n";
+  return "# Written by tailsim optimize (" + spec.name + "); its robot is the folder's copy, robot.yaml\n" +
+         std::string(e.c_str()) + "\n";
+}
+
+std::map<std::string, std::string> designFolderInputs(const std::string& design_file, const std::string& design_copy,
+                                                      const std::string& base_file, const std::string& stroke_file) {
+  std::map<std::string, std::string> in = folderInputs(loadExperiment(base_file));  // experiment.yaml, robot.yaml
+  std::map<std::string, std::string> out;
+  out["base.yaml"] = in.at("experiment.yaml");
+  out["robot.yaml"] = in.at("robot.yaml");
+  std::ifstream f(design_file, std::ios::binary);
+  if (!f) throw std::runtime_error("cannot read " + design_file);
+  std::ostringstream text;
+  text << f.rdbuf();
+  std::string design = withValueAt(design_file, text.str(), {"base"}, "base.yaml");
+  if (!stroke_file.empty()) {
+    std::map<std::string, std::string> st = folderInputs(loadExperiment(stroke_file));
+    out["stroke.yaml"] = withValueAt(stroke_file, st.at("experiment.yaml"), {"robot"}, "stroke_robot.yaml");
+    out["stroke_robot.yaml"] = st.at("robot.yaml");
+    design = withValueAt(design_file, design, {"maneuver", "stroke_from"}, "stroke.yaml");
+  }
+  out[design_copy] = design;
+  return out;
+}
+
+Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& best, const TailTrajectory& traj,
+                                double min_turn_rad) {
+  Infeasibility r;
+  if (!best.ok || !(std::abs(best.phi_net_rad) < min_turn_rad)) return r;
+  r.infeasible = true;
+  r.reach = stictionReach(p.base, traj);
+  r.peak_torque_Nm = best.figures.peak_torque_Nm;
+  r.peak_speed_dps = best.figures.peak_speed_radps * kDegPerRad;
+  const StrokeLimits& L = p.space.limits;
+  auto fmt = [](double v) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.4g", v);
+    return std::string(b);
+  };
+  const std::string limits = "torque " + (L.torque_max_Nm > 0 ? fmt(L.torque_max_Nm) + " N m" : std::string("unlimited")) +
+                             ", speed " + fmt(L.thetadot_max_radps * kDegPerRad) + " deg/s";
+  const std::string head = "no stroke within the limits (" + limits + ") turns the body by min_turn_deg " +
+                           fmt(min_turn_rad * kDegPerRad) + " or more: the best found turns it " +
+                           fmt(best.phi_net_rad * kDegPerRad) + " deg" +
+                           (r.reach.applies ? "; its yaw moment on the held body peaks at " + fmt(100.0 * r.reach.ratio) +
+                                                  " % of the static friction limit (" +
+                                                  fmt(r.reach.peak_moment_Nm) + " N m of max(mu_s, mu_d) m g L_F = " +
+                                                  fmt(r.reach.limit_Nm) + " N m)"
+                                            : std::string());
+  // The same shape run k times faster: joint torques x k^2, speeds x k (the loads are inertial).
+  StrokeProblem unlimited = p;
+  unlimited.space.limits.torque_max_Nm = 0.0;
+  unlimited.space.limits.thetadot_max_radps = std::numeric_limits<double>::infinity();
+  auto turns = [&](double k) {
+    const StrokeEvaluation e = evaluateStroke(unlimited, timeScaled(traj, k));
+    return e.ok && std::abs(e.phi_net_rad) >= min_turn_rad;
+  };
+  double lo = 1.0, hi = r.reach.applies && r.reach.ratio > 0.0 && r.reach.ratio < 1.0 ? std::sqrt(1.0 / r.reach.ratio) : 1.2;
+  while (!turns(hi) && hi < 30.0) {
+    lo = hi;
+    hi *= 1.25;
+  }
+  if (!turns(hi)) {
+    r.torque_needed_Nm = r.speed_needed_dps = std::numeric_limits<double>::infinity();
+    r.message = head + "; even 30 times faster the same stroke shape does not: widen the angle range or change the robot";
+    return r;
+  }
+  for (int it = 0; it < 40 && hi - lo > 1e-6 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (turns(mid) ? hi : lo) = mid;
+  }
+  const StrokeEvaluation c = evaluateStroke(unlimited, timeScaled(traj, hi));
+  r.check_ok = c.ok;
+  r.check_torque_Nm = c.figures.peak_torque_Nm;
+  r.check_speed_dps = c.figures.peak_speed_radps * kDegPerRad;
+  r.check_phi_net_deg = c.phi_net_rad * kDegPerRad;
+  // Exactly k^2 and k times the stroke's figures (the check's are sampled every 0.5 ms, coarse for
+  // a stroke this fast).
+  r.torque_needed_Nm = r.peak_torque_Nm * hi * hi;
+  r.speed_needed_dps = r.peak_speed_dps * hi;
+  r.message = head + ". The same stroke shape, run " + fmt(hi) + " times faster, turns it " + fmt(r.check_phi_net_deg) +
+              " deg (" + objectiveModelName(p.search_model) + " model) at a peak joint torque of " + fmt(r.torque_needed_Nm) +
+              " N m and a peak joint speed of " + fmt(r.speed_needed_dps) + " deg/s (now " + fmt(r.peak_torque_Nm) +
+              " N m, " + fmt(r.peak_speed_dps) + " deg/s): raise the limits to at least these, or change the robot";
+  return r;
 }
 
 OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress) {
@@ -170,27 +257,112 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   OptimizeReport rep;
   fs::create_directories(fs::path(out_dir) / "plots");
   const StrokeProblem& prob = spec.problem;
+  // The folder's own inputs first: best.yaml names the robot copy, and is read back below.
+  for (const auto& [name, text] : designFolderInputs(spec.source_file, "optimize.yaml", spec.base_file)) {
+    writeOwnedFile(out_dir, name, text);
+    rep.files.push_back(name);
+  }
 
-  for (std::uint64_t seed : spec.seeds) {
+  // Progress: on a terminal one line redrawn with \r (every 0.5 s), in a log a plain line every 5 s,
+  // as `tailsim run` does; a line per finished seed either way.
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  const auto period = tty ? std::chrono::milliseconds(500) : std::chrono::milliseconds(5000);
+  const double runs_estimate = optimizeRunEstimate(spec) /
+                               static_cast<double>(spec.seeds.size() + static_cast<std::size_t>(spec.pareto_points)) *
+                               static_cast<double>(spec.seeds.size());
+  const char* unit = objectiveUnit(prob.objective);
+  double best_obj = 0.0, best_phi = 0.0;  // over the finished seeds
+  bool line_open = false;
+  auto last_print = std::chrono::steady_clock::now() - period;  // the first line at once
+  for (std::size_t i = 0; i < spec.seeds.size(); ++i) {
+    const std::uint64_t seed = spec.seeds[i];
     OptimizerSettings os = spec.optimizer;
     os.seed = seed;
-    rep.per_seed.push_back(optimizeStroke(prob, os));
+    ProgressFn show;
+    if (progress)
+      show = [&](const SearchProgress& p) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_print < period) return;
+        last_print = now;
+        const bool better = p.best_objective > best_obj;
+        const double obj = better ? p.best_objective : best_obj, phi = better ? p.best_phi_net_rad : best_phi;
+        const double el = std::chrono::duration<double>(now - t0).count();
+        std::fprintf(stderr, "%s[optimize %s] seed %llu (%zu/%zu), %s: %ld runs (about %.3g in all), best so far %s %+.6g %s "
+                     "(phi_net %+.4f deg), %.1f s elapsed%s",
+                     tty ? "\r" : "", spec.name.c_str(), static_cast<unsigned long long>(seed), i + 1, spec.seeds.size(),
+                     p.stage, rep.evaluations + p.evaluations, runs_estimate, objectiveName(prob.objective),
+                     signedObjectiveDeg(obj, phi), unit, phi * kDegPerRad, el, tty ? "   " : "\n");
+        line_open = tty;
+        std::fflush(stderr);
+      };
+    rep.per_seed.push_back(optimizeStroke(prob, os, show));
     const OptimizeResult& r = rep.per_seed.back();
     rep.evaluations += r.evaluations;
-    if (progress)
-      std::fprintf(stderr, "seed %llu: %s = %.6g (phi_net %.4f deg), %ld evaluations, %.2f s\n",
-                   static_cast<unsigned long long>(seed), objectiveName(prob.objective), r.best.objective,
-                   r.best.phi_net_rad * kDegPerRad, r.evaluations, r.wall_s);
+    if (r.best.objective > best_obj) {
+      best_obj = r.best.objective;
+      best_phi = r.best.phi_net_rad;
+    }
+    if (progress) {
+      if (line_open) std::fprintf(stderr, "\n");
+      line_open = false;
+      std::fprintf(stderr, "seed %llu: %s %+.6g %s (phi_net %+.4f deg), peak torque %.4g N m, %ld runs, %.2f s\n",
+                   static_cast<unsigned long long>(seed), objectiveName(prob.objective),
+                   signedObjectiveDeg(r.best.objective, r.best.phi_net_rad), unit, r.best.phi_net_rad * kDegPerRad,
+                   r.best.figures.peak_torque_Nm, r.evaluations, r.wall_s);
+    }
   }
   double lo = 1e300, hi = -1e300;
   for (std::size_t i = 0; i < rep.per_seed.size(); ++i) {
     const double v = rep.per_seed[i].best.objective;
     lo = std::min(lo, v);
     hi = std::max(hi, v);
-    if (v > rep.per_seed[rep.best_seed_index].best.objective) rep.best_seed_index = i;
+    if (rep.per_seed[i].best.betterThan(rep.per_seed[rep.best_seed_index].best)) rep.best_seed_index = i;
   }
   rep.spread = hi > 0 ? (hi - lo) / hi : 0.0;
-  const OptimizeResult& best = rep.per_seed[rep.best_seed_index];
+  OptimizeResult best = rep.per_seed[rep.best_seed_index];
+  if (spec.objective_model == ObjectiveModel::kMujoco) {
+    // MuJoCo re-ranks the search's best distinct candidates (over every seed); the one whose MuJoCo
+    // objective is largest is the optimum.
+    std::vector<Candidate> cands;
+    for (const OptimizeResult& r : rep.per_seed) cands.insert(cands.end(), r.candidates.begin(), r.candidates.end());
+    std::stable_sort(cands.begin(), cands.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.eval.objective > b.eval.objective; });
+    std::vector<Candidate> distinct;
+    for (Candidate& c : cands) {
+      bool same = false;
+      for (const Candidate& d : distinct) same = same || std::abs(d.eval.objective - c.eval.objective) <= 1e-6 * d.eval.objective;
+      if (!same && distinct.size() < static_cast<std::size_t>(prob.keep_candidates)) distinct.push_back(std::move(c));
+    }
+    if (distinct.empty()) distinct.push_back({best.trajectory, best.best});
+    for (std::size_t k = 0; k < distinct.size(); ++k) {
+      const Candidate& c = distinct[k];
+      RerankRow row;
+      row.search_phi_net_deg = c.eval.phi_net_rad * kDegPerRad;
+      const RunResult rm = simulateMujoco(spec.base.robot, c.trajectory, spec.base.mujoco, spec.base.effects,
+                                          fullOutput(spec.base, c.trajectory));
+      row.ok = rm.summary.ok && std::isfinite(rm.summary.phi_net_deg);
+      row.error = rm.summary.error;
+      if (row.ok) {
+        row.mujoco_phi_net_deg = rm.summary.phi_net_deg;
+        row.mujoco_objective = objectiveValue(prob.objective, rm.summary.phi_net_deg / kDegPerRad, c.eval.figures);
+      }
+      if (row.mujoco_objective > (rep.rerank.empty() ? -1.0 : rep.rerank[rep.rerank_chosen].mujoco_objective))
+        rep.rerank_chosen = k;
+      rep.rerank.push_back(row);
+      if (progress)
+        std::fprintf(stderr, "MuJoCo re-rank %zu/%zu: %s phi_net %+.4f deg, MuJoCo %s\n", k + 1, distinct.size(),
+                     objectiveModelName(prob.search_model), row.search_phi_net_deg,
+                     row.ok ? (std::to_string(row.mujoco_phi_net_deg) + " deg").c_str() : ("failed: " + row.error).c_str());
+    }
+    const Candidate& chosen = distinct[rep.rerank_chosen];
+    if (rep.rerank_chosen != 0 || chosen.eval.objective != best.best.objective) {
+      best.trajectory = chosen.trajectory;
+      best.best = chosen.eval;
+      best.x.clear();
+      best.directions.clear();  // the candidates' direction patterns are not kept
+    }
+  }
+  rep.infeasible = analyseInfeasible(prob, best.best, best.trajectory, spec.min_turn_deg * M_PI / 180.0);
   // The re-simulations run the stroke as best.yaml writes it, read back by the experiment loader:
   // its angles are decimal degrees there, which need not convert back to the search's radians to
   // the last bit, and `tailsim run best.yaml` must give what summary.json reports.
@@ -239,29 +411,39 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   writeOwnedFile(out_dir, "best.yaml", best_yaml);
   rep.files.push_back("best.yaml");
 
-  // Convergence history.
+  // Convergence history, in signed degrees (the objective's sign is phi_net's).
   {
+    const std::string col = std::string("best_") + objectiveName(prob.objective) + "_" + objectiveUnitSuffix(prob.objective);
     std::ostringstream csv;
-    csv << "seed,stage,generation,evaluations,wall_s,best_objective\n";
-    std::vector<std::vector<double>> rows;
+    csv << "seed,stage,generation,evaluations,wall_s," << col
+        << (prob.objective == StrokeObjective::kPhiNet ? "" : ",best_phi_net_deg") << "\n";
     for (std::size_t i = 0; i < rep.per_seed.size(); ++i)
       for (const HistoryRow& h : rep.per_seed[i].history) {
         csv << spec.seeds[i] << "," << h.stage << "," << h.generation << "," << h.evaluations << "," << g17(h.wall_s) << ","
-            << g17(h.best_objective) << "\n";
+            << g17(signedObjectiveDeg(h.best_objective, h.best_phi_net_rad));
+        if (prob.objective != StrokeObjective::kPhiNet) csv << "," << g17(h.best_phi_net_rad * kDegPerRad);
+        csv << "\n";
       }
     writeOwnedFile(out_dir, "history.csv", csv.str());
     rep.files.push_back("history.csv");
     GnuplotFigure fig;
     fig.stem = "history";
     std::ostringstream b;
-    b << "set datafile separator ','\nset key bottom right\nset grid\n"
+    b << "set datafile separator ','\nset key outside right\nset grid\n"
       << "set title " << gpQuote("Convergence of " + spec.name + " (" + familyName(prob.space.family) + ")")
       << " noenhanced\nset xlabel 'analytic model runs'\nset ylabel "
-      << gpQuote(std::string(objectiveName(prob.objective)) + (prob.objective == StrokeObjective::kPhiNet ? " [rad]" : ""))
+      << gpQuote("best " + std::string(objectiveName(prob.objective)) + " so far [" + unit + "]")
       << " noenhanced\nplot ";
+    const std::string data = gpFileName("../history.csv");
     for (std::size_t i = 0; i < spec.seeds.size(); ++i)
-      b << (i ? ", " : "") << gpFileName("../history.csv") << " every ::1 using ($1==" << spec.seeds[i]
+      b << (i ? ", " : "") << data << " every ::1 using ($1==" << spec.seeds[i]
         << " ? $4 : 1/0):6 with steps lw 2 title " << gpQuote("seed " + std::to_string(spec.seeds[i]));
+    // The stages: a mark at every generation of each (all seeds), so the plot shows where the
+    // global search, the refine, the local restarts and the polish ran.
+    const char* stages[][2] = {{"global", "6"}, {"refine", "8"}, {"local", "4"}, {"polish", "7"}};
+    for (const auto& st : stages)
+      b << ", " << data << " every ::1 using (strcol(2) eq '" << st[0] << "' ? $4 : 1/0):6 with points pt " << st[1]
+        << " ps 0.6 lc rgb 'gray40' title '" << st[0] << "'";
     b << "\n";
     fig.body = b.str();
     renderFigure((fs::path(out_dir) / "plots").string(), fig);
@@ -288,7 +470,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
       pareto.push_back({{"torque_limit_Nm", p.space.limits.torque_max_Nm}, {"peak_torque_Nm", r.best.figures.peak_torque_Nm},
                         {"phi_net_deg", r.best.phi_net_rad * kDegPerRad}, {"feasible", r.best.feasible()}});
       if (progress)
-        std::fprintf(stderr, "pareto %d/%d: torque <= %.4g N m: phi_net %.4f deg\n", k + 1, spec.pareto_points,
+        std::fprintf(stderr, "pareto %d/%d: torque <= %.4g N m: phi_net %+.4f deg\n", k + 1, spec.pareto_points,
                      p.space.limits.torque_max_Nm, r.best.phi_net_rad * kDegPerRad);
     }
     writeOwnedFile(out_dir, "pareto.csv", csv.str());
@@ -309,6 +491,9 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["base"] = spec.base_file;
   j["family"] = familyName(prob.space.family);
   j["objective"] = objectiveName(prob.objective);
+  j["objective_model"] = objectiveModelName(spec.objective_model);
+  j["search_model"] = objectiveModelName(prob.search_model);
+  j["objective_unit"] = unit;  // of every "objective_signed" (signed like phi_net); "objective": |.| in radians
   j["n_links"] = prob.space.n_links;
   j["dimensions"] = prob.space.dim();
   j["algorithm"] = spec.optimizer.algorithm;
@@ -322,11 +507,14 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["directions_kept"] = spec.optimizer.directions_kept;
   j["polish"] = spec.optimizer.polish;
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
+                {"objective_signed", signedObjectiveDeg(best.start.objective, best.start.phi_net_rad)},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};
   nlohmann::json seeds = nlohmann::json::array();
   for (std::size_t i = 0; i < rep.per_seed.size(); ++i) {
     const OptimizeResult& r = rep.per_seed[i];
-    seeds.push_back({{"seed", spec.seeds[i]}, {"objective", r.best.objective}, {"phi_net_deg", r.best.phi_net_rad * kDegPerRad},
+    seeds.push_back({{"seed", spec.seeds[i]}, {"objective", r.best.objective},
+                     {"objective_signed", signedObjectiveDeg(r.best.objective, r.best.phi_net_rad)},
+                     {"phi_net_deg", r.best.phi_net_rad * kDegPerRad},
                      {"evaluations", r.evaluations}, {"wall_s", r.wall_s}});
   }
   j["seeds"] = seeds;
@@ -353,7 +541,8 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                         {"dT_s", p.dT_s}, {"w_ss", p.w_ss}, {"t0_s", p.t0_s}});
     }
   }
-  j["best"] = {{"objective", b.objective}, {"phi_net_deg", b.phi_net_rad * kDegPerRad},
+  j["best"] = {{"objective", b.objective}, {"objective_signed", signedObjectiveDeg(b.objective, b.phi_net_rad)},
+               {"phi_net_deg", b.phi_net_rad * kDegPerRad},
                {"peak_speed_dps", b.figures.peak_speed_radps * kDegPerRad}, {"peak_torque_Nm", b.figures.peak_torque_Nm},
                {"energy_J", b.figures.energy_J}, {"joints", joints}};
   j["improvement_over_start"] = best.start.objective > 0 ? b.objective / best.start.objective - 1.0 : 0.0;
@@ -380,6 +569,30 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                                                                : nlohmann::json()}};
   }
   if (!pareto.empty()) j["pareto"] = pareto;
+  if (!rep.rerank.empty()) {
+    nlohmann::json rr = nlohmann::json::array();
+    for (std::size_t k = 0; k < rep.rerank.size(); ++k) {
+      const RerankRow& row = rep.rerank[k];
+      rr.push_back({{"search_phi_net_deg", row.search_phi_net_deg},
+                    {"mujoco_phi_net_deg", row.ok ? nlohmann::json(row.mujoco_phi_net_deg) : nlohmann::json()},
+                    {"ok", row.ok}, {"error", row.error}, {"chosen", k == rep.rerank_chosen}});
+    }
+    j["mujoco_rerank"] = rr;
+  }
+  if (const Infeasibility& inf = rep.infeasible; inf.infeasible) {
+    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    j["infeasible"] = {{"message", inf.message},
+                       {"min_turn_deg", spec.min_turn_deg},
+                       {"stiction_ratio", inf.reach.ratio},
+                       {"tail_moment_Nm", inf.reach.peak_moment_Nm},
+                       {"friction_limit_Nm", inf.reach.limit_Nm},
+                       {"peak_torque_Nm", inf.peak_torque_Nm},
+                       {"peak_speed_dps", inf.peak_speed_dps},
+                       {"torque_needed_Nm", num(inf.torque_needed_Nm)},
+                       {"speed_needed_dps", num(inf.speed_needed_dps)},
+                       {"check", {{"ok", inf.check_ok}, {"peak_torque_Nm", inf.check_torque_Nm},
+                                  {"peak_speed_dps", inf.check_speed_dps}, {"phi_net_deg", inf.check_phi_net_deg}}}};
+  }
   j["evaluations"] = rep.evaluations;
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;

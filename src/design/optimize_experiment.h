@@ -10,10 +10,12 @@
 //   DIR/summary.json         everything the note needs (objective per seed, spread, MuJoCo difference)
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
 #include "design/optimize_config.h"
+#include "design/stiction_reach.h"
 #include "design/stroke_optimizer.h"
 #include "results/time_series.h"
 
@@ -29,7 +31,39 @@ struct LimitCheck {
 // torques by the Newton-Euler recursion from those columns; checked against `lim`.
 LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSeries& ts, const StrokeLimits& lim);
 
+// No stroke within the limits turned the body by min_turn_deg: what would. The best stroke the
+// search found is run faster (time scaled by k: its loads on the body and its joint torques grow by
+// k^2, its speeds by k) until it turns the body by min_turn_deg (bisection on k in the search's model).
+struct Infeasibility {
+  bool infeasible = false;
+  StictionReach reach;             // of the best stroke within the limits
+  double peak_torque_Nm = 0.0;     // that stroke's peak joint torque and speed
+  double peak_speed_dps = 0.0;
+  double torque_needed_Nm = 0.0;   // the same shape turning the body by min_turn_deg (infinite: not found)
+  double speed_needed_dps = 0.0;
+  // The check: that shape at the needed torque and speed (the bisection's turning end).
+  double check_torque_Nm = 0.0, check_speed_dps = 0.0, check_phi_net_deg = 0.0;
+  bool check_ok = false;
+  std::string message;             // the console's and summary.json's explanation
+};
+
+// The infeasibility analysis of a search whose best stroke turns the body by less than min_turn_rad.
+Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& best, const TailTrajectory& traj,
+                                double min_turn_rad);
+
+// One candidate of a MuJoCo re-ranking (objective model: mujoco).
+struct RerankRow {
+  double search_phi_net_deg = 0.0;  // the search model's
+  double mujoco_phi_net_deg = 0.0;
+  double mujoco_objective = -1.0;   // objectiveValue of MuJoCo's phi_net (-1: the run failed)
+  bool ok = false;
+  std::string error;
+};
+
 struct OptimizeReport {
+  Infeasibility infeasible;
+  std::vector<RerankRow> rerank;   // objective model mujoco: the candidates, best of the search first
+  std::size_t rerank_chosen = 0;   // the row chosen
   std::vector<OptimizeResult> per_seed;
   std::size_t best_seed_index = 0;
   double spread = 0.0;  // (max - min) / max of the seeds' objectives
@@ -44,6 +78,14 @@ struct OptimizeReport {
   // `tailsim run best.yaml` gives this error instead of their results.
   std::string best_yaml_error;
 };
+
+// The inputs a design folder keeps so that it runs again on its own after a move: the design file
+// (as `design_copy`, its `base:` naming base.yaml), the base experiment (its `robot:` naming
+// robot.yaml) and the robot file, as file name -> contents. With a stroke file (a maneuver's
+// stroke_from: FILE) also stroke.yaml (its `robot:` naming stroke_robot.yaml) and that robot, and
+// the design file's maneuver.stroke_from names stroke.yaml. Throws std::runtime_error.
+std::map<std::string, std::string> designFolderInputs(const std::string& design_file, const std::string& design_copy,
+                                                      const std::string& base_file, const std::string& stroke_file = "");
 
 OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress);
 

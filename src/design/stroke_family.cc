@@ -168,6 +168,37 @@ const char* objectiveName(StrokeObjective o) {
   }
   return "?";
 }
+const char* objectiveModelName(ObjectiveModel m) {
+  switch (m) {
+    case ObjectiveModel::kAnalytic: return "analytic";
+    case ObjectiveModel::kPerFoot: return "perfoot";
+    case ObjectiveModel::kMujoco: return "mujoco";
+  }
+  return "analytic";
+}
+
+double signedObjectiveDeg(double objective, double phi_net_rad) {
+  return (phi_net_rad < 0.0 ? -objective : objective) * (180.0 / M_PI);
+}
+
+const char* objectiveUnit(StrokeObjective o) {
+  switch (o) {
+    case StrokeObjective::kPhiNet: return "deg";
+    case StrokeObjective::kPhiNetPerTorque: return "deg/(N m)";
+    case StrokeObjective::kPhiNetPerEnergy: return "deg/J";
+  }
+  return "deg";
+}
+
+const char* objectiveUnitSuffix(StrokeObjective o) {
+  switch (o) {
+    case StrokeObjective::kPhiNet: return "deg";
+    case StrokeObjective::kPhiNetPerTorque: return "deg_per_Nm";
+    case StrokeObjective::kPhiNetPerEnergy: return "deg_per_J";
+  }
+  return "deg";
+}
+
 const char* familyName(StrokeFamily f) { return f == StrokeFamily::kSplitCycle ? "split_cycle" : "spline"; }
 
 }  // namespace tailsim

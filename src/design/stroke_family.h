@@ -17,6 +17,10 @@ namespace tailsim {
 enum class StrokeFamily { kSplitCycle, kSpline };
 enum class StrokeEnd { kAtRest, kAtStart };  // the tail ends at rest anywhere, or where it started
 enum class StrokeObjective { kPhiNet, kPhiNetPerTorque, kPhiNetPerEnergy };
+// The model whose phi_net the objective is: analytic and per-foot are searched directly; MuJoCo
+// re-ranks the best candidates of a search on the analytic or per-foot model.
+enum class ObjectiveModel { kAnalytic, kPerFoot, kMujoco };
+const char* objectiveModelName(ObjectiveModel m);
 
 // What the search may vary and what a stroke must keep. Every joint's angle stays in
 // [theta_min, theta_max]; its speed within thetadot_max; every joint torque within torque_max.
@@ -76,6 +80,12 @@ double limitViolation(const StrokeFigures& f, const StrokeLimits& lim);
 // The objective's value for a signed phi_net [rad] (the optimiser maximises |phi_net| / divisor).
 double objectiveValue(StrokeObjective o, double phi_net_rad, const StrokeFigures& f);
 const char* objectiveName(StrokeObjective o);
+// The objective as reported (console, summary.json, history.csv): signed like phi_net, in degrees
+// (per N m, per J): objectiveValue x sign(phi_net) x 180 / pi. Its unit, and the unit as a
+// column-name suffix ("deg", "deg_per_Nm", "deg_per_J").
+double signedObjectiveDeg(double objective, double phi_net_rad);
+const char* objectiveUnit(StrokeObjective o);
+const char* objectiveUnitSuffix(StrokeObjective o);
 const char* familyName(StrokeFamily f);
 
 }  // namespace tailsim

@@ -19,13 +19,16 @@
 #include <stdexcept>
 
 #include "models/analytic/analytic_simulation.h"
+#include "models/perfoot/per_foot_model.h"
+#include "design/stiction_reach.h"
 #include "results/work_limits.h"
 
 namespace tailsim {
 
 double StrokeEvaluation::fitness() const {
   if (!ok) return 10.0;
-  return violation > 0.0 ? violation : -objective;
+  if (violation > 0.0) return violation;
+  return objective > 0.0 ? -objective : -1e-12 * stiction_ratio;
 }
 
 Effects searchEffects(const ExperimentCase& base) {
@@ -48,12 +51,25 @@ StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& tr
   // Two rows, t = 0 and the end: phi_net comes from the state, not the rows, and a row while the
   // tail moves costs an evaluation with the M_z,T decomposition (one every 10 ms was ~1/4 of a run).
   out.sample_dt_s = traj.endTime() + out.settle_s;
-  const RunResult r = simulateAnalytic(p.base.robot, traj, p.base.analytic, searchEffects(p.base), out);
+  RunResult r;
+  if (p.search_model == ObjectiveModel::kPerFoot) {
+    Effects pe = p.base.effects;
+    pe.load_decomposition = false;
+    try {
+      r = simulatePerFoot(p.base.robot, traj, p.base.perfoot, pe, out);
+    } catch (const std::exception& ex) {  // settings it cannot run with: this point fails, the search goes on
+      e.error = ex.what();
+      return e;
+    }
+  } else {
+    r = simulateAnalytic(p.base.robot, traj, p.base.analytic, searchEffects(p.base), out);
+  }
   e.ok = r.summary.ok && std::isfinite(r.summary.phi_net_deg);
   e.error = r.summary.error;
   if (e.ok) {
     e.phi_net_rad = r.summary.phi_net_deg * M_PI / 180.0;
     e.objective = objectiveValue(p.objective, e.phi_net_rad, e.figures);
+    if (e.phi_net_rad == 0.0) e.stiction_ratio = stictionReach(p.base, traj).ratio;
   }
   return e;
 }
@@ -74,12 +90,33 @@ struct Tracker {
   bool have_best = false;
   std::vector<double> best_x;
   StrokeEvaluation best;
+  std::size_t keep = 0;  // candidates kept (StrokeProblem::keep_candidates)
+  std::vector<std::pair<std::vector<double>, StrokeEvaluation>> top;  // best first, distinct objectives
 
   void record(const std::vector<double>& x, const StrokeEvaluation& e) {
     std::lock_guard<std::mutex> lock(mu);
     ++evaluations;
-    if (e.feasible() && (!have_best || e.objective > best_objective ||
-                         (e.objective == best_objective && x < best_x))) {  // ties: deterministic
+    if (keep > 0 && e.feasible() && e.objective > 0.0 &&
+        (top.size() < keep || e.objective > top.back().second.objective)) {
+      // Distinct: a point within 1e-6 of a kept one's objective is the same optimum (the polish
+      // and the local restarts revisit it many times).
+      bool same = false;
+      for (auto& t : top)
+        if (std::abs(t.second.objective - e.objective) <= 1e-6 * t.second.objective) {
+          same = true;
+          if (e.objective > t.second.objective) t = {x, e};
+          break;
+        }
+      if (!same) {
+        top.emplace_back(x, e);
+        std::stable_sort(top.begin(), top.end(), [](const auto& a, const auto& b) { return a.second.objective > b.second.objective; });
+        if (top.size() > keep) top.pop_back();
+      } else {
+        std::stable_sort(top.begin(), top.end(), [](const auto& a, const auto& b) { return a.second.objective > b.second.objective; });
+      }
+    }
+    if (e.feasible() && (!have_best || e.betterThan(best) ||
+                         (!best.betterThan(e) && x < best_x))) {  // ties: deterministic
       have_best = true;
       best_objective = e.objective;
       best_x = x;
@@ -119,9 +156,10 @@ namespace {
 // later stages only in the best patterns (directions_kept), so the stages are separate calls.
 class SpaceSearch {
  public:
-  SpaceSearch(const StrokeProblem& prob, const OptimizerSettings& s)
-      : prob_(prob), s_(s), shared_(std::make_shared<const StrokeProblem>(prob)), tracker_(std::make_shared<Tracker>()),
+  SpaceSearch(const StrokeProblem& prob, const OptimizerSettings& s, ProgressFn progress = {})
+      : prob_(prob), s_(s), progress_(std::move(progress)), shared_(std::make_shared<const StrokeProblem>(prob)), tracker_(std::make_shared<Tracker>()),
         pp_(PagmoStroke{shared_, tracker_}) {
+    tracker_->keep = static_cast<std::size_t>(std::max(0, prob.keep_candidates));
     if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
         s.restart_growth < 1 || s.refine_generations < 0 || s.local_restarts < 0 || !(s.local_step > 0.0) ||
         s.directions_kept < 0)
@@ -211,6 +249,7 @@ class SpaceSearch {
     }
     res_.directions = prob_.space.directions;
     res_.trajectory = prob_.space.trajectory(res_.x);
+    for (const auto& [x, e] : tracker_->top) res_.candidates.push_back({prob_.space.trajectory(x), e});
     return std::move(res_);
   }
 
@@ -232,9 +271,16 @@ class SpaceSearch {
   void endStage() { wall_s_ += std::chrono::duration<double>(Clock::now() - stage_start_).count(); }
 
   void snapshot(const char* stage) {
-    std::lock_guard<std::mutex> lock(tracker_->mu);
-    res_.history.push_back({gen_count_, tracker_->evaluations, wall_s_ + std::chrono::duration<double>(Clock::now() - stage_start_).count(),
-                            tracker_->have_best ? tracker_->best_objective : 0.0, stage});
+    SearchProgress p;
+    {
+      std::lock_guard<std::mutex> lock(tracker_->mu);
+      res_.history.push_back({gen_count_, tracker_->evaluations,
+                              wall_s_ + std::chrono::duration<double>(Clock::now() - stage_start_).count(),
+                              tracker_->have_best ? tracker_->best_objective : 0.0,
+                              tracker_->have_best ? tracker_->best.phi_net_rad : 0.0, stage});
+      p = {stage, tracker_->evaluations, res_.history.back().best_objective, res_.history.back().best_phi_net_rad};
+    }
+    if (progress_) progress_(p);
   }
 
   void polish() {
@@ -292,6 +338,7 @@ class SpaceSearch {
 
   const StrokeProblem& prob_;
   OptimizerSettings s_;
+  ProgressFn progress_;
   std::shared_ptr<const StrokeProblem> shared_;
   std::shared_ptr<Tracker> tracker_;
   pagmo::problem pp_;
@@ -302,8 +349,8 @@ class SpaceSearch {
   Clock::time_point stage_start_ = Clock::now();  // wall time counts the stages only (not the waits between)
 };
 
-OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s) {
-  SpaceSearch search(prob, s);
+OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s, const ProgressFn& progress) {
+  SpaceSearch search(prob, s, progress);
   search.globalStage(0, s.restarts);
   search.localStageAndPolish();
   return search.finish();
@@ -311,8 +358,8 @@ OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s
 
 }  // namespace
 
-OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s) {
-  if (!s.enumerate_directions) return searchSpace(prob, s);
+OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s, const ProgressFn& progress) {
+  if (!s.enumerate_directions) return searchSpace(prob, s, progress);
   if (prob.space.family != StrokeFamily::kSplitCycle)
     throw std::invalid_argument("enumerating stroke directions needs the split-cycle family");
   // The n = 3 problem's basins differ in which joints stroke up and which down (the best found has
@@ -330,6 +377,23 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   const int patterns = 1 << n;
   std::vector<StrokeProblem> problems(static_cast<std::size_t>(patterns), prob);
   std::vector<std::unique_ptr<SpaceSearch>> searches;
+  // Progress over all patterns: runs summed, the best of the patterns' bests.
+  std::vector<SearchProgress> per_pattern(static_cast<std::size_t>(patterns));
+  auto patternProgress = [&](int mask) -> ProgressFn {
+    if (!progress) return {};
+    return [&, mask](const SearchProgress& p) {
+      per_pattern[static_cast<std::size_t>(mask)] = p;
+      SearchProgress all{p.stage, 0, 0.0, 0.0};
+      for (const SearchProgress& q : per_pattern) {
+        all.evaluations += q.evaluations;
+        if (q.best_objective > all.best_objective) {
+          all.best_objective = q.best_objective;
+          all.best_phi_net_rad = q.best_phi_net_rad;
+        }
+      }
+      progress(all);
+    };
+  };
   for (int mask = 0; mask < patterns; ++mask) {
     StrokeProblem& p = problems[static_cast<std::size_t>(mask)];
     p.space.directions.assign(static_cast<std::size_t>(n), 1);
@@ -337,7 +401,7 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
       if ((mask >> j) & 1) p.space.directions[static_cast<std::size_t>(j)] = -1;
     OptimizerSettings ps = s;
     ps.seed = s.seed * 4099u + static_cast<std::uint64_t>(mask);
-    searches.push_back(std::make_unique<SpaceSearch>(p, ps));
+    searches.push_back(std::make_unique<SpaceSearch>(p, ps, patternProgress(mask)));
     // Without successive halving each pattern's search runs through (as before the option).
     if (s.directions_kept == 0 || s.directions_kept >= patterns) {
       searches.back()->globalStage(0, s.restarts);
@@ -359,7 +423,7 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   }
 
   OptimizeResult all;
-  double best_so_far = 0.0;
+  double best_so_far = 0.0, best_phi = 0.0;
   for (int mask = 0; mask < patterns; ++mask) {
     OptimizeResult r = searches[static_cast<std::size_t>(mask)]->finish();
     // History: one curve over all patterns (rows after each pattern's first continue the counts).
@@ -369,15 +433,20 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
       row.generation += gen0;
       row.evaluations += all.evaluations;
       row.wall_s += all.wall_s;
-      best_so_far = std::max(best_so_far, row.best_objective);
+      if (row.best_objective > best_so_far) {
+        best_so_far = row.best_objective;
+        best_phi = row.best_phi_net_rad;
+      }
       row.best_objective = best_so_far;
+      row.best_phi_net_rad = best_phi;
       all.history.push_back(row);
     }
     all.evaluations += r.evaluations;
     all.wall_s += r.wall_s;
     all.by_direction.push_back({r.directions, r.best, r.evaluations});
+    for (Candidate& c : r.candidates) all.candidates.push_back(std::move(c));
     if (mask == 0) all.start = r.start;
-    const bool better = r.best.feasible() && (!all.best.feasible() || r.best.objective > all.best.objective);
+    const bool better = r.best.feasible() && (!all.best.feasible() || r.best.betterThan(all.best));
     if (mask == 0 || better) {
       all.x = r.x;
       all.best = r.best;
@@ -385,6 +454,10 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
       all.trajectory = r.trajectory;
     }
   }
+  std::stable_sort(all.candidates.begin(), all.candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.eval.objective > b.eval.objective; });
+  if (all.candidates.size() > static_cast<std::size_t>(std::max(0, prob.keep_candidates)))
+    all.candidates.resize(static_cast<std::size_t>(std::max(0, prob.keep_candidates)));
   // A guard (a stroke of zero length keeps every split-cycle limit, so some pattern is feasible
   // unless every run fails): return the base stroke, as a single search does.
   if (!all.best.feasible()) {

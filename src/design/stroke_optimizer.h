@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -34,17 +35,30 @@ struct StrokeProblem {
   ExperimentCase base;  // robot, effects, analytic settings; its trajectory is the search's start
   StrokeSpace space;
   StrokeObjective objective = StrokeObjective::kPhiNet;
+  ObjectiveModel search_model = ObjectiveModel::kAnalytic;  // the model every search point runs (analytic | perfoot)
+  int keep_candidates = 0;  // > 0: OptimizeResult::candidates keeps the best this many distinct feasible points
 };
 
 struct StrokeEvaluation {
-  bool ok = false;           // the analytic run succeeded
+  bool ok = false;           // the run (of StrokeProblem::search_model) succeeded
   std::string error;
   double phi_net_rad = 0.0;  // signed
   double objective = 0.0;    // objectiveValue (|phi_net| based)
   StrokeFigures figures;
   double violation = 0.0;    // limitViolation (0: feasible)
+  // A stroke that leaves the body stuck (phi_net exactly 0, stiction law): how close it came to
+  // breaking away, stictionReach's ratio (< 1); 0 otherwise. It ranks the strokes that do not turn
+  // the body (their objective is 0), so a search within limits too tight to turn it still climbs
+  // towards breakaway, and its best stroke is the shape the infeasibility report scales.
+  double stiction_ratio = 0.0;
   bool feasible() const { return ok && violation == 0.0; }
-  double fitness() const;    // minimised: -objective when feasible, else violation (> any feasible), 10 when failed
+  // Minimised: -objective when feasible and turning; -1e-12 x stiction_ratio when feasible and
+  // stuck (above every turning stroke); else violation (> any feasible), 10 when failed.
+  double fitness() const;
+  // Better than o in the tracker's order: feasible first, then objective, then stiction_ratio.
+  bool betterThan(const StrokeEvaluation& o) const {
+    return objective > o.objective || (objective == o.objective && stiction_ratio > o.stiction_ratio);
+  }
 };
 
 // The effects a search simulates with: the base's, without the output-only load decomposition and,
@@ -52,7 +66,8 @@ struct StrokeEvaluation {
 // optimum is re-run with the base's own effects (optimize_experiment.cc).
 Effects searchEffects(const ExperimentCase& base);
 
-// Runs the analytic model on traj (with searchEffects) and judges it against the limits.
+// Runs the search model on traj (analytic: with searchEffects; per-foot: the base's effects
+// without the load decomposition) and judges it against the limits.
 StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj);
 StrokeEvaluation evaluateStroke(const StrokeProblem& p, const std::vector<double>& x);
 
@@ -61,8 +76,20 @@ struct HistoryRow {
   long evaluations = 0;      // analytic runs so far
   double wall_s = 0.0;
   double best_objective = 0.0;  // best feasible so far (0 when none yet)
-  std::string stage;         // "global" | "refine" | "polish"
+  double best_phi_net_rad = 0.0;  // its signed phi_net
+  std::string stage;         // "global" | "refine" | "local" | "polish"
 };
+
+// Called after every generation (and the polish) with the search's figures so far: stage,
+// analytic runs, the best feasible point's objective and signed phi_net. Runs on the search's
+// thread, between generations.
+struct SearchProgress {
+  const char* stage = "";
+  long evaluations = 0;
+  double best_objective = 0.0;
+  double best_phi_net_rad = 0.0;
+};
+using ProgressFn = std::function<void(const SearchProgress&)>;
 
 // One joint-direction pattern's search (OptimizerSettings::enumerate_directions).
 struct DirectionResult {
@@ -71,7 +98,14 @@ struct DirectionResult {
   long evaluations = 0;
 };
 
+// A feasible point the search ran, with its trajectory (StrokeProblem::keep_candidates).
+struct Candidate {
+  TailTrajectory trajectory;
+  StrokeEvaluation eval;
+};
+
 struct OptimizeResult {
+  std::vector<Candidate> candidates;  // the best keep_candidates distinct feasible points, best first
   std::vector<double> x;  // best feasible point (the start point when nothing feasible beat it)
   std::vector<int> directions;  // the space x belongs to (StrokeSpace::directions; empty: all free)
   TailTrajectory trajectory;    // the stroke of x
@@ -83,6 +117,6 @@ struct OptimizeResult {
   double wall_s = 0.0;
 };
 
-OptimizeResult optimizeStroke(const StrokeProblem& p, const OptimizerSettings& s);
+OptimizeResult optimizeStroke(const StrokeProblem& p, const OptimizerSettings& s, const ProgressFn& progress = {});
 
 }  // namespace tailsim

@@ -102,6 +102,25 @@ std::map<std::string, std::string> folderInputs(const Experiment& e) {
   return out;
 }
 
+std::string withValueAt(const std::string& file, const std::string& text, const std::vector<std::string>& path,
+                        const std::string& by) {
+  YAML::Node v = YAML::Load(text);
+  std::string key;
+  for (const std::string& k : path) {
+    key += (key.empty() ? "" : ".") + k;
+    const YAML::Node& map = v;  // const: looking a key up must not add it
+    v = map.IsMap() && map[k] ? YAML::Node(map[k]) : YAML::Node(YAML::NodeType::Undefined);
+    if (!v.IsDefined()) break;
+  }
+  if (!v.IsDefined() || !v.IsScalar()) throw std::runtime_error(file + ": " + key + ": expected a value to copy the folder's inputs");
+  const size_t at = offsetOf(text, v.Mark());
+  const size_t len = scalarLength(text, at, v.Scalar());
+  if (len == std::string::npos) throw std::runtime_error(file + ": " + key + ": its value is not written on one line");
+  std::string out = text;
+  out.replace(at, len, by);
+  return out;
+}
+
 std::string suiteFolderFile(const std::vector<Experiment>& suite) {
   std::string s =
       "# The suite as run: each member's experiment file as copied into its result folder (its robot:\n"

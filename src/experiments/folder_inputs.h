@@ -18,6 +18,13 @@ namespace tailsim {
 // robot: "robot-<k>.yaml", k = 1.. in sweep order). Throws std::runtime_error naming the file.
 std::map<std::string, std::string> folderInputs(const Experiment& e);
 
+// The text of a YAML file with the value at `path` (keys from the top, e.g. {"maneuver",
+// "stroke_from"}: a scalar written on one line) replaced by `by` (written as a plain scalar);
+// everything else kept byte for byte. Throws std::runtime_error naming the file when the key is
+// missing or not such a scalar.
+std::string withValueAt(const std::string& file, const std::string& text, const std::vector<std::string>& path,
+                        const std::string& by);
+
 // A suite's DIR/experiment.yaml: `experiments:` listing each member's DIR/<name>/experiment.yaml.
 std::string suiteFolderFile(const std::vector<Experiment>& suite);
 

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,12 @@ struct TailLink {
   double izz_kgm2 = 0.0;      // I_zz,L,i about the link COM  [kg m^2]
   double length_m = 0.0;      // L_L: joint i to joint i+1  [m]
   double com_offset_m = 0.0;  // joint i to link COM along the link  [m] (paper: 0.5 L_L)
+  // Joint i's actuator and range (the design tool's limits; the simulations do not enforce them).
+  // 0 = not given (a range is given when theta_min_rad < theta_max_rad).
+  double torque_max_Nm = 0.0;       // peak joint torque |tau_i|  [N m]
+  double thetadot_max_radps = 0.0;  // peak joint speed |thetadot_i|  [rad/s]
+  double theta_min_rad = 0.0, theta_max_rad = 0.0;  // joint angle range  [rad]
+  bool hasRange() const { return theta_min_rad < theta_max_rad; }
 };
 
 // The quadruped body with its legs fixed (paper Table 1).
@@ -120,6 +127,18 @@ settings::For<S, TailLink> declareFields(V& v, S& s) {
   v.number(Field{"length_m", "joint i to joint i+1 [m]"}, s.length_m, Limits::positive());
   v.number(Field{"com_offset_m", "joint i to the link COM along the link; absent = 0.5 length_m [m]"}, s.com_offset_m,
            Limits::nonNegative());
+  constexpr double kRad = M_PI / 180.0;
+  v.number(Field{"torque_max_Nm", "joint i's actuator: peak torque [N m]; 0 or absent = not given (the design "
+                                  "tool then needs a limit in its file)"},
+           s.torque_max_Nm, Limits::nonNegative());
+  v.number(Field{"thetadot_max_dps", "joint i's actuator: peak speed [deg/s]; 0 or absent = not given", kRad,
+                 "thetadot_max_radps"},
+           s.thetadot_max_radps, Limits::nonNegative());
+  v.number(Field{"theta_min_deg", "joint i's angle range, lower end [deg] (a range is given when min < max)", kRad,
+                 "theta_min_rad"},
+           s.theta_min_rad, Limits::any());
+  v.number(Field{"theta_max_deg", "joint i's angle range, upper end [deg]", kRad, "theta_max_rad"}, s.theta_max_rad,
+           Limits::any());
 }
 // Paper Table 2: the n-link tail (n = 1..6), 300 mm and 2.4 kg in all.
 TailLink paperTailLink(int n);
