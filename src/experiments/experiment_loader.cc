@@ -1389,9 +1389,9 @@ void readSuite(Loader& L, const std::string* file, const YAML::Node& doc, std::v
     // The members together, bounded as one experiment's work (and at most kMaxSuiteCases cases), as they load.
     total += totalWork(e.cases);
     if (total.cases > static_cast<double>(kMaxSuiteCases))
-      r.fail(entry, "the suite's experiments up to this one make " + fmtG(total.cases) + " cases, more than " +
+      r.fail(entry, "the suite's experiments up to this one make " + formatG(total.cases) + " cases, more than " +
                         std::to_string(kMaxSuiteCases) + " (docs/experiment-format.md \"Limits\"): split the suite");
-    if (const std::string x = workTotalExcess(total, "suite's " + fmtG(total.cases) + " cases up to this experiment");
+    if (const std::string x = workTotalExcess(total, "suite's " + formatG(total.cases) + " cases up to this experiment");
         !x.empty())
       r.fail(entry, x);
     out.push_back(std::move(e));
