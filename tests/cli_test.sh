@@ -85,7 +85,7 @@ for cmd in plot report ladder; do
 done
 printf 'name: typo\nrobot: paper\ntrajectroy: {dtheta_deg: -90, dT_s: 0.25}\n' >typo.yaml
 want 1 "run typo.yaml --out wrongout" "trajectroy: unknown key; did you mean 'trajectory'?"
-sed 's/^  islands:/  islnds:/' "$src/configs/design/split_n3_seeds_long.yaml" | sed "s|base: base/|base: $src/configs/design/base/|" >typo_opt.yaml
+sed 's/^  islands:/  islnds:/' "$src/configs/design/start_here_split_cycle.yaml" | sed "s|base: base/|base: $src/configs/design/base/|" >typo_opt.yaml
 want 1 "optimize typo_opt.yaml --out wrongout" "optimize.islnds: unknown key; did you mean 'islands'?"
 ok "run/render/accuracy/mjcf/optimize/maneuver/plot/report/ladder name the right command; 'did you mean' for a misspelt key"
 

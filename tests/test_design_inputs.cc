@@ -399,7 +399,7 @@ TEST_F(UnboundedWorkRefusedAtLoad, OptimizeStepsAreEstimatedAndBounded) {
                                         "trajectory: {rule: eq25, thetadot_max_dps: 600, w_ss: 0.25}\nmodels: [analytic]\n"
                                         "analytic: {solver: fixed, fixed_dt_s: 1e-7}\n";
   const std::string slow = write("slow_opt.yaml", "name: slow\nkind: optimize\nbase: slow.yaml\noptimize:\n"
-                                                  "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                                  "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: none}\n"
                                                   "  islands: 2\n  population: 100\n  generations: 100\n  seeds: [1]\n");
   const std::string e = errorOf([&] { loadOptimizeSpec(slow); });
   EXPECT_NE(e.find("slow_opt.yaml:5:3: optimize: the search would take about "), std::string::npos) << e;
@@ -409,7 +409,7 @@ TEST_F(UnboundedWorkRefusedAtLoad, OptimizeStepsAreEstimatedAndBounded) {
   // The same search on the default (adaptive) step loads.
   EXPECT_EQ(errorOf([&] {
               loadOptimizeSpec(write("fast_opt.yaml", "name: fast\nkind: optimize\nbase: base.yaml\noptimize:\n"
-                                                      "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600}\n"
+                                                      "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: none}\n"
                                                       "  islands: 2\n  population: 100\n  generations: 100\n  seeds: [1]\n"));
             }),
             "(no error)");

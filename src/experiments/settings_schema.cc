@@ -193,16 +193,20 @@ json designFile(const std::string& kind, json section_schema) {
 json optimizeSection() {
   json lim = section({{"theta_deg", interval(-360, 360)},
                       {"thetadot_max_dps", numberIn(1, 36000)},
-                      {"torque_max_Nm", {{"anyOf", json::array({{{"type", "number"}, {"exclusiveMinimum", 0}}, {{"const", "base"}}})}}},
+                      {"torque_max_Nm", {{"anyOf", json::array({{{"type", "number"}, {"exclusiveMinimum", 0}},
+                                                                {{"enum", json::array({"base", "none"})}}})}}},
                       {"end", oneOfNames({"rest", "start"})},
                       {"dT_s", interval(0.01, 10)},
                       {"w_ss", interval(0.01, 0.99)},
-                      {"start_delay_s", numberIn(0, 10)}},
-                     {"theta_deg", "thetadot_max_dps"});
+                      {"start_delay_s", numberIn(0, 10)}});  // the limits may come from the robot file's tail entries
   using namespace limits;
   return section({{"family", oneOfNames({"split_cycle", "spline"})},
                   {"knots", integerIn(0, kMaxOptimizeKnots)},
-                  {"objective", oneOfNames({"phi_net", "phi_net_per_torque", "phi_net_per_energy"})},
+                  {"objective", {{"anyOf", json::array({oneOfNames({"phi_net", "phi_net_per_torque", "phi_net_per_energy"}),
+                                                          section({{"quantity", oneOfNames({"phi_net", "phi_net_per_torque", "phi_net_per_energy"})},
+                                                                   {"model", oneOfNames({"analytic", "perfoot", "mujoco"})},
+                                                                   {"search", oneOfNames({"analytic", "perfoot"})},
+                                                                   {"candidates", integerIn(1, 50)}})})}}},
                   {"limits", lim},
                   {"algorithm", oneOfNames({"cmaes", "de"})},
                   {"islands", integerIn(1, kMaxOptimizeIslands)},
@@ -220,8 +224,18 @@ json optimizeSection() {
                   {"seeds", {{"type", "array"}, {"minItems", 1}, {"maxItems", kMaxOptimizeSeeds}, {"uniqueItems", true},
                              {"items", integerIn(0, 1000000000)}}},
                   {"pareto_points", {{"allOf", json::array({integerIn(0, kMaxParetoPoints), {{"not", {{"const", 1}}}}})}}},
-                  {"mujoco_check", {{"type", "boolean"}}}},
+                  {"mujoco_check", {{"type", "boolean"}}},
+                  {"min_turn_deg", numberIn(0, 90)}},
                  {"family", "limits"});
+}
+
+// The maneuver section: its declared settings and stroke_from (a trajectory's source, not a number).
+json maneuverSection() {
+  json props = plain(describe<ManeuverSettings>().props);
+  props["stroke_from"] = {{"type", "string"},
+                          {"minLength", 1},
+                          {"description", "the fast stroke: base, or a one-case experiment or an optimize best.yaml"}};
+  return section(props);
 }
 
 }  // namespace
@@ -290,7 +304,7 @@ json experimentSchema() {
                       "docs/design-a-tail-stroke.md)"},
             {"$defs", defs()},
             {"oneOf", json::array({exp, suite, designFile("optimize", optimizeSection()),
-                                   designFile("maneuver", section(plain(describe<ManeuverSettings>().props)))})}};
+                                   designFile("maneuver", maneuverSection())})}};
   return s;
 }
 
