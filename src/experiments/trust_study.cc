@@ -76,6 +76,8 @@ TrustRow rowOf(const std::string& group, const std::string& setting, const RunSu
   r.phi_net_deg = s.ok ? s.phi_net_deg : kNaN;
   r.wall_s = s.wall_time_s;
   r.steps = s.solver_steps;
+  if (const auto c = s.extra.find("uncertainty_solver_steps"); c != s.extra.end())
+    r.check_steps = static_cast<long>(c->second);
   const auto u = s.extra.find("phi_net_uncertainty_deg");
   r.uncertainty_deg = u != s.extra.end() ? u->second : kNaN;
   return r;

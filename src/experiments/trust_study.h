@@ -24,6 +24,7 @@ struct TrustRow {
   double uncertainty_deg = 0;  // the default run's own estimate (phi_net_uncertainty_deg); NaN elsewhere
   double wall_s = 0;           // the run's wall time (the default: its check run included)
   long steps = 0;              // mj_step calls of the run proper (pre-roll and check run excluded)
+  long check_steps = 0;        // mj_step calls of its uncertainty check run (the default's; 0 without one)
 };
 
 struct TrustStudy {
