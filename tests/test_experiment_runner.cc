@@ -409,7 +409,9 @@ TEST(UserFiles, AFileAtAPartsPathIsRefused) {
     std::ofstream(dir / "target") << "mine";
     if (kind == "file") std::ofstream(mine) << "mine";
     if (kind == "symlink") fs::create_symlink(dir / "target", mine);
-    if (kind == "fifo") ASSERT_EQ(::mkfifo(mine.c_str(), 0644), 0);
+    if (kind == "fifo") {
+      ASSERT_EQ(::mkfifo(mine.c_str(), 0644), 0);
+    }
     try {
       runExperiment(e, o);
       ADD_FAILURE() << kind << ": a user's file at a part's path was not refused";
