@@ -452,6 +452,18 @@ TEST_F(Smaller, ManeuverValuesAreCheckedAtLoadWithLocation) {
   EXPECT_NE(e.find("m.yaml:6:16: maneuver.return_dT_s: must be at least 0.001 s"), std::string::npos) << e;
 }
 
+// (e) A plan longer than max_strokes is an error at max_strokes (file:line:col), and the folder gets
+// nothing (it was left with an empty plots/).
+TEST_F(Smaller, ManeuverPlanOverMaxStrokesNamesTheKey) {
+  const std::string f = write("m.yaml", "name: m\nkind: maneuver\nbase: base.yaml\nmaneuver:\n  heading_deg: 170\n"
+                                        "  mujoco: false\n  max_strokes: 1\n");
+  const fs::path out = dir_ / "mo";
+  const std::string e = errorOf([&] { runManeuver(loadManeuverSpec(f), out.string(), false, false); });
+  EXPECT_EQ(e.rfind(f + ":7:16: maneuver.max_strokes: the plan needs ", 0), 0u) << e;
+  EXPECT_NE(e.find("more than max_strokes = 1"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(out / "plots"));
+}
+
 // (d) A write error in optimize (here best_perfoot.csv cannot replace a folder of that name) ends
 // the command with the error; it is not reported as a failure of the per-foot model.
 TEST_F(Smaller, OptimizeWriteErrorIsNotAModelFailure) {

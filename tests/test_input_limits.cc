@@ -14,6 +14,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/yaml_file.h"
 #include "results/work_limits.h"
 
 namespace tailsim {
@@ -132,6 +133,38 @@ TEST_F(UnboundedWorkRefusedAtLoad, SuiteMembersAreBoundedTogether) {
   EXPECT_EQ(e.rfind(suite + ":1:24: experiments[1]: the suite's ", 0), 0u) << e;
   EXPECT_NE(e.find(" cases up to this experiment would take about "), std::string::npos) << e;
   EXPECT_NE(e.find("more than the limit 1e+10"), std::string::npos) << e;
+}
+
+// A render of a case whose models the renderer cannot draw (per-foot only) was accepted and failed
+// after the run ("nothing to render (no model ran)"): refused at load, at the render section.
+TEST_F(Smaller, RenderNeedsAModelItDraws) {
+  const std::string f = write("pf.yaml", "name: pf\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n"
+                                         "models: [perfoot]\nrender: {width: 64, height: 48}\n");
+  const std::string e = errorOf(f);
+  EXPECT_EQ(e.rfind(f + ":5:", 0), 0u) << e;
+  EXPECT_NE(e.find("render: a video needs the analytic or mujoco model"), std::string::npos) << e;
+  EXPECT_EQ(errorOf(write("a.yaml", "name: a\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n"
+                                    "models: [perfoot, analytic]\nrender: {width: 64, height: 48}\n")),
+            "(no error)");
+}
+
+// A NUL byte was reported by yaml-cpp as a bad escape or hex number somewhere else in the file: it
+// is named at its own line and column, for every file kind (experiments and the files read
+// through loadBoundedYaml: optimize, maneuver, robot compare).
+TEST_F(Smaller, NulByteIsNamedAtItsPlace) {
+  using namespace std::string_literals;  // the literals hold NUL bytes
+  const std::string text = "name: o\0x\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n"s;
+  const std::string f = write("nul.yaml", text);
+  EXPECT_EQ(errorOf(f), f + ":1:8: a NUL byte (0x00): the file is not text");
+  std::string e = "(no error)";
+  try {
+    loadBoundedYaml(f);
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_EQ(e, f + ":1:8: a NUL byte (0x00): the file is not text");
+  const std::string g = write("nul_end.yaml", "name: t\nrobot: paper\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n  \0\0"s);
+  EXPECT_EQ(errorOf(g), g + ":4:3: a NUL byte (0x00): the file is not text");
 }
 
 // threads is bounded before any work (the CLI's --threads and tailsim.run(threads=...) alike).

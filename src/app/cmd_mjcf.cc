@@ -10,7 +10,9 @@
 #include "experiments/experiment_runner.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "results/atomic_file.h"
+#include "results/number_text.h"
 #include "results/sha256.h"
+#include "results/work_limits.h"
 
 namespace tailsim {
 
@@ -47,6 +49,23 @@ std::string fileStem(const std::string& text) {
   return s.substr(0, 120);
 }
 
+// Refuses, before any file is written, a menagerie of more than limits::kMaxMenagerieModels models,
+// with the number of models, files and bytes it would write.
+void refuseLargeMenagerie(const std::string& exp_path, const std::vector<Experiment>& suite,
+                          const std::vector<SuiteModel>& models) {
+  if (models.size() <= static_cast<std::size_t>(limits::kMaxMenagerieModels)) return;
+  std::size_t cases = 0;
+  for (const Experiment& e : suite) cases += e.cases.size();
+  const SuiteModel& m = models[0];
+  const MenagerieFiles one = generateMenagerie(m.c->robot, m.c->mujoco, m.c->effects, "x");
+  const double bytes = static_cast<double>(models.size()) * static_cast<double>(one.robot_xml.size() + one.scene_xml.size());
+  throw ConfigError(exp_path + ":1:1: the " + std::to_string(cases) + " cases have " + std::to_string(models.size()) +
+                    " distinct MuJoCo models: --menagerie would write " + std::to_string(2 * models.size()) +
+                    " files (about " + formatG(bytes, 2) + " bytes), more than the limit of " +
+                    std::to_string(limits::kMaxMenagerieModels) +
+                    " models (docs/experiment-format.md \"Limits\"): pick one with --case NAME");
+}
+
 // `tailsim mjcf EXPERIMENT.yaml ...`: the models of an experiment's cases. Returns the exit code.
 int writeExperimentMjcf(const std::string& exp_path, const std::string& only_case, const std::string& out,
                         const std::string& menagerie_dir) {
@@ -66,6 +85,7 @@ int writeExperimentMjcf(const std::string& exp_path, const std::string& only_cas
                  models[0].c->name.c_str());
     return kExitOk;
   }
+  refuseLargeMenagerie(exp_path, suite, models);
   std::set<std::string> stems;
   for (const SuiteModel& m : models) {
     std::string stem = fileStem(models.size() == 1 && only_case.empty()

@@ -175,7 +175,8 @@ YawMap analyticYawMap(const ExperimentCase& base, const ManeuverSettings& s) {
   return m;
 }
 
-std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map) {
+std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map,
+                                        const std::string& where) {
   std::vector<StrokeCommand> plan;
   const double target = s.heading(), full = map.full();
   if (std::abs(target) <= s.tolerance()) return plan;
@@ -197,8 +198,9 @@ std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const Maneuv
     plan.push_back({hi, dir});
   }
   if (static_cast<int>(plan.size()) > s.max_strokes)
-    throw std::runtime_error("the plan needs " + std::to_string(plan.size()) + " cycles, more than maneuver.max_strokes = " +
-                             std::to_string(s.max_strokes));
+    throw ConfigError((where.empty() ? std::string("maneuver.max_strokes") : where) + ": the plan needs " +
+                      std::to_string(plan.size()) + " cycles to turn " + fmtG(s.heading_deg) + " deg, more than max_strokes = " +
+                      std::to_string(s.max_strokes) + ": raise max_strokes or lower heading_deg");
   return plan;
 }
 
@@ -370,15 +372,16 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
   if (!spec.min_scale_given) s.min_scale = derivedMinScale(base, s, minScaleFloor(s, base.robot.numLinks()));
   rep.min_scale = s.min_scale;
   const int n = base.robot.numLinks();
+  // The plan first: one that cannot be run leaves nothing in the folder.
+  rep.full_cycle = analyticCycleYaw(base, s, 1.0);
+  rep.map = analyticYawMap(base, s);
+  rep.plan = planOpenLoop(base, s, rep.map, spec.max_strokes_at);
   fs::create_directories(fs::path(out_dir) / "plots");
   // The folder's own inputs: it runs again after a move (tailsim maneuver DIR/maneuver.yaml).
   for (const auto& [name, text] : designFolderInputs(spec.source_file, "maneuver.yaml", spec.base_file, spec.stroke_file)) {
     writeOwnedFile(out_dir, name, text);
     rep.files.push_back(name);
   }
-  rep.full_cycle = analyticCycleYaw(base, s, 1.0);
-  rep.map = analyticYawMap(base, s);
-  rep.plan = planOpenLoop(base, s, rep.map);
   if (progress)
     std::fprintf(stderr, "analytic cycle: stroke %+.4f deg, return %+.4f deg; plan: %zu cycles (last scale %.4f)\n",
                  rep.full_cycle.fast_rad * kDegPerRad, rep.full_cycle.back_rad * kDegPerRad, rep.plan.size(),

@@ -24,6 +24,9 @@ struct ManeuverSpec {
   ManeuverSettings settings;  // settings.stroke_shape: the stroke_from trajectory (empty: stroke_deg ...)
   std::string stroke_file;  // stroke_from: FILE, absolute (empty: none or base)
   bool min_scale_given = false;  // else runManeuver derives it from the tolerance (derivedMinScale)
+  // "<file>:<line>:<col>: maneuver.max_strokes" (or of the maneuver section when the key is not set):
+  // where a plan longer than max_strokes is reported.
+  std::string max_strokes_at;
 };
 
 
@@ -71,8 +74,10 @@ struct ManeuverRun {
 };
 
 // The open-loop plan: N full cycles and a last one scaled (bisection on the analytic model) so the
-// analytic heading lands on the target.
-std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map);
+// analytic heading lands on the target. More than s.max_strokes cycles: ConfigError, its text
+// starting with `where` ("<file>:<line>:<col>: maneuver.max_strokes") when given.
+std::vector<StrokeCommand> planOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map,
+                                        const std::string& where = "");
 
 ManeuverRun runAnalyticOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const std::vector<StrokeCommand>& plan);
 ManeuverRun runMujocoOpenLoop(const ExperimentCase& base, const ManeuverSettings& s, const std::vector<StrokeCommand>& plan);

@@ -185,6 +185,9 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
     s.settings.stroke_shape = shiftedToZero(t);
   }
   checkStrokes(r, mv, m, s);
+  const Val& at = firstSet(mv, m, {"max_strokes"});
+  s.max_strokes_at = s.source_file + ":" + std::to_string(at.mark.line + 1) + ":" + std::to_string(at.mark.column + 1) +
+                     ": " + (at.key.empty() ? std::string("maneuver") : at.key);
   return s;
 }
 

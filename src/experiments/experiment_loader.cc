@@ -766,6 +766,16 @@ YAML::Node parseYamlText(const std::string* file, const std::string& text) {
   if (text.size() > kMaxYamlBytes)
     throw ConfigError(*file + ": the text is larger than " + std::to_string(kMaxYamlBytes >> 20) +
                       " MiB; experiment, suite and robot files are small YAML files");
+  // A NUL byte is not text (yaml-cpp reads it as the end of its input, then reports an escape or a
+  // number at some other place): refused at its own line and column first.
+  if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+    const std::size_t line_start = text.rfind('\n', nul);
+    YAML::Mark at;
+    at.pos = static_cast<int>(nul);
+    at.line = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n'));
+    at.column = static_cast<int>(line_start == std::string::npos ? nul : nul - line_start - 1);
+    fail(Loc{file, at, ""}, "a NUL byte (0x00): the file is not text");
+  }
   try {
     {
       std::istringstream in(text);

@@ -12,7 +12,10 @@ std::string simulateExperimentText(const std::string& robot, const nlohmann::ord
   nlohmann::ordered_json doc = nlohmann::ordered_json::object();
   doc["name"] = "simulate";
   doc["robot"] = robot;
-  for (const auto& kv : sections.items()) doc[kv.key()] = kv.value();
+  // Appended (an ordered_json object's operator[] searches linearly: O(n^2) for n keywords); the
+  // keywords' names are distinct and none is name, robot or models.
+  auto& entries = static_cast<nlohmann::ordered_json::object_t::Container&>(doc.get_ref<nlohmann::ordered_json::object_t&>());
+  for (const auto& kv : sections.items()) entries.emplace_back(kv.key(), kv.value());
   if (!trajectory.is_null()) doc["trajectory"] = trajectory;
   doc["models"] = nlohmann::ordered_json::array({model});
   return doc.dump(1, ' ', true, nlohmann::ordered_json::error_handler_t::replace);

@@ -236,7 +236,15 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
     const fs::path e = fs::path(d) / "experiment.yaml";
     if (!fs::is_regular_file(e, ec))
       throw std::runtime_error("merge: " + d + " is not a tailsim result folder (no experiment.yaml)");
-    if (fs::absolute(d).lexically_normal() == out) throw std::runtime_error("merge: --out must not be a shard folder");
+    const fs::path shard = fs::absolute(d).lexically_normal();
+    if (shard == out) throw std::runtime_error("merge: --out must not be a shard folder");
+    // A folder inside a shard would be merged as part of that shard (symbolic links resolved).
+    std::error_code ec_out, ec_shard;
+    const fs::path real_out = fs::weakly_canonical(out, ec_out), real_shard = fs::weakly_canonical(shard, ec_shard);
+    const fs::path in_shard = real_out.lexically_relative(real_shard);
+    if (!ec_out && !ec_shard && !in_shard.empty() && *in_shard.begin() != ".." && in_shard != ".")
+      throw std::runtime_error("merge: the merged folder " + out_dir + " is inside the shard " + d +
+                               ": choose a folder outside the shards");
     const std::string t = readAll(e);
     if (exp_text.empty()) exp_text = t;
     else if (t != exp_text)

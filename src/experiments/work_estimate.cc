@@ -127,6 +127,21 @@ WorkEstimate estimateWork(const ExperimentCase& c) {
 WorkExcess checkWork(const ExperimentCase& c) {
   WorkExcess x;
   if (c.kind != CaseKind::kSimulate) return x;
+  if (c.render.enabled) {  // a video draws the model of the highest render_rank that ran (render_case.h)
+    std::string drawn;
+    bool any = false;
+    for (const ModelEntry& m : modelRegistry()) {
+      if (m.render_rank <= 0) continue;
+      drawn += (drawn.empty() ? "" : " or ") + m.name;
+      any = any || std::find(c.models.begin(), c.models.end(), m.name) != c.models.end();
+    }
+    if (!any) {
+      x.keys = {"render", "models"};
+      x.what = "a video needs the " + drawn + " model (the ones it can draw), and models has none of them: add one to models, "
+               "or remove render";
+      return x;
+    }
+  }
   const WorkEstimate w = estimateWork(c);
   const std::string see = " (docs/experiment-format.md \"Limits\")";
   const std::string span = g(w.sim_time_s) + " s simulated";

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "experiments/experiment_loader.h"
@@ -100,7 +101,11 @@ class JsonFromPython {
       try {
         return o.cast<long long>();
       } catch (const py::cast_error&) {
+      }
+      try {
         return o.cast<double>();  // beyond 64 bits: the loader's ranges refuse it
+      } catch (const py::cast_error&) {
+        fail(path, "the integer is beyond a float's range (about 1.8e308): give a finite number");
       }
     }
     if (py::isinstance<py::float_>(o)) {
@@ -116,6 +121,10 @@ class JsonFromPython {
     }
     if (py::isinstance<py::dict>(o)) {
       oj j = oj::object();
+      // An ordered_json object finds a key by a linear search: appended through its vector, with a
+      // hash set of the keys seen, so a dict of n keys takes O(n), not O(n^2).
+      auto& entries = static_cast<oj::object_t::Container&>(j.get_ref<oj::object_t&>());
+      std::unordered_set<std::string> seen;
       for (auto kv : o.cast<py::dict>()) {
         const py::handle k = kv.first;
         if (!py::isinstance<py::str>(k) && !py::isinstance<py::int_>(k) && !py::isinstance<py::float_>(k) && !k.is_none())
@@ -125,7 +134,9 @@ class JsonFromPython {
                                                                 : std::string(py::str(k));
         const std::string sub = path.empty() ? key : path + "." + key;
         if (key.find('\0') != std::string::npos) fail(shown(sub), "the key '" + shown(key) + "' holds a NUL character");
-        j[key] = convert(kv.second, sub, depth + 1);
+        oj v = convert(kv.second, sub, depth + 1);
+        if (seen.insert(key).second) entries.emplace_back(key, std::move(v));
+        else j[key] = std::move(v);  // 1 and '1': one key, the later value (as before)
       }
       return j;
     }

@@ -27,6 +27,11 @@ constexpr double kMaxExperimentBytes = 1e11;  // estimated time-series output (1
 // 16 s), so the limit is about 14 hours of rendering.
 constexpr double kMaxExperimentRenderSamples = 1e12;
 
+// `tailsim mjcf EXPERIMENT --menagerie DIR`: distinct MuJoCo models written (two files each, a
+// robot and a scene, about 7 kB together for the paper robot). A sweep of a robot dimension has as
+// many models as cases (up to 10^5); a few hundred is more than anyone opens one by one.
+constexpr int kMaxMenagerieModels = 200;
+
 // Work of an optimize file (every seed and Pareto point): analytic model runs, and the
 // joint-direction patterns `directions: enumerate` searches (2^n for an n-link tail).
 constexpr double kMaxOptimizeRuns = 1e8;
