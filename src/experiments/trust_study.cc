@@ -1,3 +1,4 @@
+#include "results/number_text.h"
 #include "experiments/trust_study.h"
 
 #include <algorithm>
@@ -16,12 +17,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string fmt(const char* f, double x) {
-  if (!std::isfinite(x)) return "n/a";
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
-}
+std::string fmt(const char* f, double x) { return std::isfinite(x) ? formatNumber(f, x) : "n/a"; }
 
 // One variant of the case's MuJoCo settings or stroke.
 struct Variant {

@@ -1,3 +1,4 @@
+#include "results/number_text.h"
 #include "plotting/trust_report.h"
 
 #include <algorithm>
@@ -21,12 +22,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string fmt(const char* f, double x) {
-  if (!std::isfinite(x)) return "n/a";
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
-}
+std::string fmt(const char* f, double x) { return std::isfinite(x) ? formatNumber(f, x) : "n/a"; }
 
 double errOf(const TrustRow& r, const TrustRow* ref) {
   return ref && ref->ok && r.ok ? std::abs(r.phi_net_deg - ref->phi_net_deg) : kNaN;
