@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Builds tailsim and its tests with AddressSanitizer + UndefinedBehaviorSanitizer (GCC) in
 # build-asan/ and runs CTest there; any sanitizer report fails the test that raised it
-# (halt_on_error). LeakSanitizer suppressions: scripts/lsan-suppressions.txt (only OSMesa's and
-# LLVM's own allocations, which they keep for the life of the process).
+# (halt_on_error). LeakSanitizer suppressions: scripts/lsan-suppressions.txt (only OSMesa's,
+# LLVM's and libhdf5's own allocations, never tailsim's).
 #   scripts/sanitize.sh              every test but the slowest end-to-end one (see EXCLUDE)
 #   scripts/sanitize.sh -R loader    extra arguments go to ctest
 # .ci/run calls it after the normal tests when CI=true.
