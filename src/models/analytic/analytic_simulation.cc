@@ -1,4 +1,5 @@
 #include "models/analytic/analytic_simulation.h"
+#include "models/planar/at_rest.h"
 
 #include "results/columns.h"
 
@@ -25,15 +26,6 @@ namespace {
 
 namespace odeint = boost::numeric::odeint;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) {
-  std::ostringstream os;
-  os.precision(4);
-  os << "the body is still moving when the run ends at t = " << t_end << " s (|phi_dot| " << phidot_dps
-     << " deg/s, speed " << speed_mps << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
-     << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
-  return os.str();
-}
 
 // The integral of f over [a, b], where f is smooth (between two breakpoints of the tail profile):
 // 21-point Gauss-Kronrod (Boost.Math), exact for polynomials of degree 31. The interval is halved

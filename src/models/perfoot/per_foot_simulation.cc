@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "models/analytic/analytic_simulation.h"
+#include "models/planar/at_rest.h"
 #include "models/perfoot/per_foot_model.h"
 #include "models/planar/row_columns.h"
 #include "models/planar/step_control.h"
@@ -562,15 +563,6 @@ class Recorder {
   const std::vector<double>* marks_ = nullptr;
   LazyThinRows<Pending> thin_;  // thin: the states of the rows recorded so far
 };
-
-std::string notAtRestWarning(double t_end, double phidot_dps, double speed_mps) {
-  std::ostringstream os;
-  os.precision(4);
-  os << "the body is still moving when the run ends at t = " << t_end << " s (|phi_dot| " << phidot_dps
-     << " deg/s, speed " << speed_mps << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
-     << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
-  return os.str();
-}
 
 }  // namespace
 
