@@ -463,8 +463,13 @@ merge-signals)
   stale="$W/mk.merge.tmp.$mpid"
   [ -d "$stale" ] || fail "kill -9: no staging folder to clean (the test needs one)"
   mkdir -p "$W/mk.merge.tmp.999999" && echo mine > "$W/mk.merge.tmp.999999/mine.txt"
+  # killed between creating its staging folder and marking it: an empty folder (or one holding only
+  # the manifest's first bytes) of a dead pid is removed too; the kill above may land in that window.
+  mkdir -p "$W/mk.merge.tmp.999998" "$W/mk.merge.tmp.999997" && : > "$W/mk.merge.tmp.999997/.tailsim-manifest"
   "$TAILSIM" merge "$W/shard1" "$W/shard2" --out "$W/mk" > /dev/null 2> "$W/mk.err2" || { cat "$W/mk.err2"; fail "merge after kill -9"; }
-  [ ! -e "$stale" ] || fail "the dead merge's staging folder $stale was not removed"
+  [ ! -e "$stale" ] || { ls -la "$stale"; fail "the dead merge's staging folder $stale was not removed"; }
+  [ ! -e "$W/mk.merge.tmp.999998" ] || fail "an empty staging folder of a dead merge was not removed"
+  [ ! -e "$W/mk.merge.tmp.999997" ] || fail "a dead merge's staging folder holding only an empty manifest was not removed"
   [ "$(cat "$W/mk.merge.tmp.999999/mine.txt" 2>/dev/null)" = mine ] || fail "a user's folder named like a staging folder was deleted"
   echo "kill -9: the next merge removed the dead merge's staging folder, kept the user's"
   ;;

@@ -200,8 +200,24 @@ struct MergeStopped {
   int sig;
 };
 
+// True when DIR holds nothing but what a merge writes first into its new staging folder (its
+// manifest, the marker or the marker's temporary): a merge killed between creating the folder and
+// marking it left that, and removing it loses nothing.
+bool onlyFirstStageFiles(const fs::path& dir) {
+  std::error_code ec;
+  const std::string marker_tmp = std::string(kStageMarker) + ".tailsim-tmp.";
+  for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string n = it->path().filename().string();
+    std::error_code e2;
+    if (!it->is_regular_file(e2) || it->is_symlink(e2) || it->file_size(e2) > 256) return false;
+    if (n != ".tailsim-manifest" && n != kStageMarker && n.compare(0, marker_tmp.size(), marker_tmp) != 0) return false;
+  }
+  return !ec;
+}
+
 // Removes OUT.merge.tmp.<pid> folders beside OUT whose pid is no running process and that the
-// marker in their manifest shows to be a merge's staging folder; anything else is left alone.
+// marker in their manifest shows to be a merge's staging folder (or that hold only what a merge
+// writes first, see onlyFirstStageFiles); anything else is left alone.
 void removeStaleStages(const fs::path& out) {
   std::error_code ec;
   const std::string prefix = out.filename().string() + ".merge.tmp.";
@@ -215,7 +231,7 @@ void removeStaleStages(const fs::path& out) {
     if (pid <= 0 || pid == ::getpid() || !(::kill(pid, 0) < 0 && errno == ESRCH)) continue;
     std::error_code e2;
     if (it->is_symlink(e2) || !it->is_directory(e2)) continue;
-    if (!manifestNames(it->path().string(), kStageMarker, kStageMarkerText)) continue;
+    if (!manifestNames(it->path().string(), kStageMarker, kStageMarkerText) && !onlyFirstStageFiles(it->path())) continue;
     fs::remove_all(it->path(), e2);
   }
 }
