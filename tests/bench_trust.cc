@@ -2,7 +2,7 @@
 // seeded random-robot corpus of tests/random_robots.h (docs/mujoco-model.md "Contact settings:
 // the rule and its evidence"). Plain main, one thread; prints one Markdown row per rule:
 //   nice build/tests/bench_trust [--cases N=120] [--seed S=31] [--rules "today;set:imp=100,ns=3;.."]
-//                                [--ref-cache FILE] [--check16 K=10] [--csv FILE]
+//                                [--ref-cache FILE] [--check16 K=10] [--csv FILE] [--jitter-check]
 // Reference of a rule: the rule's settings at timestep / 8 (servo w_n kept), impratio >= 100,
 // noslip >= 3 (for "today": the old defaults' reference); every K-th case also at timestep / 16, to
 // show the reference itself has converged. --ref-cache keeps the reference runs (keyed by seed,
@@ -48,7 +48,7 @@ namespace {
 
 struct Run {
   bool ok = false;
-  double phi_deg = NAN, airborne = NAN, peak = NAN, wall_s = NAN, u_deg = NAN, tilt_deg = NAN;
+  double phi_deg = NAN, airborne = NAN, peak = NAN, wall_s = NAN, u_deg = NAN, tilt_deg = NAN, check_deg = NAN;
   long steps = 0;
 };
 
@@ -201,6 +201,7 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
     out.airborne = x("airborne_fraction");
     out.peak = x("peak_normal_force_over_mg");
     out.u_deg = x("phi_net_uncertainty_deg");
+    out.check_deg = x("phi_net_check_deg");
     out.tilt_deg = x("max_tilt_deg");
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "run threw: %s\n", ex.what());
@@ -276,6 +277,7 @@ double rel(double a, double ref) { return std::abs(a - ref) / std::max(std::abs(
 
 int main(int argc, char** argv) {
   int N = 120, check16 = 10;
+  bool jitter_check = false;  // --jitter-check: the jitter run has its own check run (check_jitter_phi_deg)
   unsigned seed = 31;
   std::string rule_list = "today", cache_path, csv_path;
   for (int i = 1; i < argc; ++i) {
@@ -293,6 +295,7 @@ int main(int argc, char** argv) {
     else if (a == "--ref-cache") cache_path = next();
     else if (a == "--check16") check16 = std::atoi(next().c_str());
     else if (a == "--csv") csv_path = next();
+    else if (a == "--jitter-check") jitter_check = true;
     else {
       std::fprintf(stderr, "unknown argument %s\n", a.c_str());
       return 2;
@@ -317,7 +320,7 @@ int main(int argc, char** argv) {
   if (!csv_path.empty()) {
     csv.open(csv_path);
     csv << "rule,case,ok,phi_deg,phi_jitter_deg,ref_ok,ref_phi_deg,ref_jitter_deg,today_ref_phi_deg,ref16_phi_deg,perfoot_phi_deg,airborne,"
-           "peak_over_mg,steps,wall_s,u_deg,max_tilt_deg,"
+           "peak_over_mg,steps,wall_s,u_deg,max_tilt_deg,check_phi_deg,check_jitter_phi_deg,"
            "description\n";
   }
 
@@ -358,7 +361,7 @@ int main(int argc, char** argv) {
       rule(c.robot, c.trajectory, s);
       const Run r = runOnce(c.robot, c.trajectory, s);
       MujocoSettings sj = s;
-      sj.uncertainty = false;  // the jitter run needs phi_net only
+      sj.uncertainty = jitter_check && s.uncertainty;  // the jitter run needs phi_net only
       const Run j = runOnce(c.robot, jittered(c.trajectory, 1e-6), sj);
       const Run f = refRun(rule, k, 8.0, 0.0);
       const Run fj = refRun(rule, k, 8.0, 1e-6);
@@ -370,7 +373,7 @@ int main(int argc, char** argv) {
       if (csv.is_open())
         csv << '"' << nm << "\"," << k << ',' << r.ok << ',' << r.phi_deg << ',' << j.phi_deg << ',' << f.ok << ','
             << f.phi_deg << ',' << fj.phi_deg << ',' << ft.phi_deg << ',' << f16.phi_deg << ',' << perfoot[k] << ',' << r.airborne << ','
-            << r.peak << ',' << r.steps << ',' << r.wall_s << ',' << r.u_deg << ',' << r.tilt_deg << ",\"" << describe(c) << "\"\n";
+            << r.peak << ',' << r.steps << ',' << r.wall_s << ',' << r.u_deg << ',' << r.tilt_deg << ',' << r.check_deg << ',' << j.check_deg << ",\"" << describe(c) << "\"\n";
       if (r.ok && !f.ok) ++falls_ref;
       if (!r.ok && f.ok) ++falls_here;
       if (!r.ok || !f.ok) continue;

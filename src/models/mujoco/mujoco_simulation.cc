@@ -907,6 +907,7 @@ void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, 
     sum.warnings.push_back(os.str());
     return;
   }
+  sum.extra["phi_net_check_deg"] = check.summary.phi_net_deg;
   const double u = 2.0 * std::abs(phi - check.summary.phi_net_deg) + 0.005 * scale;
   sum.extra["phi_net_uncertainty_deg"] = u;
   if (u > settings.uncertainty_warn_share * scale) {
