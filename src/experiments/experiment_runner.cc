@@ -368,14 +368,25 @@ FolderLock::FolderLock(const std::string& dir_text) {
                                                                  : " is not a regular file") +
                              ": tailsim writes its lock only into a file of its own (remove it)");
   }
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+  // A busy lock whose recorded run is dead is held for a moment more by that run's dying helper
+  // process (runHdf5Isolated's child, killed with it): waited for up to kDeadHolderWait.
+  constexpr auto kDeadHolderWait = std::chrono::seconds(2);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
     char buf[32] = {};
     const ssize_t n = ::pread(fd_, buf, sizeof buf - 1, 0);
-    ::close(fd_);
-    if (err != EWOULDBLOCK) throw std::runtime_error("cannot lock " + p.string() + ": " + std::strerror(err));
     std::string pid = n > 0 ? std::string(buf, static_cast<size_t>(n)) : "?";
     while (!pid.empty() && (pid.back() == '\n' || pid.back() == ' ')) pid.pop_back();
+    const bool holder_dead = !pid.empty() && pid.size() <= 9 &&
+                             std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+                             processGone(std::atol(pid.c_str()));
+    if (err == EWOULDBLOCK && holder_dead && std::chrono::steady_clock::now() - t0 < kDeadHolderWait) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      continue;
+    }
+    ::close(fd_);
+    if (err != EWOULDBLOCK) throw std::runtime_error("cannot lock " + p.string() + ": " + std::strerror(err));
     throw std::runtime_error(dir.string() + " is in use by another tailsim run (pid " + pid + ")");
   }
   const std::string me = std::to_string(::getpid()) + "\n";
@@ -772,12 +783,11 @@ int removeStaleTemps(const fs::path& root) {
       const long pid = tempPid(n, ".tailsim-tmp.");
       if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) {
         const long other = tempPid(n, ".tmp.");
-        if (other > 0 && other <= std::numeric_limits<pid_t>::max() && ::kill(static_cast<pid_t>(other), 0) != 0 &&
-            errno == ESRCH)
+        if (processGone(other))
           std::fprintf(stderr, "note: kept %s (named like a temporary file, but not one of tailsim's)\n", f.path().string().c_str());
         continue;
       }
-      const bool dead = ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+      const bool dead = processGone(pid);
       if ((dead || pid == ::getpid()) && fs::remove(f.path(), ec)) ++removed;
     }
   };

@@ -228,7 +228,7 @@ void removeStaleStages(const fs::path& out) {
     if (digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
       continue;
     const pid_t pid = static_cast<pid_t>(std::atol(digits.c_str()));
-    if (pid <= 0 || pid == ::getpid() || !(::kill(pid, 0) < 0 && errno == ESRCH)) continue;
+    if (pid <= 0 || pid == ::getpid() || !processGone(pid)) continue;
     std::error_code e2;
     if (it->is_symlink(e2) || !it->is_directory(e2)) continue;
     if (!manifestNames(it->path().string(), kStageMarker, kStageMarkerText) && !onlyFirstStageFiles(it->path())) continue;

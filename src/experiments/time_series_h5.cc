@@ -4,6 +4,7 @@
 #include <linux/falloc.h>
 #include <fcntl.h>
 #include <hdf5.h>  // types and constants only: libhdf5 is loaded at run time (see h5())
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <sys/wait.h>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -566,6 +568,7 @@ void runHdf5Isolated(const std::string& what, const std::function<void()>& f) {
   int pipe_fd[2];
   if (::pipe2(pipe_fd, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "cannot make a pipe");
   std::fflush(nullptr);  // (nothing buffered is written twice)
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     const int err = errno;
@@ -575,6 +578,9 @@ void runHdf5Isolated(const std::string& what, const std::function<void()>& f) {
   }
   if (pid == 0) {  // the child: f, then its outcome down the pipe ("<errno>\n<message>"), and _exit (no
                    // exit handlers: libhdf5's crashed on a full disk)
+    // The child dies with tailsim (kill -9 included): it shares the folder lock's open file, so an
+    // orphan would hold the lock, and write into the folder, after the run that started it is gone.
+    if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) ::_exit(1);
     ::close(pipe_fd[0]);
     std::string out = "0\n";
     int code = 0;

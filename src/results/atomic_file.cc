@@ -1,6 +1,7 @@
 #include "results/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -18,6 +19,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <limits>
 #include <vector>
 
 #include "results/number_text.h"
@@ -48,6 +50,17 @@ void writeFileAtomic(const std::string& path, const std::string& contents) {
     std::remove(tmp.c_str());
     throw std::system_error(err, std::generic_category(), "cannot move " + tmp + " to " + path);
   }
+}
+
+bool processGone(long pid) {
+  if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) return false;
+  if (::kill(static_cast<pid_t>(pid), 0) != 0) return errno == ESRCH;
+  // /proc/PID/stat: "PID (comm) S ...": the state follows the last ')'.
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  std::getline(stat, text);
+  const size_t close = text.rfind(')');
+  return close != std::string::npos && close + 2 < text.size() && text[close + 2] == 'Z';
 }
 
 namespace {

@@ -14,6 +14,11 @@ namespace tailsim {
 // disk is full) naming the path on failure.
 void writeFileAtomic(const std::string& path, const std::string& contents);
 
+// True when no process `pid` runs any more: none exists, or it has exited and waits to be reaped (a
+// zombie: a killed run's helper process whose new parent has not reaped it yet). Temporary files
+// and staging folders named with such a pid are left over.
+bool processGone(long pid);
+
 // Writes a file the user named on the command line (e.g. `tailsim mjcf --out PATH`) without ever
 // replacing what is at PATH with something else:
 //  - "-" is stdout; /dev/stdout, /dev/stderr, /dev/fd/N and /proc/self/fd/N are written to this
