@@ -120,6 +120,9 @@ double optimizeRunEstimate(const OptimizeSpec& s) {
     const double patterns = std::ldexp(1.0, std::min(s.problem.space.n_links, 1000));
     const double kept = o.directions_kept > 0 ? std::min<double>(o.directions_kept, patterns) : patterns;
     per_search = patterns * first + kept * later;
+    if (o.max_runs > 0) per_search = std::min(per_search, patterns * static_cast<double>(o.max_runs));
+  } else if (o.max_runs > 0) {
+    per_search = std::min(per_search, static_cast<double>(o.max_runs));
   }
   return per_search * static_cast<double>(s.seeds.size() + static_cast<std::size_t>(s.pareto_points));
 }
@@ -139,7 +142,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& base = file.base(r);  // the base experiment's own checks below point here
   const Val& opt = file.section(r);
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
+                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "max_runs", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -271,6 +274,14 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   }
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
+  if (const Val* v = Reader::get(o, "max_runs")) {
+    os.max_runs = r.integer(*v, 0, static_cast<int>(limits::kMaxOptimizeRuns));
+    const long least = 2 + static_cast<long>(os.islands) * os.population + (os.polish != "none" ? os.polish_evaluations : 0);
+    if (os.max_runs > 0 && os.max_runs < least)
+      r.fail(*v, "must be 0 (no cap) or at least " + std::to_string(least) +
+                     " (the start, one population of every island and the polish's polish_evaluations), got " +
+                     std::to_string(os.max_runs));
+  }
   if (const Val* v = Reader::get(o, "seeds")) {
     s.seeds.clear();
     for (const Val& e : r.list(*v, 1, kMaxSeeds)) {
