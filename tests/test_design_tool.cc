@@ -266,6 +266,37 @@ TEST_F(DesignLimitsTest, LimitsArePerJoint) {
       << e;
 }
 
+// A robot file's tails.n entry may give each actuator key as a list of one value per joint (the
+// link itself is the same for all n); a list of the wrong length is refused at its line.
+TEST_F(DesignLimitsTest, RobotFileGivesActuatorLimitsPerJoint) {
+  const std::string head = std::string(kRobot12kg).substr(0, std::string(kRobot12kg).find("tails:"));
+  std::ofstream(dir_ / "robot12.yaml") << head
+                                       << "tails:\n  3: {mass_kg: 0.20, izz_kgm2: 3.75e-4, length_m: 0.15, torque_max_Nm: [25, 10, 5],\n"
+                                          "      thetadot_max_dps: [600, 500, 400], theta_min_deg: -90, theta_max_deg: [90, 60, 45]}\n";
+  const OptimizeSpec a = loadOptimizeSpec(write("{}"));
+  const double d = M_PI / 180.0;
+  const StrokeLimits& L = a.problem.space.limits;
+  ASSERT_EQ(L.joints.size(), 3u);
+  EXPECT_EQ(L.joint(0).torque_max_Nm, 25.0);
+  EXPECT_EQ(L.joint(2).torque_max_Nm, 5.0);
+  EXPECT_NEAR(L.joint(1).thetadot_max_radps, 500 * d, 1e-12);
+  EXPECT_NEAR(L.joint(2).theta_max_rad, 45 * d, 1e-12);
+  EXPECT_NEAR(L.joint(2).theta_min_rad, -90 * d, 1e-12);
+  EXPECT_EQ(a.base.robot.tail.at(1).torque_max_Nm, 10.0);
+  EXPECT_EQ(a.base.robot.tail.at(1).mass_kg, 0.20);
+
+  std::ofstream(dir_ / "robot12.yaml") << head
+                                       << "tails:\n  3: {mass_kg: 0.20, izz_kgm2: 3.75e-4, length_m: 0.15, torque_max_Nm: [25, 10]}\n";
+  std::string e;
+  try {
+    loadOptimizeSpec(write("{}"));
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("robot12.yaml:5:"), std::string::npos) << e;
+  EXPECT_NE(e.find("has 2 values but the tail has 3 joints"), std::string::npos) << e;
+}
+
 // With per-joint torque limits the optimum keeps each joint's own limit, the summary lists the
 // limits and figures joint by joint and names the binding ones; an infeasible answer names the
 // joint that binds and gives the torque each joint would need.
