@@ -264,6 +264,15 @@ TEST_F(DesignLimitsTest, LimitsArePerJoint) {
   EXPECT_NE(e.find("optimize.limits.torque_max_Nm: a list gives one value per joint: the base's tail has 3 joints, got 2"),
             std::string::npos)
       << e;
+  // Limits no stroke can keep name the joint: joint 3's 1e-9 N m.
+  e.clear();
+  try {
+    loadOptimizeSpec(write("{torque_max_Nm: [40, 10, 1e-9]}"));
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("no stroke keeps these limits"), std::string::npos) << e;
+  EXPECT_NE(e.find("breaks them at joint 3:"), std::string::npos) << e;
 }
 
 // A robot file's tails.n entry may give each actuator key as a list of one value per joint (the

@@ -362,19 +362,24 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     at_rest.end = StrokeEnd::kAtRest;
     const StrokeFigures f = strokeFigures(s.base.robot.tail, probe);
     if (narrowest < amp || limitViolation(f, at_rest) > 0.0) {
-      std::string which;  // the joints whose limits the probe breaks
+      std::string which;  // the joints whose limits the probe breaks; the first is described
+      std::size_t first = f.joints.size();
       for (std::size_t i = 0; i < f.joints.size(); ++i) {
         StrokeLimits one = at_rest;
         StrokeFigures fi;
         fi.joints = {f.joints[i]};
         one.joints = {L.joint(i)};
-        if (L.joint(i).theta_max_rad - L.joint(i).theta_min_rad < amp || limitViolation(fi, one) > 0.0)
+        if (L.joint(i).theta_max_rad - L.joint(i).theta_min_rad < amp || limitViolation(fi, one) > 0.0) {
           which += (which.empty() ? "" : ", ") + std::to_string(i + 1);
+          first = std::min(first, i);
+        }
       }
-      const JointLimits J = L.joint(which.empty() ? 0 : static_cast<std::size_t>(std::stoi(which) - 1));
-      const JointFigures& g = f.joints.at(which.empty() ? 0 : static_cast<std::size_t>(std::stoi(which) - 1));
+      if (which.empty()) which = "1";
+      if (first == f.joints.size()) first = 0;
+      const JointLimits J = L.joint(first);
+      const JointFigures& g = f.joints.at(first);
       r.fail(lv, "no stroke keeps these limits: 1 deg of every joint over the longest duration (dT_s " +
-                     fmtG(L.dT_max_s) + " s) breaks them at joint " + (which.empty() ? std::string("1") : which) +
+                     fmtG(L.dT_max_s) + " s) breaks them at joint " + which +
                      ": it needs a range of 1 deg (have " + fmtG((J.theta_max_rad - J.theta_min_rad) / kRadPerDeg) +
                      "), peaks at " + fmtG(g.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
                      fmtG(J.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(g.peak_torque_Nm) + " N m (limit " +
