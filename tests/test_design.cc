@@ -380,6 +380,41 @@ TEST(StrokeDesign, LocalRestartsContinueFromTheBestAndNeverLose) {
   EXPECT_TRUE(b.best.feasible());
 }
 
+// max_runs caps a search's runs, polish included. A search whose first restart is the single-start
+// search (same islands, population, generations and seed) repeats it exactly while it runs and
+// gives only the budget it leaves (CMA-ES stopped by its tolerances) to the later restarts, the
+// local restarts and the polish: at the single start's cost it never ends below it.
+TEST(StrokeDesign, RunBudgetCapsTheSearchAndTheFirstRestartIsTheSingleStart) {
+  const StrokeProblem p = torqueLimitedProblem(1, 8.0);
+  OptimizerSettings single = smallBudget(3);
+  single.islands = 1;
+  single.population = 6;
+  single.generations = 1000;
+  single.polish_evaluations = 40;
+  const long cost = 2 + single.islands * single.population * (single.generations + 1L) + single.polish_evaluations;
+  OptimizerSettings preset = single;
+  preset.restarts = 4;
+  preset.restart_growth = 2;
+  preset.local_restarts = 2;
+  preset.local_step = 0.05;
+  preset.max_runs = cost;
+  const OptimizeResult a = optimizeStroke(p, single), b = optimizeStroke(p, preset);
+  ASSERT_LT(a.evaluations, cost / 2);  // CMA-ES stopped early: budget left for the preset's other stages
+  EXPECT_LE(b.evaluations, cost);
+  EXPECT_GT(b.evaluations, a.evaluations);
+  // The single start's global stage, row by row.
+  std::size_t g = 0;
+  for (; g < a.history.size() && a.history[g].stage == "global"; ++g) {
+    EXPECT_EQ(b.history[g].evaluations, a.history[g].evaluations) << g;
+    EXPECT_EQ(b.history[g].best_objective, a.history[g].best_objective) << g;
+  }
+  EXPECT_GE(b.best.objective, a.best.objective);
+  EXPECT_TRUE(b.best.feasible());
+  std::set<std::string> stages;
+  for (std::size_t k = g; k < b.history.size(); ++k) stages.insert(b.history[k].stage);
+  EXPECT_TRUE(stages.count("global")) << "the budget left ran a later restart";
+}
+
 // Successive halving over the joint-direction patterns: every pattern's first global restart runs,
 // the other restarts, the local restarts and the polish only in the directions_kept patterns whose
 // first restart found the most. The other patterns' results are exactly their first restart (the

@@ -199,6 +199,153 @@ TEST_F(DesignLimitsTest, ActuatorLimitsAreRobotData) {
   EXPECT_NE(e.find("torque_max_Nm: none"), std::string::npos) << e;
 }
 
+// Limits are per joint: a robot whose joints have different actuators (the base's custom tail) keeps
+// each joint's own limits, not the strictest joint's for all; a design file may give one value for
+// every joint or a list of one per joint (a list of the wrong length is refused at its key).
+TEST_F(DesignLimitsTest, LimitsArePerJoint) {
+  auto link = [](double tau, double dps, double lo, double hi) {
+    return "{mass_kg: 0.20, izz_kgm2: 3.75e-4, length_m: 0.15, torque_max_Nm: " + std::to_string(tau) +
+           ", thetadot_max_dps: " + std::to_string(dps) + ", theta_min_deg: " + std::to_string(lo) +
+           ", theta_max_deg: " + std::to_string(hi) + "}";
+  };
+  std::ofstream(dir_ / "base.yaml") << "name: b\nrobot: robot12.yaml\ntail: {custom: [" << link(30, 600, -90, 90) << ", "
+                                    << link(8, 500, -60, 60) << ", " << link(4, 400, -30, 45) << "]}\n"
+                                    << "trajectory: {rule: eq25, thetadot_max_dps: 400, w_ss: 0.25}\nmodels: [analytic]\n";
+  const double d = M_PI / 180.0;
+  const OptimizeSpec a = loadOptimizeSpec(write("{}"));
+  const StrokeLimits& L = a.problem.space.limits;
+  ASSERT_EQ(L.joints.size(), 3u);
+  EXPECT_EQ(L.joint(0).torque_max_Nm, 30.0);
+  EXPECT_EQ(L.joint(1).torque_max_Nm, 8.0);
+  EXPECT_EQ(L.joint(2).torque_max_Nm, 4.0);
+  EXPECT_NEAR(L.joint(0).thetadot_max_radps, 600 * d, 1e-12);
+  EXPECT_NEAR(L.joint(2).thetadot_max_radps, 400 * d, 1e-12);
+  EXPECT_NEAR(L.joint(1).theta_min_rad, -60 * d, 1e-12);
+  EXPECT_NEAR(L.joint(2).theta_max_rad, 45 * d, 1e-12);
+
+  // The search's points keep each joint's own range and speed (the box maps onto them).
+  std::vector<double> x(static_cast<std::size_t>(a.problem.space.dim()), 1.0);
+  const TailTrajectory top = a.problem.space.trajectory(x);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const SplitCycleParams& p = top.joints[i].params();
+    EXPECT_NEAR(p.theta0_rad, L.joint(i).theta_max_rad, 1e-12) << i;
+  }
+  // A stroke whose joint 1 torque is over the strictest joint's 4 N m but within its own 30 N m is
+  // feasible; over joint 3's own 4 N m it is not, and the violation names that joint.
+  StrokeFigures f;
+  f.joints = {{-0.1, 0.1, 5 * d, 20.0}, {-0.1, 0.1, 5 * d, 7.0}, {-0.1, 0.1, 5 * d, 3.9}};
+  EXPECT_EQ(limitViolation(f, L), 0.0);
+  f.joints[2].peak_torque_Nm = 4.4;
+  EXPECT_NEAR(limitViolation(f, L), 0.1, 1e-12);
+  const std::vector<std::string> binds = bindingLimits(f, L, 0.2);
+  ASSERT_FALSE(binds.empty());
+  EXPECT_EQ(binds.front().rfind("joint 3 torque 4.4 N m (limit 4 N m)", 0), 0u) << binds.front();
+
+  // The design file: a scalar for every joint, a list per joint.
+  const OptimizeSpec b = loadOptimizeSpec(
+      write("{theta_deg: [[-90, 90], [-45, 45], [-30, 30]], thetadot_max_dps: [600, 500, 450], torque_max_Nm: [40, 10, 5]}"));
+  const StrokeLimits& M = b.problem.space.limits;
+  ASSERT_EQ(M.joints.size(), 3u);
+  EXPECT_EQ(M.joint(1).torque_max_Nm, 10.0);
+  EXPECT_NEAR(M.joint(2).thetadot_max_radps, 450 * d, 1e-12);
+  EXPECT_NEAR(M.joint(1).theta_max_rad, 45 * d, 1e-12);
+  const OptimizeSpec c = loadOptimizeSpec(write("{theta_deg: [-50, 50], thetadot_max_dps: 300, torque_max_Nm: 6}"));
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(c.problem.space.limits.joint(i).torque_max_Nm, 6.0);
+    EXPECT_NEAR(c.problem.space.limits.joint(i).theta_max_rad, 50 * d, 1e-12);
+  }
+  std::string e;
+  try {
+    loadOptimizeSpec(write("{torque_max_Nm: [40, 10]}"));
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("opt.yaml:6:"), std::string::npos) << e;
+  EXPECT_NE(e.find("optimize.limits.torque_max_Nm: a list gives one value per joint: the base's tail has 3 joints, got 2"),
+            std::string::npos)
+      << e;
+  // Limits no stroke can keep name the joint: joint 3's 1e-9 N m.
+  e.clear();
+  try {
+    loadOptimizeSpec(write("{torque_max_Nm: [40, 10, 1e-9]}"));
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("no stroke keeps these limits"), std::string::npos) << e;
+  EXPECT_NE(e.find("breaks them at joint 3:"), std::string::npos) << e;
+}
+
+// A robot file's tails.n entry may give each actuator key as a list of one value per joint (the
+// link itself is the same for all n); a list of the wrong length is refused at its line.
+TEST_F(DesignLimitsTest, RobotFileGivesActuatorLimitsPerJoint) {
+  const std::string head = std::string(kRobot12kg).substr(0, std::string(kRobot12kg).find("tails:"));
+  std::ofstream(dir_ / "robot12.yaml") << head
+                                       << "tails:\n  3: {mass_kg: 0.20, izz_kgm2: 3.75e-4, length_m: 0.15, torque_max_Nm: [25, 10, 5],\n"
+                                          "      thetadot_max_dps: [600, 500, 400], theta_min_deg: -90, theta_max_deg: [90, 60, 45]}\n";
+  const OptimizeSpec a = loadOptimizeSpec(write("{}"));
+  const double d = M_PI / 180.0;
+  const StrokeLimits& L = a.problem.space.limits;
+  ASSERT_EQ(L.joints.size(), 3u);
+  EXPECT_EQ(L.joint(0).torque_max_Nm, 25.0);
+  EXPECT_EQ(L.joint(2).torque_max_Nm, 5.0);
+  EXPECT_NEAR(L.joint(1).thetadot_max_radps, 500 * d, 1e-12);
+  EXPECT_NEAR(L.joint(2).theta_max_rad, 45 * d, 1e-12);
+  EXPECT_NEAR(L.joint(2).theta_min_rad, -90 * d, 1e-12);
+  EXPECT_EQ(a.base.robot.tail.at(1).torque_max_Nm, 10.0);
+  EXPECT_EQ(a.base.robot.tail.at(1).mass_kg, 0.20);
+
+  std::ofstream(dir_ / "robot12.yaml") << head
+                                       << "tails:\n  3: {mass_kg: 0.20, izz_kgm2: 3.75e-4, length_m: 0.15, torque_max_Nm: [25, 10]}\n";
+  std::string e;
+  try {
+    loadOptimizeSpec(write("{}"));
+  } catch (const ConfigError& x) {
+    e = x.what();
+  }
+  EXPECT_NE(e.find("robot12.yaml:5:"), std::string::npos) << e;
+  EXPECT_NE(e.find("has 2 values but the tail has 3 joints"), std::string::npos) << e;
+}
+
+// With per-joint torque limits the optimum keeps each joint's own limit, the summary lists the
+// limits and figures joint by joint and names the binding ones; an infeasible answer names the
+// joint that binds and gives the torque each joint would need.
+TEST_F(DesignLimitsTest, TheOptimumAndTheInfeasibleAnswerNameTheBindingJoint) {
+  std::string out;
+  const std::string f = write("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: [40, 12, 6]}");
+  ASSERT_EQ(runCommand(bin() + " optimize " + f + " --out " + (dir_ / "res").string() + " --quiet", out), 0) << out;
+  nlohmann::json s;
+  std::ifstream(dir_ / "res/summary.json") >> s;
+  ASSERT_EQ(s["limits"].size(), 3u) << s.dump(2);
+  const double lim[] = {40, 12, 6};
+  double top = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(s["limits"][i]["torque_max_Nm"].get<double>(), lim[i]);
+    EXPECT_LE(s["limits"][i]["peak_torque_Nm"].get<double>(), lim[i] * (1 + 1e-9));
+    top = std::max(top, s["limits"][i]["peak_torque_Nm"].get<double>());
+  }
+  EXPECT_GT(top, 6.0);  // not the strictest joint's limit for every joint
+  EXPECT_TRUE(s["resimulated"]["analytic"]["limits_kept"].get<bool>());
+  ASSERT_FALSE(s["resimulated"]["analytic"]["binding"].empty()) << s.dump(2);
+  EXPECT_EQ(s["resimulated"]["analytic"]["binding"][0].get<std::string>().rfind("joint ", 0), 0u);
+  EXPECT_NE(out.find("(binding: joint "), std::string::npos) << out;
+
+  out.clear();
+  const std::string g = write("{theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: [10, 9, 8]}");
+  EXPECT_EQ(runCommand(bin() + " optimize " + g + " --out " + (dir_ / "inf").string() + " --quiet", out), 3) << out;
+  nlohmann::json t;
+  std::ifstream(dir_ / "inf/summary.json") >> t;
+  ASSERT_TRUE(t.contains("infeasible")) << t.dump(2);
+  const int j = t["infeasible"]["binding_joint"].get<int>();
+  ASSERT_GE(j, 1);
+  ASSERT_LE(j, 3);
+  EXPECT_NE(out.find("the binding joint is joint " + std::to_string(j)), std::string::npos) << out;
+  EXPECT_NE(out.find("per joint: joint 1 "), std::string::npos) << out;
+  ASSERT_EQ(t["infeasible"]["torque_needed_per_joint_Nm"].size(), 3u);
+  double most = 0.0;  // the stroke's peak joint torque is its largest joint's, k^2 times faster as well
+  for (const auto& v : t["infeasible"]["torque_needed_per_joint_Nm"]) most = std::max(most, v.get<double>());
+  EXPECT_NEAR(most, t["infeasible"]["torque_needed_Nm"].get<double>(), 1e-9 * most);
+}
+
 // objective: {model: perfoot} searches the per-foot model itself; {model: mujoco} re-ranks the
 // search's best candidates in MuJoCo and reports them; every model's phi_net of the optimum is in
 // summary.json.

@@ -20,50 +20,78 @@ namespace {
 constexpr double kRadPerDeg = M_PI / 180.0;
 using namespace design_yaml;
 
-// The limits the design file leaves out, from the robot file's tail entries: every joint must give
-// it, and the strictest joint's value holds for all (the narrowest common angle range). A limit
-// neither gives is refused with what to add (torque: `none` keeps no torque limit).
-void resolveRobotLimits(const Reader& r, const Val& lv, const ExperimentCase& base, const Val* theta, const Val* speed,
-                        const Val* torque, StrokeLimits& L) {
+// A joint limit given in the design file: one value for every joint, or a list of one per joint
+// (checked against the base's n once it is read).
+struct FileLimit {
+  const Val* at = nullptr;     // the key (nullptr: not given)
+  std::vector<double> values;  // 1 (every joint) or n entries; theta: pairs lo, hi flattened
+  bool per_joint = false;
+};
+
+// The joint limits, joint by joint: the design file's value (a scalar: every joint; a list: one per
+// joint), else the robot's (each joint's own tail-entry value). A limit neither gives is refused
+// with what to add (torque: `none` keeps no torque limit). When every joint ends with the same
+// limits, the scalars of StrokeLimits hold them (joints empty); else StrokeLimits::joints does.
+void resolveJointLimits(const Reader& r, const Val& lv, const ExperimentCase& base, const FileLimit& theta,
+                        const FileLimit& speed, const FileLimit& torque, bool torque_given_as_word, StrokeLimits& L) {
   const std::vector<TailLink>& tail = base.robot.tail;
-  const std::string n = std::to_string(tail.size());
+  const std::size_t n = tail.size();
   const std::string where = base.robot_file.empty() ? std::string("the base experiment's tail")
-                                                    : "the robot file " + base.robot_file + " (its tails." + n + " entry)";
-  auto missing = [&](const char* key, const std::string& add) {
+                                                    : "the robot file " + base.robot_file + " (its tails." +
+                                                          std::to_string(n) + " entry)";
+  auto missing = [&](const char* key, const std::string& add, std::size_t joint) {
     r.fail(lv.mark, lv.key + "." + key,
-           std::string("required key is missing: neither this file nor ") + where + " gives it. Add " + add);
+           std::string("required key is missing: neither this file nor ") + where + " gives it for joint " +
+               std::to_string(joint + 1) + ". Add " + add);
   };
-  if (!theta) {
-    double lo = -1e300, hi = 1e300;
-    for (const TailLink& k : tail) {
-      if (!k.hasRange()) missing("theta_deg", "theta_min_deg and theta_max_deg to the robot's tail entry, or "
-                                              "theta_deg: [low, high] here");
-      lo = std::max(lo, k.theta_min_rad);
-      hi = std::min(hi, k.theta_max_rad);
+  for (const FileLimit* f : {&theta, &speed, &torque})
+    if (f->at && f->per_joint && f->values.size() != (f == &theta ? 2 * n : n))
+      r.fail(*f->at, "a list gives one value per joint: the base's tail has " + std::to_string(n) + " joints, got " +
+                         std::to_string(f == &theta ? f->values.size() / 2 : f->values.size()));
+  auto fileValue = [](const FileLimit& f, std::size_t i, std::size_t stride, std::size_t k) {
+    return f.values[(f.per_joint ? i * stride : 0) + k];
+  };
+  std::vector<JointLimits> js(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    JointLimits& J = js[i];
+    const TailLink& k = tail[i];
+    if (theta.at) {
+      J.theta_min_rad = fileValue(theta, i, 2, 0);
+      J.theta_max_rad = fileValue(theta, i, 2, 1);
+    } else {
+      if (!k.hasRange())
+        missing("theta_deg", "theta_min_deg and theta_max_deg to the robot's tail entry, or theta_deg: [low, high] here", i);
+      J.theta_min_rad = k.theta_min_rad;
+      J.theta_max_rad = k.theta_max_rad;
     }
-    if (!(hi > lo)) r.fail(lv, "the robot's joints have no common angle range (give theta_deg here)");
-    L.theta_min_rad = lo;
-    L.theta_max_rad = hi;
-  }
-  if (!speed) {
-    double v = 1e300;
-    for (const TailLink& k : tail) {
+    if (speed.at) {
+      J.thetadot_max_radps = fileValue(speed, i, 1, 0);
+    } else {
       if (!(k.thetadot_max_radps > 0.0))
-        missing("thetadot_max_dps", "thetadot_max_dps (the actuator's peak speed) to the robot's tail entry or here");
-      v = std::min(v, k.thetadot_max_radps);
+        missing("thetadot_max_dps", "thetadot_max_dps (the actuator's peak speed) to the robot's tail entry or here", i);
+      J.thetadot_max_radps = k.thetadot_max_radps;
     }
-    L.thetadot_max_radps = v;
-  }
-  if (!torque) {
-    double v = 1e300;
-    for (const TailLink& k : tail) {
+    if (torque.at || torque_given_as_word) {
+      J.torque_max_Nm = torque.at ? fileValue(torque, i, 1, 0) : L.torque_max_Nm;
+    } else {
       if (!(k.torque_max_Nm > 0.0))
         missing("torque_max_Nm", "torque_max_Nm (the actuator's peak torque) to the robot's tail entry or here, or "
-                                 "torque_max_Nm: none here for no torque limit");
-      v = std::min(v, k.torque_max_Nm);
+                                 "torque_max_Nm: none here for no torque limit", i);
+      J.torque_max_Nm = k.torque_max_Nm;
     }
-    L.torque_max_Nm = v;
   }
+  L.joints.clear();
+  if (n == 0) return;
+  const JointLimits& a = js.front();
+  const bool uniform = std::all_of(js.begin(), js.end(), [&](const JointLimits& b) {
+    return b.theta_min_rad == a.theta_min_rad && b.theta_max_rad == a.theta_max_rad &&
+           b.thetadot_max_radps == a.thetadot_max_radps && b.torque_max_Nm == a.torque_max_Nm;
+  });
+  L.theta_min_rad = a.theta_min_rad;
+  L.theta_max_rad = a.theta_max_rad;
+  L.thetadot_max_radps = a.thetadot_max_radps;
+  L.torque_max_Nm = a.torque_max_Nm;
+  if (!uniform) L.joints = std::move(js);
 }
 }  // namespace
 
@@ -92,6 +120,9 @@ double optimizeRunEstimate(const OptimizeSpec& s) {
     const double patterns = std::ldexp(1.0, std::min(s.problem.space.n_links, 1000));
     const double kept = o.directions_kept > 0 ? std::min<double>(o.directions_kept, patterns) : patterns;
     per_search = patterns * first + kept * later;
+    if (o.max_runs > 0) per_search = std::min(per_search, patterns * static_cast<double>(o.max_runs));
+  } else if (o.max_runs > 0) {
+    per_search = std::min(per_search, static_cast<double>(o.max_runs));
   }
   return per_search * static_cast<double>(s.seeds.size() + static_cast<std::size_t>(s.pareto_points));
 }
@@ -111,7 +142,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& base = file.base(r);  // the base experiment's own checks below point here
   const Val& opt = file.section(r);
   const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
+                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "max_runs", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
                                                                                         : StrokeFamily::kSplitCycle;
@@ -156,25 +187,43 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   const Val& lv = need(o, opt, "limits");
   const auto l = r.map(lv, {"theta_deg", "thetadot_max_dps", "torque_max_Nm", "end", "dT_s", "w_ss", "start_delay_s"});
   StrokeLimits& L = sp.limits;
-  // The angle range, speed and torque limits: here, or the robot file's (its tail entry's
-  // theta_min_deg/theta_max_deg, thetadot_max_dps, torque_max_Nm; resolved once the base is read).
-  const Val* theta = Reader::get(l, "theta_deg");
-  if (theta) {
-    const auto [a, b] = r.interval(*theta, -360.0, 360.0);
-    if (!(b > a)) r.fail(*theta, "the range must not be empty");
-    L.theta_min_rad = a * kRadPerDeg;
-    L.theta_max_rad = b * kRadPerDeg;
+  // The angle range, speed and torque limits: here (a value for every joint, or a list of one per
+  // joint), or the robot file's (each joint's tail-entry theta_min_deg/theta_max_deg,
+  // thetadot_max_dps, torque_max_Nm; resolved once the base is read).
+  FileLimit theta, speed, torque;
+  if ((theta.at = Reader::get(l, "theta_deg"))) {
+    auto pair = [&](const Val& v) {
+      const auto [lo, hi] = r.interval(v, -360.0, 360.0);
+      if (!(hi > lo)) r.fail(v, "the range must not be empty");
+      theta.values.insert(theta.values.end(), {lo * kRadPerDeg, hi * kRadPerDeg});
+    };
+    theta.per_joint = theta.at->node.IsSequence() && theta.at->node.size() > 0 && theta.at->node[0].IsSequence();
+    if (theta.per_joint)
+      for (const Val& e : r.list(*theta.at, 1, 64)) pair(e);
+    else
+      pair(*theta.at);
   }
-  const Val* speed = Reader::get(l, "thetadot_max_dps");
-  if (speed) L.thetadot_max_radps = r.inRange(*speed, 1.0, 36000.0) * kRadPerDeg;
-  const Val* torque = Reader::get(l, "torque_max_Nm");
-  const bool torque_word = torque && torque->node.IsScalar() &&
-                           (torque->node.Scalar() == "base" || torque->node.Scalar() == "none");
-  if (torque && !torque_word) {
-    L.torque_max_Nm = r.number(*torque);
-    if (!(L.torque_max_Nm > 0.0))
-      r.fail(*torque, "must be > 0, base (the base stroke's peak) or none (no torque limit), got " + fmtG(L.torque_max_Nm));
+  auto numbers = [&](FileLimit& f, double lo, double hi, double scale) {
+    f.per_joint = f.at->node.IsSequence();
+    if (f.per_joint)
+      for (const Val& e : r.list(*f.at, 1, 64)) f.values.push_back(r.inRange(e, lo, hi) * scale);
+    else
+      f.values.push_back(r.inRange(*f.at, lo, hi) * scale);
+  };
+  if ((speed.at = Reader::get(l, "thetadot_max_dps"))) numbers(speed, 1.0, 36000.0, kRadPerDeg);
+  const Val* torque_key = Reader::get(l, "torque_max_Nm");
+  const bool torque_word = torque_key && torque_key->node.IsScalar() &&
+                           (torque_key->node.Scalar() == "base" || torque_key->node.Scalar() == "none");
+  if (torque_key && !torque_word) {
+    torque.at = torque_key;
+    torque.per_joint = torque_key->node.IsSequence();
+    for (const Val& e : torque.per_joint ? r.list(*torque_key, 1, 64) : std::vector<Val>{*torque_key}) {
+      const double v = r.number(e);
+      if (!(v > 0.0)) r.fail(e, "must be > 0, base (the base stroke's peak) or none (no torque limit), got " + fmtG(v));
+      torque.values.push_back(v);
+    }
   }
+  if (torque_word) L.torque_max_Nm = 0.0;  // none; base: set below from the base stroke
   if (const Val* e = Reader::get(l, "end")) {
     L.end = r.choice(*e, {"rest", "start"}) == "start" ? StrokeEnd::kAtStart : StrokeEnd::kAtRest;
     if (L.end == StrokeEnd::kAtStart && sp.family == StrokeFamily::kSplitCycle)
@@ -225,6 +274,14 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   }
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
+  if (const Val* v = Reader::get(o, "max_runs")) {
+    os.max_runs = r.integer(*v, 0, static_cast<int>(limits::kMaxOptimizeRuns));
+    const long least = 2 + static_cast<long>(os.islands) * os.population + (os.polish != "none" ? os.polish_evaluations : 0);
+    if (os.max_runs > 0 && os.max_runs < least)
+      r.fail(*v, "must be 0 (no cap) or at least " + std::to_string(least) +
+                     " (the start, one population of every island and the polish's polish_evaluations), got " +
+                     std::to_string(os.max_runs));
+  }
   if (const Val* v = Reader::get(o, "seeds")) {
     s.seeds.clear();
     for (const Val& e : r.list(*v, 1, kMaxSeeds)) {
@@ -280,32 +337,54 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
                     fmtG(limits::kMaxOptimizeSteps) +
                     " (docs/design-a-tail-stroke.md \"Limits\"): lower generations, population, islands, restarts or "
                     "seeds, or give the base a coarser analytic step (analytic.fixed_dt_s, analytic.max_step_s)");
-  resolveRobotLimits(r, lv, s.base, theta, speed, torque, L);
-  if (torque && torque->node.IsScalar() && torque->node.Scalar() == "base") {  // the base stroke's own peak joint torque
+  if (torque_word && torque_key->node.Scalar() == "base") {  // the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
-    if (!(L.torque_max_Nm > 0.0)) r.fail(*torque, "base: the base stroke has no joint torque to keep");
+    if (!(L.torque_max_Nm > 0.0)) r.fail(*torque_key, "base: the base stroke has no joint torque to keep");
   }
+  resolveJointLimits(r, lv, s.base, theta, speed, torque, torque_word, L);
   // Limits that leave no stroke to search are refused here, not after a whole search that could only
   // report "limits VIOLATED": a 1 deg split-cycle stroke of every joint over the longest duration must keep them.
   {
     const double amp = 1.0 * kRadPerDeg;
-    SplitCycleParams p;
-    p.theta0_rad = std::max(L.theta_min_rad, std::min(0.0, L.theta_max_rad - amp));
-    p.dtheta_rad = amp;
-    p.dT_s = L.dT_max_s;
-    p.w_ss = std::max(L.w_ss_min, std::min(0.5, L.w_ss_max));
     TailTrajectory probe;
-    for (int i = 0; i < sp.n_links; ++i) probe.joints.emplace_back(p);
+    double narrowest = 1e300;
+    for (int i = 0; i < sp.n_links; ++i) {
+      const JointLimits J = L.joint(static_cast<std::size_t>(i));
+      SplitCycleParams p;
+      p.theta0_rad = std::max(J.theta_min_rad, std::min(0.0, J.theta_max_rad - amp));
+      p.dtheta_rad = amp;
+      p.dT_s = L.dT_max_s;
+      p.w_ss = std::max(L.w_ss_min, std::min(0.5, L.w_ss_max));
+      probe.joints.emplace_back(p);
+      narrowest = std::min(narrowest, J.theta_max_rad - J.theta_min_rad);
+    }
     StrokeLimits at_rest = L;  // a stroke that must end where it started is a spline's: not this probe
     at_rest.end = StrokeEnd::kAtRest;
     const StrokeFigures f = strokeFigures(s.base.robot.tail, probe);
-    if (L.theta_max_rad - L.theta_min_rad < amp || limitViolation(f, at_rest) > 0.0)
+    if (narrowest < amp || limitViolation(f, at_rest) > 0.0) {
+      std::string which;  // the joints whose limits the probe breaks; the first is described
+      std::size_t first = f.joints.size();
+      for (std::size_t i = 0; i < f.joints.size(); ++i) {
+        StrokeLimits one = at_rest;
+        StrokeFigures fi;
+        fi.joints = {f.joints[i]};
+        one.joints = {L.joint(i)};
+        if (L.joint(i).theta_max_rad - L.joint(i).theta_min_rad < amp || limitViolation(fi, one) > 0.0) {
+          which += (which.empty() ? "" : ", ") + std::to_string(i + 1);
+          first = std::min(first, i);
+        }
+      }
+      if (which.empty()) which = "1";
+      if (first == f.joints.size()) first = 0;
+      const JointLimits J = L.joint(first);
+      const JointFigures& g = f.joints.at(first);
       r.fail(lv, "no stroke keeps these limits: 1 deg of every joint over the longest duration (dT_s " +
-                     fmtG(L.dT_max_s) + " s) needs a range of 1 deg (have " +
-                     fmtG((L.theta_max_rad - L.theta_min_rad) / kRadPerDeg) + "), peaks at " +
-                     fmtG(f.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
-                     fmtG(L.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(f.peak_torque_Nm) + " N m (limit " +
-                     (L.torque_max_Nm > 0 ? fmtG(L.torque_max_Nm) : std::string("none")) + "): widen them");
+                     fmtG(L.dT_max_s) + " s) breaks them at joint " + which +
+                     ": it needs a range of 1 deg (have " + fmtG((J.theta_max_rad - J.theta_min_rad) / kRadPerDeg) +
+                     "), peaks at " + fmtG(g.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
+                     fmtG(J.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(g.peak_torque_Nm) + " N m (limit " +
+                     (J.torque_max_Nm > 0 ? fmtG(J.torque_max_Nm) : std::string("none")) + "): widen them");
+    }
   }
   s.problem.base = s.base;
   return s;

@@ -84,14 +84,9 @@ LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSer
                ts.at(r, ts.column("thetaddot" + k + "_dps2")) * d2r};
     }
     const std::vector<double> tau = jointTorques(links, js);
+    f.addSample(js, tau);
     double p = 0;
-    for (int i = 0; i < n; ++i) {
-      f.theta_min_rad = std::min(f.theta_min_rad, js[i].theta);
-      f.theta_max_rad = std::max(f.theta_max_rad, js[i].theta);
-      f.peak_speed_radps = std::max(f.peak_speed_radps, std::abs(js[i].theta_dot));
-      f.peak_torque_Nm = std::max(f.peak_torque_Nm, std::abs(tau[i]));
-      p += std::abs(tau[i] * js[i].theta_dot);
-    }
+    for (int i = 0; i < n; ++i) p += std::abs(tau[i] * js[i].theta_dot);
     if (r > 0) f.energy_J += 0.5 * (p + prev_p) * (t[r] - t[r - 1]);
     prev_p = p;
     if (r + 1 == ts.numRows() && r > 0)
@@ -99,13 +94,21 @@ LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSer
         f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js[i].theta - ts.at(0, ts.column("theta" + std::to_string(i + 1) + "_deg")) * d2r));
   }
   auto over = exceedsLimit;  // the optimiser's rule (limitViolation)
-  if (over(f.theta_max_rad, L.theta_max_rad) || over(L.theta_min_rad, f.theta_min_rad))
-    c.violations.push_back("joint angle " + std::to_string(f.theta_min_rad * kDegPerRad) + ".." +
-                           std::to_string(f.theta_max_rad * kDegPerRad) + " deg outside the range");
-  if (over(f.peak_speed_radps, L.thetadot_max_radps))
-    c.violations.push_back("peak joint speed " + std::to_string(f.peak_speed_radps * kDegPerRad) + " deg/s over the limit");
-  if (L.torque_max_Nm > 0 && over(f.peak_torque_Nm, L.torque_max_Nm))
-    c.violations.push_back("peak joint torque " + std::to_string(f.peak_torque_Nm) + " N m over the limit");
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    const JointLimits J = L.joint(i);
+    const JointFigures& g = f.joints[i];
+    const std::string who = "joint " + std::to_string(i + 1) + " ";
+    if (over(g.theta_max_rad, J.theta_max_rad) || over(J.theta_min_rad, g.theta_min_rad))
+      c.violations.push_back(who + "angle " + std::to_string(g.theta_min_rad * kDegPerRad) + ".." +
+                             std::to_string(g.theta_max_rad * kDegPerRad) + " deg outside its range " +
+                             std::to_string(J.theta_min_rad * kDegPerRad) + ".." + std::to_string(J.theta_max_rad * kDegPerRad));
+    if (over(g.peak_speed_radps, J.thetadot_max_radps))
+      c.violations.push_back(who + "peak speed " + std::to_string(g.peak_speed_radps * kDegPerRad) + " deg/s over its limit " +
+                             std::to_string(J.thetadot_max_radps * kDegPerRad));
+    if (J.torque_max_Nm > 0 && over(g.peak_torque_Nm, J.torque_max_Nm))
+      c.violations.push_back(who + "peak torque " + std::to_string(g.peak_torque_Nm) + " N m over its limit " +
+                             std::to_string(J.torque_max_Nm));
+  }
   if (L.end == StrokeEnd::kAtStart && f.end_offset_rad > 1e-6)
     c.violations.push_back("the tail ends " + std::to_string(f.end_offset_rad * kDegPerRad) + " deg from its start");
   c.ok = c.violations.empty();
@@ -204,11 +207,30 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
     std::snprintf(b, sizeof b, "%.4g", v);
     return std::string(b);
   };
-  const std::string limits = "torque " + (L.torque_max_Nm > 0 ? fmt(L.torque_max_Nm) + " N m" : std::string("unlimited")) +
-                             ", speed " + fmt(L.thetadot_max_radps * kDegPerRad) + " deg/s";
+  // The joint that binds: the one whose torque uses the largest share of its limit.
+  r.binding_joint = mostLoadedJoint(best.figures, L);
+  const JointLimits B = L.joint(static_cast<std::size_t>(std::max(0, r.binding_joint)));
+  if (r.binding_joint >= 0) {
+    r.binding_torque_Nm = best.figures.joints[static_cast<std::size_t>(r.binding_joint)].peak_torque_Nm;
+    r.binding_limit_Nm = B.torque_max_Nm;
+  }
+  std::string limits;
+  if (L.joints.empty())
+    limits = "torque " + (L.torque_max_Nm > 0 ? fmt(L.torque_max_Nm) + " N m" : std::string("unlimited")) + ", speed " +
+             fmt(L.thetadot_max_radps * kDegPerRad) + " deg/s";
+  else
+    for (std::size_t i = 0; i < L.joints.size(); ++i)
+      limits += (i ? "; joint " : "joint ") + std::to_string(i + 1) + ": torque " +
+                (L.joints[i].torque_max_Nm > 0 ? fmt(L.joints[i].torque_max_Nm) + " N m" : std::string("unlimited")) +
+                ", speed " + fmt(L.joints[i].thetadot_max_radps * kDegPerRad) + " deg/s";
+  const std::string binding =
+      r.binding_joint < 0 ? std::string()
+                          : "; the binding joint is joint " + std::to_string(r.binding_joint + 1) + " (" +
+                                fmt(r.binding_torque_Nm) + " N m" +
+                                (B.torque_max_Nm > 0 ? " of its " + fmt(B.torque_max_Nm) + " N m" : std::string()) + ")";
   const std::string head = "no stroke within the limits (" + limits + ") turns the body by min_turn_deg " +
                            fmt(min_turn_rad * kDegPerRad) + " or more: the best found turns it " +
-                           fmt(best.phi_net_rad * kDegPerRad) + " deg" +
+                           fmt(best.phi_net_rad * kDegPerRad) + " deg" + binding +
                            (r.reach.applies ? "; its yaw moment on the held body peaks at " + fmt(100.0 * r.reach.ratio) +
                                                   " % of the static friction limit (" +
                                                   fmt(r.reach.peak_moment_Nm) + " N m of max(mu_s, mu_d) m g L_F = " +
@@ -218,6 +240,10 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
   StrokeProblem unlimited = p;
   unlimited.space.limits.torque_max_Nm = 0.0;
   unlimited.space.limits.thetadot_max_radps = std::numeric_limits<double>::infinity();
+  for (JointLimits& j : unlimited.space.limits.joints) {
+    j.torque_max_Nm = 0.0;
+    j.thetadot_max_radps = std::numeric_limits<double>::infinity();
+  }
   auto turns = [&](double k) {
     const StrokeEvaluation e = evaluateStroke(unlimited, timeScaled(traj, k));
     return e.ok && std::abs(e.phi_net_rad) >= min_turn_rad;
@@ -245,10 +271,21 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
   // a stroke this fast).
   r.torque_needed_Nm = r.peak_torque_Nm * hi * hi;
   r.speed_needed_dps = r.peak_speed_dps * hi;
+  for (const JointFigures& g : best.figures.joints) {
+    r.torque_needed_per_joint_Nm.push_back(g.peak_torque_Nm * hi * hi);
+    r.speed_needed_per_joint_dps.push_back(g.peak_speed_radps * kDegPerRad * hi);
+  }
+  std::string per_joint;
+  if (!L.joints.empty())
+    for (std::size_t i = 0; i < r.torque_needed_per_joint_Nm.size(); ++i)
+      per_joint += (i ? ", joint " : "; per joint: joint ") + std::to_string(i + 1) + " " +
+                   fmt(r.torque_needed_per_joint_Nm[i]) + " N m, " + fmt(r.speed_needed_per_joint_dps[i]) + " deg/s";
   r.message = head + ". The same stroke shape, run " + fmt(hi) + " times faster, turns it " + fmt(r.check_phi_net_deg) +
               " deg (" + objectiveModelName(p.search_model) + " model) at a peak joint torque of " + fmt(r.torque_needed_Nm) +
               " N m and a peak joint speed of " + fmt(r.speed_needed_dps) + " deg/s (now " + fmt(r.peak_torque_Nm) +
-              " N m, " + fmt(r.peak_speed_dps) + " deg/s): raise the limits to at least these, or change the robot";
+              " N m, " + fmt(r.peak_speed_dps) + " deg/s" + per_joint + "): raise the limits to at least these" +
+              (r.binding_joint >= 0 ? " (first joint " + std::to_string(r.binding_joint + 1) + "'s torque)" : std::string()) +
+              ", or change the robot";
   return r;
 }
 
@@ -461,6 +498,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
       p.objective = StrokeObjective::kPhiNet;
       const double lim = tau_top * (0.2 + 0.8 * k / (spec.pareto_points - 1));
       p.space.limits.torque_max_Nm = prob.space.limits.torque_max_Nm > 0 ? std::min(lim, prob.space.limits.torque_max_Nm) : lim;
+      for (JointLimits& jl : p.space.limits.joints) jl.torque_max_Nm = jl.torque_max_Nm > 0 ? std::min(lim, jl.torque_max_Nm) : lim;
       OptimizerSettings os = spec.optimizer;
       os.seed = spec.seeds.front();
       const OptimizeResult r = optimizeStroke(p, os);
@@ -552,7 +590,27 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                                   {"theta_min_deg", lc.figures.theta_min_rad * kDegPerRad},
                                   {"theta_max_deg", lc.figures.theta_max_rad * kDegPerRad},
                                   {"peak_speed_dps", lc.figures.peak_speed_radps * kDegPerRad},
-                                  {"peak_torque_Nm", lc.figures.peak_torque_Nm}};
+                                  {"peak_torque_Nm", lc.figures.peak_torque_Nm},
+                                  {"binding", bindingLimits(lc.figures, prob.space.limits)}};
+  {
+    nlohmann::json per = nlohmann::json::array();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(prob.space.n_links); ++i) {
+      const JointLimits J = prob.space.limits.joint(i);
+      nlohmann::json row = {{"joint", i + 1},
+                            {"theta_min_deg", J.theta_min_rad * kDegPerRad},
+                            {"theta_max_deg", J.theta_max_rad * kDegPerRad},
+                            {"thetadot_max_dps", J.thetadot_max_radps * kDegPerRad},
+                            {"torque_max_Nm", J.torque_max_Nm > 0 ? nlohmann::json(J.torque_max_Nm) : nlohmann::json()}};
+      if (i < lc.figures.joints.size()) {
+        const JointFigures& g = lc.figures.joints[i];
+        row["peak_torque_Nm"] = g.peak_torque_Nm;
+        row["peak_speed_dps"] = g.peak_speed_radps * kDegPerRad;
+        row["theta_range_deg"] = {g.theta_min_rad * kDegPerRad, g.theta_max_rad * kDegPerRad};
+      }
+      per.push_back(row);
+    }
+    j["limits"] = per;  // per joint: the limits and the re-run's figures
+  }
   if (spec.mujoco_check)
     j["resimulated"]["mujoco"] = {{"ok", rep.mujoco.ok}, {"phi_net_deg", rep.mujoco.phi_net_deg}, {"error", rep.mujoco.error},
                                   {"difference_deg", rep.mujoco.phi_net_deg - rep.analytic.phi_net_deg},
@@ -589,6 +647,9 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                        {"peak_torque_Nm", inf.peak_torque_Nm},
                        {"peak_speed_dps", inf.peak_speed_dps},
                        {"torque_needed_Nm", num(inf.torque_needed_Nm)},
+                       {"binding_joint", inf.binding_joint + 1},
+                       {"torque_needed_per_joint_Nm", inf.torque_needed_per_joint_Nm},
+                       {"speed_needed_per_joint_dps", inf.speed_needed_per_joint_dps},
                        {"speed_needed_dps", num(inf.speed_needed_dps)},
                        {"check", {{"ok", inf.check_ok}, {"peak_torque_Nm", inf.check_torque_Nm},
                                   {"peak_speed_dps", inf.check_speed_dps}, {"phi_net_deg", inf.check_phi_net_deg}}}};

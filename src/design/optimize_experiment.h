@@ -41,6 +41,11 @@ struct Infeasibility {
   double peak_speed_dps = 0.0;
   double torque_needed_Nm = 0.0;   // the same shape turning the body by min_turn_deg (infinite: not found)
   double speed_needed_dps = 0.0;
+  std::vector<double> torque_needed_per_joint_Nm, speed_needed_per_joint_dps;  // the same, joint by joint
+  // The joint that binds (0-based; -1: none): the largest share of its torque limit (of the
+  // largest torque without one), its peak torque and limit (0: none).
+  int binding_joint = -1;
+  double binding_torque_Nm = 0.0, binding_limit_Nm = 0.0;
   // The check: that shape at the needed torque and speed (the bisection's turning end).
   double check_torque_Nm = 0.0, check_speed_dps = 0.0, check_phi_net_deg = 0.0;
   bool check_ok = false;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "models/planar/tail_dynamics.h"
@@ -26,26 +27,27 @@ TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const {
   const int d = dimPerJoint();
   for (int i = 0; i < n_links; ++i) {
     const double* u = x.data() + static_cast<std::ptrdiff_t>(i) * d;
+    const JointLimits J = L.joint(static_cast<std::size_t>(i));
     if (family == StrokeFamily::kSplitCycle) {
       SplitCycleParams p;
-      p.theta0_rad = lerp(L.theta_min_rad, L.theta_max_rad, u[0]);
+      p.theta0_rad = lerp(J.theta_min_rad, J.theta_max_rad, u[0]);
       const int dir = directions.empty() ? 0 : directions.at(static_cast<std::size_t>(i));
-      const double end = dir > 0   ? lerp(p.theta0_rad, L.theta_max_rad, u[1])
-                         : dir < 0 ? lerp(p.theta0_rad, L.theta_min_rad, u[1])
-                                   : lerp(L.theta_min_rad, L.theta_max_rad, u[1]);
+      const double end = dir > 0   ? lerp(p.theta0_rad, J.theta_max_rad, u[1])
+                         : dir < 0 ? lerp(p.theta0_rad, J.theta_min_rad, u[1])
+                                   : lerp(J.theta_min_rad, J.theta_max_rad, u[1]);
       p.dtheta_rad = end - p.theta0_rad;
       // Peak speed 2 |dtheta| / dT (Eq. 23) as a share of the limit: speed kept by construction
       // unless the duration range clips dT.
       const double share = lerp(0.05, 1.0, u[2]);
-      p.dT_s = std::min(L.dT_max_s, std::max(L.dT_min_s, 2.0 * std::abs(p.dtheta_rad) / (share * L.thetadot_max_radps)));
+      p.dT_s = std::min(L.dT_max_s, std::max(L.dT_min_s, 2.0 * std::abs(p.dtheta_rad) / (share * J.thetadot_max_radps)));
       p.w_ss = lerp(L.w_ss_min, L.w_ss_max, u[3]);
       p.t0_s = lerp(0.0, L.t0_max_s, u[4]);
       t.joints.emplace_back(p);
     } else {
       SplineParams s;
       int k = 0;
-      for (; k < 1 + knots; ++k) s.knots_rad.push_back(lerp(L.theta_min_rad, L.theta_max_rad, u[k]));
-      if (L.end == StrokeEnd::kAtRest) s.knots_rad.push_back(lerp(L.theta_min_rad, L.theta_max_rad, u[k++]));
+      for (; k < 1 + knots; ++k) s.knots_rad.push_back(lerp(J.theta_min_rad, J.theta_max_rad, u[k]));
+      if (L.end == StrokeEnd::kAtRest) s.knots_rad.push_back(lerp(J.theta_min_rad, J.theta_max_rad, u[k++]));
       else s.knots_rad.push_back(s.knots_rad.front());
       s.dT_s = lerp(L.dT_min_s, L.dT_max_s, u[k++]);
       s.t0_s = lerp(0.0, L.t0_max_s, u[k++]);
@@ -60,15 +62,16 @@ std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& jo
   std::vector<double> x;
   for (int i = 0; i < n_links; ++i) {
     const SplitCycleParams& p = joints.at(static_cast<std::size_t>(i));
+    const JointLimits J = L.joint(static_cast<std::size_t>(i));
     const double a = p.theta0_rad, b = p.theta0_rad + p.dtheta_rad;
     if (family == StrokeFamily::kSplitCycle) {
-      const double speed = p.dT_s > 0 ? 2.0 * std::abs(p.dtheta_rad) / p.dT_s : L.thetadot_max_radps;
+      const double speed = p.dT_s > 0 ? 2.0 * std::abs(p.dtheta_rad) / p.dT_s : J.thetadot_max_radps;
       const int dir = directions.empty() ? 0 : directions.at(static_cast<std::size_t>(i));
-      const double u_end = dir > 0   ? unlerp(a, L.theta_max_rad, b)
-                           : dir < 0 ? (a > L.theta_min_rad ? clamp01((a - b) / (a - L.theta_min_rad)) : 0.0)
-                                     : unlerp(L.theta_min_rad, L.theta_max_rad, b);
-      x.insert(x.end(), {unlerp(L.theta_min_rad, L.theta_max_rad, a), u_end,
-                         unlerp(0.05, 1.0, speed / L.thetadot_max_radps), unlerp(L.w_ss_min, L.w_ss_max, p.w_ss),
+      const double u_end = dir > 0   ? unlerp(a, J.theta_max_rad, b)
+                           : dir < 0 ? (a > J.theta_min_rad ? clamp01((a - b) / (a - J.theta_min_rad)) : 0.0)
+                                     : unlerp(J.theta_min_rad, J.theta_max_rad, b);
+      x.insert(x.end(), {unlerp(J.theta_min_rad, J.theta_max_rad, a), u_end,
+                         unlerp(0.05, 1.0, speed / J.thetadot_max_radps), unlerp(L.w_ss_min, L.w_ss_max, p.w_ss),
                          unlerp(0.0, L.t0_max_s, p.t0_s)});
     } else {
       // The split-cycle stroke sampled at the knots (out and back when the tail must end at its start).
@@ -77,7 +80,7 @@ std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& jo
       for (int k = 0; k < N - 1 + (L.end == StrokeEnd::kAtRest ? 1 : 0); ++k) {
         double frac = static_cast<double>(k) / (N - 1);
         if (L.end == StrokeEnd::kAtStart) frac = frac <= 0.5 ? 2 * frac : 2 - 2 * frac;
-        x.push_back(unlerp(L.theta_min_rad, L.theta_max_rad, prof.at(p.t0_s + frac * p.dT_s).theta));
+        x.push_back(unlerp(J.theta_min_rad, J.theta_max_rad, prof.at(p.t0_s + frac * p.dT_s).theta));
       }
       x.push_back(unlerp(L.dT_min_s, L.dT_max_s, L.end == StrokeEnd::kAtStart ? 2 * p.dT_s : p.dT_s));
       x.push_back(unlerp(0.0, L.t0_max_s, p.t0_s));
@@ -100,6 +103,25 @@ std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::
   return tau;
 }
 
+void StrokeFigures::addSample(const std::vector<JointState>& js, const std::vector<double>& tau) {
+  if (joints.size() != js.size()) {
+    joints.assign(js.size(), JointFigures{});
+    for (std::size_t i = 0; i < js.size(); ++i) joints[i].theta_min_rad = joints[i].theta_max_rad = js[i].theta;
+    if (!js.empty() && theta_min_rad > theta_max_rad) theta_min_rad = theta_max_rad = js[0].theta;
+  }
+  for (std::size_t i = 0; i < js.size(); ++i) {
+    JointFigures& g = joints[i];
+    g.theta_min_rad = std::min(g.theta_min_rad, js[i].theta);
+    g.theta_max_rad = std::max(g.theta_max_rad, js[i].theta);
+    g.peak_speed_radps = std::max(g.peak_speed_radps, std::abs(js[i].theta_dot));
+    g.peak_torque_Nm = std::max(g.peak_torque_Nm, std::abs(tau[i]));
+    theta_min_rad = std::min(theta_min_rad, js[i].theta);
+    theta_max_rad = std::max(theta_max_rad, js[i].theta);
+    peak_speed_radps = std::max(peak_speed_radps, g.peak_speed_radps);
+    peak_torque_Nm = std::max(peak_torque_Nm, g.peak_torque_Nm);
+  }
+}
+
 StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt) {
   StrokeFigures f;
   const double t_a = traj.startTime(), t_b = traj.endTime();
@@ -111,27 +133,28 @@ StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajec
   traj.evaluate(t_a - 1.0, js0);
   traj.evaluate(t_b + 1.0, js1);
   f.theta_min_rad = f.theta_max_rad = js0.empty() ? 0.0 : js0[0].theta;
+  f.joints.resize(js0.size());
+  for (std::size_t i = 0; i < js0.size(); ++i) f.joints[i].theta_min_rad = f.joints[i].theta_max_rad = js0[i].theta;
   double prev_t = ts.empty() ? 0.0 : ts.front(), prev_p = 0.0;
   TailKinematics kin;       // scratch: no allocation per sample
   std::vector<double> tau;
   for (double t : ts) {
     traj.evaluate(t, js);
     jointTorques(links, js, kin, tau);
+    f.addSample(js, tau);
     double p = 0.0;
-    for (std::size_t i = 0; i < js.size(); ++i) {
-      f.theta_min_rad = std::min(f.theta_min_rad, js[i].theta);
-      f.theta_max_rad = std::max(f.theta_max_rad, js[i].theta);
-      f.peak_speed_radps = std::max(f.peak_speed_radps, std::abs(js[i].theta_dot));
-      f.peak_torque_Nm = std::max(f.peak_torque_Nm, std::abs(tau[i]));
-      p += std::abs(tau[i] * js[i].theta_dot);
-    }
+    for (std::size_t i = 0; i < js.size(); ++i) p += std::abs(tau[i] * js[i].theta_dot);
     f.energy_J += 0.5 * (p + prev_p) * (t - prev_t);  // trapezoid
     prev_t = t;
     prev_p = p;
   }
   for (std::size_t i = 0; i < js0.size(); ++i) f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js1[i].theta - js0[i].theta));
-  for (const auto& j : traj.joints)
-    if (j.isSpline()) f.peak_speed_radps = std::max(f.peak_speed_radps, std::abs(j.peakSpeed()));
+  for (std::size_t i = 0; i < traj.joints.size(); ++i)
+    if (traj.joints[i].isSpline()) {
+      const double v = std::abs(traj.joints[i].peakSpeed());
+      f.peak_speed_radps = std::max(f.peak_speed_radps, v);
+      if (i < f.joints.size()) f.joints[i].peak_speed_radps = std::max(f.joints[i].peak_speed_radps, v);
+    }
   return f;
 }
 
@@ -141,13 +164,67 @@ double limitViolation(const StrokeFigures& f, const StrokeLimits& L) {
   // it, and an end angle at the angle bound lands 1 ulp outside. Counted strictly, those points
   // were infeasible, so the search was pushed off the bounds the n = 3 optimum lies on
   // (docs/design-a-tail-stroke.md). checkLimitsOnSeries (the re-run's check) uses the same rule.
-  const double range = std::max(L.theta_max_rad - L.theta_min_rad, 1e-9);
   auto excess = [](double value, double limit, double scale) { return exceedsLimit(value, limit) ? (value - limit) / scale : 0.0; };
-  double v = excess(f.theta_max_rad, L.theta_max_rad, range) + excess(-f.theta_min_rad, -L.theta_min_rad, range);
-  v += excess(f.peak_speed_radps, L.thetadot_max_radps, L.thetadot_max_radps);
-  if (L.torque_max_Nm > 0) v += excess(f.peak_torque_Nm, L.torque_max_Nm, L.torque_max_Nm);
-  if (L.end == StrokeEnd::kAtStart) v += f.end_offset_rad / range;
+  // Per kind of limit the worst joint's relative excess (with the same limits at every joint: the
+  // excess of the figure over all joints), summed over the kinds.
+  double hi = 0.0, lo = 0.0, speed = 0.0, torque = 0.0, widest = 1e-9;
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    const JointLimits J = L.joint(i);
+    const JointFigures& g = f.joints[i];
+    const double range = std::max(J.theta_max_rad - J.theta_min_rad, 1e-9);
+    widest = std::max(widest, range);
+    hi = std::max(hi, excess(g.theta_max_rad, J.theta_max_rad, range));
+    lo = std::max(lo, excess(-g.theta_min_rad, -J.theta_min_rad, range));
+    speed = std::max(speed, excess(g.peak_speed_radps, J.thetadot_max_radps, J.thetadot_max_radps));
+    if (J.torque_max_Nm > 0) torque = std::max(torque, excess(g.peak_torque_Nm, J.torque_max_Nm, J.torque_max_Nm));
+  }
+  double v = hi + lo + speed + torque;
+  if (L.end == StrokeEnd::kAtStart) v += f.end_offset_rad / widest;
   return v;
+}
+
+std::vector<std::string> bindingLimits(const StrokeFigures& f, const StrokeLimits& L, double share) {
+  std::vector<std::pair<double, std::string>> used;  // (share of the limit used, text)
+  auto num = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.4g", v);
+    return std::string(b);
+  };
+  constexpr double kDeg = 180.0 / M_PI;
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    const JointLimits J = L.joint(i);
+    const JointFigures& g = f.joints[i];
+    const std::string who = "joint " + std::to_string(i + 1) + " ";
+    if (J.torque_max_Nm > 0 && g.peak_torque_Nm >= (1.0 - share) * J.torque_max_Nm)
+      used.emplace_back(g.peak_torque_Nm / J.torque_max_Nm,
+                        who + "torque " + num(g.peak_torque_Nm) + " N m (limit " + num(J.torque_max_Nm) + " N m)");
+    if (g.peak_speed_radps >= (1.0 - share) * J.thetadot_max_radps)
+      used.emplace_back(g.peak_speed_radps / J.thetadot_max_radps, who + "speed " + num(g.peak_speed_radps * kDeg) +
+                                                                         " deg/s (limit " + num(J.thetadot_max_radps * kDeg) + " deg/s)");
+    const double range = J.theta_max_rad - J.theta_min_rad;
+    if (g.theta_max_rad >= J.theta_max_rad - share * range)
+      used.emplace_back(1.0, who + "angle " + num(g.theta_max_rad * kDeg) + " deg (limit " + num(J.theta_max_rad * kDeg) + " deg)");
+    if (g.theta_min_rad <= J.theta_min_rad + share * range)
+      used.emplace_back(1.0, who + "angle " + num(g.theta_min_rad * kDeg) + " deg (limit " + num(J.theta_min_rad * kDeg) + " deg)");
+  }
+  std::stable_sort(used.begin(), used.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::string> out;
+  for (auto& u : used) out.push_back(std::move(u.second));
+  return out;
+}
+
+int mostLoadedJoint(const StrokeFigures& f, const StrokeLimits& L) {
+  int best = -1;
+  double top = -1.0;
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    const double lim = L.joint(i).torque_max_Nm;
+    const double s = lim > 0 ? f.joints[i].peak_torque_Nm / lim : f.joints[i].peak_torque_Nm;
+    if (s > top) {
+      top = s;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
 }
 
 double objectiveValue(StrokeObjective o, double phi_net_rad, const StrokeFigures& f) {

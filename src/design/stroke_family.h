@@ -22,12 +22,24 @@ enum class StrokeObjective { kPhiNet, kPhiNetPerTorque, kPhiNetPerEnergy };
 enum class ObjectiveModel { kAnalytic, kPerFoot, kMujoco };
 const char* objectiveModelName(ObjectiveModel m);
 
-// What the search may vary and what a stroke must keep. Every joint's angle stays in
-// [theta_min, theta_max]; its speed within thetadot_max; every joint torque within torque_max.
+// One joint's actuator and range: its angle stays in [theta_min, theta_max], its speed within
+// thetadot_max, its torque within torque_max.
+struct JointLimits {
+  double theta_min_rad = -M_PI / 2, theta_max_rad = M_PI / 2;
+  double thetadot_max_radps = 600.0 * M_PI / 180.0;
+  double torque_max_Nm = 0.0;  // 0 = no torque limit
+};
+
+// What the search may vary and what a stroke must keep. The joint limits are per joint: `joints`
+// holds one entry per joint, or is empty and the scalars below hold for every joint (joint(i)).
 struct StrokeLimits {
   double theta_min_rad = -M_PI / 2, theta_max_rad = M_PI / 2;
   double thetadot_max_radps = 600.0 * M_PI / 180.0;
   double torque_max_Nm = 0.0;  // 0 = no torque limit
+  std::vector<JointLimits> joints;  // empty: the scalars for every joint
+  JointLimits joint(std::size_t i) const {
+    return joints.empty() ? JointLimits{theta_min_rad, theta_max_rad, thetadot_max_radps, torque_max_Nm} : joints.at(i);
+  }
   StrokeEnd end = StrokeEnd::kAtRest;
   double dT_min_s = 0.05, dT_max_s = 1.0;      // stroke duration range  [s]
   double w_ss_min = 0.05, w_ss_max = 0.95;     // split-cycle only
@@ -58,12 +70,22 @@ std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::
 void jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints, TailKinematics& kin,
                   std::vector<double>& tau);
 
+// One joint's figures over the samples.
+struct JointFigures {
+  double theta_min_rad = 0, theta_max_rad = 0;
+  double peak_speed_radps = 0;  // max |thetadot_i|
+  double peak_torque_Nm = 0;    // max |tau_i|
+};
+
 struct StrokeFigures {
   double theta_min_rad = 0, theta_max_rad = 0;  // over all joints and samples
   double peak_speed_radps = 0;                  // max |thetadot_i|
   double peak_torque_Nm = 0;                    // max |tau_i|
   double energy_J = 0;                          // sum_i integral |tau_i thetadot_i| dt
   double end_offset_rad = 0;                    // max_i |theta_i(end) - theta_i(start)|
+  std::vector<JointFigures> joints;             // per joint (the maxima above are over these)
+  // Adds one sample of every joint (angle, speed, torque) to the per-joint and overall figures.
+  void addSample(const std::vector<JointState>& js, const std::vector<double>& tau);
 };
 
 // Figures on the absolute grid t = k dt covering the stroke, plus every breakpoint; the grid
@@ -73,9 +95,18 @@ StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajec
 // A value exceeds its limit when over it by more than 1e-9 of max(1, |limit|) (less is rounding).
 inline bool exceedsLimit(double value, double limit) { return value > limit + 1e-9 * std::max(1.0, std::abs(limit)); }
 
-// Relative excess over each limit (0 when all are kept, exceedsLimit): the sum of the excesses, each
-// relative to its limit (angles: to the angle range).
+// Relative excess over the limits (0 when all are kept, exceedsLimit): per kind of limit (upper
+// angle, lower angle, speed, torque) the largest over the joints of the excess relative to that
+// joint's limit (angles: to its range), summed over the kinds.
 double limitViolation(const StrokeFigures& f, const StrokeLimits& lim);
+
+// The limits a stroke uses up: every joint limit whose figure is within `share` of it (torque and
+// speed: figure >= (1 - share) limit; angles: within share x range of an end), most used first,
+// as "joint 2 torque 19.99 N m (limit 20 N m)". Empty when none is.
+std::vector<std::string> bindingLimits(const StrokeFigures& f, const StrokeLimits& lim, double share = 1e-3);
+// The joint whose torque is the largest share of its limit (of the largest torque without a torque
+// limit), 0-based; -1 without joints.
+int mostLoadedJoint(const StrokeFigures& f, const StrokeLimits& lim);
 
 // The objective's value for a signed phi_net [rad] (the optimiser maximises |phi_net| / divisor).
 double objectiveValue(StrokeObjective o, double phi_net_rad, const StrokeFigures& f);

@@ -164,6 +164,7 @@ class SpaceSearch {
         s.restart_growth < 1 || s.refine_generations < 0 || s.local_restarts < 0 || !(s.local_step > 0.0) ||
         s.directions_kept < 0)
       throw std::invalid_argument("optimizer settings out of range");
+    if (s.max_runs > 0) budget_ = s.max_runs - (s.polish != "none" ? s.polish_evaluations : 0);
     // The start: the base experiment's own trajectory (e.g. Eq. 25), in every island's population.
     x0_ = prob.space.pointOf(prob.base.joints);
     res_.start = evaluateStroke(prob, prob.base.trajectory());
@@ -187,6 +188,7 @@ class SpaceSearch {
     long pop_size = s_.population;
     for (int r = 0; r < first; ++r) pop_size *= s_.restart_growth;
     for (int r = first; r < last; ++r, pop_size *= s_.restart_growth) {
+      if (!room(s_.islands * pop_size)) break;  // the budget cannot hold its first population
       pagmo::archipelago archi;
       for (int i = 0; i < s_.islands; ++i) {
         const unsigned seed = subSeed(i, r);
@@ -194,7 +196,7 @@ class SpaceSearch {
         if (r == 0) pop.set_x(0, x0_);
         archi.push_back(pagmo::thread_island{}, makeAlgorithm(s_, seed + 1u), std::move(pop));
       }
-      evolve(archi, s_.generations, "global");
+      evolve(archi, s_.generations, "global", s_.islands * pop_size);
       // Refine: CMA-ES continues on each island's population, centred on its best point with a
       // small step (5 % of the box): the global search (e.g. DE, which explores widely but
       // converges slowly) finds the basin, CMA-ES converges in it.
@@ -202,7 +204,7 @@ class SpaceSearch {
         for (int i = 0; i < s_.islands; ++i)
           archi[static_cast<pagmo::archipelago::size_type>(i)].set_algorithm(
               pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, 0.05, 1e-9, 1e-9, true, true, subSeed(i, r) + 2u)));
-        evolve(archi, s_.refine_generations, "refine");
+        evolve(archi, s_.refine_generations, "refine", s_.islands * pop_size);
       }
     }
     endStage();
@@ -217,6 +219,7 @@ class SpaceSearch {
   void localStageAndPolish() {
     stage_start_ = Clock::now();
     for (int k = 0; k < s_.local_restarts; ++k) {
+      if (!room(static_cast<long>(s_.islands) * s_.population)) break;
       std::vector<double> centre;
       {
         std::lock_guard<std::mutex> lock(tracker_->mu);
@@ -231,7 +234,7 @@ class SpaceSearch {
                         pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, s_.local_step, 1e-9, 1e-9, true, true, seed + 1u)),
                         std::move(pop));
       }
-      evolve(archi, s_.generations, "local");
+      evolve(archi, s_.generations, "local", static_cast<long>(s_.islands) * s_.population);
     }
     if (s_.polish != "none" && s_.polish_evaluations > 0 && tracker_->have_best) polish();
     endStage();
@@ -259,8 +262,17 @@ class SpaceSearch {
                                  static_cast<unsigned>(restart) * 104729u);
   }
 
-  void evolve(pagmo::archipelago& archi, int generations, const char* stage) {
+  // True when `runs` more keep the search within its budget (OptimizerSettings::max_runs).
+  bool room(long runs) const {
+    std::lock_guard<std::mutex> lock(tracker_->mu);
+    return tracker_->evaluations + runs <= budget_;
+  }
+
+  // `generations` generations of every island, each of at most `runs_per_generation` runs; stops
+  // before a generation the budget cannot hold.
+  void evolve(pagmo::archipelago& archi, int generations, const char* stage, long runs_per_generation) {
     for (int g = 1; g <= generations; ++g) {
+      if (!room(runs_per_generation)) break;
       archi.evolve(1);
       archi.wait_check();
       ++gen_count_;
@@ -288,7 +300,13 @@ class SpaceSearch {
     nlopt::opt opt(s_.polish == "cobyla" ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, d);
     opt.set_lower_bounds(std::vector<double>(d, 0.0));
     opt.set_upper_bounds(std::vector<double>(d, 1.0));
-    opt.set_maxeval(s_.polish_evaluations);
+    long evals = s_.polish_evaluations;
+    if (s_.max_runs > 0) {
+      std::lock_guard<std::mutex> lock(tracker_->mu);
+      evals = std::min(evals, s_.max_runs - tracker_->evaluations);
+    }
+    if (evals <= 0) return;
+    opt.set_maxeval(static_cast<int>(evals));
     opt.set_xtol_rel(1e-7);
     opt.set_initial_step(0.02);
     struct Ctx {
@@ -346,6 +364,7 @@ class SpaceSearch {
   OptimizeResult res_;
   int gen_count_ = 0;
   double wall_s_ = 0.0;
+  long budget_ = std::numeric_limits<long>::max();  // runs before the polish (max_runs less the polish's share)
   Clock::time_point stage_start_ = Clock::now();  // wall time counts the stages only (not the waits between)
 };
 

@@ -28,6 +28,11 @@ struct OptimizerSettings {
   int directions_kept = 0;          // enumerate: local restarts and polish only in the K best patterns (0: all)
   std::string polish = "cobyla";    // "cobyla" | "bobyqa" | "none" (NLopt)
   int polish_evaluations = 200;
+  // At most this many model runs per search (0: no cap): a generation, a restart or a local restart
+  // that would take the runs so far over max_runs - polish_evaluations is not started, and the
+  // polish gets what is left (at most polish_evaluations). The stages keep their order, so a search
+  // whose first restart uses the whole budget is exactly the single-start search of that size.
+  long max_runs = 0;
   std::uint64_t seed = 1;
 };
 

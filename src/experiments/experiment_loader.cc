@@ -613,7 +613,7 @@ struct RobotFile {
   std::string file;  // absolute path
   RobotParams base;  // tail empty
   Origins origin;    // quadruped.*, friction.*, gravity_mps2
-  std::map<int, TailLink> tails;
+  std::map<int, std::vector<TailLink>> tails;  // tails.n: its n links (the same link, but for per-joint actuator keys)
   std::map<int, Origins> tail_origin;  // keys "tail link 1 <field>"
 };
 
@@ -817,13 +817,34 @@ std::unique_ptr<RobotFile> readRobotFile(const std::string& abs) {
   for (const auto& [k, item] : tails.fields) {
     const int n = std::stoi(k);
     Origins o;
+    // The actuator keys may give one value per joint (a list of n); the link itself is one for all.
+    // A list stands in the node as its first value while the link is read, then sets each joint's.
+    constexpr std::pair<const char*, double> kPerJoint[] = {
+        {"torque_max_Nm", 1.0}, {"thetadot_max_dps", M_PI / 180.0}, {"theta_min_deg", M_PI / 180.0}, {"theta_max_deg", M_PI / 180.0}};
+    std::vector<std::pair<int, std::vector<Item>>> lists;  // (index in kPerJoint, the n values)
+    if (item.node.IsMap())
+      for (int q = 0; q < 4; ++q)
+        if (const YAML::Node v = item.node[kPerJoint[q].first]; v && v.IsSequence()) {
+          const Item list{v, joinKey(item.key, kPerJoint[q].first), v.Mark()};
+          lists.emplace_back(q, r.perJoint(list, n));
+          YAML::Node target = item.node;
+          target[kPerJoint[q].first] = v[0];
+        }
     const TailLink link = readLink(r, item, 1, o);
+    std::vector<TailLink> links(static_cast<std::size_t>(n), link);
+    for (const auto& [q, values] : lists)
+      for (int i = 0; i < n; ++i) {
+        const double x = r.number(values[static_cast<std::size_t>(i)]) * kPerJoint[q].second;
+        TailLink& l = links[static_cast<std::size_t>(i)];
+        (q == 0 ? l.torque_max_Nm : q == 1 ? l.thetadot_max_radps : q == 2 ? l.theta_min_rad : l.theta_max_rad) = x;
+        if (q < 2 && x < 0.0) r.fail(values[static_cast<std::size_t>(i)], "must be >= 0, got " + formatG(x / kPerJoint[q].second));
+      }
     RobotParams check = rf->base;
-    check.tail = {link};
+    check.tail = links;
     Origins all = rf->origin;
     all.insert(o.begin(), o.end());
     validateRobot(check, all, r.loc(item));
-    rf->tails[n] = link;
+    rf->tails[n] = std::move(links);
     rf->tail_origin[n] = std::move(o);
   }
   return rf;
@@ -1225,7 +1246,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
       const int n = r.integer(*links, 1, 6);
       const auto f = rf.tails.find(n);
       if (f == rf.tails.end()) r.fail(*links, "robot file " + rf.file + " has no tails." + std::to_string(n));
-      c.robot.tail.assign(static_cast<std::size_t>(n), f->second);  // n identical links (Table 2)
+      c.robot.tail = f->second;  // n identical links (Table 2), but for per-joint actuator keys
       for (int i = 1; i <= n; ++i)
         for (const auto& [k, loc] : rf.tail_origin.at(n))  // keys "tail link 1 <field>"
           origin["tail link " + std::to_string(i) + k.substr(std::string("tail link 1").size())] = loc;
@@ -1237,7 +1258,7 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   } else {  // default: tail: {links: 1}
     const auto f = rf.tails.find(1);
     if (f == rf.tails.end()) tailsim::fail(r.locAt(root, "tail"), "missing, and robot file " + rf.file + " has no tails.1");
-    c.robot.tail = {f->second};
+    c.robot.tail = f->second;
     origin.insert(rf.tail_origin.at(1).begin(), rf.tail_origin.at(1).end());
   }
   if (const Item* q = top.get("quadruped")) readQuadruped(r, *q, false, c.robot.quadruped, origin);
@@ -1526,7 +1547,9 @@ RobotFileData loadRobotFile(const std::string& name_or_path) {
   std::error_code ec;
   if (!fs::is_regular_file(abs, ec)) throw ConfigError(abs + ": robot file not found");
   const std::unique_ptr<RobotFile> rf = readRobotFile(abs);
-  return RobotFileData{rf->file, rf->base, rf->tails};
+  RobotFileData d{rf->file, rf->base, {}};
+  for (const auto& [n, links] : rf->tails) d.tails[n] = links.front();  // per-joint actuator keys: joint 1's
+  return d;
 }
 
 std::vector<Experiment> loadExperimentSuite(const std::string& path) {

@@ -39,7 +39,8 @@ Experiment loadExperimentText(const std::string& text, const std::string& label)
 struct RobotFileData {
   std::string file;               // absolute path of the file read
   RobotParams base;               // quadruped, friction, gravity; tail empty
-  std::map<int, TailLink> tails;  // tails.<n>: the link of an n-link tail (all n links alike)
+  std::map<int, TailLink> tails;  // tails.<n>: the link of an n-link tail (all n links alike; per-joint
+                                  // actuator keys: joint 1's values)
 };
 RobotFileData loadRobotFile(const std::string& name_or_path);
 

@@ -191,9 +191,13 @@ json designFile(const std::string& kind, json section_schema) {
 
 // The optimize section as src/design/optimize_config.cc reads it (docs/design-a-tail-stroke.md).
 json optimizeSection() {
-  json lim = section({{"theta_deg", interval(-360, 360)},
-                      {"thetadot_max_dps", numberIn(1, 36000)},
-                      {"torque_max_Nm", {{"anyOf", json::array({{{"type", "number"}, {"exclusiveMinimum", 0}},
+  // A joint limit: one value for every joint, or a list of one per joint.
+  auto perJoint = [](json one) {
+    return json{{"anyOf", json::array({one, {{"type", "array"}, {"minItems", 1}, {"items", one}}})}};
+  };
+  json lim = section({{"theta_deg", perJoint(interval(-360, 360))},
+                      {"thetadot_max_dps", perJoint(numberIn(1, 36000))},
+                      {"torque_max_Nm", {{"anyOf", json::array({perJoint({{"type", "number"}, {"exclusiveMinimum", 0}}),
                                                                 {{"enum", json::array({"base", "none"})}}})}}},
                       {"end", oneOfNames({"rest", "start"})},
                       {"dT_s", interval(0.01, 10)},
@@ -221,6 +225,7 @@ json optimizeSection() {
                   {"directions_kept", integerIn(0, 1 << kMaxKeptDirectionsLog2)},
                   {"polish", oneOfNames({"cobyla", "bobyqa", "none"})},
                   {"polish_evaluations", integerIn(0, kMaxPolishEvaluations)},
+                  {"max_runs", integerIn(0, static_cast<int>(kMaxOptimizeRuns))},
                   {"seeds", {{"type", "array"}, {"minItems", 1}, {"maxItems", kMaxOptimizeSeeds}, {"uniqueItems", true},
                              {"items", integerIn(0, 1000000000)}}},
                   {"pareto_points", {{"allOf", json::array({integerIn(0, kMaxParetoPoints), {{"not", {{"const", 1}}}}})}}},
@@ -310,7 +315,11 @@ json experimentSchema() {
 
 json robotSchema() {
   // Robot files hold no sweeps: the plain declared types.
-  json link = section(plain(describe<TailLink>().props), {"mass_kg", "izz_kgm2", "length_m"});
+  json props = plain(describe<TailLink>().props);
+  for (const char* k : {"torque_max_Nm", "thetadot_max_dps", "theta_min_deg", "theta_max_deg"})  // or one per joint
+    if (props.contains(k))
+      props[k] = json{{"anyOf", json::array({props[k], {{"type", "array"}, {"minItems", 1}, {"items", props[k]}}})}};
+  json link = section(props, {"mass_kg", "izz_kgm2", "length_m"});
   json tails = {{"type", "object"}, {"additionalProperties", false}, {"minProperties", 1}, {"properties", json::object()}};
   for (int n = 1; n <= 6; ++n) tails["properties"][std::to_string(n)] = link;
   return {{"$schema", "https://json-schema.org/draft/2020-12/schema"},

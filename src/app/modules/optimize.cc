@@ -61,9 +61,19 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
       return std::string(v);
     };
     char tau_lim[32] = "none";
-    if (L.torque_max_Nm > 0) std::snprintf(tau_lim, sizeof tau_lim, "%.4g N m", L.torque_max_Nm);
+    if (!L.joints.empty()) std::snprintf(tau_lim, sizeof tau_lim, "per joint");
+    else if (L.torque_max_Nm > 0) std::snprintf(tau_lim, sizeof tau_lim, "%.4g N m", L.torque_max_Nm);
+    char speed_lim[32];
+    if (!L.joints.empty()) std::snprintf(speed_lim, sizeof speed_lim, "per joint");
+    else std::snprintf(speed_lim, sizeof speed_lim, "%.4g", L.thetadot_max_radps * 180 / M_PI);
+    // The limits the optimum uses up, joint by joint (the constraint that binds).
+    const std::vector<std::string> binding = bindingLimits(r.limits_analytic.figures, L);
+    std::string binds;
+    for (std::size_t k = 0; k < binding.size() && k < 3; ++k) binds += (k ? ", " : "") + binding[k];
+    if (binding.size() > 3) binds += ", ...";
+    if (binds.empty()) binds = "none";
     std::printf("%s: %s, best %s %+.6g %s (phi_net %+.4f deg, %s search%s); re-runs: analytic %s, per-foot %s, "
-                "MuJoCo %s; peak joint torque %.4g N m (limit %s), peak joint speed %.4g deg/s (limit %.4g); limits %s; "
+                "MuJoCo %s; peak joint torque %.4g N m (limit %s), peak joint speed %.4g deg/s (limit %s); limits %s (binding: %s); "
                 "%zu seeds, spread %.3g %%; %ld runs, %.2f s wall\n",
                 spec.name.c_str(), familyName(spec.problem.space.family), objectiveName(spec.problem.objective),
                 signedObjectiveDeg(b.objective, b.phi_net_rad), objectiveUnit(spec.problem.objective),
@@ -71,8 +81,9 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
                 r.rerank.empty() ? "" : (", MuJoCo re-rank of " + std::to_string(r.rerank.size()) + " candidates").c_str(),
                 deg(r.analytic, true).c_str(), deg(r.perfoot, true).c_str(),
                 deg(r.mujoco, spec.mujoco_check).c_str(), r.limits_analytic.figures.peak_torque_Nm, tau_lim,
-                r.limits_analytic.figures.peak_speed_radps * 180 / M_PI, L.thetadot_max_radps * 180 / M_PI,
+                r.limits_analytic.figures.peak_speed_radps * 180 / M_PI, speed_lim,
                 r.infeasible.infeasible ? "kept, but the turn is below min_turn_deg" : r.limits_analytic.ok ? "kept" : "VIOLATED",
+                binds.c_str(),
                 r.per_seed.size(), 100.0 * r.spread, r.evaluations, r.wall_s);
     for (const std::string& f : r.files) std::printf("%s/%s\n", out_dir, f.c_str());
     std::fflush(stdout);
