@@ -200,6 +200,15 @@ TEST(RobotModelExperiment, ErrorsNameFileLineAndKey) {
   m = run("{mjcf: box.xml, feet: [f1, f2, f3, toe]}");
   expectAt(m, f, 2, "robot.feet");
   EXPECT_NE(m.find("no geom named 'toe'"), std::string::npos) << m;
+  // Commands whose MuJoCo run is the rigid box or changes its settings refuse it (trust, accuracy, mjcf).
+  t.write("e.yaml", experiment("{mjcf: box.xml}"));
+  try {
+    refuseRobotModels(loadExperimentSuite(f), "trust");
+    ADD_FAILURE() << "tailsim trust took a robot from its model file";
+  } catch (const ConfigError& e) {
+    expectAt(e.what(), f, 2, "robot.mjcf");
+    EXPECT_NE(std::string(e.what()).find("`tailsim trust` does not take a robot from its model file"), std::string::npos);
+  }
   // A tail base in front of the COM.
   m = run("{mjcf: box.xml}", "{mount: {pos_m: [0.25, 0, 0]}, links: 1}");
   expectAt(m, f, 3, "tail.mount.pos_m");

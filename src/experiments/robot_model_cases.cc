@@ -79,6 +79,15 @@ void resolveRobotModels(std::vector<Experiment>& suite) {
   for (Experiment& e : suite) resolveRobotModels(e);
 }
 
+void refuseRobotModels(const std::vector<Experiment>& suite, const std::string& command) {
+  for (const Experiment& e : suite)
+    for (const ExperimentCase& c : e.cases)
+      if (c.robot_model)
+        throw ConfigError(where(c, "robot.mjcf") + "`tailsim " + command +
+                          "` does not take a robot from its model file (its MuJoCo run is the articulated robot, on "
+                          "the model's own settings): run the experiment with `tailsim run`");
+}
+
 std::string articulatedMjcf(const ExperimentCase& c) {
   if (!c.robot_derived) throw std::invalid_argument("articulatedMjcf: the robot was not derived");
   MujocoSettings s = c.mujoco;

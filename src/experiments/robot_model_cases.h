@@ -19,6 +19,10 @@ namespace tailsim {
 void resolveRobotModels(std::vector<Experiment>& suite);
 void resolveRobotModels(Experiment& e);
 
+// Commands that change the MuJoCo settings or need the rigid box (trust, accuracy, mjcf) refuse a
+// robot from its model file: ConfigError at its robot.mjcf, naming the command.
+void refuseRobotModels(const std::vector<Experiment>& suite, const std::string& command);
+
 // The MJCF the articulated run simulates (the robot with the tail attached), for the result folder.
 std::string articulatedMjcf(const ExperimentCase& c);
 
