@@ -50,7 +50,8 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
 
   c.articulated = runArticulated(c.robot, spec.mount, c.tail, k.trajectory(), k.mujoco, choice.stand_s,
                                  choice.settle_after_s);
-  ModelRow art{"mujoco (articulated)", c.articulated.ok, c.articulated.phi_net_deg, c.articulated.warnings};
+  ModelRow art{c.robot.legs_locked ? "mujoco (articulated, legs locked)" : "mujoco (articulated)", c.articulated.ok,
+               c.articulated.phi_net_deg, c.articulated.warnings};
   if (!c.articulated.ok) art.warnings.insert(art.warnings.begin(), c.articulated.error);
   const ArticulatedRun& a = c.articulated;
   art.warnings.push_back("tilt (absolute / from the stance): stance " + f3(a.stance_tilt_deg) + " deg; after standing " +
