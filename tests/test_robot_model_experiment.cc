@@ -20,21 +20,14 @@
 #include "experiments/robot_compare.h"
 #include "experiments/robot_model_cases.h"
 #include "models/mujoco/robot_import.h"
+#include "menagerie_models.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path menagerieDir() {
-  for (fs::path p = fs::absolute(TAILSIM_SOURCE_DIR); !p.empty(); p = p.parent_path()) {
-    const fs::path m = p.parent_path() / "shared" / "robots" / "menagerie";
-    std::error_code ec;
-    if (fs::is_directory(m, ec)) return m;
-    if (p == p.parent_path()) break;
-  }
-  return {};
-}
+using tailsim_test::menagerieDir;
 
 struct Scratch {
   fs::path dir;
