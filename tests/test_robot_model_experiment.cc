@@ -270,7 +270,7 @@ TEST(RobotModelExperiment, Go1ExperimentRunsTheThreeModelsArticulated) {
   EXPECT_EQ(again.front().cases.front().robot.quadruped.d_Q2B_m, cmp.robot.quadruped.d_Q2B_m);
 }
 
-// Standing 2 s with the tail (issue 34 item 4): the tilt from the settled stance is what the tail
+// Standing 2 s with the tail: the tilt from the settled stance is what the tail
 // causes. On their own kp-100 servos Go1 and ANYmal C tilt 1 deg or more (a warning says so);
 // with `legs: locked` (joint equalities at the stood angles) both stay below 1 deg.
 TEST(RobotModelExperiment, StandingTiltWithTheTailOnServosAndLockedLegs) {
