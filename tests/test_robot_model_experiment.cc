@@ -129,6 +129,11 @@ TEST(RobotModelExperiment, LoaderReadsTheKeysAndDerivesNothing) {
   EXPECT_NEAR(d.robot.tail[0].mass_kg, 0.5, 1e-12);
   EXPECT_NEAR(d.robot.tail[0].length_m, 0.5 * d.robot.quadruped.l_F_m, 1e-12);
   EXPECT_EQ(d.mujoco.body_height_m, d.robot.quadruped.com_height_m);
+  // `tailsim robot EXP.yaml`: the derived robot and the tail of the first case.
+  const std::string shown = describeYamlRobot(f);
+  EXPECT_NE(shown.find("quadruped.mass_kg       10 "), std::string::npos) << shown;
+  EXPECT_NE(shown.find("friction.mu_s = mu_d    0.4 "), std::string::npos) << shown;
+  EXPECT_NE(shown.find("link 2: mass_kg 0.5,"), std::string::npos) << shown;
 }
 
 // Each error: a ConfigError naming the experiment file, the line and the key, before any case runs.
