@@ -13,6 +13,7 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/robot_compare.h"
 #include "models/mujoco/robot_import.h"
+#include "menagerie_models.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;
@@ -21,16 +22,7 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// shared/robots/menagerie beside the source dir or beside one of its ancestors ("" if absent).
-fs::path menagerieDir() {
-  for (fs::path p = fs::absolute(TAILSIM_SOURCE_DIR); !p.empty(); p = p.parent_path()) {
-    const fs::path m = p.parent_path() / "shared" / "robots" / "menagerie";
-    std::error_code ec;
-    if (fs::is_directory(m, ec)) return m;
-    if (p == p.parent_path()) break;
-  }
-  return {};
-}
+using tailsim_test::menagerieDir;
 
 #define REQUIRE_MENAGERIE(dir)                                                                            \
   const fs::path dir = menagerieDir();                                                                    \

@@ -6,6 +6,7 @@
 #include "app/commands.h"
 #include "experiments/accuracy_study.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/robot_model_cases.h"
 #include "plotting/accuracy_plot.h"
 
 namespace tailsim {
@@ -28,6 +29,7 @@ void addAccuracyCommand(CLI::App& app, int& exit_code) {
   accuracy->add_flag("--no-mujoco", a->no_mujoco, "analytic model only");
   accuracy->callback([a, &exit_code] {
     const Experiment e = loadExperiment(a->exp_path);
+    refuseRobotModels({e}, "accuracy");
     std::filesystem::create_directories(a->out);
     checkAccuracyTables(a->out);
     AccuracyOptions ao;

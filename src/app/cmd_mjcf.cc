@@ -8,6 +8,7 @@
 #include "app/commands.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "experiments/robot_model_cases.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "results/atomic_file.h"
 #include "results/number_text.h"
@@ -70,6 +71,7 @@ void refuseLargeMenagerie(const std::string& exp_path, const std::vector<Experim
 int writeExperimentMjcf(const std::string& exp_path, const std::string& only_case, const std::string& out,
                         const std::string& menagerie_dir) {
   const std::vector<Experiment> suite = loadExperimentSuite(exp_path);  // all errors before any work
+  refuseRobotModels(suite, "mjcf");
   requireCase(suite, exp_path, only_case);
   const std::vector<SuiteModel> models = distinctModels(suite, only_case);
   if (!out.empty()) {

@@ -21,6 +21,7 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
     double mount_yaw_deg = 0.0, mu = -1.0, settle_s = 1.0;
     bool compare = false;
     std::string write_robot;
+    std::string legs = "servos";
     RobotTailChoice tail;
   };
   auto o = std::make_shared<Options>();
@@ -40,6 +41,10 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
       ->expected(3);
   cmd->add_option("--mount-yaw-deg", o->mount_yaw_deg, "forward = the mount body's x turned by this about z [deg]");
   cmd->add_option("--mu", o->mu, "foot friction (default: from the foot contacts)");
+  cmd->add_option("--legs", o->legs,
+                  "--compare: the articulated robot's legs: servos (the model's actuators) or locked (joint equalities)")
+      ->check(CLI::IsMember({"servos", "locked"}))
+      ->capture_default_str();
   cmd->add_option("--settle-s", o->settle_s, "standing time before measuring [s]")->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--compare", o->compare,
                 "also run the four models with a tail: MuJoCo articulated, MuJoCo rigid box, perfoot, analytic");
@@ -76,6 +81,7 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
       spec.feet = o->feet;
       spec.mu = o->mu;
       spec.settle_s = o->settle_s;
+      spec.legs = o->legs;
       spec.mount.body = o->mount_body;
       if (o->mount_pos.size() == 3) spec.mount.pos_m = {o->mount_pos[0], o->mount_pos[1], o->mount_pos[2]};
       spec.mount.yaw_rad = o->mount_yaw_deg * M_PI / 180.0;

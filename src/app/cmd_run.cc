@@ -15,6 +15,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
 #include "experiments/sharding.h"
+#include "experiments/robot_model_cases.h"
 #include "plotting/report.h"
 #include "plotting/result_folder.h"
 #include "plotting/result_page.h"
@@ -165,6 +166,7 @@ int runCommand(const RunArgs& a) {
     }
   }
   std::vector<Experiment> suite = loadExperimentSuite(a.exp_path);  // all errors before any work
+  resolveRobotModels(suite);  // robots from their model files, before any case runs
   selectModels(suite, a.only_models, a.exp_path);
   RunOptions o;
   o.out_dir = a.out_dir;

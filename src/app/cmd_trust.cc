@@ -8,6 +8,7 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/trust_study.h"
+#include "experiments/robot_model_cases.h"
 #include "plotting/trust_report.h"
 
 namespace tailsim {
@@ -30,6 +31,7 @@ void addTrustCommand(CLI::App& app, int& exit_code) {
   cmd->callback([o, &exit_code] {
     try {
       const Experiment e = loadExperiment(o->experiment);  // every error before any work
+      refuseRobotModels({e}, "trust");
       TrustOptions opt;
       opt.only_case = o->only_case;
       requireCase({e}, o->experiment, o->only_case);  // before the folder is made

@@ -3,9 +3,12 @@
 #pragma once
 
 #include <map>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "robot/robot_model_spec.h"
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 #include "robot/scene_effects.h"
@@ -16,6 +19,8 @@
 #include "results/output_settings.h"
 
 namespace tailsim {
+
+struct DerivedRobot;  // models/mujoco/robot_import.h
 
 
 enum class CaseKind {
@@ -39,7 +44,16 @@ struct ExperimentCase {
   std::string experiment;   // experiment name
   std::string name;         // case name: "base" or "key=value,key=value" for sweeps
   std::string source_file;  // the YAML file it came from
-  std::string robot_file;   // the robot file it names (absolute)
+  std::string robot_file;   // the robot file it names (absolute); robot: {mjcf: ...}: the model file
+  // robot: {mjcf: PATH, ...}: the robot from its MuJoCo model file. The loader reads the spec (and
+  // where each key was written, "file:line:col" by dotted key); robot, quadruped, friction, gravity
+  // and a `tail: {links: n}` tail are then derived by resolveRobotModels (experiments/robot_model_cases.h)
+  // before any case runs, which sets robot_derived (the stood robot, shared by the cases of one
+  // experiment: the MuJoCo model runs it articulated).
+  std::optional<RobotModelSpec> robot_model;
+  int robot_model_links = 0;  // tail: {links: n} of a model-file robot (0: tail: {custom: [...]})
+  std::map<std::string, std::string> robot_model_at;
+  std::shared_ptr<const DerivedRobot> robot_derived;
   std::map<std::string, std::string> sweep_values;  // swept key -> value as written
 
   CaseKind kind = CaseKind::kSimulate;

@@ -84,13 +84,16 @@ struct Loc {
   std::string key;  // dotted key
 };
 
-[[noreturn]] void fail(const Loc& at, const std::string& what) {
+// "file:line:col: key: " of a Loc, as every message starts.
+std::string locText(const Loc& at) {
   std::string s = at.file ? *at.file : std::string("<unknown file>");
   if (!at.mark.is_null()) s += ":" + std::to_string(at.mark.line + 1) + ":" + std::to_string(at.mark.column + 1);
   s += ": ";
   if (!at.key.empty()) s += clip(at.key, 200) + ": ";
-  throw ConfigError(s + clip(what, 2000));
+  return s;
 }
+
+[[noreturn]] void fail(const Loc& at, const std::string& what) { throw ConfigError(locText(at) + clip(what, 2000)); }
 
 // Re-throws a std::invalid_argument from tailsim::validate() / SplitCycleProfile as a
 // ConfigError at the value its message names: the longest key in `at` that prefixes the message.
@@ -1206,6 +1209,85 @@ void requireContinuousThresholds(const Reader& r, const MapView& top, const Expe
   }
 }
 
+// robot: {mjcf: PATH, mu, stance: {keyframe, joints_deg: {NAME: deg}}, feet: [geom, ...]}: the
+// model file is checked here (a regular file, within kMaxModelFileBytes; its path UTF-8 without
+// control characters); loading it and standing the robot need MuJoCo and happen later, once per
+// experiment (resolveRobotModels), each of its errors then named at the key recorded here.
+void readRobotModel(const Reader& r, const Item& item, const std::string& source, ExperimentCase& c) {
+  static const std::vector<std::string> kKeys = [] {
+    std::vector<std::string> k = declaredKeys<RobotModelSpec>();
+    k.insert(k.end(), {"stance", "feet"});
+    return k;
+  }();
+  c.robot_model.emplace();
+  RobotModelSpec& spec = *c.robot_model;
+  auto at = [&](const std::string& key, const Item& it) { c.robot_model_at[key] = locText(r.loc(it)); };
+  if (isSweepMap(item.node)) r.fail(item, "a sweep can replace a single value only, not a section or list");
+  const MapView m = r.map(item, kKeys);
+  const Item& file = r.need(m, "mjcf");
+  const std::string rel = r.string(file);
+  if (rel.empty()) r.fail(file, "needs the path of the robot's MJCF or URDF file");
+  if (rel.size() > 4096) r.fail(file, "a path of more than 4096 bytes");
+  if (std::any_of(rel.begin(), rel.end(), [](char ch) { return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f; }))
+    r.fail(file, "the path holds a control character (a line break, a tab, a NUL byte ...)");
+  if (invalidUtf8At(rel) != std::string::npos) r.fail(file, "the path is not UTF-8");
+  spec.file = resolveRelative(source, rel);
+  {
+    struct stat st {};
+    if (::stat(spec.file.c_str(), &st) != 0)
+      r.fail(file, "model file not found: " + spec.file + " (" + std::strerror(errno) + ")");
+    if (!S_ISREG(st.st_mode))
+      r.fail(file, spec.file + " is not a regular file (a folder, a device or a FIFO): expected an MJCF or URDF file");
+    if (static_cast<unsigned long long>(st.st_size) > kMaxModelFileBytes)
+      r.fail(file, spec.file + " is larger than " + std::to_string(kMaxModelFileBytes >> 20) +
+                       " MiB; an MJCF or URDF file is text of at most a few MB (its meshes are files of their own)");
+  }
+  c.robot_file = spec.file;
+  at("robot.mjcf", file);
+  at("robot", item);
+  if (const Item* mu = m.get("mu")) {
+    spec.mu = r.nonNegative(*mu);
+    at("robot.mu", *mu);
+  }
+  if (const Item* legs = m.get("legs")) {
+    spec.legs = r.choice(*legs, {"servos", "locked"});
+    at("robot.legs", *legs);
+  }
+  if (const Item* st = m.get("stance")) {
+    at("robot.stance", *st);
+    const MapView sm = r.map(*st, {"keyframe", "joints_deg"});
+    if (const Item* k = sm.get("keyframe")) {
+      spec.keyframe = r.string(*k);
+      if (spec.keyframe.empty()) r.fail(*k, "must not be empty (absent: the model's `home` keyframe)");
+    }
+    if (const Item* j = sm.get("joints_deg")) {
+      if (r.pick(*j) || !j->node.IsMap()) r.fail(*j, "expected a map of joint name: angle [deg]");
+      for (const auto& kv : j->node) {
+        if (!kv.first.IsScalar()) tailsim::fail(Loc{r.file(), kv.first.Mark(), j->key}, "keys must be joint names");
+        const std::string name = kv.first.Scalar();
+        if (name.empty()) tailsim::fail(Loc{r.file(), kv.first.Mark(), j->key}, "a joint name must not be empty");
+        const Item v{kv.second, joinKey(j->key, name), kv.second.Mark().is_null() ? kv.first.Mark() : kv.second.Mark()};
+        if (spec.joint_angles_rad.count(name)) r.fail(v, "duplicate joint");
+        spec.joint_angles_rad[name] = boundedDeg(r, v, 360.0) * units::kRadPerDeg;
+      }
+      if (spec.joint_angles_rad.empty()) r.fail(*j, "needs at least one joint (or leave joints_deg out)");
+    }
+  }
+  if (const Item* f = m.get("feet")) {
+    at("robot.feet", *f);
+    const std::vector<Item> v = r.list(*f);
+    if (v.size() == 3)
+      r.fail(*f, "names 3 feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet: name 4 feet");
+    if (v.size() != 4) r.fail(*f, "needs the 4 foot geoms' names, got " + std::to_string(v.size()));
+    for (const Item& x : v) {
+      const std::string g = r.string(x);
+      if (g.empty()) r.fail(x, "a geom name must not be empty");
+      if (std::find(spec.feet.begin(), spec.feet.end(), g) != spec.feet.end()) r.fail(x, "'" + clip(g) + "' is listed twice");
+      spec.feet.push_back(g);
+    }
+  }
+}
+
 // Pass 2: one case, with the sweeps resolved by `r`.
 ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
   const Item root = r.root(doc);
@@ -1224,25 +1306,51 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   if (const std::string why = experimentNameProblem(c.experiment); !why.empty()) r.fail(name, why);
   if (const Item* d = top.get("description")) r.string(*d);
 
-  // Robot file, then the experiment's overrides.
+  // Robot file, then the experiment's overrides; or a robot from its MuJoCo model file.
   const Item& robotItem = r.need(top, "robot");
-  const std::string robotRel = r.string(robotItem);
-  if (robotRel.empty()) r.fail(robotItem, "needs a built-in robot name (paper) or the path of a robot file");
-  c.robot_file = isBuiltinRobotName(robotRel) ? builtinRobotFile(robotRel, r.loc(robotItem))
-                                              : resolveRelative(source, robotRel);
-  const RobotFile& rf = L.robot(c.robot_file, r.loc(robotItem));
+  const bool modelRobot = !r.pick(robotItem) && robotItem.node.IsMap();
+  static const RobotFile kNoRobotFile{};
+  const RobotFile* rfp = &kNoRobotFile;
+  if (modelRobot) {
+    readRobotModel(r, robotItem, source, c);
+    for (const char* k : {"quadruped", "friction", "gravity_mps2"})
+      if (const Item* x = top.get(k))
+        r.fail(*x, "not used with robot: {mjcf: ...}: derived from the model file (robot.mu sets the friction)");
+  } else {
+    const std::string robotRel = r.string(robotItem);
+    if (robotRel.empty()) r.fail(robotItem, "needs a built-in robot name (paper) or the path of a robot file");
+    c.robot_file = isBuiltinRobotName(robotRel) ? builtinRobotFile(robotRel, r.loc(robotItem))
+                                                : resolveRelative(source, robotRel);
+    rfp = &L.robot(c.robot_file, r.loc(robotItem));
+  }
+  const RobotFile& rf = *rfp;
   c.robot = rf.base;
   Origins origin = rf.origin;
 
   if (const Item* k = top.get("kind")) c.kind = r.choice(*k, kindNames());
 
   if (const Item* t = top.get("tail")) {
-    const MapView tm = r.map(*t, {"links", "custom"});
+    const MapView tm = r.map(*t, {"links", "custom", "mount"});
     const Item* links = tm.get("links");
     const Item* custom = tm.get("custom");
+    if (const Item* mount = tm.get("mount")) {
+      if (!modelRobot) r.fail(*mount, "only used with a robot from its model file (robot: {mjcf: PATH})");
+      static const std::vector<std::string> kMountKeys = declaredKeys<TailMount>();
+      const MapView mm = readDeclared(r, *mount, c.robot_model->mount);
+      for (const std::string& k : kMountKeys)
+        if (const Item* x = mm.get(k)) c.robot_model_at["tail.mount." + k] = locText(r.loc(*x));
+      if (const Item* b = mm.get("body"))
+        if (c.robot_model->mount.body.empty()) r.fail(*b, "must not be empty (absent: the root body)");
+    }
     if (!links && !custom) r.fail(*t, "give links: n (1..6) or custom: [{mass_kg, izz_kgm2, length_m}, ...]");
     if (links && custom) r.fail(*custom, "give links: n or custom: [...], not both");
-    if (links) {
+    if (links && modelRobot) {
+      // n links sharing 10 % of the robot's mass and one body length, derived with the robot.
+      const int n = r.integer(*links, 1, 6);
+      c.robot_model_links = n;
+      c.robot.tail.assign(static_cast<std::size_t>(n), TailLink{});
+      c.robot_model_at["tail.links"] = locText(r.loc(*links));
+    } else if (links) {
       const int n = r.integer(*links, 1, 6);
       const auto f = rf.tails.find(n);
       if (f == rf.tails.end()) r.fail(*links, "robot file " + rf.file + " has no tails." + std::to_string(n));
@@ -1255,6 +1363,10 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
       if (v.empty()) r.fail(*custom, "needs at least one link (n >= 1)");
       for (std::size_t i = 0; i < v.size(); ++i) c.robot.tail.push_back(readLink(r, v[i], static_cast<int>(i + 1), origin));
     }
+  } else if (modelRobot) {  // default: tail: {links: 1}, derived with the robot
+    c.robot_model_links = 1;
+    c.robot.tail.assign(1, TailLink{});
+    c.robot_model_at["tail.links"] = locText(r.locAt(root, "tail"));
   } else {  // default: tail: {links: 1}
     const auto f = rf.tails.find(1);
     if (f == rf.tails.end()) tailsim::fail(r.locAt(root, "tail"), "missing, and robot file " + rf.file + " has no tails.1");
@@ -1267,8 +1379,18 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     c.robot.gravity_mps2 = r.number(*g);
     origin["gravity_mps2"] = r.loc(*g);
   }
-  validateRobot(c.robot, origin, r.loc(root));
-  checkMasses(c.robot, origin, r.loc(root));
+  if (modelRobot) {
+    // The robot's own values come with its derivation (resolveRobotModels); a custom tail is checked now.
+    if (c.robot_model_links == 0) {
+      RobotParams check;
+      check.tail = c.robot.tail;
+      validateRobot(check, origin, r.loc(root));
+      checkMasses(check, origin, r.loc(root));
+    }
+  } else {
+    validateRobot(c.robot, origin, r.loc(root));
+    checkMasses(c.robot, origin, r.loc(root));
+  }
   const int n = c.robot.numLinks();
 
   const Item* traj = top.get("trajectory");
@@ -1328,6 +1450,11 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
       readDeclared(r, *x, v);
     }
   });
+  if (c.robot_model) {
+    if (const Item* x = top.get("render"))
+      r.fail(*x, "videos of a robot from its model file are not drawn yet: leave render: out");
+    if (c.kind != CaseKind::kSimulate) r.fail(*top.get("kind"), "a robot from its model file runs kind: simulate only");
+  }
   requireContinuousThresholds(r, top, c, origin);
   checkCaseWork(r, top, c);
   return c;

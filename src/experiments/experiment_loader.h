@@ -72,6 +72,8 @@ constexpr std::size_t kMaxSuiteCases = 10 * kMaxCases;
 // and maps counting each alias (*name) as everything it stands for, and the nesting of suites.
 // Aliases inside the node they name (cycles) are refused, and every string must be UTF-8.
 constexpr std::size_t kMaxYamlBytes = std::size_t{16} << 20;
+// The largest MJCF or URDF file `robot: {mjcf: PATH}` names (text; its meshes are files of their own).
+constexpr std::size_t kMaxModelFileBytes = std::size_t{64} << 20;
 constexpr int kMaxYamlDepth = 64;
 constexpr long kMaxYamlNodes = 100000;
 constexpr std::size_t kMaxSuiteDepth = 64;

@@ -41,6 +41,7 @@
 #include "experiments/verdict.h"
 #include "experiments/time_series_h5.h"
 #include "experiments/work_estimate.h"
+#include "experiments/robot_model_cases.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "results/atomic_file.h"
@@ -169,6 +170,9 @@ void requireCase(const std::vector<Experiment>& suite, const std::string& file, 
 
 std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {
   std::vector<RunResult> out;
+  if (c.robot_model && !c.robot_derived)  // the caller derives it first (resolveRobotModels)
+    throw std::invalid_argument("case " + c.name + ": its robot's model file " + c.robot_model->file +
+                                " was not stood and measured before the run (resolveRobotModels)");
   if (c.kind == CaseKind::kPose) {
     std::vector<JointState> js(c.robot.numLinks());
     for (size_t i = 0; i < js.size(); ++i)
@@ -675,7 +679,7 @@ void clearResultFolder(const fs::path& root) {
     }
     removeIf(root / name, own);
   }
-  std::vector<std::string> top = {"cases.jsonl", "results.csv", "experiment.yaml", "robot.yaml"};
+  std::vector<std::string> top = {"cases.jsonl", "results.csv", "experiment.yaml", "robot.yaml", "robot.xml"};
   for (const auto& f : fs::directory_iterator(root, ec))
     if (isRobotCopy(f.path().filename().string())) top.push_back(f.path().filename().string());
   top.push_back("summary.json");  // last: ownFile of the others may read it
@@ -1032,7 +1036,7 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
   if (c.kind != CaseKind::kPose && simulates_mjcf) {
     std::string xml;
     try {
-      xml = generateMjcf(c.robot, c.mujoco, c.effects);
+      xml = c.robot_model ? articulatedMjcf(c) : generateMjcf(c.robot, c.mujoco, c.effects);
     } catch (const std::exception&) {
     }
     if (!xml.empty()) {

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "models/mujoco/robot_import.h"
 #include "results/sha256.h"
 
 namespace tailsim {
@@ -68,6 +69,23 @@ std::map<std::string, std::string> folderInputs(const Experiment& e) {
   };
   // Each written robot value -> the file it resolved to (from the cases, i.e. the loader's answer).
   std::vector<std::pair<YAML::Node, std::string>> values;  // scalar node, robot file
+  if (e.cases.front().robot_model) {
+    // A robot from its model file: the model as tailsim compiles it (includes inlined, asset folders
+    // absolute, missing-file visual geoms dropped), which stands and derives the same robot.
+    const YAML::Node file = robot.IsMap() ? robot["mjcf"] : YAML::Node();
+    if (!file || !file.IsScalar()) throw cannot(robot, "robot.mjcf is not a single value");
+    const ExperimentCase& first = e.cases.front();
+    for (const ExperimentCase& c : e.cases)
+      if (!c.robot_derived || c.robot_model->file != first.robot_model->file)
+        throw cannot(file, c.robot_derived ? "cases use different model files" : "the robot was not derived");
+    const size_t at = offsetOf(text, file.Mark());
+    const size_t len = scalarLength(text, at, file.Scalar());
+    if (len == std::string::npos) throw cannot(file, "its value is not written on one line");
+    std::map<std::string, std::string> out;
+    out["robot.xml"] = first.robot_derived->model.xml;
+    out["experiment.yaml"] = std::string(text).replace(at, len, "robot.xml");
+    return out;
+  }
   if (robot.IsScalar()) {
     for (const ExperimentCase& c : e.cases)
       if (c.robot_file != e.cases.front().robot_file) throw cannot(robot, "cases use different robot files");

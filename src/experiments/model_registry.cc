@@ -1,11 +1,13 @@
 #include "experiments/model_registry.h"
 
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 
 #include "models/analytic/analytic_recorder.h"
 #include "models/analytic/analytic_simulation.h"
 #include "models/perfoot/per_foot_model.h"
+#include "models/mujoco/attach_tail.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "experiments/work_estimate.h"
 #include "results/columns.h"
@@ -43,6 +45,24 @@ OutputSettings recordedOutput(const ExperimentCase& c) {
   const double t_end = c.simDuration();  // the models' own end (planRun)
   if (t_end > o.sample_dt_s) o.sample_dt_s = t_end;
   return o;
+}
+
+// The MuJoCo model of a robot given by its model file (robot: {mjcf: ...}): the robot itself, legs
+// held by its own actuators, with the tail attached, standing kArticulatedStandS with the tail
+// before the stroke (attach_tail.h).
+constexpr double kArticulatedStandS = 2.0;
+RunResult simulateRobotModel(const ExperimentCase& c) {
+  if (!c.robot_derived)
+    throw std::invalid_argument("the robot of its model file was not derived (resolveRobotModels) before the run");
+  const TailTrajectory traj = c.trajectory();
+  const double t_end = c.simDuration();
+  const double dt = c.output.time_series == TimeSeriesOutput::kNone && !c.render.enabled ? t_end : c.output.sample_dt_s;
+  const auto t0 = std::chrono::steady_clock::now();
+  const ArticulatedRun a = runArticulated(*c.robot_derived, c.robot_model->mount, c.robot.tail, traj, c.mujoco,
+                                          kArticulatedStandS, t_end - traj.endTime(), dt);
+  RunResult r = articulatedRunResult(a, kMujocoModel);
+  r.summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
 }
 
 // The built-in models and those ModelRegistration added, in order.
@@ -92,6 +112,7 @@ std::deque<ModelEntry>& registry() {
     mujoco.long_running = true;
     mujoco.run = [](const ExperimentCase& c, RunContext* ctx) {
       try {
+        if (c.robot_model) return simulateRobotModel(c);
         return simulateMujoco(c.robot, c.trajectory(), c.mujoco, c.effects, c.output, nullptr,
                               ctx ? &ctx->mujoco_settle : nullptr);
       } catch (const std::exception& e) {

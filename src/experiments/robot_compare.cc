@@ -7,6 +7,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/model_registry.h"
+#include "experiments/robot_model_cases.h"
 #include "experiments/yaml_file.h"
 
 #include <yaml-cpp/yaml.h>
@@ -49,7 +50,8 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
 
   c.articulated = runArticulated(c.robot, spec.mount, c.tail, k.trajectory(), k.mujoco, choice.stand_s,
                                  choice.settle_after_s);
-  ModelRow art{"mujoco (articulated)", c.articulated.ok, c.articulated.phi_net_deg, c.articulated.warnings};
+  ModelRow art{c.robot.legs_locked ? "mujoco (articulated, legs locked)" : "mujoco (articulated)", c.articulated.ok,
+               c.articulated.phi_net_deg, c.articulated.warnings};
   if (!c.articulated.ok) art.warnings.insert(art.warnings.begin(), c.articulated.error);
   const ArticulatedRun& a = c.articulated;
   art.warnings.push_back("tilt (absolute / from the stance): stance " + f3(a.stance_tilt_deg) + " deg; after standing " +
@@ -107,7 +109,20 @@ std::string describeYamlRobot(const std::string& path) {
   RobotParams p;
   std::string source;
   if (doc.IsMap() && (doc["name"] || doc["experiments"])) {
-    const std::vector<Experiment> e = loadExperimentSuite(path);
+    std::vector<Experiment> e = loadExperimentSuite(path);
+    if (e.front().cases.front().robot_model) {  // a robot from its model file: derived, as `tailsim run` does
+      resolveRobotModels(e.front());
+      const ExperimentCase& c = e.front().cases.front();
+      std::string out = describeDerivedRobot(*c.robot_derived) + "\ntail (case " + c.name + "):\n";
+      for (std::size_t i = 0; i < c.robot.tail.size(); ++i) {
+        char line[160];
+        const TailLink& l = c.robot.tail[i];
+        std::snprintf(line, sizeof line, "  link %zu: mass_kg %.9g, izz_kgm2 %.9g, length_m %.9g, com_offset_m %.9g\n",
+                      i + 1, l.mass_kg, l.izz_kgm2, l.length_m, l.com_offset_m);
+        out += line;
+      }
+      return out;
+    }
     const ExperimentCase& c = e.front().cases.front();
     p = c.robot;
     source = "robot file " + c.robot_file + " with the overrides of experiment " + e.front().name + " (case " + c.name + ")";

@@ -4,6 +4,8 @@
 #include <type_traits>
 #include <stdexcept>
 
+#include "models/mujoco/robot_import.h"
+#include "results/sha256.h"
 #include "tailsim_version.h"
 
 namespace tailsim {
@@ -91,6 +93,33 @@ const json& need(const json& j, const char* k) {
   return j.at(k);
 }
 
+// A robot from its model file: the model (by the SHA-256 of the text tailsim compiles, so a folder's
+// copy gives the same key), what the user said, and every derived value with where it came from.
+json robotModelJson(const ExperimentCase& c) {
+  const RobotModelSpec& s = *c.robot_model;
+  json j;
+  json given = toJson(s);
+  given.erase("mjcf");  // the path: robot_file
+  given["keyframe"] = s.keyframe;
+  given["joints_rad"] = s.joint_angles_rad;
+  given["feet"] = s.feet;
+  given["mount"] = toJson(s.mount);
+  given["tail_links"] = c.robot_model_links;
+  j["given"] = given;
+  if (const DerivedRobot* d = c.robot_derived.get()) {
+    j["model_sha256"] = sha256Hex(d->model.xml);
+    j["stance"] = d->stance;
+    j["feet"] = d->feet;
+    j["root_body"] = d->root_body;
+    j["mount_body"] = d->mount_body;
+    j["standing_tilt_deg"] = d->tilt_deg;
+    j["derived"] = json::array();
+    for (const DerivedValue& v : d->values)
+      j["derived"].push_back({{"key", v.key}, {"value", v.value}, {"unit", v.unit}, {"source", v.source}});
+  }
+  return j;
+}
+
 }  // namespace
 
 json resolvedJson(const ExperimentCase& c) {
@@ -114,6 +143,7 @@ json resolvedJson(const ExperimentCase& c) {
     j["splines"] = json::array();
     for (const SplineParams& p : c.splines) j["splines"].push_back(toJson(p));
   }
+  if (c.robot_model) j["robot_model"] = robotModelJson(c);
   j["pose"] = {{"theta_rad", c.pose.theta_rad},
                {"thetadot_radps", c.pose.thetadot_radps},
                {"thetaddot_radps2", c.pose.thetaddot_radps2}};

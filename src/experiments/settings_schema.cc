@@ -275,13 +275,28 @@ json experimentSchema() {
                {"additionalProperties", false},
                {"properties",
                 {{"links", orSweep({{"type", "integer"}, {"minimum", 1}, {"maximum", 6}})},
-                 {"custom", {{"type", "array"}, {"minItems", 1}, {"items", link}}}}},
+                 {"custom", {{"type", "array"}, {"minItems", 1}, {"items", link}}},
+                 {"mount", section(describe<TailMount>().props)}}},
                {"minProperties", 1},
-               {"maxProperties", 1}};
+               {"maxProperties", 2}};
+  // robot: a robot file (or built-in name), or a robot from its MuJoCo model file.
+  json modelRobot = section(describe<RobotModelSpec>().props, {"mjcf"});
+  modelRobot["properties"]["stance"] = section(
+      {{"keyframe", describe<RobotStanceKeys>().props["keyframe"]},
+       {"joints_deg",
+        {{"type", "object"},
+         {"description", "joint name: angle [deg], over the keyframe (or the reference pose qpos0)"},
+         {"additionalProperties", orSweep({{"type", "number"}, {"minimum", -360}, {"maximum", 360}})}}}});
+  modelRobot["properties"]["feet"] = {{"type", "array"},
+                                      {"minItems", 4},
+                                      {"maxItems", 4},
+                                      {"uniqueItems", true},
+                                      {"description", "the 4 foot geoms (absent: those touching the floor after standing)"},
+                                      {"items", orSweep({{"type", "string"}, {"minLength", 1}})}};
   json exp = section(
       {{"name", nameSchema()},
        {"description", {{"type", "string"}}},
-       {"robot", orSweep({{"type", "string"}, {"minLength", 1}})},
+       {"robot", {{"anyOf", json::array({{{"type", "string"}, {"minLength", 1}}, sweepRef(), modelRobot})}}},
        {"kind", orSweep({{"type", "string"}, {"enum", settings::namesOf(kindNames())}})},
        {"tail", tail},
        {"quadruped", section(quadrupedProps())},
@@ -360,6 +375,22 @@ std::string settingsMarkdown() {
   table("tail links", "Each entry of `tail: {custom: [...]}` and of a robot file's `tails.n`; `mass_kg`, "
                       "`izz_kgm2`, `length_m` required.",
         describe<TailLink>().rows);
+  table("robot from its model file", "`robot: {mjcf: PATH, ...}` instead of a robot file: the robot's MJCF or URDF, "
+                                     "stood in its stance and measured; `quadruped`, `friction` and `gravity_mps2` "
+                                     "are then derived, not keys ([your-robot.md](your-robot.md) \"Experiments\").",
+        describe<RobotModelSpec>().rows +
+            "| `stance` | map | `keyframe` `home` | `{keyframe: NAME, joints_deg: {JOINT: deg}}`: the pose the legs are "
+            "held in; no `home` keyframe and none given: an error |\n" +
+            [] {
+              std::string k = describe<RobotStanceKeys>().rows;
+              return k.replace(k.find("| `keyframe`"), 12, "| `stance.keyframe`");
+            }() +
+            "| `stance.joints_deg` | map of joint name: number, [-360, 360] | (none) | stance: joint angles over the keyframe "
+            "(or qpos0) [deg] |\n"
+            "| `feet` | 4 geom names | (touching the floor) | the foot geoms; the planar models need 4 |\n");
+  table("tail.mount", "A robot from its model file only: where the tail is attached. `tail: {links: n}` is then n "
+                      "links sharing 10 % of the robot's mass and one body length (l_F).",
+        describe<TailMount>().rows);
   const ExperimentCase defaults;
   forEachSection(defaults, [&](const SectionInfo& s, const auto& v) {
     table(s.key, s.note, describe<std::decay_t<decltype(v)>>().rows);

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "experiments/experiment_runner.h"
+#include "experiments/robot_model_cases.h"
 #include "results/atomic_file.h"
 #include "results/sha256.h"
 
@@ -352,7 +353,8 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
     }
     // The summary and results table are written by the runner itself, resuming every case and
     // running none (a case in no shard is an error): the same code as a single-process run.
-    const std::vector<Experiment> suite = loadExperimentSuite((stage / "experiment.yaml").string());
+    std::vector<Experiment> suite = loadExperimentSuite((stage / "experiment.yaml").string());
+    resolveRobotModels(suite);  // the cases' keys include the derived robot
     RunOptions o;
     o.out_dir = stage.string();
     o.threads = threads;

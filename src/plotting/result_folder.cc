@@ -16,6 +16,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
 #include "experiments/time_series_h5.h"
+#include "experiments/robot_model_cases.h"
 #include "results/atomic_file.h"
 
 namespace tailsim {
@@ -306,7 +307,8 @@ ExperimentResults loadResults(const std::string& dir) {
   // The cases as run, from the folder's own copies (experiment.yaml -> robot.yaml).
   if (fs::exists(root / "experiment.yaml")) {
     try {
-      const Experiment e = loadExperiment((root / "experiment.yaml").string());
+      Experiment e = loadExperiment((root / "experiment.yaml").string());
+      resolveRobotModels(e);  // a robot from its model file: the values the run used
       for (const ExperimentCase& c : e.cases) r.resolved.emplace(c.name, c);
       if (!kind_given && !e.cases.empty()) r.kind = name(e.cases.front().kind);
       if (r.description.empty()) r.description = e.description;

@@ -23,6 +23,7 @@
 #include "experiments/keyword_args.h"
 #include "experiments/model_registry.h"
 #include "experiments/settings_json.h"
+#include "experiments/robot_model_cases.h"
 #include "results/columns.h"
 #include "results/thin_series.h"
 #include "tailsim_version.h"
@@ -239,6 +240,7 @@ py::object run(const std::string& experiment, const std::string& out, std::vecto
   {
     py::gil_scoped_release free;
     suite = loadExperimentSuite(experiment);  // all errors before any work
+    resolveRobotModels(suite);                 // robots from their model files, before any case runs
     selectModels(suite, models, experiment);  // the CLI's checks and messages (ConfigError)
     requireCase(suite, experiment, case_name);
     RunOptions o;

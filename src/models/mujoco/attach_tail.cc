@@ -8,6 +8,7 @@
 #include <functional>
 
 #include "controllers/tail_controller.h"
+#include "results/columns.h"
 #include "models/mujoco/mjcf_generator.h"
 
 namespace tailsim {
@@ -108,6 +109,21 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
     g->SetAttribute("rgba", "0.85 0.45 0.1 1");
     at = link;
   }
+  if (r.legs_locked) {
+    // Each leg joint held at its stood angle (solref 0.002 s, critically damped; MuJoCo raises the
+    // time constant to 2 timesteps where it is shorter).
+    XMLElement* eq = doc.NewElement("equality");
+    root->InsertEndChild(eq);
+    for (const auto& [name, target] : r.hold_target_rad) {
+      (void)target;
+      XMLElement* e = doc.NewElement("joint");
+      eq->InsertEndChild(e);
+      e->SetAttribute("name", ("tailsim_lock_" + name).c_str());
+      e->SetAttribute("joint1", name.c_str());
+      e->SetAttribute("polycoef", nums({r.settled_qpos.at(name).at(0), 0.0, 0.0, 0.0, 0.0}).c_str());
+      e->SetAttribute("solref", "0.002 1");
+    }
+  }
   XMLElement* act = root->FirstChildElement("actuator");
   if (!act) {
     act = doc.NewElement("actuator");
@@ -132,7 +148,7 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
 
 ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                               const TailTrajectory& trajectory, const MujocoSettings& s_in, double stand_s,
-                              double settle_after_s) {
+                              double settle_after_s, double sample_dt_s) {
   ArticulatedRun out;
   MujocoMessages messages;
   // The servo gains at the model's own timestep.
@@ -188,6 +204,7 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
       d->qfrc_applied[pdv[k]] = kStancePdKp * (pdTarget[k] - d->qpos[pdq[k]]) - kStancePdKv * d->qvel[pdv[k]];
     ctrl.apply(m, d, t_ref, false);
     mj_step2(m, d);
+    ++out.steps;
   };
   const double dt = m->opt.timestep;
   const long standSteps = std::lround(stand_s / dt);
@@ -211,22 +228,84 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
   double phi = 0.0, prev = yaw0;
   const double t_end = trajectory.endTime() + settle_after_s;
   const long runSteps = std::lround(t_end / dt);
+  // Rows on the output grid (the sample nearest each grid time: the step that reaches it).
+  std::vector<int> colTheta, colThetadot, colTrack;
+  int colT = -1, colX = -1, colY = -1, colPhi = -1, colPhidot = -1;
+  if (sample_dt_s > 0.0) {
+    colT = out.series.addColumn(col::kT);
+    for (int i = 1; i <= n; ++i) colTheta.push_back(out.series.addColumn(col::theta(i)));
+    for (int i = 1; i <= n; ++i) colThetadot.push_back(out.series.addColumn(col::thetadot(i)));
+    colX = out.series.addColumn(col::kX);
+    colY = out.series.addColumn(col::kY);
+    colPhi = out.series.addColumn(col::kPhi);
+    colPhidot = out.series.addColumn(col::kPhidot);
+    for (int i = 1; i <= n; ++i) colTrack.push_back(out.series.addColumn(col::trackErr(i)));
+  }
+  const double* root = d->xpos + 3 * body;
+  const double x0 = root[0], y0 = root[1];
+  long nextRow = 0;
+  std::vector<double> row(out.series.numColumns());
+  std::vector<JointState> ref;
+  auto record = [&](double t) {
+    if (sample_dt_s <= 0.0) return;
+    while (nextRow * sample_dt_s <= t + 0.5 * dt && nextRow * sample_dt_s <= t_end + 1e-9 * sample_dt_s) {
+      trajectory.evaluate(t, ref);
+      row[colT] = nextRow * sample_dt_s;
+      for (int i = 0; i < n; ++i) {
+        row[colTheta[i]] = d->qpos[qadr[i]] * 180.0 / kPi;
+        row[colThetadot[i]] = d->qvel[vadr[i]] * 180.0 / kPi;
+        row[colTrack[i]] = (d->qpos[qadr[i]] - ref[i].theta) * 180.0 / kPi;
+      }
+      row[colX] = root[0] - x0;
+      row[colY] = root[1] - y0;
+      row[colPhi] = phi * 180.0 / kPi;
+      row[colPhidot] = d->cvel[6 * body + 2] * 180.0 / kPi;  // world-frame angular velocity z (com-based)
+      out.series.appendRow(row);
+      ++nextRow;
+    }
+  };
+  record(0.0);
   for (long k = 0; k < runSteps && out.ok; ++k) {
     step((k + 1) * dt);
     const double y = yaw();
     phi += std::remainder(y - prev, 2 * kPi);
     prev = y;
+    record((k + 1) * dt);
     out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
     out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
   }
   out.run_s = t_end;
   out.phi_net_deg = phi * 180.0 / kPi;
-  if (out.stand_max_rel_tilt_deg >= 1.0)
+  {
+    const double* v = d->cvel + 6 * body;  // [angular; linear] at the subtree COM, world frame
+    out.at_rest = std::abs(v[2]) * 180.0 / kPi < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
+  }
+  if (out.stand_max_rel_tilt_deg >= kStandingTiltLimitDeg)
     out.warnings.push_back("the body tilted up to " + std::to_string(out.stand_max_rel_tilt_deg) + " deg from its stance (" +
                            std::to_string(out.stand_max_tilt_deg) + " deg absolute) while standing with the tail");
   if (!messages.text().empty()) out.warnings.push_back(messages.text());
   return out;
+}
+
+RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model) {
+  RunResult r;
+  RunSummary& s = r.summary;
+  s.model = model;
+  s.ok = a.ok;
+  s.error = a.error;
+  s.phi_net_deg = a.phi_net_deg;
+  s.t_stop_s = a.run_s;
+  s.solver_steps = a.steps;
+  s.at_rest = a.at_rest;
+  s.warnings = a.warnings;
+  s.extra["stance_tilt_deg"] = a.stance_tilt_deg;
+  s.extra["stand_end_tilt_from_stance_deg"] = a.stand_end_rel_tilt_deg;
+  s.extra["stand_max_tilt_from_stance_deg"] = a.stand_max_rel_tilt_deg;
+  s.extra["stroke_max_tilt_from_stance_deg"] = a.max_rel_tilt_deg;
+  s.extra["feet_in_contact"] = a.feet_in_contact;
+  r.series = a.series;
+  return r;
 }
 
 }  // namespace tailsim

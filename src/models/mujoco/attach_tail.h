@@ -8,6 +8,7 @@
 
 #include "models/mujoco/mujoco_settings.h"
 #include "models/mujoco/robot_import.h"
+#include "results/time_series.h"
 #include "robot/robot_params.h"
 #include "trajectory/split_cycle_profile.h"
 
@@ -37,12 +38,24 @@ struct ArticulatedRun {
   double phi_net_deg = 0.0;         // heading change of the root body from the stroke's start [deg]
   double stand_s = 0.0, run_s = 0.0;
   int feet_in_contact = 0;          // foot geoms touching the floor at the stroke's start
+  long steps = 0;                   // mj_step calls, standing included
+  bool at_rest = true;              // yaw rate below 0.1 deg/s and COM speed below 1 mm/s at the end
   std::vector<std::string> warnings;
+  // sample_dt_s > 0: rows from the stroke's start (t_s = 0) every sample_dt_s: t_s, theta<i>_deg,
+  // thetadot<i>_dps, x_m, y_m (root body), phi_deg (heading change), phidot_dps, track_err<i>_deg.
+  TimeSeries series;
 };
+
+// Standing with the tail: a larger tilt from the stance is warned about.
+inline constexpr double kStandingTiltLimitDeg = 1.0;
 
 // Stands stand_s with the tail held at theta(0), then runs the stroke and settle_after_s more.
 ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                               const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
-                              double settle_after_s);
+                              double settle_after_s, double sample_dt_s = 0.0);
+
+// The articulated run as a model's RunResult (tailsim run's `mujoco` model on a robot from its model
+// file): phi_net, the rows, the tilt figures in `extra` and the warnings.
+RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model);
 
 }  // namespace tailsim

@@ -28,7 +28,9 @@ std::string g6(double v) {
   return b;
 }
 
-[[noreturn]] void fail(const std::string& file, const std::string& what) { throw RobotImportError(file + ": " + what); }
+[[noreturn]] void fail(const std::string& file, const std::string& what, const std::string& key = "robot.mjcf") {
+  throw RobotImportError(file + ": " + what, key);
+}
 
 void loadXmlFile(XMLDocument& doc, const std::string& file) {
   if (doc.LoadFile(file.c_str()) != tinyxml2::XML_SUCCESS)
@@ -399,21 +401,22 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
     if (k < 0) {
       std::string names;
       for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
-      fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")");
+      fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
     }
     s.qpos.assign(m->key_qpos + k * m->nq, m->key_qpos + (k + 1) * m->nq);
     s.words = "keyframe '" + key + "'";
   } else if (spec.joint_angles_rad.empty()) {
     fail(file, "no stance: the model has no `home` keyframe; name a keyframe or give the joint angles of its "
-               "standing pose (docs/your-robot.md)");
+               "standing pose (docs/your-robot.md)",
+         "robot.stance");
   } else {
     s.words = "the model's reference pose (qpos0)";
   }
   for (const auto& [name, angle] : spec.joint_angles_rad) {
     const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
-    if (j < 0) fail(file, "stance: no joint named '" + name + "'");
+    if (j < 0) fail(file, "stance: no joint named '" + name + "'", "robot.stance");
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
-      fail(file, "stance: joint '" + name + "' is not a hinge or slide");
+      fail(file, "stance: joint '" + name + "' is not a hinge or slide", "robot.stance");
     s.qpos[m->jnt_qposadr[j]] = angle;
   }
   if (!spec.joint_angles_rad.empty())
@@ -446,6 +449,9 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   r.root_body = mj_id2name(m, mjOBJ_BODY, root) ? mj_id2name(m, mjOBJ_BODY, root) : "";
   const Stance stance = stanceOf(m, spec, file);
   r.stance = stance.words;
+  if (spec.legs != "servos" && spec.legs != "locked")
+    fail(file, "legs: '" + spec.legs + "' is neither servos nor locked", "robot.legs");
+  r.legs_locked = spec.legs == "locked";
 
   // Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
   // ctrl; a joint without one is held by a PD tailsim adds through qfrc_applied.
@@ -500,7 +506,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   if (!spec.feet.empty()) {
     for (const std::string& n : spec.feet) {
       const int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
-      if (g < 0) fail(file, "feet: no geom named '" + n + "'");
+      if (g < 0) fail(file, "feet: no geom named '" + n + "'", "robot.feet");
       feet.push_back(g);
     }
   } else {
@@ -523,9 +529,14 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
                    std::to_string(feet.size()) + " geom" + (feet.size() == 1 ? "" : "s") +
                    (names.empty() ? "" : " (" + names + ")") +
                    "; a quadruped stands on 3 or 4 feet: check the stance (tilt " + g6(r.tilt_deg) +
-                   " deg) or name the feet with feet: [...]");
+                   " deg) or name the feet with feet: [...]",
+         "robot.feet");
   }
-  if (feet.size() != 4) fail(file, "the planar models need 4 feet; the robot stands on " + std::to_string(feet.size()));
+  if (feet.size() != 4)
+    fail(file, "the robot stands on " + std::to_string(feet.size()) +
+                   " feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet, so a 3-foot stance is "
+                   "refused: name 4 feet with feet: [...] or change the stance",
+         "robot.feet");
 
   // Robot bodies: the root body's tree (not the world, nor other bodies of a scene).
   auto robotBody = [&](int b) { return b > 0 && m->body_rootid[b] == root; };
@@ -550,7 +561,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
 
   // The planar frame: the mount body's x axis turned by the mount yaw, projected on the floor.
   const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
-  if (mount < 0) fail(file, "tail mount: no body named '" + spec.mount.body + "'");
+  if (mount < 0) fail(file, "tail mount: no body named '" + spec.mount.body + "'", "tail.mount.body");
   r.mount_body = mj_id2name(m, mjOBJ_BODY, mount) ? mj_id2name(m, mjOBJ_BODY, mount) : "";
   const double* Rm = d->xmat + 9 * mount;
   const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
@@ -569,7 +580,8 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
     const bool front = fp[i][0] > mx, left = fp[i][1] > my;
     const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
     if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
-                                         std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")");
+                                         std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
+                            "robot.feet");
     order[slot] = i;
   }
   for (int s = 0; s < 4; ++s) {

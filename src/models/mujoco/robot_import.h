@@ -10,29 +10,10 @@
 #include <vector>
 
 #include "models/mujoco/mujoco_handles.h"
+#include "robot/robot_model_spec.h"
 #include "robot/robot_params.h"
 
 namespace tailsim {
-
-// Where the tail goes: under body `body`, at pos_m in that body's frame. The planar robot frame's
-// forward axis is the mount body's x axis turned by yaw_rad about z (0: the body's x is forward);
-// the straight tail points backward along it.
-struct TailMount {
-  std::string body;                   // "": the robot's root body (the one with the free joint)
-  std::array<double, 3> pos_m{};      // [m]
-  double yaw_rad = 0.0;               // [rad]
-};
-
-// What the user says about the model besides its file.
-struct RobotModelSpec {
-  std::string file;                                // MJCF or URDF (absolute or relative to the working dir)
-  std::string keyframe;                            // "": the model's `home` key when it has one
-  std::map<std::string, double> joint_angles_rad;  // stance by joint name (over the keyframe, or qpos0)
-  std::vector<std::string> feet;                   // foot geom names; empty: those touching the floor
-  double mu = -1.0;                                // < 0: from the foot contacts
-  TailMount mount;
-  double settle_s = 1.0;                           // standing time before the robot is measured [s]
-};
 
 // The user's file as tailsim compiles it: includes inlined, asset folders absolute, missing-file
 // geoms and textures dropped, a floor added when the model has none.
@@ -52,7 +33,14 @@ PreparedModel prepareRobotModel(const std::string& file);
 
 class RobotImportError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  // key: the experiment key the error is about (robot.mjcf, robot.stance, robot.feet,
+  // tail.mount.body), for an experiment's ConfigError.
+  explicit RobotImportError(const std::string& what, std::string key = "robot.mjcf")
+      : std::runtime_error(what), key_(std::move(key)) {}
+  const std::string& key() const { return key_; }
+
+ private:
+  std::string key_;
 };
 
 // One derived value, as `tailsim robot` prints it.
@@ -73,6 +61,7 @@ struct DerivedRobot {
   std::vector<std::string> feet;        // foot geom names, ordered FL, FR, RR, RL (planar frame)
   std::string root_body, mount_body;
   std::string stance;                   // how the stance was set, in words
+  bool legs_locked = false;             // the spec's legs: locked (attachTail adds the joint equalities)
   double tilt_deg = 0.0;                // root body tilt after settling [deg]
   double lateral_com_to_feet_m = 0.0;   // y of the foot centroid in the planar frame (the planar models take 0) [m]
   double lateral_mount_m = 0.0;         // y of the tail base in the planar frame [m]

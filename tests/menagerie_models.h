@@ -1,0 +1,22 @@
+// Where the tests find the MuJoCo Menagerie models nobody here wrote (go1/, anymal_c/): the folder
+// shared/robots/menagerie beside the source tree or beside one of its ancestors. The repository
+// ships none; a test that needs them skips when the folder is absent.
+#pragma once
+
+#include <filesystem>
+
+namespace tailsim_test {
+
+// shared/robots/menagerie beside the source dir or beside one of its ancestors ("" if absent).
+inline std::filesystem::path menagerieDir() {
+  namespace fs = std::filesystem;
+  for (fs::path p = fs::absolute(TAILSIM_SOURCE_DIR); !p.empty(); p = p.parent_path()) {
+    const fs::path m = p.parent_path() / "shared" / "robots" / "menagerie";
+    std::error_code ec;
+    if (fs::is_directory(m, ec)) return m;
+    if (p == p.parent_path()) break;
+  }
+  return {};
+}
+
+}  // namespace tailsim_test
