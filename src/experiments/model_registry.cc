@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "models/analytic/analytic_recorder.h"
+#include "models/analytic/analytic_rows.h"
 #include "models/analytic/analytic_simulation.h"
 #include "models/perfoot/per_foot_model.h"
 #include "models/mujoco/mujoco_simulation.h"
