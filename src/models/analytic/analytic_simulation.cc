@@ -19,6 +19,7 @@
 #include "models/planar/stick_slip_driver.h"
 #include "models/planar/support_check.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
@@ -266,7 +267,7 @@ void summarize(const Run& run, RunSummary& sum) {
   const State& y = run.y;
   const AnalyticStickSlip& ss = run.model;
   const AnalyticModel& m = ss.model;
-  sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
+  sum.phi_net_deg = units::degrees(y[kPhi]);
   const bool still = !m.stiction() || !run.modes.stuck[kRot];
   sum.t_stop_s = still ? run.plan.t_end : ss.t_stop;
   sum.stick_slip_events = ss.switches;
@@ -276,12 +277,12 @@ void summarize(const Run& run, RunSummary& sum) {
   sum.extra["held_steps"] = static_cast<double>(run.held);
   sum.extra["final_x_m"] = y[kX];
   sum.extra["final_y_m"] = y[kY];
-  sum.extra["final_phidot_dps"] = y[kPhiDot] * 180.0 / M_PI;
+  sum.extra["final_phidot_dps"] = units::degrees(y[kPhiDot]);
   sum.extra["final_speed_mps"] = std::hypot(y[kVx], y[kVy]);
   sum.extra["still_rotating_at_end"] = still && std::abs(y[kPhiDot]) > 0 ? 1.0 : 0.0;
   sum.extra["ever_rotated"] = ss.ever_rotated || !m.stiction() ? 1.0 : 0.0;
   // At rest: both DOFs stuck (stiction), or rate and speed below the documented thresholds.
-  const double phidot_dps = std::abs(y[kPhiDot]) * 180.0 / M_PI, speed = std::hypot(y[kVx], y[kVy]);
+  const double phidot_dps = units::degrees(std::abs(y[kPhiDot])), speed = std::hypot(y[kVx], y[kVy]);
   sum.at_rest = ss.held(run.modes) || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
   if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(run.plan.t_end, phidot_dps, speed));
 }
@@ -296,15 +297,15 @@ void paperCouplingDiagnostic(Run& run, RunSummary& sum) {
   const double alpha = m.needsArm() && std::isfinite(ev_end.L_F)
                            ? m.robot.friction.mu_d * m.weight * ev_end.L_F / ev_end.loads.Izz_kgm2
                            : 0.0;
-  const double turn_deg = w_res == 0.0 ? 0.0 : alpha > 0 ? w_res * w_res / (2.0 * alpha) * 180.0 / M_PI
+  const double turn_deg = w_res == 0.0 ? 0.0 : alpha > 0 ? units::degrees(w_res * w_res / (2.0 * alpha))
                                                         : std::numeric_limits<double>::infinity();
-  sum.extra["paper_residual_spin_dps"] = w_res * 180.0 / M_PI;
+  sum.extra["paper_residual_spin_dps"] = units::degrees(w_res);
   sum.extra["paper_spurious_turn_deg"] = turn_deg;
   if (turn_deg <= limits::kMaxPaperSpuriousTurnDeg) return;
   std::ostringstream os;
   os.precision(3);
   os << "the paper coupling's angular-momentum error is large: with mu = 0 it would leave the body spinning at "
-     << w_res * 180.0 / M_PI << " deg/s after the tail stops (the exact coupling: 0), enough to turn it by "
+     << units::degrees(w_res) << " deg/s after the tail stops (the exact coupling: 0), enough to turn it by "
      << turn_deg << " deg against sliding friction (limit " << limits::kMaxPaperSpuriousTurnDeg
      << " deg); the paper's model is outside its validity here, compare analytic.coupling: exact";
   sum.warnings.push_back(os.str());
@@ -355,7 +356,7 @@ RunResult evaluatePose(const RobotParams& robot, const std::vector<JointState>& 
   for (int i = 1; i <= n; ++i) ts.addColumn(col::theta(i));
   for (int i = 1; i <= n; ++i) ts.addColumn(col::thetadot(i));
   for (int i = 1; i <= n; ++i) ts.addColumn(col::thetaddot(i));
-  const double d = 180.0 / M_PI;
+  const double d = units::kDegPerRad;
   for (const auto& j : joints) row.push_back(j.theta * d);
   for (const auto& j : joints) row.push_back(j.theta_dot * d);
   for (const auto& j : joints) row.push_back(j.theta_ddot * d);

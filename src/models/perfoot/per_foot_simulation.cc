@@ -17,6 +17,7 @@
 #include "models/planar/support_check.h"
 #include "results/columns.h"
 #include "robot/friction_law.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
@@ -608,14 +609,14 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     result.series = run.rec.take();
     result.series_thinned = run.rec.thinned();
     const bool stuck = run.modes.stuck[kRot];
-    sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
+    sum.phi_net_deg = units::degrees(y[kPhi]);
     sum.t_stop_s = stuck ? ss.t_stop : t_end;
     sum.stick_slip_events = ss.switches;
     sum.solver_steps = run.steps;
-    const double phidot_dps = std::abs(y[kW]) * 180.0 / M_PI, speed = std::hypot(y[kVx], y[kVy]);
+    const double phidot_dps = units::degrees(std::abs(y[kW])), speed = std::hypot(y[kVx], y[kVy]);
     sum.extra["final_x_m"] = y[kX];
     sum.extra["final_y_m"] = y[kY];
-    sum.extra["final_phidot_dps"] = y[kW] * 180.0 / M_PI;
+    sum.extra["final_phidot_dps"] = units::degrees(y[kW]);
     sum.extra["final_speed_mps"] = speed;
     sum.extra["breakaways"] = ss.breakaways;
     sum.extra["rhs_evaluations"] = static_cast<double>(run.rhs);

@@ -15,6 +15,7 @@
 #include "models/planar/stick_slip.h"
 #include "results/thin_series.h"
 #include "results/time_series.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -88,7 +89,7 @@ class PlanarRecorder {
     const bool stiction = model_.stiction(), trans = stiction && model_.translation();
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     auto light = [&](const Pending& p) {
-      return std::array<double, 3>{model_.phi(p.y) * (180.0 / M_PI),
+      return std::array<double, 3>{model_.phi(p.y) * units::kDegPerRad,
                                    stiction ? (p.modes.stuck[kRot] ? 0.0 : 1.0) : kNaN,
                                    trans ? (p.modes.stuck[kTrans] ? 0.0 : 1.0) : kNaN};
     };

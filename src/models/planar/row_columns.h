@@ -14,6 +14,7 @@
 #include "models/planar/system_loads.h"
 #include "results/columns.h"
 #include "trajectory/split_cycle_profile.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -30,13 +31,13 @@ template <class Row>
 void addTimeAndJointColumns(std::vector<RowColumn<Row>>& table, int links) {
   table.push_back({col::kT, [](const Row& r, int) { return r.t; }});
   for (int i = 1; i <= links; ++i)
-    table.push_back({col::theta(i), [](const Row& r, int j) { return r.joints[j].theta * (180.0 / M_PI); }, i - 1});
+    table.push_back({col::theta(i), [](const Row& r, int j) { return r.joints[j].theta * units::kDegPerRad; }, i - 1});
   for (int i = 1; i <= links; ++i)
     table.push_back(
-        {col::thetadot(i), [](const Row& r, int j) { return r.joints[j].theta_dot * (180.0 / M_PI); }, i - 1});
+        {col::thetadot(i), [](const Row& r, int j) { return r.joints[j].theta_dot * units::kDegPerRad; }, i - 1});
   for (int i = 1; i <= links; ++i)
     table.push_back(
-        {col::thetaddot(i), [](const Row& r, int j) { return r.joints[j].theta_ddot * (180.0 / M_PI); }, i - 1});
+        {col::thetaddot(i), [](const Row& r, int j) { return r.joints[j].theta_ddot * units::kDegPerRad; }, i - 1});
 }
 
 // What every planar model's row holds (the model's own row type derives from it).
@@ -64,7 +65,7 @@ inline double stickSlipState(bool exists, bool stuck) {
 template <class Row>
 void addBodyColumns(std::vector<RowColumn<Row>>& table) {
   using R = const Row&;
-  constexpr double kDeg = 180.0 / M_PI;
+  constexpr double kDeg = units::kDegPerRad;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   const std::vector<RowColumn<Row>> body = {
       {col::kX, [](R r, int) { return r.x; }},
