@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""Are two tailsim result folders the same, measured wall times aside?  usage: compare_folders.py A B
+"""Are two tailsim result folders the same, measured wall times aside?  usage: compare_folders.py A B [--other-build]
 Every file under A and B (except .tailsim.lock and .tailsim-manifest) must exist in both; each
 .tailsim-manifest must name its folder's files as they are (it hashes them, wall times included); JSON files are compared with every
 "wall_time_s" removed (also each line of cases.jsonl), results.csv files without their wall_time_s column,
 time_series.h5 by its h5dump listing (contents, not file layout), everything else byte for byte.
+--other-build: A and B come from two builds (a change checked against the code before it): the JSON
+files also without "key" (each case's key hashes the build) and "tailsim_git_commit".
 Prints the differences and exits 1, or "identical: N files" and 0."""
 import csv, hashlib, io, json, os, subprocess, sys
 
@@ -27,9 +29,11 @@ def walk(root):
                 out.add(rel)
     return out
 
+skip = {"wall_time_s"} | ({"key", "tailsim_git_commit"} if "--other-build" in sys.argv else set())
+
 def strip(j):
     if isinstance(j, dict):
-        return {k: strip(v) for k, v in j.items() if k != "wall_time_s"}
+        return {k: strip(v) for k, v in j.items() if k not in skip}
     if isinstance(j, list):
         return [strip(v) for v in j]
     return j
@@ -41,7 +45,7 @@ def table(path):
     drop = [i for i, h in enumerate(rows[0]) if h == "wall_time_s"]
     return [[c for i, c in enumerate(r) if i not in drop] for r in rows]
 
-a, b = sys.argv[1], sys.argv[2]
+a, b = [x for x in sys.argv[1:] if x != "--other-build"][:2]
 fa, fb = walk(a), walk(b)
 bad = [f"only in {a}: {f}" for f in sorted(fa - fb)] + [f"only in {b}: {f}" for f in sorted(fb - fa)]
 for rel in sorted(fa & fb):

@@ -11,6 +11,7 @@
 #include "experiments/robot_compare.h"
 #include "results/atomic_file.h"
 #include "models/mujoco/robot_import.h"
+#include "settings/units.h"
 
 namespace tailsim {
 void addRobotCommand(CLI::App& app, int& exit_code) {
@@ -76,7 +77,7 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
         if (eq == std::string::npos || eq == 0 || std::sscanf(j.c_str() + eq + 1, "%lf%c", &deg, &extra) != 1 ||
             !std::isfinite(deg))
           throw RobotImportError("--joint " + j + ": expected NAME=DEG (e.g. LF_HFE=23)");
-        spec.joint_angles_rad[j.substr(0, eq)] = deg * M_PI / 180.0;
+        spec.joint_angles_rad[j.substr(0, eq)] = units::radians(deg);
       }
       spec.feet = o->feet;
       spec.mu = o->mu;
@@ -84,7 +85,7 @@ void addRobotCommand(CLI::App& app, int& exit_code) {
       spec.legs = o->legs;
       spec.mount.body = o->mount_body;
       if (o->mount_pos.size() == 3) spec.mount.pos_m = {o->mount_pos[0], o->mount_pos[1], o->mount_pos[2]};
-      spec.mount.yaw_rad = o->mount_yaw_deg * M_PI / 180.0;
+      spec.mount.yaw_rad = units::radians(o->mount_yaw_deg);
       if (o->compare) {
         const RobotComparison c = compareRobotModels(spec, o->tail);
         std::fputs(describeDerivedRobot(c.robot).c_str(), stdout);

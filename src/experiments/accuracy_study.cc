@@ -66,6 +66,230 @@ AccuracyRow makeRow(const std::string& model, const std::string& family, const s
   return row;
 }
 
+// The analytic model's study: adaptive tolerances and fixed RK4 steps against rel_tol = 1e-12.
+void studyAnalytic(const ExperimentCase& c, const TailTrajectory& traj, const AccuracyOptions& opt, AccuracyStudy& st) {
+  const AnalyticSettings defaults_a;
+  char b[512];
+  auto analytic = [&](const AnalyticSettings& s) { return simulateAnalytic(c.robot, traj, s, c.effects, c.output); };
+  auto adaptive = [&](double tol) {
+    AnalyticSettings s = c.analytic;
+    s.solver = AnalyticSolver::kAdaptive;
+    s.rel_tol = tol;
+    s.abs_tol = tol * 1e-2;
+    return s;
+  };
+  const RunResult ref_a = analytic(adaptive(1e-12));
+  st.analytic.present = true;
+  st.analytic.setting = "adaptive rel_tol=1e-12 abs_tol=1e-14";
+  st.analytic.phi_net_deg = ref_a.summary.phi_net_deg;
+  {
+    // Successive refinements 1e-9 .. 1e-12: their differences shrink towards the reference.
+    std::string line = "analytic adaptive, phi_net at rel_tol 1e-9, 1e-10, 1e-11, 1e-12:";
+    std::vector<double> seq;
+    for (double tol : {1e-9, 1e-10, 1e-11}) seq.push_back(analytic(adaptive(tol)).summary.phi_net_deg);
+    seq.push_back(ref_a.summary.phi_net_deg);
+    for (double v : seq) {
+      std::snprintf(b, sizeof b, " %.10f", v);
+      line += b;
+    }
+    line += " deg; successive differences";
+    for (size_t i = 1; i < seq.size(); ++i) {
+      std::snprintf(b, sizeof b, " %.1e", std::abs(seq[i] - seq[i - 1]));
+      line += b;
+    }
+    st.analytic.uncertainty_deg = std::abs(seq[3] - seq[2]);
+    std::snprintf(b, sizeof b, " deg. Reference error estimate: %.0e deg (|1e-12 - 1e-11|).", st.analytic.uncertainty_deg);
+    st.analytic.evidence.push_back(line + b);
+  }
+  {
+    AnalyticSettings ex = adaptive(1e-12);
+    ex.coupling = Coupling::kExact;
+    st.analytic_exact_deg = analytic(ex).summary.phi_net_deg;
+  }
+  const std::vector<double> tols = opt.quick ? std::vector<double>{1e-4, 1e-8}
+                                             : std::vector<double>{1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11};
+  for (double tol : tols) {
+    const AnalyticSettings s = adaptive(tol);
+    double wall = 0, mean = 0;
+    int runs = 0;
+    const RunResult r = timed([&](int) { return analytic(s); }, opt.repeats, wall, mean, runs);
+    const bool dflt = tol == defaults_a.rel_tol && s.abs_tol == defaults_a.abs_tol;
+    st.rows.push_back(makeRow("analytic", "adaptive", "rel_tol=" + formatG(tol), tol, dflt, r, wall, mean, 1, ref_a));
+  }
+  const std::vector<double> hs = opt.quick ? std::vector<double>{1e-3}
+                                           : std::vector<double>{1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6};
+  for (double h : hs) {
+    AnalyticSettings s = c.analytic;
+    s.solver = AnalyticSolver::kFixed;
+    s.fixed_dt_s = h;
+    double wall = 0, mean = 0;
+    int runs = 0;
+    const RunResult r = timed([&](int) { return analytic(s); }, opt.repeats, wall, mean, runs);
+    st.rows.push_back(makeRow("analytic", "fixed RK4", "fixed_dt_s=" + formatG(h), h, false, r, wall, mean, 1, ref_a));
+  }
+}
+
+// phi_net over an ensemble of MuJoCo runs: mean, sample standard deviation, the runs that
+// succeeded, the first failure.
+struct Ensemble {
+  double mean = NAN, sd = NAN;
+  int ok = 0;
+  std::string error;
+};
+
+// MuJoCo runs of one case: a failure to build or run is a failed RunResult. Contact chatter makes
+// MuJoCo's phi_net sensitive to microscopic changes (docs/mujoco-model.md): an ensemble over
+// dT_s + k us, k = 0..K-1, measures that sensitivity and averages it out.
+struct MujocoRuns {
+  const ExperimentCase& c;
+  const TailTrajectory& traj;
+  int K;      // ensemble size
+  double wn;  // the case's servo w_n = servo_wn_dt / timestep_s  [rad/s]
+
+  RunResult run(const MujocoSettings& s, const TailTrajectory& tr) const {
+    try {
+      return simulateMujoco(c.robot, tr, s, c.effects, c.output);
+    } catch (const std::exception& ex) {
+      RunResult r;
+      r.summary.ok = false;
+      r.summary.error = ex.what();
+      return r;
+    }
+  }
+  // The servo gains follow w_n = servo_wn_dt / timestep_s; changing the step alone would change
+  // the model (stiffer servos at smaller steps). Every timestep variant keeps the case's w_n.
+  MujocoSettings withStep(MujocoSettings s, double h) const {
+    s.timestep_s = h;
+    if (s.kp == 0.0) s.servo_wn_dt = wn * h;
+    return s;
+  }
+  // The trajectory with every joint's dT_s + k us.
+  TailTrajectory perturbed(int k) const {
+    TailTrajectory t;
+    for (const SplitCycleProfile& j : traj.joints) {
+      if (j.isSpline()) {
+        SplineParams p = j.spline();
+        p.dT_s += 1e-6 * k;
+        t.joints.emplace_back(p);
+      } else {
+        SplitCycleParams p = j.params();
+        p.dT_s += 1e-6 * k;
+        t.joints.emplace_back(p);
+      }
+    }
+    return t;
+  }
+  Ensemble ensemble(const MujocoSettings& s) const {
+    Ensemble en;
+    std::vector<double> v;
+    for (int k = 0; k < K; ++k) {
+      const RunResult r = run(s, perturbed(k));
+      if (r.summary.ok && std::isfinite(r.summary.phi_net_deg)) v.push_back(r.summary.phi_net_deg);
+      else if (en.error.empty()) en.error = r.summary.error;
+    }
+    en.ok = static_cast<int>(v.size());
+    if (v.empty()) return en;
+    double sum = 0, sq = 0;
+    for (double x : v) sum += x;
+    en.mean = sum / v.size();
+    for (double x : v) sq += (x - en.mean) * (x - en.mean);
+    en.sd = v.size() > 1 ? std::sqrt(sq / (v.size() - 1)) : 0.0;
+    return en;
+  }
+};
+
+// MuJoCo's reference: the implicit integrator with a tight solver at a small step (w_n kept), an
+// ensemble there and at twice the step, and the evidence lines; returns the reference settings.
+MujocoSettings mujocoReference(const MujocoRuns& mj, const AccuracyOptions& opt, AccuracyStudy& st) {
+  const int K = mj.K;
+  char b[512];
+  const double h_ref = opt.quick ? 1e-4 : 2.5e-5;
+  MujocoSettings ref_m = mj.withStep(mj.c.mujoco, h_ref);
+  ref_m.integrator = MujocoIntegrator::kImplicit;
+  ref_m.iterations = std::max(ref_m.iterations, 100);
+  ref_m.tolerance = std::min(ref_m.tolerance, 1e-10);
+  const Ensemble e_ref = mj.ensemble(ref_m);
+  const Ensemble e_2h = mj.ensemble(mj.withStep(ref_m, 2 * h_ref));
+  const Ensemble e_def = mj.ensemble(mj.c.mujoco);
+  st.mujoco.present = e_ref.ok > 0;
+  st.mujoco.setting = "implicit timestep_s=" + formatG(h_ref) + " (w_n kept), mean of " + std::to_string(K) +
+                      " runs with dT_s + 0.." + std::to_string(K - 1) + " us";
+  st.mujoco.phi_net_deg = e_ref.mean;
+  st.mujoco.noise_deg = e_ref.sd;
+  st.mujoco.noise_default_deg = e_def.sd;
+  const double se = std::sqrt((e_ref.sd * e_ref.sd + e_2h.sd * e_2h.sd) / K);
+  st.mujoco.uncertainty_deg = std::max(std::abs(e_ref.mean - e_2h.mean), se);
+  std::snprintf(b, sizeof b,
+                "MuJoCo ensemble means (implicit, tight solver, servo w_n = %.0f rad/s kept): timestep %g s: %.4f "
+                "+- %.4f deg; %g s: %.4f +- %.4f deg (+- = standard error); difference %.4f deg against a combined "
+                "standard error of %.4f deg. Reference error estimate: %.3f deg.",
+                mj.wn, 2 * h_ref, e_2h.mean, e_2h.sd / std::sqrt(K), h_ref, e_ref.mean, e_ref.sd / std::sqrt(K),
+                std::abs(e_ref.mean - e_2h.mean), se, st.mujoco.uncertainty_deg);
+  st.mujoco.evidence.push_back(b);
+  std::snprintf(b, sizeof b,
+                "MuJoCo sensitivity: dT_s changed by 1..%d us (a relative %.0e) moves phi_net with a standard "
+                "deviation of %.4f deg at the reference step and %.4f deg (%.2f %%) at tailsim's defaults (mean "
+                "%.4f deg). Single-run errors below this are contact-chatter noise, not step error.",
+                K - 1, 1e-6 * (K - 1) / mj.traj.joints.front().params().dT_s, e_ref.sd, e_def.sd,
+                100 * e_def.sd / std::abs(e_def.mean), e_def.mean);
+  st.mujoco.evidence.push_back(b);
+  if (!e_ref.error.empty()) st.mujoco.evidence.push_back("Reference run failures: " + e_ref.error);
+  return ref_m;
+}
+
+// MuJoCo's rows: timestep x integrator, then one family at a time around the defaults, each
+// against the reference ensemble's mean.
+void studyMujoco(const ExperimentCase& c, const TailTrajectory& traj, const AccuracyOptions& opt, AccuracyStudy& st) {
+  const MujocoSettings defaults_m;
+  const MujocoRuns mj{c, traj, opt.quick ? 3 : 6, c.mujoco.servo_wn_dt / c.mujoco.timestep_s};
+  const MujocoSettings ref_m = mujocoReference(mj, opt, st);
+  RunResult ref_mj;  // makeRow compares against the ensemble mean
+  ref_mj.summary.phi_net_deg = st.mujoco.phi_net_deg;
+  ref_mj.series = mj.run(ref_m, traj).series;
+  auto add = [&](const std::string& family, const std::string& setting, double value, const MujocoSettings& s) {
+    // The repeats double as a small ensemble (dT_s + k us): phi_net is their mean.
+    double wall = 0, mean = 0;
+    int runs = 0;
+    const RunResult r = timed([&](int k) { return mj.run(s, mj.perturbed(k)); }, opt.repeats, wall, mean, runs);
+    const bool dflt = s.timestep_s == defaults_m.timestep_s && s.integrator == defaults_m.integrator &&
+                      s.solver == defaults_m.solver && s.iterations == defaults_m.iterations &&
+                      s.tolerance == defaults_m.tolerance && s.cone == defaults_m.cone &&
+                      s.noslip_iterations == defaults_m.noslip_iterations && s.servo_wn_dt == defaults_m.servo_wn_dt;
+    st.rows.push_back(makeRow("mujoco", family, setting, value, dflt, r, wall, mean, runs, ref_mj));
+  };
+  const std::vector<double> steps = opt.quick ? std::vector<double>{5e-4, 2e-4}
+                                              : std::vector<double>{1e-3, 5e-4, 2e-4, 1e-4, 5e-5};
+  for (const MujocoIntegrator in : {MujocoIntegrator::kImplicit, MujocoIntegrator::kEuler, MujocoIntegrator::kRK4})
+    for (double h : steps) {
+      const std::string integ = name(in);
+      MujocoSettings s = mj.withStep(c.mujoco, h);
+      s.integrator = in;
+      add(std::string("timestep/") + integ, std::string("integrator=") + integ + " timestep_s=" + formatG(h), h, s);
+    }
+  if (opt.quick) return;
+  for (const MujocoSolver so : {MujocoSolver::kNewton, MujocoSolver::kCG, MujocoSolver::kPGS}) {
+    MujocoSettings s = c.mujoco;
+    s.solver = so;
+    add("solver", std::string("solver=") + name(so), 0, s);
+  }
+  for (auto [it, tol] : {std::pair<int, double>{100, 1e-10}, {20, 1e-6}, {5, 1e-3}}) {
+    MujocoSettings s = c.mujoco;
+    s.iterations = it;
+    s.tolerance = tol;
+    add("iterations", "iterations=" + std::to_string(it) + " tolerance=" + formatG(tol), tol, s);
+  }
+  for (const MujocoCone co : {MujocoCone::kElliptic, MujocoCone::kPyramidal}) {
+    MujocoSettings s = c.mujoco;
+    s.cone = co;
+    add("cone", std::string("cone=") + name(co), 0, s);
+  }
+  for (int ns : {0, 10}) {
+    MujocoSettings s = c.mujoco;
+    s.noslip_iterations = ns;
+    add("noslip", "noslip_iterations=" + std::to_string(ns), ns, s);
+  }
+}
+
 }  // namespace
 
 std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyOptions& opt) {
@@ -75,211 +299,8 @@ std::vector<AccuracyStudy> runAccuracyStudy(const Experiment& e, const AccuracyO
     AccuracyStudy st;
     st.case_name = e.name + (c.name == "base" ? "" : ":" + c.name);
     const TailTrajectory traj = c.trajectory();
-    const AnalyticSettings defaults_a;
-    const MujocoSettings defaults_m;
-    char b[512];
-
-    // --- analytic: adaptive tolerances and fixed RK4 steps against rel_tol = 1e-12 --------------
-    auto analytic = [&](const AnalyticSettings& s) { return simulateAnalytic(c.robot, traj, s, c.effects, c.output); };
-    auto adaptive = [&](double tol) {
-      AnalyticSettings s = c.analytic;
-      s.solver = AnalyticSolver::kAdaptive;
-      s.rel_tol = tol;
-      s.abs_tol = tol * 1e-2;
-      return s;
-    };
-    const RunResult ref_a = analytic(adaptive(1e-12));
-    st.analytic.present = true;
-    st.analytic.setting = "adaptive rel_tol=1e-12 abs_tol=1e-14";
-    st.analytic.phi_net_deg = ref_a.summary.phi_net_deg;
-    {
-      // Successive refinements 1e-9 .. 1e-12: their differences shrink towards the reference.
-      std::string line = "analytic adaptive, phi_net at rel_tol 1e-9, 1e-10, 1e-11, 1e-12:";
-      std::vector<double> seq;
-      for (double tol : {1e-9, 1e-10, 1e-11}) seq.push_back(analytic(adaptive(tol)).summary.phi_net_deg);
-      seq.push_back(ref_a.summary.phi_net_deg);
-      for (double v : seq) {
-        std::snprintf(b, sizeof b, " %.10f", v);
-        line += b;
-      }
-      line += " deg; successive differences";
-      for (size_t i = 1; i < seq.size(); ++i) {
-        std::snprintf(b, sizeof b, " %.1e", std::abs(seq[i] - seq[i - 1]));
-        line += b;
-      }
-      st.analytic.uncertainty_deg = std::abs(seq[3] - seq[2]);
-      std::snprintf(b, sizeof b, " deg. Reference error estimate: %.0e deg (|1e-12 - 1e-11|).", st.analytic.uncertainty_deg);
-      st.analytic.evidence.push_back(line + b);
-    }
-    {
-      AnalyticSettings ex = adaptive(1e-12);
-      ex.coupling = Coupling::kExact;
-      st.analytic_exact_deg = analytic(ex).summary.phi_net_deg;
-    }
-    const std::vector<double> tols = opt.quick ? std::vector<double>{1e-4, 1e-8}
-                                               : std::vector<double>{1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11};
-    for (double tol : tols) {
-      const AnalyticSettings s = adaptive(tol);
-      double wall = 0, mean = 0;
-      int runs = 0;
-      const RunResult r = timed([&](int) { return analytic(s); }, opt.repeats, wall, mean, runs);
-      const bool dflt = tol == defaults_a.rel_tol && s.abs_tol == defaults_a.abs_tol;
-      st.rows.push_back(makeRow("analytic", "adaptive", "rel_tol=" + formatG(tol), tol, dflt, r, wall, mean, 1, ref_a));
-    }
-    const std::vector<double> hs = opt.quick ? std::vector<double>{1e-3}
-                                             : std::vector<double>{1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6};
-    for (double h : hs) {
-      AnalyticSettings s = c.analytic;
-      s.solver = AnalyticSolver::kFixed;
-      s.fixed_dt_s = h;
-      double wall = 0, mean = 0;
-      int runs = 0;
-      const RunResult r = timed([&](int) { return analytic(s); }, opt.repeats, wall, mean, runs);
-      st.rows.push_back(makeRow("analytic", "fixed RK4", "fixed_dt_s=" + formatG(h), h, false, r, wall, mean, 1, ref_a));
-    }
-
-    // --- MuJoCo: timestep x integrator, then one family at a time around the defaults ------------
-    if (opt.mujoco) {
-      auto mujoco = [&](const MujocoSettings& s, const TailTrajectory& tr) {
-        try {
-          return simulateMujoco(c.robot, tr, s, c.effects, c.output);
-        } catch (const std::exception& ex) {
-          RunResult r;
-          r.summary.ok = false;
-          r.summary.error = ex.what();
-          return r;
-        }
-      };
-      // The servo gains follow w_n = servo_wn_dt / timestep_s; changing the step alone would change
-      // the model (stiffer servos at smaller steps). Every timestep variant keeps the case's w_n.
-      const double wn = c.mujoco.servo_wn_dt / c.mujoco.timestep_s;
-      auto withStep = [&](MujocoSettings s, double h) {
-        s.timestep_s = h;
-        if (s.kp == 0.0) s.servo_wn_dt = wn * h;
-        return s;
-      };
-      // Contact chatter makes MuJoCo's phi_net sensitive to microscopic changes (docs/mujoco-model.md):
-      // an ensemble over dT_s + k us, k = 0..K-1, measures that sensitivity and averages it out.
-      const int K = opt.quick ? 3 : 6;
-      auto perturbed = [&](int k) {
-        TailTrajectory t;
-        for (const SplitCycleProfile& j : traj.joints) {
-          if (j.isSpline()) {
-            SplineParams p = j.spline();
-            p.dT_s += 1e-6 * k;
-            t.joints.emplace_back(p);
-          } else {
-            SplitCycleParams p = j.params();
-            p.dT_s += 1e-6 * k;
-            t.joints.emplace_back(p);
-          }
-        }
-        return t;
-      };
-      struct Ensemble {
-        double mean = NAN, sd = NAN;
-        int ok = 0;
-        std::string error;
-      };
-      auto ensemble = [&](const MujocoSettings& s) {
-        Ensemble en;
-        std::vector<double> v;
-        for (int k = 0; k < K; ++k) {
-          const RunResult r = mujoco(s, perturbed(k));
-          if (r.summary.ok && std::isfinite(r.summary.phi_net_deg)) v.push_back(r.summary.phi_net_deg);
-          else if (en.error.empty()) en.error = r.summary.error;
-        }
-        en.ok = static_cast<int>(v.size());
-        if (v.empty()) return en;
-        double sum = 0, sq = 0;
-        for (double x : v) sum += x;
-        en.mean = sum / v.size();
-        for (double x : v) sq += (x - en.mean) * (x - en.mean);
-        en.sd = v.size() > 1 ? std::sqrt(sq / (v.size() - 1)) : 0.0;
-        return en;
-      };
-      const double h_ref = opt.quick ? 1e-4 : 2.5e-5;
-      MujocoSettings ref_m = withStep(c.mujoco, h_ref);
-      ref_m.integrator = MujocoIntegrator::kImplicit;
-      ref_m.iterations = std::max(ref_m.iterations, 100);
-      ref_m.tolerance = std::min(ref_m.tolerance, 1e-10);
-      const Ensemble e_ref = ensemble(ref_m);
-      const Ensemble e_2h = ensemble(withStep(ref_m, 2 * h_ref));
-      const Ensemble e_def = ensemble(c.mujoco);
-      st.mujoco.present = e_ref.ok > 0;
-      st.mujoco.setting = "implicit timestep_s=" + formatG(h_ref) + " (w_n kept), mean of " + std::to_string(K) +
-                          " runs with dT_s + 0.." + std::to_string(K - 1) + " us";
-      st.mujoco.phi_net_deg = e_ref.mean;
-      st.mujoco.noise_deg = e_ref.sd;
-      st.mujoco.noise_default_deg = e_def.sd;
-      const double se = std::sqrt((e_ref.sd * e_ref.sd + e_2h.sd * e_2h.sd) / K);
-      st.mujoco.uncertainty_deg = std::max(std::abs(e_ref.mean - e_2h.mean), se);
-      std::snprintf(b, sizeof b,
-                    "MuJoCo ensemble means (implicit, tight solver, servo w_n = %.0f rad/s kept): timestep %g s: %.4f "
-                    "+- %.4f deg; %g s: %.4f +- %.4f deg (+- = standard error); difference %.4f deg against a combined "
-                    "standard error of %.4f deg. Reference error estimate: %.3f deg.",
-                    wn, 2 * h_ref, e_2h.mean, e_2h.sd / std::sqrt(K), h_ref, e_ref.mean, e_ref.sd / std::sqrt(K),
-                    std::abs(e_ref.mean - e_2h.mean), se, st.mujoco.uncertainty_deg);
-      st.mujoco.evidence.push_back(b);
-      std::snprintf(b, sizeof b,
-                    "MuJoCo sensitivity: dT_s changed by 1..%d us (a relative %.0e) moves phi_net with a standard "
-                    "deviation of %.4f deg at the reference step and %.4f deg (%.2f %%) at tailsim's defaults (mean "
-                    "%.4f deg). Single-run errors below this are contact-chatter noise, not step error.",
-                    K - 1, 1e-6 * (K - 1) / traj.joints.front().params().dT_s, e_ref.sd, e_def.sd,
-                    100 * e_def.sd / std::abs(e_def.mean), e_def.mean);
-      st.mujoco.evidence.push_back(b);
-      if (!e_ref.error.empty()) st.mujoco.evidence.push_back("Reference run failures: " + e_ref.error);
-
-      RunResult ref_mj;  // makeRow compares against the ensemble mean
-      ref_mj.summary.phi_net_deg = e_ref.mean;
-      ref_mj.series = mujoco(ref_m, traj).series;
-      auto add = [&](const std::string& family, const std::string& setting, double value, const MujocoSettings& s) {
-        // The repeats double as a small ensemble (dT_s + k us): phi_net is their mean.
-        double wall = 0, mean = 0;
-        int runs = 0;
-        const RunResult r = timed([&](int k) { return mujoco(s, perturbed(k)); }, opt.repeats, wall, mean, runs);
-        const bool dflt = s.timestep_s == defaults_m.timestep_s && s.integrator == defaults_m.integrator &&
-                          s.solver == defaults_m.solver && s.iterations == defaults_m.iterations &&
-                          s.tolerance == defaults_m.tolerance && s.cone == defaults_m.cone &&
-                          s.noslip_iterations == defaults_m.noslip_iterations &&
-                          s.servo_wn_dt == defaults_m.servo_wn_dt;
-        st.rows.push_back(makeRow("mujoco", family, setting, value, dflt, r, wall, mean, runs, ref_mj));
-      };
-      const std::vector<double> steps = opt.quick ? std::vector<double>{5e-4, 2e-4}
-                                                  : std::vector<double>{1e-3, 5e-4, 2e-4, 1e-4, 5e-5};
-      for (const MujocoIntegrator in : {MujocoIntegrator::kImplicit, MujocoIntegrator::kEuler, MujocoIntegrator::kRK4})
-        for (double h : steps) {
-          const std::string integ = name(in);
-          MujocoSettings s = withStep(c.mujoco, h);
-          s.integrator = in;
-          add(std::string("timestep/") + integ, std::string("integrator=") + integ + " timestep_s=" + formatG(h), h, s);
-        }
-      if (!opt.quick) {
-        for (const MujocoSolver so : {MujocoSolver::kNewton, MujocoSolver::kCG, MujocoSolver::kPGS}) {
-          const std::string solver = name(so);
-          MujocoSettings s = c.mujoco;
-          s.solver = so;
-          add("solver", std::string("solver=") + solver, 0, s);
-        }
-        for (auto [it, tol] : {std::pair<int, double>{100, 1e-10}, {20, 1e-6}, {5, 1e-3}}) {
-          MujocoSettings s = c.mujoco;
-          s.iterations = it;
-          s.tolerance = tol;
-          add("iterations", "iterations=" + std::to_string(it) + " tolerance=" + formatG(tol), tol, s);
-        }
-        for (const MujocoCone co : {MujocoCone::kElliptic, MujocoCone::kPyramidal}) {
-          const std::string cone = name(co);
-          MujocoSettings s = c.mujoco;
-          s.cone = co;
-          add("cone", std::string("cone=") + cone, 0, s);
-        }
-        for (int ns : {0, 10}) {
-          MujocoSettings s = c.mujoco;
-          s.noslip_iterations = ns;
-          add("noslip", "noslip_iterations=" + std::to_string(ns), ns, s);
-        }
-      }
-    }
+    studyAnalytic(c, traj, opt, st);
+    if (opt.mujoco) studyMujoco(c, traj, opt, st);
     out.push_back(std::move(st));
   }
   return out;

@@ -20,6 +20,7 @@
 #include "results/work_limits.h"
 #include "results/number_text.h"
 #include "settings/units.h"
+#include "settings/trajectory_section.h"
 
 #include <algorithm>
 #include <cctype>
@@ -942,16 +943,24 @@ struct JointLocs {
   Loc dT, w_ss;
 };
 
-// The trajectory section's keys: split-cycle (the default family) and spline (family: spline).
-const std::vector<std::string> kSplitCycleKeys = {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps", "w_ss",
-                                                  "t0_s", "rule", "thetadot_max_dps", "thetadot_max_radps"};
-const std::vector<std::string> kSplineKeys = {"knots_deg", "dT_s", "t0_s"};
+// The trajectory section's keys (settings/trajectory_section.h): split-cycle (the default family)
+// and spline (family: spline), each ending with family.
+const std::vector<std::string> kSplitCycleKeys = settings::declaredKeys<SplitCycleSection>();
+const std::vector<std::string> kSplineKeys = settings::declaredKeys<SplineSection>();
+
+// The keys of a list but `family`, comma-separated.
+std::string keysButFamily(const std::vector<std::string>& keys) {
+  std::string s;
+  for (const std::string& k : keys)
+    if (k != "family") s += (s.empty() ? "" : ", ") + k;
+  return s;
+}
 
 // family: spline -- per joint a clamped cubic spline through equally spaced knots (JointProfile).
 std::vector<SplineParams> readSplineTrajectory(const Reader& r, const Item& item, const MapView& t, int n) {
   for (const auto& [k, it] : t.fields)
-    if (k != "family" && std::find(kSplineKeys.begin(), kSplineKeys.end(), k) == kSplineKeys.end())
-      r.fail(it, "not used with family: spline (spline keys: knots_deg, dT_s, t0_s)");
+    if (std::find(kSplineKeys.begin(), kSplineKeys.end(), k) == kSplineKeys.end())
+      r.fail(it, "not used with family: spline (spline keys: " + keysButFamily(kSplineKeys) + ")");
   std::vector<SplineParams> joints(static_cast<std::size_t>(n));
   // knots_deg: one list of knots for every joint, or a list of n lists (one per joint).
   const Item& kn = r.need(t, "knots_deg");
@@ -996,9 +1005,7 @@ std::vector<SplineParams> readSplineTrajectory(const Reader& r, const Item& item
 }
 
 std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, int n) {
-  std::vector<std::string> allowed = kSplitCycleKeys;
-  allowed.push_back("family");
-  const MapView t = r.map(item, allowed);
+  const MapView t = r.map(item, kSplitCycleKeys);
   if (const Item* f = t.get("family")) r.choice(*f, {"split_cycle"});  // spline: readSplineTrajectory
   std::vector<SplitCycleParams> joints(static_cast<std::size_t>(n));
   std::vector<JointLocs> locs(static_cast<std::size_t>(n), JointLocs{r.loc(item), r.loc(item)});
@@ -1400,8 +1407,9 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     if (!traj) tailsim::fail(r.locAt(root, "trajectory"), "required for kind: simulate");
     // family: split_cycle (default: Eqs. 20-23) or spline (a clamped cubic spline per joint).
     const MapView tm = r.map(*traj, [] {
-      std::vector<std::string> k = kSplitCycleKeys;
-      k.insert(k.end(), {"family", "knots_deg"});
+      std::vector<std::string> k = kSplitCycleKeys;  // ... family, then the spline's own keys
+      for (const std::string& key : kSplineKeys)
+        if (std::find(k.begin(), k.end(), key) == k.end()) k.push_back(key);
       return k;
     }());
     const Item* fam = tm.get("family");

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "models/analytic/analytic_recorder.h"
+#include "models/analytic/analytic_rows.h"
 #include "models/analytic/analytic_simulation.h"
 #include "models/perfoot/per_foot_model.h"
 #include "models/mujoco/attach_tail.h"

@@ -9,6 +9,7 @@
 #include "experiments/model_registry.h"
 #include "experiments/robot_model_cases.h"
 #include "experiments/yaml_file.h"
+#include "settings/units.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -44,7 +45,7 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
   k.robot.friction.mu_s = k.robot.friction.mu_d = c.robot.mu;
   k.robot.gravity_mps2 = c.robot.gravity_mps2;
   for (int i = 0; i < n; ++i)
-    k.joints.push_back(equalPeakSpeedParams(n, choice.thetadot_max_dps * M_PI / 180.0, 0.25));  // Eq. (25)
+    k.joints.push_back(equalPeakSpeedParams(n, units::radians(choice.thetadot_max_dps), 0.25));  // Eq. (25)
   k.mujoco.body_height_m = k.robot.quadruped.com_height_m;
   k.output.settle_s = choice.settle_after_s;
 

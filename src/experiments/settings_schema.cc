@@ -3,6 +3,7 @@
 #include "controllers/heading_controller.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <type_traits>
@@ -12,6 +13,7 @@
 #include "experiments/model_registry.h"
 #include "results/work_limits.h"
 #include "results/number_text.h"
+#include "settings/trajectory_section.h"
 
 namespace tailsim {
 namespace {
@@ -25,6 +27,13 @@ json orSweep(json value) { return {{"anyOf", json::array({std::move(value), swee
 void limitsInto(json& s, const settings::Limits& l) {
   if (l.hasLo()) s[l.lo_open ? "exclusiveMinimum" : "minimum"] = l.lo;
   if (l.hasHi()) s[l.hi_open ? "exclusiveMaximum" : "maximum"] = l.hi;
+}
+
+// A number for all joints, or one per joint.
+json perJointSchema(json value, const std::string& doc) {
+  json one = orSweep(value);
+  return {{"description", doc},
+          {"anyOf", json::array({value, sweepRef(), {{"type", "array"}, {"minItems", 1}, {"items", one}}})}};
 }
 
 // One declared struct -> schema properties and Markdown rows.
@@ -44,8 +53,29 @@ struct Describer {
     json v = {{"type", "number"}};
     limitsInto(v, l);
     const std::string t = l.text();
-    add(f, v, t.empty() ? "number" : "number, " + t.substr(t.find(' ') + 1), formatG(x));
+    add(f, v, t.empty() ? "number" : "number, " + t.substr(t.find(' ') + 1), defaultText(x));
   }
+  // A number for every joint, or a list of one per joint.
+  void perJoint(const settings::Field& f, double x, const settings::Limits& l) {
+    json v = {{"type", "number"}};
+    limitsInto(v, l);
+    const std::string t = l.text();
+    add(f, v, t.empty() ? "number or one per joint" : "number or one per joint, " + t.substr(t.find(' ') + 1),
+        defaultText(x));
+    props[f.key] = perJointSchema(v, f.doc);
+  }
+  // A list of 2..max knots within l, or a list of one such list per joint.
+  void knotLists(const settings::Field& f, const settings::Limits& l, int max) {
+    json knot = {{"type", "number"}};
+    limitsInto(knot, l);
+    const json knots = {{"type", "array"}, {"minItems", 2}, {"maxItems", max}, {"items", orSweep(knot)}};
+    const std::string t = l.text();
+    add(f, knots, "2.." + std::to_string(max) + " numbers, each " + t.substr(t.find(' ') + 1) + "; or one such list per joint",
+        "");
+    props[f.key] = {{"description", f.doc},
+                    {"anyOf", json::array({knots, {{"type", "array"}, {"minItems", 1}, {"items", knots}}})}};
+  }
+  static std::string defaultText(double x) { return std::isnan(x) ? "" : formatG(x); }
   void integer(const settings::Field& f, int x, const settings::Limits& l, const settings::IntSet& only = {}) {
     json v = {{"type", "integer"}};
     limitsInto(v, l);
@@ -79,9 +109,10 @@ struct Describer {
     }
     if (!rule.one_of.empty()) {
       v["enum"] = rule.one_of;
-      allowed = "`" + rule.one_of.front() + "` .. `" + rule.one_of.back() + "`";
+      allowed = rule.one_of.size() == 1 ? "`" + rule.one_of.front() + "`"
+                                        : "`" + rule.one_of.front() + "` .. `" + rule.one_of.back() + "`";
     }
-    add(f, v, allowed, "`" + x + "`");
+    add(f, v, allowed, x.empty() ? std::string() : "`" + x + "`");
   }
   template <std::size_t N>
   void numbers(const settings::Field& f, const std::array<double, N>& x) {
@@ -144,11 +175,6 @@ json quadrupedProps() {
   return p;
 }
 
-json perJoint(json value, const std::string& doc) {
-  json one = orSweep(value);
-  return {{"description", doc},
-          {"anyOf", json::array({value, sweepRef(), {{"type", "array"}, {"minItems", 1}, {"items", one}}})}};
-}
 
 // Declared properties without their sweep alternative (files that hold no sweeps).
 json plain(json props) {
@@ -248,29 +274,15 @@ json maneuverSection() {
 json experimentSchema() {
   const json num = {{"type", "number"}};
   json link = section(describe<TailLink>().props, {"mass_kg", "izz_kgm2", "length_m"});
-  const json knot = orSweep({{"type", "number"}, {"minimum", -limits::kMaxAbsTheta0Deg}, {"maximum", limits::kMaxAbsTheta0Deg}});
-  const json knots = {{"type", "array"}, {"minItems", 2}, {"maxItems", limits::kMaxSplineKnots}, {"items", knot}};
-  json traj = section({
-      {"theta0_deg", perJoint({{"type", "number"}, {"minimum", -limits::kMaxAbsTheta0Deg}, {"maximum", limits::kMaxAbsTheta0Deg}},
-                              "start angle theta_0 [deg]")},
-      {"dtheta_deg", perJoint({{"type", "number"}, {"minimum", -limits::kMaxAbsDthetaDeg}, {"maximum", limits::kMaxAbsDthetaDeg}},
-                              "displacement Delta theta [deg]")},
-      {"dT_s", perJoint({{"type", "number"}, {"minimum", limits::kMinDT_s}}, "duration Delta T [s]")},
-      {"peak_speed_dps", perJoint({{"type", "number"}, {"exclusiveMinimum", 0}}, "peak joint speed; sets dT [deg/s]")},
-      {"w_ss", perJoint({{"type", "number"}, {"minimum", limits::kMinWss}, {"maximum", limits::kMaxWss}},
-                        "split-cycle parameter")},
-      {"t0_s", perJoint({{"type", "number"}, {"minimum", 0}}, "start time [s]")},
-      {"rule", orSweep({{"type", "string"}, {"enum", {"eq25"}}})},
-      {"family", orSweep({{"type", "string"}, {"enum", {"split_cycle", "spline"}}})},
-      {"knots_deg",
-       {{"description", "family: spline: knot angles [deg], one list for all joints or one list per joint"},
-        {"anyOf", json::array({knots, {{"type", "array"}, {"minItems", 1}, {"items", knots}}})}}},
-      {"thetadot_max_dps", orSweep({{"type", "number"}, {"exclusiveMinimum", 0}})},
-      {"thetadot_max_radps", orSweep({{"type", "number"}, {"exclusiveMinimum", 0}})},
-  });
-  json pose = section({{"theta_deg", perJoint(num, "joint angles [deg]")},
-                       {"thetadot_radps", perJoint(num, "joint speeds [rad/s]")},
-                       {"thetaddot_radps2", perJoint(num, "joint accelerations [rad/s^2]")}});
+  // The trajectory section: the split-cycle keys and the spline's (settings/trajectory_section.h).
+  json traj_props = describe<SplitCycleSection>().props;
+  const json spline_props = describe<SplineSection>().props;  // named: not a range-for over a temporary
+  for (const auto& [k, v] : spline_props.items())
+    if (!traj_props.contains(k)) traj_props[k] = v;
+  json traj = section(traj_props);
+  json pose = section({{"theta_deg", perJointSchema(num, "joint angles [deg]")},
+                       {"thetadot_radps", perJointSchema(num, "joint speeds [rad/s]")},
+                       {"thetaddot_radps2", perJointSchema(num, "joint accelerations [rad/s^2]")}});
   json tail = {{"type", "object"},
                {"additionalProperties", false},
                {"properties",
@@ -398,6 +410,14 @@ std::string settingsMarkdown() {
   table("maneuver", "The `maneuver:` section of a `kind: maneuver` file (`tailsim maneuver`, "
                     "[design-a-tail-stroke.md](design-a-tail-stroke.md) \"Maneuvers\"), not of `tailsim run` experiments.",
         describe<ManeuverSettings>().rows);
+  table("trajectory (split-cycle, Eqs. 20-23)",
+        "The default family. Each per-joint key is a number (the same for every joint) or a list with one value per "
+        "joint (exactly n values). Give `dtheta_deg` and one of `dT_s`, `peak_speed_dps`; or `rule: eq25` with "
+        "`thetadot_max_dps` or `thetadot_max_radps` (below).",
+        describe<SplitCycleSection>().rows);
+  table("trajectory (spline, `family: spline`)",
+        "Per joint a clamped cubic spline through equally spaced knots (below); `knots_deg` and `dT_s` required.",
+        describe<SplineSection>().rows);
   std::string s = o.str();
   while (s.size() >= 2 && s[s.size() - 1] == '\n' && s[s.size() - 2] == '\n') s.pop_back();
   return s;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "settings/fields.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -127,7 +128,7 @@ settings::For<S, TailLink> declareFields(V& v, S& s) {
   v.number(Field{"length_m", "joint i to joint i+1 [m]"}, s.length_m, Limits::positive());
   v.number(Field{"com_offset_m", "joint i to the link COM along the link; absent = 0.5 length_m [m]"}, s.com_offset_m,
            Limits::nonNegative());
-  constexpr double kRad = M_PI / 180.0;
+  constexpr double kRad = units::kRadPerDeg;
   v.number(Field{"torque_max_Nm", "joint i's actuator: peak torque [N m]; 0 or absent = not given (the design "
                                   "tool then needs a limit in its file)"},
            s.torque_max_Nm, Limits::nonNegative());

@@ -10,16 +10,16 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include "models/analytic/analytic_model.h"
-#include "models/analytic/analytic_recorder.h"
+#include "models/analytic/analytic_rows.h"
 #include "models/planar/foot_loads.h"
-#include "models/planar/step_control.h"
+#include "models/planar/stick_slip_driver.h"
 #include "models/planar/support_check.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
@@ -66,24 +66,6 @@ double paperResidualSpin(const RobotParams& robot, const TailTrajectory& traj) {
   return w;
 }
 
-bool allFinite(const State& y) {
-  for (double v : y)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
-
-using DenseDopri5 = StabilizedDenseDopri5<State>;
-
-// What a run needs to know before it starts: its end, its rows, its step sizes.
-struct RunPlan {
-  double t_end = 0;     // [s]
-  long rows = 0;        // output rows
-  double tail_end = 0;  // the tail stops moving  [s]
-  double h_scan = 0;    // event sampling interval, the shortest phase of all / 32  [s] (segmentScales: per segment)
-  double h_max = 0;     // adaptive step bound while the tail moves, the shortest phase of all / 8  [s] (idem)
-  bool adaptive = true;
-};
-
 // Checks the settings (std::invalid_argument) and plans the run.
 RunPlan planRun(const TailTrajectory& trajectory, const AnalyticSettings& settings, const OutputSettings& output) {
   if (settings.solver != AnalyticSolver::kAdaptive && settings.solver != AnalyticSolver::kFixed)
@@ -114,42 +96,110 @@ RunPlan planRun(const TailTrajectory& trajectory, const AnalyticSettings& settin
   return plan;
 }
 
-// One run in progress: the constant model and plan, the workspace, the output and the state.
-struct Run {
-  // thin: output.time_series thin (the recorder evaluates only the rows that thinning keeps).
-  Run(const AnalyticModel& m, const RunPlan& p, double sample_dt_s, double v_stop_mps, bool thin)
-      : model(m), plan(p), breakpoints(m.traj.breakpoints()),
-        rec(m.robot.numLinks(), sample_dt_s, p.rows, thin ? &breakpoints : nullptr), v_stop(v_stop_mps) {}
+// The analytic model as the planar driver runs it (stick_slip_driver.h): its right-hand side,
+// event margins (both DOFs), mode switches and rows, with the workspace and the switch counters.
+class AnalyticStickSlip {
+ public:
+  using State = tailsim::State;
+  static constexpr bool kDefersRowsInSteps = true;   // a step's rows wait while a stuck margin falls at its end
+  static constexpr bool kHitOnlyWithinStep = false;  // a switch located past tb by round-off still ends the step
+  static constexpr bool kFillsGridToEnd = false;     // rows more than 1e-12 s past t_end are not written
+
+  AnalyticStickSlip(const AnalyticModel& m, double v_stop) : model(m), v_stop_(v_stop), rows_(m.robot.numLinks()) {}
 
   const AnalyticModel& model;
-  const RunPlan& plan;
   AnalyticWorkspace ws;
-  std::vector<double> breakpoints;  // of the tail profile (also thinning's marks)
-  AnalyticRecorder rec;
-  double v_stop;  // a slide below this speed may stick (fixed solver: at least one step's friction)
-  State y{};
-  Modes modes;
-  double t = 0.0;
-  int switches = 0;       // stick/slip events
-  double t_stop = 0.0;    // the rotation last stuck
+  int switches = 0;         // stick/slip events
+  double t_stop = 0.0;      // the rotation last stuck
   bool ever_rotated = false;
-  long steps = 0;         // accepted solver steps
-  long rhs = 0;           // right-hand sides the solver evaluated (accepted and rejected trial steps)
-  long rejected = 0;      // adaptive: trial steps the error control rejected
-  long held = 0;          // adaptive: steps with every DOF stuck (heldChunk: scanned, not integrated)
-  double dt_resume = 0.0;  // the step to restart with after a tail breakpoint (0: after a switch)
-  double held_dt = 0.0;    // heldChunk: the chunk to go on with (0: after a switch, start small)
-  // The last step's scan, kept while the modes stay (adaptiveSegment): its end margins start the
-  // next scan; when a stuck margin was still falling there (dipMayCross), its last two samples
-  // and its dense output too, and the rows after its second-last sample wait for the next step.
-  struct Carry {
-    bool have = false;    // end holds the scan of the step that ended at t_end
-    bool across = false;  // and stepper its dense output: the next scan looks across t_end
-    double t_end = 0;
-    ScanEnd end;
-    std::optional<DenseDopri5> stepper;
-  } carry;
+
+  const std::vector<std::string>& columns() const { return rows_.names(); }
+  void fillRow(double t, const State& y, const Modes& modes, double* out) { rows_.fill(model, ws, t, y, modes, out); }
+  static double phi(const State& y) { return y[kPhi]; }
+  bool stiction() const { return model.stiction(); }
+  bool translation() const { return model.translation(); }
+  const AnalyticSettings& settings() const { return model.settings; }
+  double vStop() const { return v_stop_; }
+
+  // Both DOFs stuck (the translation stuck or locked): nothing will change until a margin says so.
+  bool held(const Modes& modes) const {
+    return model.stiction() && modes.stuck[kRot] && (modes.stuck[kTrans] || !model.translation());
+  }
+
+  // Event sampling interval and step bound over [t, seg_end], which lies between two breakpoints
+  // of the tail profile: each joint is in one phase there. Both follow the shortest phase of the
+  // joints that move (planRun's rules restricted to what moves: a joint at rest adds no load
+  // variation, and a load peak is as wide as the phase that makes it): step bound 1/8 of it,
+  // sampling 1/32. A margin's dip is found when it spans at most two sample intervals, also
+  // across a step's end (docs/accuracy.md "A dip across a step boundary"; docs/scale.md
+  // "Analytic hot path"). With the whole tail at rest its loads vanish (no joint speed or
+  // acceleration); with the paper coupling every margin is then monotone in time (constant
+  // friction decelerations, no tail force), so a step's midpoint and end suffice. With the exact
+  // coupling the rotation and the translation still exchange momentum: the run's sampling stays.
+  SegmentScales scales(const RunPlan& plan, double t, double seg_end) const {
+    const double shortest = model.traj.shortestActivePhase(0.5 * (t + seg_end));
+    if (!std::isfinite(shortest)) {
+      const bool paper = model.settings.coupling == Coupling::kPaper;
+      return {paper ? shortest : plan.h_scan, plan.h_max};
+    }
+    const double max_step = model.settings.max_step_s;
+    return {shortest / 32.0, max_step > 0 ? max_step : shortest / 8.0};
+  }
+
+  bool scansSteps() const { return model.stiction(); }
+  bool keepsScanEnd() const { return model.stiction(); }
+  static const Modes& scanModes(const Modes& modes) { return modes; }
+  Margins margins(double t, const State& y, const Modes& modes) {
+    return eventMargins(model, ws, v_stop_, t, y, modes);
+  }
+  void onHit(const Found&, const State&, const Modes&) const {}
+  void onHeldScan(const Found&, bool, const State&, const Modes&, const ScanEnd&) const {}
+
+  void switchAt(double t, State& y, Modes& modes, int which) {
+    const Modes before = modes;
+    if (which >= 0) {
+      applySwitch(model, ws, which, t, y, modes);
+      ++switches;
+    }
+    switches += settleModes(model, ws, v_stop_, t, y, modes);
+    if (!before.stuck[kRot] && modes.stuck[kRot]) t_stop = t;
+    if (!modes.stuck[kRot]) ever_rotated = true;
+  }
+
+  // A translation that has just broken away starts inside the friction's regularization band
+  // (|v| < v_reg), where the friction relaxes v at the rate mu_d W / (m v_reg): the first step
+  // resolves a fifth of that time instead of being rejected down to it from 1e-4 s.
+  double firstStep(double dt0, const State& y, const Modes& modes) const {
+    const AnalyticModel& m = model;
+    if (m.stiction() && m.translation() && !modes.stuck[kTrans] && m.v_reg > 0.0 &&
+        std::hypot(y[kVx], y[kVy]) < m.v_reg && m.robot.friction.mu_d > 0.0)
+      return std::min(dt0, 0.2 * m.v_reg * m.robot.systemMass() / (m.robot.friction.mu_d * m.weight));
+    return dt0;
+  }
+
+  void derivative(double t, const State& y, const Modes& modes, State& dy) {
+    tailsim::derivative(model, ws, t, y, modes, dy);
+  }
+
+  std::string stepBudgetMessage(double t, double t_end, bool /*held*/) const {
+    return "step budget of " + std::to_string(model.settings.max_steps) + " steps exhausted at t=" +
+           std::to_string(t) + " s of " + std::to_string(t_end) +
+           " s (docs/experiment-format.md \"Limits\"): loosen analytic.rel_tol/abs_tol, "
+           "raise max_step_s or fixed_dt_s, or shorten the run";
+  }
+  std::string nonFiniteMessage(double t) const {
+    const std::string advice = model.settings.solver == AnalyticSolver::kFixed
+                                   ? "analytic.fixed_dt_s=" + std::to_string(model.settings.fixed_dt_s) + " is too large"
+                                   : "tighten analytic.rel_tol (" + std::to_string(model.settings.rel_tol) + ")";
+    return "state became non-finite at t=" + std::to_string(t) + " s: " + advice;
+  }
+
+ private:
+  double v_stop_;  // a slide below this speed may stick (fixed solver: at least one step's friction)
+  AnalyticRows rows_;
 };
+
+using Run = PlanarRun<AnalyticStickSlip>;
 
 // The fixed-step solver checks once per step: a slide slower than one step's friction
 // deceleration (mu_d g h) would reverse within the next step, so it counts as stopped.
@@ -159,220 +209,13 @@ double stopSpeed(const AnalyticModel& m, const RunPlan& plan) {
                        : std::max(s.v_stop_mps, m.robot.friction.mu_d * m.weight / m.robot.systemMass() * s.fixed_dt_s);
 }
 
-// Switches DOF `which` (or none, -1) at run.t, then settles the modes; keeps the summary counters.
-void switchAt(Run& run, int which) {
-  const Modes before = run.modes;
-  run.held_dt = 0.0;
-  if (which >= 0) {
-    applySwitch(run.model, run.ws, which, run.t, run.y, run.modes);
-    ++run.switches;
-  }
-  run.switches += settleModes(run.model, run.ws, run.v_stop, run.t, run.y, run.modes);
-  if (!before.stuck[kRot] && run.modes.stuck[kRot]) run.t_stop = run.t;
-  if (!run.modes.stuck[kRot]) run.ever_rotated = true;
-}
-
 // Initially at rest: stuck wherever stiction holds (Eqs. 14-16, first cases); a load already
 // above the static limit breaks away at once.
 void startAtRest(Run& run) {
   if (!run.model.stiction()) return;
   run.modes.stuck[kRot] = true;
   run.modes.stuck[kTrans] = run.model.translation();
-  switchAt(run, -1);
-}
-
-// Both DOFs stuck with the tail still: nothing will change any more.
-bool stuckForGood(const Run& run) {
-  const AnalyticModel& m = run.model;
-  return m.stiction() && run.modes.stuck[kRot] && (run.modes.stuck[kTrans] || !m.translation());
-}
-bool settled(const Run& run, double t) { return t >= run.plan.tail_end && stuckForGood(run); }
-
-// The next breakpoint of the tail profile after t (or the end of the run).
-double nextBreak(const Run& run, double t) {
-  for (double b : run.breakpoints)
-    if (b > t + 1e-14) return std::min(b, run.plan.t_end);
-  return run.plan.t_end;
-}
-
-// Records every sample up to t_hi, with stateAt(t, y) the state there.
-template <class StateAt>
-void recordUpTo(Run& run, double t_hi, const StateAt& stateAt) {
-  State ys;
-  while (!run.rec.done() && run.rec.nextTime() <= t_hi + 1e-12) {
-    const double ts = std::min(run.rec.nextTime(), run.plan.t_end);
-    stateAt(ts, ys);
-    run.rec.record(run.model, run.ws, ts, ys, run.modes);
-  }
-}
-
-bool allFinite(const State& y);
-
-// `advice` is called only to word the error.
-template <class Advice>
-void checkFinite(const Run& run, const Advice& advice) {
-  if (!allFinite(run.y))
-    throw std::runtime_error("state became non-finite at t=" + std::to_string(run.t) + " s: " + advice());
-}
-
-// Step budget: a run that needs more steps fails with this message instead of running on.
-void countStep(Run& run) {
-  ++run.steps;
-  const long max_steps = run.model.settings.max_steps;
-  if (run.steps > max_steps)
-    throw std::runtime_error("step budget of " + std::to_string(max_steps) + " steps exhausted at t=" +
-                             std::to_string(run.t) + " s of " + std::to_string(run.plan.t_end) +
-                             " s (docs/experiment-format.md \"Limits\"): loosen analytic.rel_tol/abs_tol, "
-                             "raise max_step_s or fixed_dt_s, or shorten the run");
-}
-
-// Event sampling interval and step bound over [t, seg_end], which lies between two breakpoints of
-// the tail profile: each joint is in one phase there. Both follow the shortest phase of the joints
-// that move (planRun's rules restricted to what moves: a joint at rest adds no load variation, and
-// a load peak is as wide as the phase that makes it): step bound 1/8 of it, sampling 1/32. A
-// margin's dip is found when it spans at most two sample intervals, also across a step's end
-// (docs/accuracy.md "A dip across a step boundary"; the sampling followed the whole run's shortest
-// phase until that fix was in, docs/scale.md "Analytic hot path"). With the whole tail at rest its
-// loads vanish (no joint speed or acceleration); with the paper coupling every margin is then
-// monotone in time (constant friction decelerations, no tail force), so a step's midpoint and end
-// suffice. With the exact coupling the rotation and the translation still exchange momentum: the
-// run's sampling stays.
-struct SegmentScales {
-  double h_scan, h_max;
-};
-SegmentScales segmentScales(const Run& run, double t, double seg_end) {
-  const double shortest = run.model.traj.shortestActivePhase(0.5 * (t + seg_end));
-  if (!std::isfinite(shortest)) {
-    const bool paper = run.model.settings.coupling == Coupling::kPaper;
-    return {paper ? shortest : run.plan.h_scan, run.plan.h_max};
-  }
-  const double max_step = run.model.settings.max_step_s;
-  return {shortest / 32.0, max_step > 0 ? max_step : shortest / 8.0};
-}
-
-// While every DOF is stuck (both, or the rotation with the translation locked) the body does not
-// move: its state is constant and there is nothing to integrate. The margins are scanned chunk by
-// chunk as a solver step's would be, with the state held; a margin still falling at the chunk's
-// end carries into the next chunk's scan (a dip across the boundary), and the rows after its
-// second-last sample wait for that scan. The chunks grow as the solver's steps would with no error
-// to control: 1e-4 s after a switch, then 10 times the last one, up to the step bound (across a
-// tail breakpoint too). So a margin's dip right after a switch is sampled finely: a chunk has no
-// sample before its start to show a dip whose lowest sample is that start. One chunk counts as
-// one solver step and costs no right-hand side.
-void heldChunk(Run& run, double seg_end) {
-  const AnalyticModel& m = run.model;
-  const double t_end = run.plan.t_end;
-  const SegmentScales scales = segmentScales(run, run.t, seg_end);
-  const double dt = std::min(run.held_dt > 0.0 ? run.held_dt : 1e-4, scales.h_max);
-  const double ta = run.t, tb = std::min(seg_end, ta + dt);
-  const State y = run.y;
-  auto stateAt = [&](double, State& ys) { ys = y; };
-  auto gAt = [&](double tt) { return eventMargins(m, run.ws, run.v_stop, tt, y, run.modes); };
-  Run::Carry& carry = run.carry;
-  const bool have = carry.have && carry.t_end == ta;
-  ScanEnd end;
-  const Found f = findSwitch(gAt, run.modes, ta, tb, scales.h_scan, m.settings.event_tol_s, have ? &carry.end : nullptr,
-                             &end, have && carry.across);
-  countStep(run);
-  ++run.held;
-  run.dt_resume = 0.0;
-  run.held_dt = 10.0 * (tb - ta);  // (switchAt below resets it)
-  const double t_cut = f.hit ? f.t : tb;
-  const bool defer = !f.hit && dipMayCross(run.modes, end) && tb < t_end - 1e-15 && !(tb >= run.plan.tail_end);
-  recordUpTo(run, defer ? end.t_before : t_cut, stateAt);
-  run.t = t_cut;
-  carry.stepper.reset();
-  if (f.hit) {
-    carry.have = carry.across = false;
-    switchAt(run, f.which);
-    return;
-  }
-  carry.have = true;
-  carry.across = defer;
-  carry.t_end = tb;
-  carry.end = end;
-}
-
-// Adaptive dense-output Dormand-Prince from run.t until a located switch, a breakpoint of the
-// tail profile (seg_end), the end, or rest: the stepper restarts there.
-void adaptiveSegment(Run& run, double seg_end) {
-  const AnalyticModel& m = run.model;
-  const AnalyticSettings& s = m.settings;
-  const double t_end = run.plan.t_end;
-  const bool tail_moving = run.t < run.plan.tail_end;
-  const SegmentScales scales = segmentScales(run, run.t, seg_end);
-  const double max_dt = (tail_moving || run.modes.stuck[kRot] || run.modes.stuck[kTrans]) ? scales.h_max : (t_end - run.t);
-  auto rhs = [&](const State& x, State& dx, double tt) {
-    ++run.rhs;
-    derivative(m, run.ws, tt, x, run.modes, dx);
-  };
-  DenseDopri5 stepper = makeStabilizedDopri5<State>(s.abs_tol, s.rel_tol, max_dt, &run.rejected);
-  // After a switch the dynamics change: start small. After a tail breakpoint they continue with
-  // a jump in the tail acceleration only: go on with the step size the solver had reached.
-  double dt0 = std::min(max_dt, run.dt_resume > 0 ? run.dt_resume : 1e-4);
-  // A translation that has just broken away starts inside the friction's regularization band
-  // (|v| < v_reg), where the friction relaxes v at the rate mu_d W / (m v_reg): the first step
-  // resolves a fifth of that time instead of being rejected down to it from 1e-4 s.
-  if (run.dt_resume == 0.0 && m.stiction() && m.translation() && !run.modes.stuck[kTrans] && m.v_reg > 0.0 &&
-      std::hypot(run.y[kVx], run.y[kVy]) < m.v_reg && m.robot.friction.mu_d > 0.0)
-    dt0 = std::min(dt0, 0.2 * m.v_reg * m.robot.systemMass() / (m.robot.friction.mu_d * m.weight));
-  run.dt_resume = 0.0;
-  stepper.initialize(run.y, run.t, dt0);
-  for (;;) {
-    // A step that would cross the next breakpoint (where the tail acceleration jumps) ends on it
-    // instead: across it the error estimate fails and the step is rejected over and over.
-    const double t_now = stepper.current_time(), dt_now = stepper.current_time_step();
-    if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12)
-      stepper.initialize(stepper.current_state(), t_now, seg_end - t_now);
-    const auto [ta, tb_raw] = stepper.do_step(rhs);
-    countStep(run);
-    const double tb = std::min(tb_raw, seg_end);
-    Run::Carry& carry = run.carry;
-    const bool have = carry.have && carry.t_end == ta, across = have && carry.across;
-    // Before ta (a dip looked for across the boundary): the previous step's dense output.
-    auto stateAt = [&](double tt, State& ys) {
-      if (across && tt < ta)
-        carry.stepper->calc_state(tt, ys);
-      else
-        stepper.calc_state(tt, ys);
-    };
-    Found f;
-    ScanEnd end;
-    if (m.stiction()) {
-      State yg;
-      auto gAt = [&](double tt) {
-        stateAt(tt, yg);
-        return eventMargins(m, run.ws, run.v_stop, tt, yg, run.modes);
-      };
-      f = findSwitch(gAt, run.modes, ta, tb, scales.h_scan, s.event_tol_s, have ? &carry.end : nullptr, &end, across);
-    }
-    const double t_cut = f.hit ? f.t : tb;
-    // A margin still falling at tb may dip below zero just after it: the rows after the last
-    // sample before tb wait until the next step's scan has looked (the switch may come first).
-    const bool defer = !f.hit && m.stiction() && dipMayCross(run.modes, end) && tb < t_end - 1e-15 &&
-                       !(tb >= run.plan.tail_end && stuckForGood(run));
-    recordUpTo(run, defer ? end.t_before : t_cut, stateAt);
-    stateAt(t_cut, run.y);
-    run.t = t_cut;
-    checkFinite(run, [&] { return "tighten analytic.rel_tol (" + std::to_string(s.rel_tol) + ")"; });
-    if (f.hit) {
-      carry.have = carry.across = false;
-      switchAt(run, f.which);
-      return;
-    }
-    carry.have = m.stiction();
-    carry.across = defer;
-    carry.t_end = tb;
-    carry.end = end;
-    if (defer) carry.stepper = stepper;
-    if (tb_raw >= seg_end - 1e-15) {  // a breakpoint of the tail profile: restart the step there
-      if (tb_raw <= seg_end + 1e-12) run.dt_resume = std::max(stepper.current_time_step(), tb_raw - ta);
-      return;
-    }
-    if (run.t >= t_end - 1e-15 || settled(run, run.t)) return;
-    // The solver's internal state may lie beyond t (when tb was clipped): continue from t.
-    if (stepper.current_time() > run.t + 1e-15) return;
-  }
+  planar_driver::switchAt(run, -1);
 }
 
 // Fixed-step classic RK4; switches checked once per step, the way a fixed-step Simulink model
@@ -381,17 +224,19 @@ void adaptiveSegment(Run& run, double seg_end) {
 // fixed over the step's four stages, so a rotation that stops inside a step overshoots zero and
 // is caught, instead of its stages averaging the Coulomb sign away into an endless creep.
 void fixedStep(Run& run, double seg_end) {
-  const AnalyticModel& m = run.model;
+  using namespace planar_driver;
+  AnalyticStickSlip& ss = run.model;
+  const AnalyticModel& m = ss.model;
   const double dt = m.settings.fixed_dt_s;
   auto rhs = [&](const State& x, State& dx, double tt) {
     ++run.rhs;
-    derivative(m, run.ws, tt, x, run.modes, dx);
+    ss.derivative(tt, x, run.modes, dx);
   };
   odeint::runge_kutta4<State> rk4;
   const double t0 = run.t, h = std::min(dt, seg_end - t0);
   const State y0 = run.y;
   rk4.do_step(rhs, run.y, t0, h);
-  countStep(run);
+  countStep(run, false);
   const double t1 = t0 + h;
   const State y1 = run.y;
   auto lerp = [&](double tt, State& ys) {
@@ -400,7 +245,7 @@ void fixedStep(Run& run, double seg_end) {
   };
   recordUpTo(run, t1 - 1e-13, lerp);
   run.t = t1;
-  checkFinite(run, [&] { return "analytic.fixed_dt_s=" + std::to_string(dt) + " is too large"; });
+  checkFinite(run);
   if (m.stiction()) {
     // A 2-D slide whose velocity turned by more than 90 deg over the step stopped inside it.
     const State& y = run.y;
@@ -409,7 +254,7 @@ void fixedStep(Run& run, double seg_end) {
     if (reversed) {
       Modes probe = run.modes;
       probe.stuck[kTrans] = true;
-      const Eval e = evaluate(m, run.ws, run.t, run.y, probe);
+      const Eval e = evaluate(m, ss.ws, run.t, run.y, probe);
       if (e.F_required.norm() < e.F_break) switchAt(run, kTrans);
     }
     switchAt(run, -1);
@@ -417,55 +262,28 @@ void fixedStep(Run& run, double seg_end) {
   recordUpTo(run, run.t, [&](double, State& ys) { ys = run.y; });
 }
 
-// Once at rest for good: one evaluated row, then copies of it to the end.
-void finishAtRest(Run& run) {
-  if (!run.rec.done() && run.rec.nextTime() <= run.plan.t_end + 1e-12) {
-    State ys = run.y;
-    run.rec.record(run.model, run.ws, std::min(run.rec.nextTime(), run.plan.t_end), ys, run.modes);
-    run.rec.repeatLastUntilDone();
-  }
-  run.t = run.plan.t_end;
-}
-
-// From t = 0 to the end of the run, segment by segment (breakpoints, switches).
-void integrate(Run& run) {
-  const double t_end = run.plan.t_end;
-  while (run.t < t_end - 1e-15) {
-    if (settled(run, run.t)) {
-      finishAtRest(run);
-      break;
-    }
-    const double seg_end = nextBreak(run, run.t);
-    if (run.plan.adaptive && stuckForGood(run))
-      heldChunk(run, seg_end);
-    else if (run.plan.adaptive)
-      adaptiveSegment(run, seg_end);
-    else
-      fixedStep(run, seg_end);
-  }
-}
-
 // Summaries from the simulated state at t_end, not from the sampled rows (phi(0) = 0).
 void summarize(const Run& run, RunSummary& sum) {
   const State& y = run.y;
-  const AnalyticModel& m = run.model;
-  sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
+  const AnalyticStickSlip& ss = run.model;
+  const AnalyticModel& m = ss.model;
+  sum.phi_net_deg = units::degrees(y[kPhi]);
   const bool still = !m.stiction() || !run.modes.stuck[kRot];
-  sum.t_stop_s = still ? run.plan.t_end : run.t_stop;
-  sum.stick_slip_events = run.switches;
+  sum.t_stop_s = still ? run.plan.t_end : ss.t_stop;
+  sum.stick_slip_events = ss.switches;
   sum.solver_steps = run.steps;
   sum.extra["rhs_evaluations"] = static_cast<double>(run.rhs);
   sum.extra["rejected_steps"] = static_cast<double>(run.rejected);
   sum.extra["held_steps"] = static_cast<double>(run.held);
   sum.extra["final_x_m"] = y[kX];
   sum.extra["final_y_m"] = y[kY];
-  sum.extra["final_phidot_dps"] = y[kPhiDot] * 180.0 / M_PI;
+  sum.extra["final_phidot_dps"] = units::degrees(y[kPhiDot]);
   sum.extra["final_speed_mps"] = std::hypot(y[kVx], y[kVy]);
   sum.extra["still_rotating_at_end"] = still && std::abs(y[kPhiDot]) > 0 ? 1.0 : 0.0;
-  sum.extra["ever_rotated"] = run.ever_rotated || !m.stiction() ? 1.0 : 0.0;
+  sum.extra["ever_rotated"] = ss.ever_rotated || !m.stiction() ? 1.0 : 0.0;
   // At rest: both DOFs stuck (stiction), or rate and speed below the documented thresholds.
-  const double phidot_dps = std::abs(y[kPhiDot]) * 180.0 / M_PI, speed = std::hypot(y[kVx], y[kVy]);
-  sum.at_rest = stuckForGood(run) || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
+  const double phidot_dps = units::degrees(std::abs(y[kPhiDot])), speed = std::hypot(y[kVx], y[kVy]);
+  sum.at_rest = ss.held(run.modes) || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
   if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(run.plan.t_end, phidot_dps, speed));
 }
 
@@ -473,21 +291,21 @@ void summarize(const Run& run, RunSummary& sum) {
 // before sliding friction (deceleration mu_d m g L_F / I_zz at the final pose) stops it,
 // w^2 / (2 alpha); a warning above limits::kMaxPaperSpuriousTurnDeg.
 void paperCouplingDiagnostic(Run& run, RunSummary& sum) {
-  const AnalyticModel& m = run.model;
+  const AnalyticModel& m = run.model.model;
   const double w_res = paperResidualSpin(m.robot, m.traj);
-  const Eval ev_end = evaluate(m, run.ws, run.plan.t_end, run.y, run.modes);
+  const Eval ev_end = evaluate(m, run.model.ws, run.plan.t_end, run.y, run.modes);
   const double alpha = m.needsArm() && std::isfinite(ev_end.L_F)
                            ? m.robot.friction.mu_d * m.weight * ev_end.L_F / ev_end.loads.Izz_kgm2
                            : 0.0;
-  const double turn_deg = w_res == 0.0 ? 0.0 : alpha > 0 ? w_res * w_res / (2.0 * alpha) * 180.0 / M_PI
+  const double turn_deg = w_res == 0.0 ? 0.0 : alpha > 0 ? units::degrees(w_res * w_res / (2.0 * alpha))
                                                         : std::numeric_limits<double>::infinity();
-  sum.extra["paper_residual_spin_dps"] = w_res * 180.0 / M_PI;
+  sum.extra["paper_residual_spin_dps"] = units::degrees(w_res);
   sum.extra["paper_spurious_turn_deg"] = turn_deg;
   if (turn_deg <= limits::kMaxPaperSpuriousTurnDeg) return;
   std::ostringstream os;
   os.precision(3);
   os << "the paper coupling's angular-momentum error is large: with mu = 0 it would leave the body spinning at "
-     << w_res * 180.0 / M_PI << " deg/s after the tail stops (the exact coupling: 0), enough to turn it by "
+     << units::degrees(w_res) << " deg/s after the tail stops (the exact coupling: 0), enough to turn it by "
      << turn_deg << " deg against sliding friction (limit " << limits::kMaxPaperSpuriousTurnDeg
      << " deg); the paper's model is outside its validity here, compare analytic.coupling: exact";
   sum.warnings.push_back(os.str());
@@ -508,10 +326,11 @@ RunResult simulateAnalytic(const RobotParams& robot, const TailTrajectory& traje
     // Tipping over depends on the trajectory alone: checked along all of it before the run, not
     // only where the loads happen to be evaluated (docs/paper-notes.md point 5).
     if (model.needsArm() && effects.foot_loads == FootLoadModel::kDistributed) requireSupport(robot, trajectory, plan.t_end);
-    Run run(model, plan, output.sample_dt_s, stopSpeed(model, plan), output.time_series == TimeSeriesOutput::kThin);
+    AnalyticStickSlip ss(model, stopSpeed(model, plan));
+    Run run(ss, plan, trajectory.breakpoints(), output.sample_dt_s, output.time_series == TimeSeriesOutput::kThin);
     startAtRest(run);
-    integrate(run);
-    result.series = run.rec.take(model, run.ws);
+    integrate(run, fixedStep);
+    result.series = run.rec.take();
     result.series_thinned = run.rec.thinned();
     summarize(run, sum);
     if (settings.coupling == Coupling::kPaper) paperCouplingDiagnostic(run, sum);
@@ -537,7 +356,7 @@ RunResult evaluatePose(const RobotParams& robot, const std::vector<JointState>& 
   for (int i = 1; i <= n; ++i) ts.addColumn(col::theta(i));
   for (int i = 1; i <= n; ++i) ts.addColumn(col::thetadot(i));
   for (int i = 1; i <= n; ++i) ts.addColumn(col::thetaddot(i));
-  const double d = 180.0 / M_PI;
+  const double d = units::kDegPerRad;
   for (const auto& j : joints) row.push_back(j.theta * d);
   for (const auto& j : joints) row.push_back(j.theta_dot * d);
   for (const auto& j : joints) row.push_back(j.theta_ddot * d);

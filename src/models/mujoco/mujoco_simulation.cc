@@ -23,12 +23,13 @@
 #include "results/sha256.h"
 #include "results/work_limits.h"
 #include "robot/friction_law.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
 namespace {
 
-constexpr double kRad2Deg = 180.0 / M_PI;
+constexpr double kRad2Deg = units::kDegPerRad;
 
 // Indices into mjModel for the elements the simulation reads.
 struct Layout {
@@ -282,7 +283,7 @@ class StandingMonitor {
         h_(s.timestep_s),
         enforce_(e.gravity && e.ground_contact),
         pyramid_rows_(s.cone == MujocoCone::kPyramidal),
-        cos_limit_(s.max_tilt_deg > 0.0 ? std::cos(s.max_tilt_deg * M_PI / 180.0) : -2.0),
+        cos_limit_(s.max_tilt_deg > 0.0 ? std::cos(units::radians(s.max_tilt_deg)) : -2.0),
         off_limit_steps_(s.max_all_feet_off_s > 0.0 ? static_cast<long>(std::ceil(s.max_all_feet_off_s / h_ - 1e-9))
                                                     : -1),
         max_tilt_deg_(s.max_tilt_deg),

@@ -2,7 +2,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
-#include <boost/numeric/odeint.hpp>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -13,17 +12,15 @@
 #include "models/planar/at_rest.h"
 #include "models/perfoot/per_foot_model.h"
 #include "models/planar/row_columns.h"
-#include "models/planar/step_control.h"
+#include "models/planar/stick_slip_driver.h"
 #include "models/planar/stick_slip.h"
 #include "models/planar/support_check.h"
 #include "results/columns.h"
-#include "results/thin_series.h"
 #include "robot/friction_law.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
-
-namespace odeint = boost::numeric::odeint;
 
 // State: x, y (quadruped COM, world), phi, and their rates.
 using State = std::array<double, 6>;
@@ -414,66 +411,26 @@ Margins scanMargins(const Model& model, double t, const State& y, bool stuck, do
   return {std::max(fast, model.evaluate(t, y, true).load_factor - 1.0), g_sup};
 }
 
-template <class StateAt>
-Found findSwitch(const Model& model, bool stuck, double v_stop, double ta, double tb, double h_scan, double tol,
-                 const StateAt& stateAt, const ScanEnd* prev = nullptr, ScanEnd* end = nullptr) {
-  State y;
-  const Modes modes = scanModes(stuck);
-  auto gAt = [&](double t) {
-    stateAt(t, y);
-    return scanMargins(model, t, y, stuck, v_stop);
-  };
-  return tailsim::findSwitch(gAt, modes, ta, tb, h_scan, tol, prev, end, prev != nullptr);
-}
-
 // The centre of pressure left the support at t (a located exit): the TippingError, with the time.
 [[noreturn]] void throwTipping(const Model& model, const QuadrupedParams& q, double t, const State& y, bool stuck) {
   const Eval ev = model.evaluate(t, y, stuck);
   throw TippingError(supportLossMessage(q, SupportLoss{t, ev.cop_CC}, "centre of pressure (load transfer)"));
 }
 
-// What one output row is read from (its column table below).
-struct PerFootRow {
-  double t;
-  const State& y;
-  bool stuck;
+// What one output row is read from (its column table below): the planar models' row, and the
+// feet's forces, normal loads and the held wrench's load factor.
+struct PerFootRow : PlanarRow {
   const Eval& ev;
-  const std::vector<JointState>& joints;  // at t
-  bool decomp;       // effects.load_decomposition: the M_zT parts were evaluated
-  bool stiction;     // the stick/slip state exists
-  bool translation;  // the body translates
+  bool stuck;
 };
 
 // The per-foot model's columns: name and value, in the CSV's order: the analytic model's columns,
 // then each foot's friction force and normal load, and the load factor of the held wrench.
 std::vector<RowColumn<PerFootRow>> perFootColumnTable(int links) {
   using R = const PerFootRow&;
-  constexpr double kDeg = 180.0 / M_PI;
   std::vector<RowColumn<PerFootRow>> t;
   addTimeAndJointColumns(t, links);
-  const std::vector<RowColumn<PerFootRow>> body = {
-      {col::kX, [](R r, int) { return r.y[kX]; }},
-      {col::kY, [](R r, int) { return r.y[kY]; }},
-      {col::kPhi, [](R r, int) { return r.y[kPhi] * kDeg; }},
-      {col::kPhidot, [](R r, int) { return (r.stuck ? 0.0 : r.y[kW]) * kDeg; }},
-      {col::kPhiddot, [](R r, int) { return r.ev.phi_ddot * kDeg; }},
-      {col::kMzT, [](R r, int) { return r.ev.loads.MzT; }},
-      {col::kMzTAcc, [](R r, int) { return r.decomp ? r.ev.loads.MzT_acc : kNaN; }},
-      {col::kMzTSpeed, [](R r, int) { return r.decomp ? r.ev.loads.MzT_speed : kNaN; }},
-      {col::kMzTTan, [](R r, int) { return r.decomp ? r.ev.loads.MzT_tan : kNaN; }},
-      {col::kMzTCen, [](R r, int) { return r.decomp ? r.ev.loads.MzT_cen : kNaN; }},
-      {col::kMzF, [](R r, int) { return r.ev.friction.M; }},
-      {col::kIzzPhiddot, [](R r, int) { return r.ev.loads.Izz_kgm2 * r.ev.phi_ddot; }},
-      {col::kIzz, [](R r, int) { return r.ev.loads.Izz_kgm2; }},
-      {col::kLF, [](R r, int) { return r.ev.L_F; }},
-      {col::kFTx, [](R r, int) { return r.ev.FT_W.x(); }},
-      {col::kFTy, [](R r, int) { return r.ev.FT_W.y(); }},
-      {col::kFFx, [](R r, int) { return r.ev.friction.F.x(); }},
-      {col::kFFy, [](R r, int) { return r.ev.friction.F.y(); }},
-      {col::kRotState, [](R r, int) { return r.stiction ? (r.stuck ? 0.0 : 1.0) : kNaN; }},
-      {col::kTransState, [](R r, int) { return r.translation && r.stiction ? (r.stuck ? 0.0 : 1.0) : kNaN; }},
-  };
-  t.insert(t.end(), body.begin(), body.end());
+  addBodyColumns(t);
   for (int k = 1; k <= 4; ++k) {
     t.push_back({col::footFx(k), [](R r, int i) { return r.ev.Ff[i].x(); }, k - 1});
     t.push_back({col::footFy(k), [](R r, int i) { return r.ev.Ff[i].y(); }, k - 1});
@@ -483,85 +440,107 @@ std::vector<RowColumn<PerFootRow>> perFootColumnTable(int links) {
   return t;
 }
 
-class Recorder {
+// The per-foot model as the planar driver runs it (stick_slip_driver.h): one stick/slip mode
+// (the body held or sliding), its margin in the scan's first slot and the load transfer's support
+// margin in the second; a located exit of the support ends the run (TippingError).
+class PerFootStickSlip {
  public:
-  Recorder(const Model& model, int n_links, double dt, long n_samples)
-      : model_(model), dt_(dt), n_samples_(n_samples), table_(perFootColumnTable(n_links)) {
-    for (const RowColumn<PerFootRow>& c : table_) ts_.addColumn(c.name);
-    row_.assign(table_.size(), 0.0);
-  }
-  double nextTime() const { return next_ < n_samples_ ? next_ * dt_ : std::numeric_limits<double>::infinity(); }
-  bool done() const { return next_ >= n_samples_; }
+  using State = std::array<double, 6>;
+  static constexpr bool kDefersRowsInSteps = false;  // a sliding step's rows are written at once
+  static constexpr bool kHitOnlyWithinStep = true;   // a switch located past tb by round-off ends nothing
+  static constexpr bool kFillsGridToEnd = true;      // every row of the grid, one past t_end at its state
 
-  // thin_marks (output.time_series: thin): the rows are kept as states and evaluated in take(),
-  // only those thinRowIndices keeps, as the analytic model's recorder does: the rule reads t, phi
-  // and the stick/slip states, which the state gives. The same rows, bit for bit, as thinning the
-  // full series (test TimeSeriesOutput.ThinRowsEvaluatedLazilyEqualThinningTheFullSeries).
-  void setThinMarks(const std::vector<double>* marks) {
-    marks_ = marks;
-    if (marks_) thin_.reserve(static_cast<size_t>(n_samples_));
-  }
-  bool thinned() const { return marks_ != nullptr; }
+  PerFootStickSlip(const Model& m, const RobotParams& robot, const PerFootSettings& s, int links)
+      : model_(m), robot_(robot), s_(s), table_(perFootColumnTable(links)), names_(columnNames(table_)) {}
 
-  void record(double t, const State& y, bool stuck) {
-    if (marks_) thin_.push({t, y, stuck});
-    else {
-      fillRow(t, y, stuck);
-      ts_.appendRow(row_);
-    }
-    ++next_;
-  }
-  void repeatLastUntilDone() {
-    if (marks_) {
-      if (thin_.empty() || done()) return;
-      thin_.repeatLast(next_, n_samples_ - next_);
-      next_ = n_samples_;
-      return;
-    }
-    if (ts_.numRows() == 0) return;
-    while (!done()) {
-      row_[0] = nextTime();
-      ts_.appendRow(row_);
-      ++next_;
-    }
-  }
-  TimeSeries take() {
-    if (!marks_) return std::move(ts_);
-    auto light = [&](const Pending& p) {  // as fillRow writes them
-      const double state = model_.stiction() ? (p.stuck ? 0.0 : 1.0) : kNaN;
-      return std::array<double, 3>{p.y[kPhi] * (180.0 / M_PI), state, model_.translation() ? state : kNaN};
-    };
-    auto emit = [&](const Pending& p, double t, bool same) {
-      if (!same) fillRow(p.t, p.y, p.stuck);
-      row_[0] = t;  // a repeated row: its grid time
-      ts_.appendRow(row_);
-    };
-    thin_.take(*marks_, dt_, light, emit);
-    return std::move(ts_);
-  }
+  int switches = 0, breakaways = 0;
+  double t_stop = 0.0;           // the body last stuck
+  double max_load_factor = 0.0;  // of the held wrench, over the held chunks
 
- private:
-  // row_ = the row of (t, y, stuck).
-  void fillRow(double t, const State& y, bool stuck) {
+  const std::vector<std::string>& columns() const { return names_; }
+  void fillRow(double t, const State& y, const Modes& modes, double* out) {
+    const bool stuck = modes.stuck[kRot];
     const bool decomp = model_.effects().load_decomposition;
     const Eval ev = model_.evaluate(t, y, stuck, decomp);
     model_.joints(t, js_);
-    fillColumns(table_, PerFootRow{t, y, stuck, ev, js_, decomp, model_.stiction(), model_.translation()}, row_.data());
+    const double state = stickSlipState(model_.stiction(), stuck);
+    const PerFootRow row{{t, js_, y[kX], y[kY], y[kPhi], stuck ? 0.0 : y[kW], ev.phi_ddot, ev.loads, decomp,
+                          ev.friction.M, ev.L_F, ev.FT_W, ev.friction.F, state,
+                          model_.translation() ? state : kNaN},
+                         ev,
+                         stuck};
+    fillColumns(table_, row, out);
   }
-  struct Pending {
-    double t;
-    State y;
-    bool stuck;
-  };
+  static double phi(const State& y) { return y[kPhi]; }
+  bool stiction() const { return model_.stiction(); }
+  bool translation() const { return model_.translation(); }
+  const PerFootSettings& settings() const { return s_; }
+
+  // The body's one mode as the planar Modes: both DOFs held or both sliding.
+  static Modes modesOf(bool stuck) {
+    Modes m;
+    m.stuck[kRot] = m.stuck[kTrans] = stuck;
+    return m;
+  }
+  static bool held(const Modes& modes) { return modes.stuck[kRot]; }
+  // The whole run's shortest tail phase (RunPlan) in every segment.
+  static SegmentScales scales(const RunPlan& plan, double, double) { return {plan.h_scan, plan.h_max}; }
+  bool scansSteps() const { return model_.stiction() || model_.scansSupport(); }
+  bool keepsScanEnd() const { return model_.scansSupport(); }
+  static Modes scanModes(const Modes& modes) { return tailsim::scanModes(modes.stuck[kRot]); }
+  Margins margins(double t, const State& y, const Modes& modes) const {
+    return scanMargins(model_, t, y, modes.stuck[kRot], s_.v_stop_mps);
+  }
+  void onHit(const Found& f, const State& y, const Modes& modes) const {
+    if (f.which == kSupport) throwTipping(model_, robot_.quadruped, f.t, y, modes.stuck[kRot]);
+  }
+  // The load factor at the chunk's end (the scan's last sample), or where it broke away (about
+  // 1): not at tb then, where the held body no longer exists (that read up to 60 on random runs).
+  void onHeldScan(const Found& f, bool hit, const State& y, const Modes&, const ScanEnd& end) {
+    max_load_factor =
+        std::max(max_load_factor, 1.0 - (hit ? margin(model_, f.t, y, true, s_.v_stop_mps) : end.g_end[kRot]));
+  }
+
+  // Makes the mode consistent with (t, y): a held wrench outside the limit surface breaks away, a
+  // slide slower than v_stop whose holding wrench is inside sticks (twist set to zero).
+  void switchAt(double t, State& y, Modes& modes, int /*which*/) {
+    if (!model_.stiction()) return;
+    bool stuck = modes.stuck[kRot];
+    for (int n = 0;; ++n) {
+      if (n > 8) throw std::runtime_error("stick/slip modes do not settle at t=" + std::to_string(t) + " s");
+      const double g = margin(model_, t, y, stuck, s_.v_stop_mps);
+      if (stuck && g <= 0) {
+        stuck = false;
+        ++breakaways;
+      } else if (!stuck && g < 0) {
+        stuck = true;
+        y[kVx] = y[kVy] = y[kW] = 0.0;
+        t_stop = t;
+      } else {
+        break;
+      }
+      ++switches;
+      modes = modesOf(stuck);
+    }
+  }
+  static double firstStep(double dt0, const State&, const Modes&) { return dt0; }
+  void derivative(double t, const State& y, const Modes&, State& dy) const { model_.derivative(t, y, dy); }
+
+  std::string stepBudgetMessage(double t, double, bool held) const {
+    if (held) return "step budget exhausted";
+    return "step budget of " + std::to_string(s_.max_steps) + " steps exhausted at t=" + std::to_string(t) + " s";
+  }
+  static std::string nonFiniteMessage(double t) {
+    return "state became non-finite at t=" + std::to_string(t) + " s";
+  }
+
+ private:
   const Model& model_;
-  double dt_;
-  long n_samples_ = 0, next_ = 0;
+  const RobotParams& robot_;
+  const PerFootSettings& s_;
   std::vector<RowColumn<PerFootRow>> table_;
-  TimeSeries ts_;
-  std::vector<double> row_;
+  std::vector<std::string> names_;
   std::vector<JointState> js_;
-  const std::vector<double>* marks_ = nullptr;
-  LazyThinRows<Pending> thin_;  // thin: the states of the rows recorded so far
 };
 
 }  // namespace
@@ -596,11 +575,14 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   RunResult result;
   RunSummary& sum = result.summary;
   sum.model = "perfoot";
-  const double tail_end = trajectory.endTime();
+  RunPlan plan;
+  plan.t_end = t_end;
+  plan.rows = static_cast<long>(rows);
+  plan.tail_end = trajectory.endTime();
   double shortest = trajectory.shortestPhase();
   if (!std::isfinite(shortest)) shortest = t_end;
-  const double h_scan = shortest / 32.0;
-  const double h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
+  plan.h_scan = shortest / 32.0;
+  plan.h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
 
   long newton_solves = 0;
   try {
@@ -613,186 +595,33 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads, t_end);
     model.countNewtonSolvesInto(&newton_solves);
-    Recorder rec(model, robot.numLinks(), output.sample_dt_s, static_cast<long>(rows));
-    const std::vector<double> bps = trajectory.breakpoints();  // (also thinning's marks)
-    if (output.time_series == TimeSeriesOutput::kThin) rec.setThinMarks(&bps);
-    const double v_stop = settings.v_stop_mps;
-    State y{};
+    PerFootStickSlip ss(model, robot, settings, robot.numLinks());
+    PlanarRun<PerFootStickSlip> run(ss, plan, trajectory.breakpoints(), output.sample_dt_s,
+                                    output.time_series == TimeSeriesOutput::kThin);
+    State& y = run.y;
     y[kVx] = settings.initial_velocity[0];
     y[kVy] = settings.initial_velocity[1];
     y[kW] = settings.initial_velocity[2];
-    double t = 0.0, t_stop = 0.0, max_load_factor = 0.0;
-    bool stuck = model.stiction() && model.maxFootSpeed(y) == 0.0;
-    int switches = 0, breakaways = 0;
-    long steps = 0;
+    run.modes = PerFootStickSlip::modesOf(model.stiction() && model.maxFootSpeed(y) == 0.0);
+    planar_driver::switchAt(run, -1);
+    integrate(run);
 
-    double held_dt = 0.0;  // the stuck chunk to go on with (0: after a switch, start small)
-    // Makes the mode consistent with (t, y): a held wrench outside the limit surface breaks away, a
-    // slide slower than v_stop whose holding wrench is inside sticks (twist set to zero).
-    auto settle = [&]() {
-      held_dt = 0.0;
-      if (!model.stiction()) return;
-      for (int n = 0;; ++n) {
-        if (n > 8) throw std::runtime_error("stick/slip modes do not settle at t=" + std::to_string(t) + " s");
-        const double g = margin(model, t, y, stuck, v_stop);
-        if (stuck && g <= 0) {
-          stuck = false;
-          ++breakaways;
-        } else if (!stuck && g < 0) {
-          stuck = true;
-          y[kVx] = y[kVy] = y[kW] = 0.0;
-          t_stop = t;
-        } else {
-          return;
-        }
-        ++switches;
-      }
-    };
-    settle();
-    auto settled = [&](double tt) { return tt >= tail_end && stuck; };
-    auto recordUpTo = [&](double t_hi, auto&& stateAt) {
-      State ys;
-      while (!rec.done() && rec.nextTime() <= t_hi + 1e-12) {
-        const double ts = std::min(rec.nextTime(), t_end);
-        stateAt(ts, ys);
-        rec.record(ts, ys, stuck);
-      }
-    };
-    auto nextBreak = [&](double tt) {
-      for (double b : bps)
-        if (b > tt + 1e-14) return std::min(b, t_end);
-      return t_end;
-    };
-    long rhs_count = 0, rejected = 0;  // right-hand sides evaluated, trial steps rejected
-    auto rhs = [&](const State& x, State& dx, double tt) {
-      ++rhs_count;
-      model.derivative(tt, x, dx);
-    };
-    struct {
-      bool have = false;  // end holds the scan of the stuck chunk that ended at t_end
-      double t_end = 0;
-      ScanEnd end;
-    } chunk;
-    double dt_resume = 0.0;  // the step to go on with after a tail breakpoint (0: start small)
-    using Stepper = StabilizedDenseDopri5<State>;
-    struct {
-      bool have = false;  // the last sliding step (scanned for the support margin) ended at t_end
-      double t_end = 0;
-      ScanEnd end;
-      Stepper stepper;    // its dense output
-    } slide;
-
-    while (t < t_end - 1e-15) {
-      if (settled(t)) {
-        if (!rec.done()) {
-          rec.record(std::min(rec.nextTime(), t_end), y, stuck);
-          rec.repeatLastUntilDone();
-        }
-        t = t_end;
-        break;
-      }
-      const double seg_end = nextBreak(t);
-      if (stuck) {
-        slide.have = false;
-        // Nothing moves: scan the load factor up to the next breakpoint, chunk by chunk. A margin
-        // still falling at a chunk's end goes on into the next chunk's scan (a dip across the
-        // boundary), and the rows after its second-last sample wait for that scan. The chunks grow
-        // as the solver's steps would: 1e-4 s after a switch, then tenfold up to h_max, so a dip
-        // just after the switch is sampled finely (analytic model: heldChunk).
-        const double tb = std::min(seg_end, t + std::min(held_dt > 0.0 ? held_dt : 1e-4, h_max));
-        held_dt = 10.0 * (tb - t);  // (settle() resets it)
-        auto stateAt = [&](double, State& ys) { ys = y; };
-        const bool have = chunk.have && chunk.t_end == t;
-        ScanEnd end;
-        const Found f = findSwitch(model, true, v_stop, t, tb, h_scan, settings.event_tol_s, stateAt,
-                                   have ? &chunk.end : nullptr, &end);
-        if (f.hit && f.which == kSupport) throwTipping(model, robot.quadruped, f.t, y, true);
-        const double ts = f.hit ? f.t : std::numeric_limits<double>::infinity();
-        const bool hit = ts <= tb;
-        // The load factor at the chunk's end (the scan's last sample), or where it broke away (about
-        // 1): not at tb then, where the held body no longer exists (that read up to 60 on random runs).
-        max_load_factor = std::max(max_load_factor, 1.0 - (hit ? margin(model, ts, y, true, v_stop) : end.g_end[kRot]));
-        const bool defer = !hit && dipMayCross(scanModes(true), end) && tb < t_end - 1e-15 && !settled(tb);
-        const double t_cut = std::min(ts, tb);
-        recordUpTo(defer ? end.t_before : t_cut, stateAt);
-        t = t_cut;
-        chunk = {!hit, tb, end};
-        ++steps;
-        if (hit) settle();
-        if (steps > settings.max_steps) throw std::runtime_error("step budget exhausted");
-        continue;
-      }
-      chunk.have = false;
-      const double max_dt = t < tail_end ? h_max : t_end - t;
-      // The analytic model's step control (step_control.h): odeint's default rejected every other
-      // step where a slide slows to a stop.
-      Stepper stepper = makeStabilizedDopri5<State>(settings.abs_tol, settings.rel_tol, max_dt, &rejected);
-      // As in the analytic model (analytic_simulation.cc): after a switch start small, after a
-      // breakpoint go on with the reached step; a step never crosses a breakpoint (the tail
-      // acceleration jumps there and the error estimate fails), it ends on it.
-      stepper.initialize(y, t, std::min(max_dt, dt_resume > 0 ? dt_resume : 1e-4));
-      dt_resume = 0.0;
-      bool restart = false;
-      while (!restart) {
-        const double t_now = stepper.current_time(), dt_now = stepper.current_time_step();
-        if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12)
-          stepper.initialize(stepper.current_state(), t_now, seg_end - t_now);
-        const auto [ta, tb_raw] = stepper.do_step(rhs);
-        ++steps;
-        if (steps > settings.max_steps)
-          throw std::runtime_error("step budget of " + std::to_string(settings.max_steps) + " steps exhausted at t=" +
-                                   std::to_string(t) + " s");
-        const double tb = std::min(tb_raw, seg_end);
-        // Before ta (a dip of the support margin across the step boundary), the previous step's
-        // dense output answers.
-        const bool across = slide.have && slide.t_end == ta;
-        auto stateAt = [&](double tt, State& ys) { (tt < ta && across ? slide.stepper : stepper).calc_state(tt, ys); };
-        double ts = std::numeric_limits<double>::infinity();
-        if (model.stiction() || model.scansSupport()) {
-          ScanEnd end;
-          const Found f = findSwitch(model, false, v_stop, ta, tb, h_scan, settings.event_tol_s, stateAt,
-                                     across ? &slide.end : nullptr, &end);
-          if (f.hit && f.which == kSupport) {
-            State ye;
-            stateAt(f.t, ye);
-            throwTipping(model, robot.quadruped, f.t, ye, false);
-          }
-          if (f.hit) ts = f.t;
-          slide.have = model.scansSupport() && !f.hit;
-          if (slide.have) slide = {true, tb, end, stepper};
-        }
-        const double t_cut = std::min(ts, tb);
-        recordUpTo(t_cut, stateAt);
-        stepper.calc_state(t_cut, y);
-        t = t_cut;
-        for (double v : y)
-          if (!std::isfinite(v)) throw std::runtime_error("state became non-finite at t=" + std::to_string(t) + " s");
-        if (ts <= tb) {
-          settle();
-          restart = true;
-        } else if (tb_raw >= seg_end - 1e-15 && tb_raw <= seg_end + 1e-12) {
-          dt_resume = std::max(stepper.current_time_step(), tb_raw - ta);
-        }
-        if (tb_raw >= seg_end - 1e-15 || t >= t_end - 1e-15 || stepper.current_time() > t + 1e-15) restart = true;
-      }
-    }
-    recordUpTo(t_end, [&](double, State& ys) { ys = y; });
-
-    result.series = rec.take();
-    result.series_thinned = rec.thinned();
-    sum.phi_net_deg = y[kPhi] * 180.0 / M_PI;
-    sum.t_stop_s = stuck ? t_stop : t_end;
-    sum.stick_slip_events = switches;
-    sum.solver_steps = steps;
-    const double phidot_dps = std::abs(y[kW]) * 180.0 / M_PI, speed = std::hypot(y[kVx], y[kVy]);
+    result.series = run.rec.take();
+    result.series_thinned = run.rec.thinned();
+    const bool stuck = run.modes.stuck[kRot];
+    sum.phi_net_deg = units::degrees(y[kPhi]);
+    sum.t_stop_s = stuck ? ss.t_stop : t_end;
+    sum.stick_slip_events = ss.switches;
+    sum.solver_steps = run.steps;
+    const double phidot_dps = units::degrees(std::abs(y[kW])), speed = std::hypot(y[kVx], y[kVy]);
     sum.extra["final_x_m"] = y[kX];
     sum.extra["final_y_m"] = y[kY];
-    sum.extra["final_phidot_dps"] = y[kW] * 180.0 / M_PI;
+    sum.extra["final_phidot_dps"] = units::degrees(y[kW]);
     sum.extra["final_speed_mps"] = speed;
-    sum.extra["breakaways"] = breakaways;
-    sum.extra["rhs_evaluations"] = static_cast<double>(rhs_count);
-    sum.extra["rejected_steps"] = static_cast<double>(rejected);
-    if (model.stiction()) sum.extra["max_load_factor_stuck"] = max_load_factor;
+    sum.extra["breakaways"] = ss.breakaways;
+    sum.extra["rhs_evaluations"] = static_cast<double>(run.rhs);
+    sum.extra["rejected_steps"] = static_cast<double>(run.rejected);
+    if (model.stiction()) sum.extra["max_load_factor_stuck"] = ss.max_load_factor;
     sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
     if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
   } catch (const TippingError& e) {
