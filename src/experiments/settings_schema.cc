@@ -47,7 +47,7 @@ struct Describer {
     std::string doc = f.doc;
     for (char& ch : doc)
       if (ch == '|') ch = '/';
-    rows += "| `" + std::string(f.key) + "` | " + allowed + " | " + dflt + " | " + doc + " |\n";
+    rows += "| `" + std::string(f.key) + "` | " + allowed + " | " + (dflt.empty() ? std::string("(none)") : dflt) + " | " + doc + " |\n";
   }
   void number(const settings::Field& f, double x, const settings::Limits& l) {
     json v = {{"type", "number"}};
