@@ -315,3 +315,47 @@ TEST(RobotModelExperiment, StandingTiltWithTheTailOnServosAndLockedLegs) {
     }
   }
 }
+
+// The articulated run estimates its own uncertainty by the rigid-box run's rule
+// (run_uncertainty.h): a check run of the same robot at twice the model's timestep gives
+// phi_net_check_deg, phi_net_uncertainty_deg = 2 |phi_h - phi_2h| + 0.5 % of max(|phi_h|, 0.5 deg)
+// and the uncertain warning beyond mujoco.uncertainty_warn_share; `mujoco: {uncertainty: false}`
+// skips it. Go1 at 600 deg/s: +0.165 +- 0.014 deg; at 1200 deg/s: -0.931 +- 0.491 deg (the check
+// run -1.174), which warns.
+TEST(RobotModelExperiment, ArticulatedRunCarriesItsOwnUncertainty) {
+  const fs::path men = menagerieDir();
+  if (men.empty()) GTEST_SKIP() << "no shared/robots/menagerie beside the source tree or its parents";
+  Scratch t;
+  for (const bool on : {true, false}) {
+    const std::string f = t.write(
+        "go1_u.yaml", "name: go1_u\nrobot: {mjcf: " + (men / "go1" / "go1.xml").string() +
+                          "}\ntail: {mount: {body: trunk, pos_m: [-0.2, 0, 0]}, links: 1}\n"
+                          "trajectory: {rule: eq25, thetadot_max_dps: {sweep: [600, 1200]}}\nmodels: [mujoco]\n"
+                          "mujoco: {uncertainty: " + std::string(on ? "true" : "false") +
+                          "}\noutput: {time_series: none}\n");
+    std::vector<Experiment> s = loadExperimentSuite(f);
+    resolveRobotModels(s);
+    ASSERT_EQ(s.front().cases.size(), 2u);
+    for (const ExperimentCase& c : s.front().cases) {
+      const RunSummary r = runCase(c, nullptr).front().summary;
+      ASSERT_TRUE(r.ok) << r.error;
+      bool warned = false;
+      for (const std::string& w : r.warnings) warned = warned || w.rfind(kUncertainWarning, 0) == 0;
+      if (!on) {
+        EXPECT_FALSE(r.extra.count("phi_net_uncertainty_deg"));
+        EXPECT_FALSE(r.extra.count("phi_net_check_deg"));
+        EXPECT_FALSE(warned);
+        continue;
+      }
+      ASSERT_TRUE(r.extra.count("phi_net_uncertainty_deg"));
+      ASSERT_TRUE(r.extra.count("phi_net_check_deg"));
+      const double u = r.extra.at("phi_net_uncertainty_deg"), check = r.extra.at("phi_net_check_deg");
+      std::printf("go1 %s: phi_net %+.4f +- %.4f deg, check run %+.4f deg\n",
+                  c.name.c_str(), r.phi_net_deg, u, check);
+      EXPECT_NE(check, r.phi_net_deg);  // a second run, at another step
+      EXPECT_DOUBLE_EQ(u, 2.0 * std::abs(r.phi_net_deg - check) + 0.005 * std::max(std::abs(r.phi_net_deg), 0.5));
+      EXPECT_NEAR(r.extra.at("uncertainty_solver_steps"), 0.5 * r.solver_steps, 1.0);  // twice the step
+      EXPECT_EQ(warned, c.name.find("1200") != std::string::npos) << c.name << ": U " << u;
+    }
+  }
+}

@@ -1,7 +1,6 @@
 #include "experiments/model_registry.h"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 
 #include "models/analytic/analytic_rows.h"
@@ -49,7 +48,7 @@ OutputSettings recordedOutput(const ExperimentCase& c) {
 
 // The MuJoCo model of a robot given by its model file (robot: {mjcf: ...}): the robot itself, legs
 // held by its own actuators, with the tail attached, standing kArticulatedStandS with the tail
-// before the stroke (attach_tail.h).
+// before the stroke, and its check run at twice the model's timestep (attach_tail.h).
 constexpr double kArticulatedStandS = 2.0;
 RunResult simulateRobotModel(const ExperimentCase& c) {
   if (!c.robot_derived)
@@ -57,12 +56,8 @@ RunResult simulateRobotModel(const ExperimentCase& c) {
   const TailTrajectory traj = c.trajectory();
   const double t_end = c.simDuration();
   const double dt = c.output.time_series == TimeSeriesOutput::kNone && !c.render.enabled ? t_end : c.output.sample_dt_s;
-  const auto t0 = std::chrono::steady_clock::now();
-  const ArticulatedRun a = runArticulated(*c.robot_derived, c.robot_model->mount, c.robot.tail, traj, c.mujoco,
-                                          kArticulatedStandS, t_end - traj.endTime(), dt);
-  RunResult r = articulatedRunResult(a, kMujocoModel);
-  r.summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
+  return simulateArticulated(*c.robot_derived, c.robot_model->mount, c.robot.tail, traj, c.mujoco, kArticulatedStandS,
+                             t_end - traj.endTime(), dt, kMujocoModel);
 }
 
 // The built-in models and those ModelRegistration added, in order.

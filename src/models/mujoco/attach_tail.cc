@@ -3,13 +3,16 @@
 #include <tinyxml2.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <stdexcept>
 
 #include "controllers/tail_controller.h"
 #include "results/columns.h"
 #include "models/mujoco/mjcf_generator.h"
+#include "models/mujoco/run_uncertainty.h"
 
 namespace tailsim {
 namespace {
@@ -146,19 +149,18 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
   return printer.CStr();
 }
 
-ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
-                              const TailTrajectory& trajectory, const MujocoSettings& s_in, double stand_s,
-                              double settle_after_s, double sample_dt_s) {
+namespace {
+
+// The articulated run at s.timestep_s (the model's own, or the check run's twice that): the tail's
+// servo gains from s, the model's option timestep replaced by s.timestep_s.
+ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                                const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
+                                double settle_after_s, double sample_dt_s) {
   ArticulatedRun out;
   MujocoMessages messages;
-  // The servo gains at the model's own timestep.
-  MujocoSettings s = s_in;
-  {
-    ModelPtr probe = loadModelFromXml(r.model.xml);
-    s.timestep_s = probe->opt.timestep;
-  }
   ModelPtr mp = loadModelFromXml(attachTail(r, mount, tail, s));
   mjModel* m = mp.get();
+  m->opt.timestep = s.timestep_s;
   DataPtr dp = makeData(m);
   mjData* d = dp.get();
   const int n = static_cast<int>(tail.size());
@@ -288,6 +290,21 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
   return out;
 }
 
+// The settings at the model's own timestep.
+MujocoSettings atModelTimestep(const DerivedRobot& r, const MujocoSettings& s_in) {
+  MujocoSettings s = s_in;
+  s.timestep_s = loadModelFromXml(r.model.xml)->opt.timestep;
+  return s;
+}
+
+}  // namespace
+
+ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                              const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
+                              double settle_after_s, double sample_dt_s) {
+  return runArticulatedAt(r, mount, tail, trajectory, atModelTimestep(r, s), stand_s, settle_after_s, sample_dt_s);
+}
+
 RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model) {
   RunResult r;
   RunSummary& s = r.summary;
@@ -306,6 +323,32 @@ RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model
   s.extra["feet_in_contact"] = a.feet_in_contact;
   r.series = a.series;
   return r;
+}
+
+RunResult simulateArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                              const TailTrajectory& trajectory, const MujocoSettings& s_in, double stand_s,
+                              double settle_after_s, double sample_dt_s, const std::string& model,
+                              ArticulatedRun* run) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const MujocoSettings s = atModelTimestep(r, s_in);
+  ArticulatedRun a = runArticulatedAt(r, mount, tail, trajectory, s, stand_s, settle_after_s, sample_dt_s);
+  RunResult res = articulatedRunResult(a, model);
+  if (s.uncertainty && a.ok) {
+    const MujocoSettings coarse = checkRunSettings(s);
+    RunSummary check;
+    try {
+      check = articulatedRunResult(runArticulatedAt(r, mount, tail, trajectory, coarse, stand_s, settle_after_s, 0.0),
+                                   model).summary;
+    } catch (const std::exception& e) {
+      check.ok = false;
+      check.error = e.what();
+    }
+    applyCheckRun(res.summary, check, coarse.timestep_s,
+                  s.uncertainty_warn_share, "lower the timestep of the model's <option> (the model file's own step)");
+  }
+  res.summary.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (run) *run = std::move(a);
+  return res;
 }
 
 }  // namespace tailsim

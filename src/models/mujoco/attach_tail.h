@@ -49,7 +49,8 @@ struct ArticulatedRun {
 // Standing with the tail: a larger tilt from the stance is warned about.
 inline constexpr double kStandingTiltLimitDeg = 1.0;
 
-// Stands stand_s with the tail held at theta(0), then runs the stroke and settle_after_s more.
+// Stands stand_s with the tail held at theta(0), then runs the stroke and settle_after_s more, at
+// the model's own timestep; one run, without an uncertainty estimate (simulateArticulated).
 ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                               const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
                               double settle_after_s, double sample_dt_s = 0.0);
@@ -57,5 +58,18 @@ ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, con
 // The articulated run as a model's RunResult (tailsim run's `mujoco` model on a robot from its model
 // file): phi_net, the rows, the tilt figures in `extra` and the warnings.
 RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model);
+
+// The articulated run as tailsim's `mujoco` model reports it (articulatedRunResult) with, when
+// s.uncertainty, its own error estimate: the same robot run again at twice the model's timestep,
+// the tail servo's natural frequency kept and the legs on the model's own actuators, by the rule
+// of the rigid-box run (run_uncertainty.h: phi_net_uncertainty_deg, phi_net_check_deg,
+// uncertainty_solver_steps, the uncertain warning). Of s it reads the tail servo (kp, kv,
+// servo_wn_dt, velocity_feedforward, inverse_dynamics_feedforward), uncertainty and
+// uncertainty_warn_share; the step is the model's own. wall_time_s covers both runs. `run`:
+// optional, receives the run itself (its tilt figures).
+RunResult simulateArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                              const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
+                              double settle_after_s, double sample_dt_s, const std::string& model,
+                              ArticulatedRun* run = nullptr);
 
 }  // namespace tailsim

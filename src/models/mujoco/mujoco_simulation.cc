@@ -20,6 +20,7 @@
 #include "controllers/tail_controller.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_handles.h"
+#include "models/mujoco/run_uncertainty.h"
 #include "results/sha256.h"
 #include "results/work_limits.h"
 #include "robot/friction_law.h"
@@ -878,45 +879,19 @@ RunResult runMujoco(const RobotParams& robot, const TailTrajectory& trajectory, 
   return run.judge();
 }
 
-// The run's error estimate from a second run at twice the step (docs/mujoco-model.md "Uncertainty
-// of a run"): U = 2 |phi_h - phi_2h| + 0.5 % of max(|phi_h|, 0.5 deg), the factor and the floor
-// measured on the random-robot corpus (tests/bench_trust.cc). Adds phi_net_uncertainty_deg
-// (NaN when the check run failed) and uncertainty_solver_steps to the extras, and a warning when U
-// exceeds settings.uncertainty_warn_share of max(|phi_h|, 0.5 deg) or the check run failed.
+// The run's error estimate from a second run at twice the step (run_uncertainty.h): its own
+// pre-roll, not the run's settle cache (whose hit and miss counts are the runs'), no time series;
+// its wall time is added to the run's.
 void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
                     const Effects& effects, const OutputSettings& output, RunResult& fine) {
-  MujocoSettings coarse = settings;
-  coarse.timestep_s *= 2.0;
-  if (coarse.kp == 0.0) coarse.servo_wn_dt *= 2.0;  // the same servo w_n
-  coarse.max_steps = std::max(1L, settings.max_steps / 2);
+  const MujocoSettings coarse = checkRunSettings(settings);
   OutputSettings quiet = output;
   quiet.time_series = TimeSeriesOutput::kNone;
   const auto wall0 = std::chrono::steady_clock::now();
-  // Its own pre-roll, not the run's settle cache (whose hit and miss counts are the runs').
   const RunResult check = runMujoco(robot, trajectory, coarse, effects, quiet, nullptr, nullptr, nullptr);
-  RunSummary& sum = fine.summary;
-  sum.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  sum.extra["uncertainty_solver_steps"] = static_cast<double>(check.summary.solver_steps);
-  const double floor_deg = 0.5, phi = sum.phi_net_deg;
-  const double scale = std::max(std::abs(phi), floor_deg);
-  std::ostringstream os;
-  os.precision(3);
-  if (!check.summary.ok) {
-    sum.extra["phi_net_uncertainty_deg"] = std::numeric_limits<double>::quiet_NaN();
-    os << kUncertainWarning << ": the check run at twice the timestep (" << coarse.timestep_s
-       << " s) failed (" << check.summary.error << "), so this result is not converged in the step";
-    sum.warnings.push_back(os.str());
-    return;
-  }
-  sum.extra["phi_net_check_deg"] = check.summary.phi_net_deg;
-  const double u = 2.0 * std::abs(phi - check.summary.phi_net_deg) + 0.005 * scale;
-  sum.extra["phi_net_uncertainty_deg"] = u;
-  if (u > settings.uncertainty_warn_share * scale) {
-    os << kUncertainWarning << ": +-" << u << " deg (" << 100.0 * u / scale << " % of max(|phi_net|, 0.5 deg); limit "
-       << 100.0 * settings.uncertainty_warn_share << " %, mujoco.uncertainty_warn_share); at twice the timestep "
-       << "phi_net is " << check.summary.phi_net_deg << " deg: lower mujoco.timestep_s or see `tailsim trust`";
-    sum.warnings.push_back(os.str());
-  }
+  fine.summary.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  applyCheckRun(fine.summary, check.summary, coarse.timestep_s, settings.uncertainty_warn_share,
+                "lower mujoco.timestep_s or see `tailsim trust`");
 }
 
 }  // namespace
