@@ -125,6 +125,34 @@ TEST(Verdict, AGapIsAssignedToTheLadderStepBetweenTheModels) {
   EXPECT_NE(v.find("agree:"), std::string::npos) << v;
 }
 
+// The verdict quotes "+- U" only for an uncertainty the run estimated itself: the planar models
+// (which estimate none) and a MuJoCo run without its check run are quoted bare, and the verdict
+// says what each model was compared with (its own estimate, or the 0.5 % floor).
+TEST(Verdict, QuotesOnlyTheUncertaintiesTheRunsEstimated) {
+  auto count = [](const std::string& s, const std::string& what) {
+    int n = 0;
+    for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+    return n;
+  };
+  // MuJoCo with its estimate: its +- U only.
+  std::string v = caseVerdict({standing("analytic", 0.0), standing("perfoot", 0.0), standing("mujoco", 0.301, 0.012)});
+  EXPECT_NE(v.find("[analytic +0.000, per-foot +0.000, MuJoCo +0.301 +- 0.012 deg]"), std::string::npos) << v;
+  EXPECT_EQ(count(v, "+-"), 1) << v;
+  EXPECT_NE(v.find("MuJoCo its own estimate"), std::string::npos) << v;
+  EXPECT_NE(v.find("analytic and per-foot none estimated, the floor 0.5 %"), std::string::npos) << v;
+  // MuJoCo without one (mujoco.uncertainty: false): no "+-" at all; compared with the floor, said so.
+  v = caseVerdict({standing("analytic", 0.0), standing("perfoot", 0.0), standing("mujoco", 0.301)});
+  EXPECT_EQ(count(v, "+-"), 0) << v;
+  EXPECT_NE(v.find("MuJoCo +0.301 (uncertainty not estimated)"), std::string::npos) << v;
+  EXPECT_NE(v.find("the floor is the least it could be"), std::string::npos) << v;
+  // Its check run failed (phi_net_uncertainty_deg NaN): the same, and why.
+  RunSummary failed = standing("mujoco", 7.0);
+  failed.extra["phi_net_uncertainty_deg"] = NAN;
+  v = caseVerdict({standing("perfoot", 6.0), failed});
+  EXPECT_EQ(count(v, "+-"), 0) << v;
+  EXPECT_NE(v.find("its check run failed"), std::string::npos) << v;
+}
+
 TEST(Verdict, FallsAreFallsAndADisagreementNamesItsReason) {
   const std::string tip = "system COM 0.01 m beyond its rear edge: the robot tips over at t = 0.2 s";
   const std::string fell = "robot fell over at t = 0.3 s: body tilt 5.01 deg (limit max_tilt_deg = 5 deg)";

@@ -1,5 +1,6 @@
 // `tailsim trust`: the convergence and sensitivity study of an experiment's MuJoCo results
 // (experiments/trust_study.h, docs/accuracy.md "tailsim trust").
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -43,7 +44,11 @@ void addTrustCommand(CLI::App& app, int& exit_code) {
         const TrustRow* d = st.row("default");
         const TrustRow* r = st.row("reference");
         std::printf("%s: MuJoCo phi_net %s deg, reference %s deg\n", st.case_name.c_str(),
-                    d && d->ok ? (std::to_string(d->phi_net_deg) + " +- " + std::to_string(d->uncertainty_deg)).c_str()
+                    d && d->ok ? (std::to_string(d->phi_net_deg) +
+                                  (std::isfinite(d->uncertainty_deg) ? " +- " + std::to_string(d->uncertainty_deg)
+                                                                     : std::string(" (uncertainty not estimated: "
+                                                                                   "its check run failed)")))
+                                     .c_str()
                                : "failed",
                     r && r->ok ? std::to_string(r->phi_net_deg).c_str() : "failed");
         if (!st.verdict.empty()) std::printf("  verdict: %s\n", st.verdict.c_str());

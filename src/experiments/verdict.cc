@@ -29,14 +29,41 @@ struct Entry {
   bool fell;
 };
 
-// A standing model's result as the verdict quotes it.
+bool isMujoco(const RunSummary& r) { return r.model == "mujoco"; }
+
+// A standing model's result as the verdict quotes it: "+- U" only for an estimate the run made.
 std::string quote(const Entry& e) {
-  return std::string(e.title) + " " + fmt("%+.3f", e.run->phi_net_deg) + " +- " + fmt("%.3f", phiUncertaintyDeg(*e.run));
+  std::string s = std::string(e.title) + " " + fmt("%+.3f", e.run->phi_net_deg);
+  const double u = ownUncertaintyDeg(*e.run);
+  if (std::isfinite(u)) return s + " +- " + fmt("%.3f", u);
+  if (!isMujoco(*e.run)) return s;
+  return s + (e.run->extra.count("phi_net_uncertainty_deg") ? " (uncertainty not estimated: its check run failed)"
+                                                              : " (uncertainty not estimated)");
 }
 
 std::string join(const std::vector<const Entry*>& v) {
   std::string s;
   for (size_t i = 0; i < v.size(); ++i) s += (i == 0 ? "" : i + 1 == v.size() ? " and " : ", ") + std::string(v[i]->title);
+  return s;
+}
+
+// What the agreement test used for each model: its own estimate or the floor.
+std::string toleranceNote(const std::vector<Entry>& e) {
+  std::vector<const Entry*> own, floor;
+  bool mujocoFloor = false;
+  for (const Entry& x : e) {
+    const bool has = std::isfinite(ownUncertaintyDeg(*x.run));
+    (has ? own : floor).push_back(&x);
+    mujocoFloor = mujocoFloor || (!has && isMujoco(*x.run));
+  }
+  std::string s = "; tolerance, the sum of two models' uncertainties: ";
+  if (!own.empty()) s += join(own) + (own.size() == 1 ? " its own estimate" : " their own estimates");
+  if (!floor.empty())
+    s += (own.empty() ? "" : "; ") + join(floor) + " none estimated, the floor " +
+         fmt("%g", 100.0 * kUncertaintyFloorShare) + " % of max(|phi_net|, " + fmt("%g", kUncertaintyFloorDeg) + " deg)";
+  if (mujocoFloor)
+    s += " (MuJoCo's error was not estimated, mujoco.uncertainty false or its check run failed: the floor is the "
+         "least it could be)";
   return s;
 }
 
@@ -53,14 +80,17 @@ const char* ladderStep(const std::string& a, const std::string& b) {
 
 }  // namespace
 
+double ownUncertaintyDeg(const RunSummary& run) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!run.ok || !std::isfinite(run.phi_net_deg)) return nan;
+  const auto it = run.extra.find("phi_net_uncertainty_deg");
+  return it != run.extra.end() && std::isfinite(it->second) ? it->second : nan;
+}
+
 double phiUncertaintyDeg(const RunSummary& run) {
   if (!run.ok || !std::isfinite(run.phi_net_deg)) return std::numeric_limits<double>::quiet_NaN();
-  const double planar = kPlanarUncertaintyShare * std::max(std::abs(run.phi_net_deg), kUncertaintyFloorDeg);
-  if (run.model == "mujoco") {
-    const auto it = run.extra.find("phi_net_uncertainty_deg");
-    if (it != run.extra.end() && std::isfinite(it->second)) return it->second;
-  }
-  return planar;
+  const double own = ownUncertaintyDeg(run);
+  return std::isfinite(own) ? own : kUncertaintyFloorShare * std::max(std::abs(run.phi_net_deg), kUncertaintyFloorDeg);
 }
 
 std::string caseVerdict(const std::vector<RunSummary>& runs) {
@@ -121,7 +151,8 @@ std::string caseVerdict(const std::vector<RunSummary>& runs) {
            " deg, although each step between them is within the uncertainties";
   std::string values;
   for (const Entry& x : e) values += (values.empty() ? "" : ", ") + quote(x);
-  std::string s = gaps.empty() ? "agree: " + values + " deg" : "differ: " + gaps + " [" + values + " deg]";
+  std::string s = (gaps.empty() ? "agree: " + values + " deg" : "differ: " + gaps + " [" + values + " deg]") +
+                  toleranceNote(e);
   if (mj && uncertainWarning(*mj->run))
     s = "uncertain: MuJoCo's result is uncertain (its warning says why: its own uncertainty beyond "
         "mujoco.uncertainty_warn_share, a failed check run, or a near fall); " + s;

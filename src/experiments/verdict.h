@@ -7,28 +7,35 @@
 #include <string>
 #include <vector>
 
+#include "models/mujoco/run_uncertainty.h"
 #include "results/time_series.h"
 
 namespace tailsim {
 
-// Uncertainty of a planar (analytic, per-foot) result: their solvers' tolerances are orders below
-// this, so it is the same floor the MuJoCo estimate carries: this share of max(|phi_net|, 0.5 deg).
-inline constexpr double kPlanarUncertaintyShare = 0.005;
-inline constexpr double kUncertaintyFloorDeg = 0.5;
 
 // Text in a failed run's error that says the robot fell (the planar models' support check: "the
 // robot tips over"; MuJoCo's standing monitor: "robot fell over").
 inline constexpr char kPlanarTipText[] = "the robot tips over";
 inline constexpr char kMujocoFallText[] = "robot fell over";
 
-// A result's uncertainty [deg]: MuJoCo's phi_net_uncertainty_deg when the run estimated it, else
-// the planar floor above. NaN for a failed run.
+// The uncertainty a run estimated itself [deg]: a MuJoCo run's finite phi_net_uncertainty_deg
+// (run_uncertainty.h); NaN when it has none (the planar models estimate none; a MuJoCo run with
+// mujoco.uncertainty false, or whose check run failed, has none) or the run failed.
+double ownUncertaintyDeg(const RunSummary& run);
+
+// The tolerance the verdict gives a result [deg]: its own estimate, else the floor
+// kUncertaintyFloorShare of max(|phi_net|, kUncertaintyFloorDeg) (run_uncertainty.h). The planar
+// models' solvers are far below the floor (analytic 1.4e-6 deg at its default rel_tol,
+// docs/accuracy.md), so for them the floor is a bound; for a MuJoCo run without an estimate it is
+// only the least it could be, and the verdict says so. NaN for a failed run.
 double phiUncertaintyDeg(const RunSummary& run);
 
 // The verdict of one case's runs (any order; models other than analytic, perfoot and mujoco are
 // left out). Empty when fewer than two of them ran. Begins with one word: "agree", "differ",
 // "falls" (the models disagree on whether the robot falls), "fall" (every model sees it fall),
 // "uncertain" (MuJoCo's result carries kUncertainWarning; compared all the same) or "no-verdict".
+// The results it quotes carry "+- U" only where the run estimated U itself (ownUncertaintyDeg);
+// "agree" and "differ" end with the tolerance each model was compared with.
 std::string caseVerdict(const std::vector<RunSummary>& runs);
 
 }  // namespace tailsim

@@ -148,14 +148,16 @@ void trustCaseMarkdown(const TrustStudy& st, std::ostream& o) {
   o << "## Case " << st.case_name << "\n\n";
   if (def && def->ok && ref && ref->ok) {
     const double err = std::abs(def->phi_net_deg - ref->phi_net_deg);
-    o << "MuJoCo at the case's settings: phi_net " << fmt("%+.3f", def->phi_net_deg) << " +- "
-      << fmt("%.3f", def->uncertainty_deg) << " deg (" << fmt("%.3g", 1e3 * def->wall_s)
+    o << "MuJoCo at the case's settings: phi_net " << fmt("%+.3f", def->phi_net_deg)
+      << (std::isfinite(def->uncertainty_deg) ? " +- " + fmt("%.3f", def->uncertainty_deg)
+                                              : std::string(" (uncertainty not estimated: its check run failed)"))
+      << " deg (" << fmt("%.3g", 1e3 * def->wall_s)
       << " ms); the reference: " << fmt("%+.3f", ref->phi_net_deg) << " deg (" << fmt("%.3g", 1e3 * ref->wall_s)
       << " ms). The default is off by " << fmt("%.3f", err) << " deg ("
       << fmt("%.2f", 100.0 * err / std::max(std::abs(ref->phi_net_deg), kUncertaintyFloorDeg)) << " %), "
-      << (std::isfinite(def->uncertainty_deg) && err <= def->uncertainty_deg
-              ? "within its own uncertainty."
-              : "more than its own uncertainty says.")
+      << (!std::isfinite(def->uncertainty_deg) ? "and it has no uncertainty of its own to compare with."
+          : err <= def->uncertainty_deg         ? "within its own uncertainty."
+                                                : "more than its own uncertainty says.")
       << "\n\n";
   } else if (def && !def->ok) {
     o << "MuJoCo at the case's settings failed: " << def->failure << "\n\n";
@@ -175,8 +177,10 @@ void trustCaseMarkdown(const TrustStudy& st, std::ostream& o) {
   }
   o << "\nWhat the answer depends on (largest |change| against the default):";
   for (const auto& [g, v] : largest) o << " " << g << " " << fmt("%.3f", v) << " deg;";
-  o << " the default's own uncertainty " << (def ? fmt("%.3f", def->uncertainty_deg) : std::string("n/a"))
-    << " deg.\n\n";
+  o << " the default's own uncertainty "
+    << (def && std::isfinite(def->uncertainty_deg) ? fmt("%.3f", def->uncertainty_deg) + " deg"
+                                                    : std::string("not estimated (its check run failed)"))
+    << ".\n\n";
   if (!st.verdict.empty()) o << "Verdict across the models: " << st.verdict << "\n\n";
 }
 
