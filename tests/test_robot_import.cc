@@ -122,6 +122,17 @@ void expectFourModelsRun(const RobotModelSpec& spec) {
   EXPECT_LT(c.articulated.stand_end_tilt_deg, MujocoSettings{}.max_tilt_deg);
   EXPECT_LT(c.articulated.max_tilt_deg, 10.0);
   EXPECT_NEAR(c.tail.front().mass_kg, 0.1 * c.robot.quadruped.mass_kg, 1e-12);
+  // Each MuJoCo row's phi_net carries its own +- U (the articulated robot's check run at twice the
+  // model's timestep, the rigid box's at twice timestep_s); the planar rows, which estimate none, do not.
+  const std::string table = describeComparison(c);
+  for (const char* row : {"| mujoco (articulated", "| mujoco (rigid box) |", "| perfoot |", "| analytic |"}) {
+    const std::size_t at = table.find(row);
+    ASSERT_NE(at, std::string::npos) << row << "\n" << table;
+    const std::string line = table.substr(at, table.find('\n', at) - at);
+    const std::size_t a = line.find('|', 1), b = line.find('|', a + 1);
+    const std::string phi = line.substr(a + 1, b - a - 1);
+    EXPECT_EQ(phi.find(" +- ") != std::string::npos, std::string(row).rfind("| mujoco", 0) == 0) << line;
+  }
 }
 
 TEST(RobotImport, Go1WithATailStandsTurnsAndAllModelsRun) {

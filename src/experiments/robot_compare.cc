@@ -21,6 +21,27 @@ std::string f3(double v) {
   std::snprintf(b, sizeof b, "%.3f", v);
   return b;
 }
+// A run as a row of the comparison: the error first among the warnings.
+ModelRow rowOf(const std::string& title, const RunSummary& r) {
+  ModelRow row{title, r.ok, r.phi_net_deg, std::nullopt, r.warnings};
+  if (const auto u = r.extra.find("phi_net_uncertainty_deg"); u != r.extra.end()) row.phi_net_uncertainty_deg = u->second;
+  if (!r.ok) row.warnings.insert(row.warnings.begin(), r.error);
+  return row;
+}
+
+// A row's phi_net: "6.123", a MuJoCo row with its estimate "6.123 +- 0.050", with a failed check run
+// "6.123 +- n/a (check run failed)"; "(uncertain)" after it when a warning says so.
+std::string phiCell(const ModelRow& r) {
+  if (!r.ok) return "failed";
+  std::string t = f3(r.phi_net_deg);
+  if (r.phi_net_uncertainty_deg)
+    t += std::isfinite(*r.phi_net_uncertainty_deg) ? " +- " + f3(*r.phi_net_uncertainty_deg)
+                                                   : std::string(" +- n/a (check run failed)");
+  for (const std::string& w : r.warnings)
+    if (w.rfind(kUncertainWarning, 0) == 0) return t + " (uncertain)";
+  return t;
+}
+
 }  // namespace
 
 std::vector<TailLink> tailFor(const DerivedRobot& r, const RobotTailChoice& c) {
@@ -49,11 +70,11 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
   k.mujoco.body_height_m = k.robot.quadruped.com_height_m;
   k.output.settle_s = choice.settle_after_s;
 
-  c.articulated = runArticulated(c.robot, spec.mount, c.tail, k.trajectory(), k.mujoco, choice.stand_s,
-                                 choice.settle_after_s);
-  ModelRow art{c.robot.legs_locked ? "mujoco (articulated, legs locked)" : "mujoco (articulated)", c.articulated.ok,
-               c.articulated.phi_net_deg, c.articulated.warnings};
-  if (!c.articulated.ok) art.warnings.insert(art.warnings.begin(), c.articulated.error);
+  const RunResult articulated = simulateArticulated(c.robot, spec.mount, c.tail, k.trajectory(), k.mujoco,
+                                                    choice.stand_s, choice.settle_after_s, 0.0, "mujoco",
+                                                    &c.articulated);
+  ModelRow art = rowOf(c.robot.legs_locked ? "mujoco (articulated, legs locked)" : "mujoco (articulated)",
+                       articulated.summary);
   const ArticulatedRun& a = c.articulated;
   art.warnings.push_back("tilt (absolute / from the stance): stance " + f3(a.stance_tilt_deg) + " deg; after standing " +
                          f3(choice.stand_s) + " s with the tail " + f3(a.stand_end_tilt_deg) + " / " +
@@ -66,10 +87,7 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
     if (!e) continue;
     k.models = {name};
     const RunResult res = e->run(k, nullptr);
-    ModelRow row{std::string(name) == "mujoco" ? "mujoco (rigid box)" : name, res.summary.ok, res.summary.phi_net_deg,
-                 res.summary.warnings};
-    if (!res.summary.ok) row.warnings.insert(row.warnings.begin(), res.summary.error);
-    c.rows.push_back(row);
+    c.rows.push_back(rowOf(std::string(name) == "mujoco" ? "mujoco (rigid box)" : name, res.summary));
   }
   return c;
 }
@@ -165,7 +183,7 @@ std::string describeComparison(const RobotComparison& c) {
   for (const ModelRow& r : c.rows) {
     std::string w;
     for (const std::string& x : r.warnings) w += (w.empty() ? "" : "; ") + x;
-    o << "| " << r.model << " | " << (r.ok ? f3(r.phi_net_deg) : std::string("failed")) << " | " << w << " |\n";
+    o << "| " << r.model << " | " << phiCell(r) << " | " << w << " |\n";
   }
   return o.str();
 }

@@ -3,6 +3,7 @@
 // on the parameters derived from the same file: MuJoCo's rigid box, perfoot and analytic.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,9 @@ struct ModelRow {
   std::string model;  // "mujoco (articulated)", "mujoco (rigid box)", "perfoot", "analytic"
   bool ok = true;
   double phi_net_deg = 0.0;
+  // The MuJoCo rows' own estimate (phi_net_uncertainty_deg: NaN when their check run failed);
+  // absent for the planar rows, which estimate none.
+  std::optional<double> phi_net_uncertainty_deg;
   std::vector<std::string> warnings;  // and the error when !ok
 };
 
@@ -52,7 +56,8 @@ std::string describeYamlRobot(const std::string& path);
 // over n links): `tailsim robot FILE --write-robot OUT.yaml`, for experiments.
 std::string derivedRobotFile(const DerivedRobot& r, const RobotTailChoice& c);
 
-// The comparison as a Markdown table plus each run's warnings.
+// The comparison as a Markdown table plus each run's warnings; a MuJoCo row's phi_net with its
+// "+- U" (docs/your-robot.md).
 std::string describeComparison(const RobotComparison& c);
 
 }  // namespace tailsim
