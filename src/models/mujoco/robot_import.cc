@@ -196,16 +196,9 @@ std::string urdfToMjcf(const std::string& file) {
   return printer.CStr();
 }
 
-}  // namespace
-
-PreparedModel prepareRobotModel(const std::string& file_in) {
-  PreparedModel out;
-  out.source = fs::absolute(file_in).lexically_normal().string();
-  const std::string& file = out.source;
-  if (!isFile(file)) fail(file, "model file not found");
-  const fs::path dir = fs::path(file).parent_path();
-
-  XMLDocument doc;
+// Stage 1: the file parsed into doc as MJCF (a URDF through MuJoCo's URDF reader), its includes
+// inlined; returns the <mujoco> root.
+XMLElement* loadModelXml(XMLDocument& doc, const std::string& file, PreparedModel& out) {
   loadXmlFile(doc, file);
   if (!doc.RootElement()) fail(file, "empty XML file");
   if (std::string(doc.RootElement()->Name()) == "robot") {
@@ -219,9 +212,19 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
     fail(file, "neither MJCF (<mujoco>) nor URDF (<robot>)");
   }
   XMLElement* root = doc.RootElement();
-  inlineIncludes(doc, root, dir, 0);
+  inlineIncludes(doc, root, fs::path(file).parent_path(), 0);
+  return root;
+}
 
-  // Asset folders made absolute, so the compiled text finds the files the user's file names.
+// Where the model's asset files are, and whether bodies without <inertial> take their mass from geoms.
+struct AssetDirs {
+  fs::path meshdir, texturedir;
+  bool inertia_from_geom = false;
+};
+
+// Stage 2: the compiler's asset folders made absolute, so the compiled text finds the files the
+// user's file names.
+AssetDirs absoluteAssetDirs(XMLDocument& doc, XMLElement* root, const fs::path& dir) {
   XMLElement* compiler = root->FirstChildElement("compiler");
   if (!compiler) {
     compiler = doc.NewElement("compiler");
@@ -236,23 +239,33 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
     compiler->SetAttribute(attr, text.c_str());
     return a;
   };
+  AssetDirs d;
   const char* assetdir = compiler->Attribute("assetdir");
-  const fs::path meshdir = compiler->Attribute("meshdir") || !assetdir ? absDir("meshdir") : absDir("assetdir");
-  const fs::path texturedir =
+  d.meshdir = compiler->Attribute("meshdir") || !assetdir ? absDir("meshdir") : absDir("assetdir");
+  d.texturedir =
       compiler->Attribute("texturedir") || !assetdir ? absDir("texturedir") : fs::path(compiler->Attribute("assetdir"));
   if (assetdir) absDir("assetdir");
-  const bool inertiaFromGeom = compiler->Attribute("inertiafromgeom") &&
-                               std::string(compiler->Attribute("inertiafromgeom")) == "true";
+  d.inertia_from_geom = compiler->Attribute("inertiafromgeom") &&
+                        std::string(compiler->Attribute("inertiafromgeom")) == "true";
+  return d;
+}
 
-  // Missing mesh and texture files.
-  std::map<std::string, std::string> missingMesh;     // mesh name -> the missing file
-  std::set<std::string> missingTexture;
-  std::vector<XMLElement*> dropAssets;
+// The assets whose files are missing.
+struct MissingAssets {
+  std::map<std::string, std::string> mesh;  // mesh name -> the missing file
+  std::set<std::string> texture;
+  std::vector<XMLElement*> elements;  // their <mesh> and <texture> elements, to drop
+};
+
+// Stage 3: the missing mesh and texture files (a missing hfield or skin file is an error); the
+// materials lose their missing textures.
+MissingAssets findMissingAssets(XMLElement* root, const AssetDirs& dirs, const std::string& file) {
+  MissingAssets m;
   for (XMLElement* asset = root->FirstChildElement("asset"); asset; asset = asset->NextSiblingElement("asset")) {
     for (XMLElement* e = asset->FirstChildElement(); e; e = e->NextSiblingElement()) {
       const std::string tag = e->Name();
       if (tag != "mesh" && tag != "texture" && tag != "hfield" && tag != "skin") continue;
-      const fs::path base = tag == "texture" ? texturedir : meshdir;
+      const fs::path base = tag == "texture" ? dirs.texturedir : dirs.meshdir;
       std::vector<std::string> files;
       for (const char* a : {"file", "fileright", "fileleft", "fileup", "filedown", "filefront", "fileback"})
         if (const char* f = e->Attribute(a)) files.push_back(f);
@@ -260,42 +273,39 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
         const fs::path p = fs::path(f).is_absolute() ? fs::path(f) : base / f;
         if (isFile(p)) continue;
         const std::string name = e->Attribute("name") ? e->Attribute("name") : stemOf(f);
-        if (tag == "mesh") missingMesh[name] = p.string();
-        else if (tag == "texture") missingTexture.insert(name);
+        if (tag == "mesh") m.mesh[name] = p.string();
+        else if (tag == "texture") m.texture.insert(name);
         else fail(file, "<" + tag + "> '" + name + "': file " + p.string() + " is missing");
-        dropAssets.push_back(e);
+        m.elements.push_back(e);
         break;
       }
     }
   }
-  if (!missingTexture.empty()) {
+  if (!m.texture.empty()) {
     std::vector<XMLElement*> materials;
     forEachElement(root, [&](XMLElement* e) {
-      if (std::string(e->Name()) == "material" && e->Attribute("texture") && missingTexture.count(e->Attribute("texture")))
+      if (std::string(e->Name()) == "material" && e->Attribute("texture") && m.texture.count(e->Attribute("texture")))
         materials.push_back(e);
     });
-    for (XMLElement* m : materials) m->DeleteAttribute("texture");
+    for (XMLElement* mat : materials) mat->DeleteAttribute("texture");
   }
+  return m;
+}
 
-  // Geoms that use a missing mesh: dropped when they cannot collide; otherwise an error.
-  const Defaults defaults(root);
-  XMLElement* world = root->FirstChildElement("worldbody");
-  if (!world) fail(file, "no <worldbody>");
-  std::vector<XMLElement*> geoms;
-  forEachElement(world, [&](XMLElement* e) {
-    if (std::string(e->Name()) == "geom") geoms.push_back(e);
-  });
+bool isPlane(const Defaults& defaults, XMLElement* gm) {
+  const char* type = defaults.geomAttr(gm, "type");
+  return type && std::string(type) == "plane";
+}
+
+// Stage 4: the geoms that use a missing mesh: returned to be dropped when they cannot collide;
+// otherwise an error (also when their body's mass comes from its geoms).
+std::vector<XMLElement*> geomsWithoutMesh(const std::vector<XMLElement*>& geoms, const Defaults& defaults,
+                                          MissingAssets& missing, const AssetDirs& dirs, const std::string& file) {
   std::vector<std::string> colliding;
-  std::vector<XMLElement*> dropGeoms;
-  bool hasPlane = false;
+  std::vector<XMLElement*> drop;
   for (XMLElement* gm : geoms) {
-    const char* type = defaults.geomAttr(gm, "type");
-    if (type && std::string(type) == "plane") {
-      hasPlane = true;
-      if (out.floor_geom.empty()) out.floor_geom = gm->Attribute("name") ? gm->Attribute("name") : "";
-    }
     const char* mesh = defaults.geomAttr(gm, "mesh");
-    if (!mesh || !missingMesh.count(mesh)) continue;
+    if (!mesh || !missing.mesh.count(mesh)) continue;
     const char* ct = defaults.geomAttr(gm, "contype");
     const char* ca = defaults.geomAttr(gm, "conaffinity");
     const bool collides = (ct ? std::atoi(ct) : 1) != 0 || (ca ? std::atoi(ca) : 1) != 0;
@@ -305,63 +315,103 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
         gm->Attribute("name") ? "'" + std::string(gm->Attribute("name")) + "'" : "(unnamed, mesh '" + std::string(mesh) + "')";
     if (collides) {
       colliding.push_back("geom " + geomName + " in body '" + bodyName + "' collides but its mesh file " +
-                          missingMesh[mesh] + " is missing");
+                          missing.mesh[mesh] + " is missing");
       continue;
     }
-    const bool massFromGeoms = inertiaFromGeom || (body && !body->FirstChildElement("inertial"));
+    const bool massFromGeoms = dirs.inertia_from_geom || (body && !body->FirstChildElement("inertial"));
     if (massFromGeoms && std::string(body ? body->Name() : "") == "body")
-      fail(file, "geom " + geomName + " in body '" + bodyName + "' has a missing mesh file " + missingMesh[mesh] +
+      fail(file, "geom " + geomName + " in body '" + bodyName + "' has a missing mesh file " + missing.mesh[mesh] +
                      " and the body's mass and inertia come from its geoms (no <inertial>): supply the file");
-    dropGeoms.push_back(gm);
+    drop.push_back(gm);
   }
   if (!colliding.empty()) {
     std::string msg = std::to_string(colliding.size()) + " colliding geom" + (colliding.size() > 1 ? "s have" : " has") +
                       " a missing mesh file: ";
     for (std::size_t i = 0; i < colliding.size() && i < 5; ++i) msg += (i ? "; " : "") + colliding[i];
     if (colliding.size() > 5) msg += "; and " + std::to_string(colliding.size() - 5) + " more";
-    fail(file, msg + ". Supply the mesh files (meshdir " + meshdir.string() +
+    fail(file, msg + ". Supply the mesh files (meshdir " + dirs.meshdir.string() +
                    "), or make such geoms visual-only (contype=\"0\" conaffinity=\"0\")");
   }
-  for (XMLElement* gm : dropGeoms) gm->Parent()->DeleteChild(gm);
-  for (XMLElement* a : dropAssets) a->Parent()->DeleteChild(a);
-  out.dropped_geoms = static_cast<int>(dropGeoms.size());
-  out.dropped_textures = static_cast<int>(missingTexture.size());
-  if (out.dropped_geoms || out.dropped_textures)
-    out.notes.push_back("dropped " + std::to_string(out.dropped_geoms) + " non-colliding geom" +
-                        (out.dropped_geoms == 1 ? "" : "s") + " whose mesh file is missing and " +
-                        std::to_string(out.dropped_textures) + " texture" + (out.dropped_textures == 1 ? "" : "s") +
-                        " whose file is missing (their materials keep their colour)");
+  return drop;
+}
 
-  // Every joint named (the stance is carried by name into a model with a tail).
+// Stage 5: every joint named (the stance is carried by name into a model with a tail).
+void nameJoints(XMLElement* world) {
   int unnamed = 0;
   forEachElement(world, [&](XMLElement* e) {
     const std::string tag = e->Name();
     if ((tag == "joint" || tag == "freejoint") && !e->Attribute("name"))
       e->SetAttribute("name", ("tailsim_joint" + std::to_string(++unnamed)).c_str());
   });
+}
 
-  // A floor when the model has none (a robot file without its scene).
-  if (!hasPlane || out.floor_geom.empty()) {
-    if (hasPlane) {
-      // The model's plane has no name: name it.
-      for (XMLElement* gm : geoms) {
-        const char* type = defaults.geomAttr(gm, "type");
-        if (type && std::string(type) == "plane") {
-          gm->SetAttribute("name", "tailsim_floor");
-          break;
-        }
-      }
-    } else {
-      XMLElement* floor = doc.NewElement("geom");
-      floor->SetAttribute("name", "tailsim_floor");
-      floor->SetAttribute("type", "plane");
-      floor->SetAttribute("size", "0 0 1");
-      world->InsertFirstChild(floor);
-      out.notes.push_back("added a floor (plane, MuJoCo's default friction 1): the model has none");
+// Whether the model has a plane; out.floor_geom names the first (empty when unnamed).
+bool findFloor(const std::vector<XMLElement*>& geoms, const Defaults& defaults, PreparedModel& out) {
+  bool hasPlane = false;
+  for (XMLElement* gm : geoms)
+    if (isPlane(defaults, gm)) {
+      hasPlane = true;
+      if (out.floor_geom.empty()) out.floor_geom = gm->Attribute("name") ? gm->Attribute("name") : "";
     }
-    out.floor_geom = "tailsim_floor";
-  }
+  return hasPlane;
+}
 
+// Stage 6: a floor when the model has none (a robot file without its scene), or a name for its
+// unnamed plane; out.floor_geom names it.
+void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLElement*>& geoms, const Defaults& defaults,
+                 bool hasPlane, PreparedModel& out) {
+  if (hasPlane && !out.floor_geom.empty()) return;
+  if (hasPlane) {
+    // The model's plane has no name: name it.
+    for (XMLElement* gm : geoms)
+      if (isPlane(defaults, gm)) {
+        gm->SetAttribute("name", "tailsim_floor");
+        break;
+      }
+  } else {
+    XMLElement* floor = doc.NewElement("geom");
+    floor->SetAttribute("name", "tailsim_floor");
+    floor->SetAttribute("type", "plane");
+    floor->SetAttribute("size", "0 0 1");
+    world->InsertFirstChild(floor);
+    out.notes.push_back("added a floor (plane, MuJoCo's default friction 1): the model has none");
+  }
+  out.floor_geom = "tailsim_floor";
+}
+
+}  // namespace
+
+// The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
+// joint names, floor, print.
+PreparedModel prepareRobotModel(const std::string& file_in) {
+  PreparedModel out;
+  out.source = fs::absolute(file_in).lexically_normal().string();
+  const std::string& file = out.source;
+  if (!isFile(file)) fail(file, "model file not found");
+  XMLDocument doc;
+  XMLElement* root = loadModelXml(doc, file, out);
+  const AssetDirs dirs = absoluteAssetDirs(doc, root, fs::path(file).parent_path());
+  MissingAssets missing = findMissingAssets(root, dirs, file);
+  const Defaults defaults(root);
+  XMLElement* world = root->FirstChildElement("worldbody");
+  if (!world) fail(file, "no <worldbody>");
+  std::vector<XMLElement*> geoms;
+  forEachElement(world, [&](XMLElement* e) {
+    if (std::string(e->Name()) == "geom") geoms.push_back(e);
+  });
+  const bool hasPlane = findFloor(geoms, defaults, out);
+  const std::vector<XMLElement*> dropGeoms = geomsWithoutMesh(geoms, defaults, missing, dirs, file);
+  for (XMLElement* gm : dropGeoms) gm->Parent()->DeleteChild(gm);
+  for (XMLElement* a : missing.elements) a->Parent()->DeleteChild(a);
+  out.dropped_geoms = static_cast<int>(dropGeoms.size());
+  out.dropped_textures = static_cast<int>(missing.texture.size());
+  if (out.dropped_geoms || out.dropped_textures)
+    out.notes.push_back("dropped " + std::to_string(out.dropped_geoms) + " non-colliding geom" +
+                        (out.dropped_geoms == 1 ? "" : "s") + " whose mesh file is missing and " +
+                        std::to_string(out.dropped_textures) + " texture" + (out.dropped_textures == 1 ? "" : "s") +
+                        " whose file is missing (their materials keep their colour)");
+  nameJoints(world);
+  ensureFloor(doc, world, geoms, defaults, hasPlane, out);
   tinyxml2::XMLPrinter printer;
   doc.Print(&printer);
   out.xml = printer.CStr();
