@@ -17,12 +17,13 @@
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
 using namespace design_yaml;
-constexpr double kDegPerRad = 180.0 / M_PI;
+using units::kDegPerRad;
 
 std::string g17(double v) {
   char b[40];

@@ -13,11 +13,12 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
-constexpr double kRadPerDeg = M_PI / 180.0;
+using units::kRadPerDeg;
 using namespace design_yaml;
 
 // A joint limit given in the design file: one value for every joint, or a list of one per joint

@@ -21,12 +21,13 @@
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDegPerRad = 180.0 / M_PI;
+using units::kDegPerRad;
 
 std::string g17(double v) {
   char b[40];
@@ -70,7 +71,7 @@ TimeSeries trajectorySeries(const std::vector<TailLink>& links, const TailTrajec
 LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSeries& ts, const StrokeLimits& L) {
   LimitCheck c;
   const int n = static_cast<int>(links.size());
-  const double d2r = M_PI / 180.0;
+  const double d2r = units::kRadPerDeg;
   StrokeFigures& f = c.figures;
   f.theta_min_rad = std::numeric_limits<double>::infinity();
   f.theta_max_rad = -f.theta_min_rad;
@@ -737,7 +738,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   searchSeeds(spec, progress, t0, rep);
   OptimizeResult best = pickBestSeed(rep);
   if (spec.objective_model == ObjectiveModel::kMujoco) rerankWithMujoco(spec, progress, best, rep);
-  rep.infeasible = analyseInfeasible(spec.problem, best.best, best.trajectory, spec.min_turn_deg * M_PI / 180.0);
+  rep.infeasible = analyseInfeasible(spec.problem, best.best, best.trajectory, units::radians(spec.min_turn_deg));
   const std::string best_yaml = bestExperimentYaml(spec, best.trajectory);
   const TailTrajectory traj = readBackBest(best_yaml, best.trajectory, out_dir, rep);
   resimulateBest(spec, traj, best_yaml, out_dir, rep);

@@ -13,14 +13,14 @@
 #include <set>
 #include <sstream>
 
+#include "settings/units.h"
+
 namespace tailsim {
 namespace {
 
 namespace fs = std::filesystem;
 using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string g6(double v) {
   char b[48];
@@ -537,7 +537,7 @@ void stand(const mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance
   mj_forward(m, d);
   if (warningCount(d) > 0) fail(file, "MuJoCo warnings while standing: " + describeWarnings(d));
   const double* Rroot = d->xmat + 9 * root;
-  r.tilt_deg = std::acos(std::clamp(Rroot[8], -1.0, 1.0)) * 180.0 / kPi;
+  r.tilt_deg = units::degrees(std::acos(std::clamp(Rroot[8], -1.0, 1.0)));
 }
 
 // A geom's name, or "geom #k of body 'b'" for an unnamed one.
@@ -710,7 +710,7 @@ void listValues(const RobotModelSpec& spec, const std::string& muSource, Derived
   const QuadrupedParams& q = r.quadruped;
   const std::string stood = " (stance after standing " + g6(spec.settle_s) + " s)";
   const std::string frame = "planar frame: body '" + r.mount_body + "' x" +
-                            (spec.mount.yaw_rad != 0.0 ? " turned by " + g6(spec.mount.yaw_rad * 180 / kPi) + " deg" : "");
+                            (spec.mount.yaw_rad != 0.0 ? " turned by " + g6(units::degrees(spec.mount.yaw_rad)) + " deg" : "");
   r.values = {
       {"quadruped.mass_kg", q.mass_kg, "kg", "sum of the model's body masses (MuJoCo body_subtreemass of '" + r.root_body + "': " + g6(r.mujoco_subtreemass_kg) + ")"},
       {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2", "composite I_zz about the COM, legs held" + stood + "; MuJoCo cinert sum " + g6(r.mujoco_cinert_izz_kgm2)},
