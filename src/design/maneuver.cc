@@ -17,12 +17,13 @@
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
 using namespace design_yaml;
-constexpr double kDegPerRad = 180.0 / M_PI;
+using units::kDegPerRad;
 
 std::string g17(double v) {
   char b[40];
@@ -364,146 +365,139 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
   return run;
 }
 
-ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress) {
-  const auto w0 = std::chrono::steady_clock::now();
-  ManeuverSettings s = spec.settings;
-  const ExperimentCase& base = spec.base;
-  ManeuverReport rep;
-  if (!spec.min_scale_given) s.min_scale = derivedMinScale(base, s, minScaleFloor(s, base.robot.numLinks()));
-  rep.min_scale = s.min_scale;
-  const int n = base.robot.numLinks();
-  // The plan first: one that cannot be run leaves nothing in the folder.
-  rep.full_cycle = analyticCycleYaw(base, s, 1.0);
-  rep.map = analyticYawMap(base, s);
-  rep.plan = planOpenLoop(base, s, rep.map, spec.max_strokes_at);
-  fs::create_directories(fs::path(out_dir) / "plots");
-  // The folder's own inputs: it runs again after a move (tailsim maneuver DIR/maneuver.yaml).
-  for (const auto& [name, text] : designFolderInputs(spec.source_file, "maneuver.yaml", spec.base_file, spec.stroke_file)) {
-    writeOwnedFile(out_dir, name, text);
-    rep.files.push_back(name);
-  }
-  if (progress)
-    std::fprintf(stderr, "analytic cycle: stroke %+.4f deg, return %+.4f deg; plan: %zu cycles (last scale %.4f)\n",
-                 rep.full_cycle.fast_rad * kDegPerRad, rep.full_cycle.back_rad * kDegPerRad, rep.plan.size(),
-                 rep.plan.empty() ? 0.0 : rep.plan.back().scale);
-  rep.runs.push_back(runAnalyticOpenLoop(base, s, rep.plan));
-  if (s.mujoco) {
-    rep.runs.push_back(runMujocoOpenLoop(base, s, rep.plan));
-    if (progress) std::fprintf(stderr, "MuJoCo open loop done\n");
-    // Closed loop: time for twice the plan's cycles plus two (MuJoCo turns less per cycle), at most max_strokes.
-    const int cycles = std::min(s.max_strokes, 2 * static_cast<int>(rep.plan.size()) + 2);
-    const double dur = cycles * (cycleDuration(s, 1.0) + 0.2) + 0.5;
-    rep.runs.push_back(runMujocoClosedLoop(base, s, rep.map, dur));
-    if (progress) std::fprintf(stderr, "MuJoCo closed loop done\n");
-  }
+namespace {
 
-  // maneuver.csv: heading of each run on the output grid (empty where a run has no row).
-  {
-    std::ostringstream csv;
-    csv << "t_s";
-    std::size_t rows = 0;
+// Stage 2: the runs: the analytic open loop, and with maneuver.mujoco MuJoCo's open and closed loops.
+void runManeuverModels(const ExperimentCase& base, const ManeuverSettings& s, bool progress, ManeuverReport& rep) {
+  rep.runs.push_back(runAnalyticOpenLoop(base, s, rep.plan));
+  if (!s.mujoco) return;
+  rep.runs.push_back(runMujocoOpenLoop(base, s, rep.plan));
+  if (progress) std::fprintf(stderr, "MuJoCo open loop done\n");
+  // Closed loop: time for twice the plan's cycles plus two (MuJoCo turns less per cycle), at most max_strokes.
+  const int cycles = std::min(s.max_strokes, 2 * static_cast<int>(rep.plan.size()) + 2);
+  const double dur = cycles * (cycleDuration(s, 1.0) + 0.2) + 0.5;
+  rep.runs.push_back(runMujocoClosedLoop(base, s, rep.map, dur));
+  if (progress) std::fprintf(stderr, "MuJoCo closed loop done\n");
+}
+
+// Stage 3: maneuver.csv: heading of each run on the output grid (empty where a run has no row).
+void writeHeadings(const ExperimentCase& base, const std::string& out_dir, ManeuverReport& rep) {
+  std::ostringstream csv;
+  csv << "t_s";
+  std::size_t rows = 0;
+  for (const ManeuverRun& r : rep.runs) {
+    csv << "," << r.label << "_heading_deg";
+    rows = std::max(rows, r.series.numRows());
+  }
+  csv << "\n";
+  const double dt = base.output.sample_dt_s;
+  for (std::size_t k = 0; k < rows; ++k) {
+    csv << g17(k * dt);
     for (const ManeuverRun& r : rep.runs) {
-      csv << "," << r.label << "_heading_deg";
-      rows = std::max(rows, r.series.numRows());
+      csv << ",";
+      if (k < r.series.numRows()) csv << g17(r.series.values("phi_deg")[k] - r.series.values("phi_deg")[0]);
     }
     csv << "\n";
-    const double dt = base.output.sample_dt_s;
-    for (std::size_t k = 0; k < rows; ++k) {
-      csv << g17(k * dt);
-      for (const ManeuverRun& r : rep.runs) {
-        csv << ",";
-        if (k < r.series.numRows()) csv << g17(r.series.values("phi_deg")[k] - r.series.values("phi_deg")[0]);
-      }
-      csv << "\n";
-    }
-    writeOwnedFile(out_dir, "maneuver.csv", csv.str());
-    rep.files.push_back("maneuver.csv");
   }
-  {
-    std::ostringstream csv;
-    csv << "run,cycle,t_start_s,scale,direction,dtheta_deg,dT_s,return_dT_s,heading_before_deg,heading_after_deg,yaw_deg\n";
-    for (const ManeuverRun& r : rep.runs)
-      for (std::size_t k = 0; k < r.strokes.size(); ++k) {
-        const StrokeRecord& x = r.strokes[k];
-        // Joint 1's fast-stroke angle change and the fast stroke's duration.
-        const CycleStrokes cs = cycleStrokes(s, n, x.command, 0.0);
-        std::vector<JointState> a, b;
-        cs.fast.evaluate(-1.0, a);
-        cs.fast.evaluate(cs.fast.endTime() + 1.0, b);
-        csv << r.label << "," << k + 1 << "," << g17(x.t_start_s) << "," << g17(x.command.scale) << "," << x.command.direction
-            << "," << g17((b[0].theta - a[0].theta) * kDegPerRad) << "," << g17(cs.fast.endTime() - cs.fast.startTime())
-            << "," << g17(s.return_dT_s) << "," << g17(x.heading_before_rad * kDegPerRad) << ","
-            << g17(x.heading_after_rad * kDegPerRad) << "," << g17((x.heading_after_rad - x.heading_before_rad) * kDegPerRad)
-            << "\n";
-      }
-    writeOwnedFile(out_dir, "strokes.csv", csv.str());
-    rep.files.push_back("strokes.csv");
-  }
-  {
-    std::ostringstream csv;
-    csv << "scale,cycle_yaw_deg\n";
-    for (std::size_t k = 0; k < rep.map.scale.size(); ++k)
-      csv << g17(rep.map.scale[k]) << "," << g17(rep.map.yaw_rad[k] * kDegPerRad) << "\n";
-    writeOwnedFile(out_dir, "yaw_map.csv", csv.str());
-    rep.files.push_back("yaw_map.csv");
-  }
-  {
-    GnuplotFigure fig;
-    fig.stem = "heading";
-    std::ostringstream b;
-    std::ostringstream title;
-    title << "Maneuver " << spec.name << ": heading to " << s.heading_deg << " deg";
-    b << "set datafile separator ','\nset key bottom right\nset grid\n"
-      << "set title " << gpQuote(title.str()) << " noenhanced\n"
-      << "set xlabel 't [s]'\nset ylabel 'heading change [deg]'\n";
-    // The time axis ends 15 % after the last action: the last stroke's return and rest, or the
-    // closed loop settling within tolerance (the runs idle afterwards).
-    double t_action = 0;
-    for (const ManeuverRun& r : rep.runs) {
-      if (!r.strokes.empty()) {
-        const StrokeRecord& x = r.strokes.back();
-        t_action = std::max(t_action, x.t_start_s + cycleDuration(s, x.command.scale));
-      }
-      t_action = std::max(t_action, r.t_within_s);
-    }
-    if (t_action > 0) b << "set xrange [0:" << g17(1.15 * t_action) << "]\n";
-    b << "plot " << s.heading_deg << " with lines dt 2 lc rgb '#000000' title 'target'";
-    // Runs that follow the same heading stay visible: wide solid under narrower dashed lines.
-    const char* colours[] = {"#0072B2", "#E69F00", "#009E73"};
-    const char* lines[] = {"lw 5 dt 1", "lw 2.5 dt 2", "lw 2 dt 4"};
-    for (std::size_t i = 0; i < rep.runs.size(); ++i)
-      b << ", " << gpFileName("../maneuver.csv") << " every ::1 using 1:" << i + 2 << " with lines " << lines[i % 3] << " lc rgb "
-        << gpQuote(colours[i % 3]) << " title " << gpQuote(rep.runs[i].label) << " noenhanced";
-    b << "\n";
-    fig.body = b.str();
-    renderFigure((fs::path(out_dir) / "plots").string(), fig);
-    rep.files.push_back("plots/heading.png");
-  }
-  if (video && s.mujoco) {
-    ExperimentCase c = base;
-    c.name = spec.name;
-    c.render.enabled = true;
-    c.render.slowmo = 1.0;
-    // Show the turn and 2 s after the closed loop is within tolerance (the run idles afterwards).
-    if (rep.runs[2].t_within_s >= 0) c.render.duration_s = rep.runs[2].t_within_s + 2.0;
-    std::vector<RunResult> runs(2);
-    runs[0].summary.model = "analytic";
-    runs[0].series = rep.runs[0].series;
-    runs[1].summary.model = "mujoco";
-    runs[1].series = rep.runs[2].series;
-    // The video's phase text follows the case trajectory: the first planned stroke.
-    c.joints.clear();
-    c.splines.clear();
-    if (!rep.plan.empty())
-      for (const auto& jp : cycleStrokes(s, n, rep.plan.front(), 0.0).fast.joints) {
-        if (jp.isSpline()) c.splines.push_back(jp.spline());
-        else c.joints.push_back(jp.params());
-      }
-    renderCase(c, runs, (fs::path(out_dir) / "renders").string(), "open-loop plan (analytic)");
-    rep.files.push_back("renders/" + spec.name + ".mp4");
-  }
-  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  writeOwnedFile(out_dir, "maneuver.csv", csv.str());
+  rep.files.push_back("maneuver.csv");
+}
 
+// Stage 4: strokes.csv, a row per stroke of every run.
+void writeStrokes(const ManeuverSettings& s, int n, const std::string& out_dir, ManeuverReport& rep) {
+  std::ostringstream csv;
+  csv << "run,cycle,t_start_s,scale,direction,dtheta_deg,dT_s,return_dT_s,heading_before_deg,heading_after_deg,yaw_deg\n";
+  for (const ManeuverRun& r : rep.runs)
+    for (std::size_t k = 0; k < r.strokes.size(); ++k) {
+      const StrokeRecord& x = r.strokes[k];
+      // Joint 1's fast-stroke angle change and the fast stroke's duration.
+      const CycleStrokes cs = cycleStrokes(s, n, x.command, 0.0);
+      std::vector<JointState> a, b;
+      cs.fast.evaluate(-1.0, a);
+      cs.fast.evaluate(cs.fast.endTime() + 1.0, b);
+      csv << r.label << "," << k + 1 << "," << g17(x.t_start_s) << "," << g17(x.command.scale) << "," << x.command.direction
+          << "," << g17((b[0].theta - a[0].theta) * kDegPerRad) << "," << g17(cs.fast.endTime() - cs.fast.startTime())
+          << "," << g17(s.return_dT_s) << "," << g17(x.heading_before_rad * kDegPerRad) << ","
+          << g17(x.heading_after_rad * kDegPerRad) << "," << g17((x.heading_after_rad - x.heading_before_rad) * kDegPerRad)
+          << "\n";
+    }
+  writeOwnedFile(out_dir, "strokes.csv", csv.str());
+  rep.files.push_back("strokes.csv");
+}
+
+// Stage 5: yaw_map.csv, the analytic cycle yaw against the stroke scale.
+void writeYawMap(const std::string& out_dir, ManeuverReport& rep) {
+  std::ostringstream csv;
+  csv << "scale,cycle_yaw_deg\n";
+  for (std::size_t k = 0; k < rep.map.scale.size(); ++k)
+    csv << g17(rep.map.scale[k]) << "," << g17(rep.map.yaw_rad[k] * kDegPerRad) << "\n";
+  writeOwnedFile(out_dir, "yaw_map.csv", csv.str());
+  rep.files.push_back("yaw_map.csv");
+}
+
+// Stage 6: plots/heading.png, every run's heading against the target.
+void plotHeadings(const ManeuverSpec& spec, const ManeuverSettings& s, const std::string& out_dir, ManeuverReport& rep) {
+  GnuplotFigure fig;
+  fig.stem = "heading";
+  std::ostringstream b;
+  std::ostringstream title;
+  title << "Maneuver " << spec.name << ": heading to " << s.heading_deg << " deg";
+  b << "set datafile separator ','\nset key bottom right\nset grid\n"
+    << "set title " << gpQuote(title.str()) << " noenhanced\n"
+    << "set xlabel 't [s]'\nset ylabel 'heading change [deg]'\n";
+  // The time axis ends 15 % after the last action: the last stroke's return and rest, or the
+  // closed loop settling within tolerance (the runs idle afterwards).
+  double t_action = 0;
+  for (const ManeuverRun& r : rep.runs) {
+    if (!r.strokes.empty()) {
+      const StrokeRecord& x = r.strokes.back();
+      t_action = std::max(t_action, x.t_start_s + cycleDuration(s, x.command.scale));
+    }
+    t_action = std::max(t_action, r.t_within_s);
+  }
+  if (t_action > 0) b << "set xrange [0:" << g17(1.15 * t_action) << "]\n";
+  b << "plot " << s.heading_deg << " with lines dt 2 lc rgb '#000000' title 'target'";
+  // Runs that follow the same heading stay visible: wide solid under narrower dashed lines.
+  const char* colours[] = {"#0072B2", "#E69F00", "#009E73"};
+  const char* lines[] = {"lw 5 dt 1", "lw 2.5 dt 2", "lw 2 dt 4"};
+  for (std::size_t i = 0; i < rep.runs.size(); ++i)
+    b << ", " << gpFileName("../maneuver.csv") << " every ::1 using 1:" << i + 2 << " with lines " << lines[i % 3] << " lc rgb "
+      << gpQuote(colours[i % 3]) << " title " << gpQuote(rep.runs[i].label) << " noenhanced";
+  b << "\n";
+  fig.body = b.str();
+  renderFigure((fs::path(out_dir) / "plots").string(), fig);
+  rep.files.push_back("plots/heading.png");
+}
+
+// Stage 7 (--video with MuJoCo): the video of the analytic open loop beside MuJoCo's closed loop.
+void renderManeuverVideo(const ManeuverSpec& spec, const ManeuverSettings& s, int n, const std::string& out_dir,
+                         ManeuverReport& rep) {
+  ExperimentCase c = spec.base;
+  c.name = spec.name;
+  c.render.enabled = true;
+  c.render.slowmo = 1.0;
+  // Show the turn and 2 s after the closed loop is within tolerance (the run idles afterwards).
+  if (rep.runs[2].t_within_s >= 0) c.render.duration_s = rep.runs[2].t_within_s + 2.0;
+  std::vector<RunResult> runs(2);
+  runs[0].summary.model = "analytic";
+  runs[0].series = rep.runs[0].series;
+  runs[1].summary.model = "mujoco";
+  runs[1].series = rep.runs[2].series;
+  // The video's phase text follows the case trajectory: the first planned stroke.
+  c.joints.clear();
+  c.splines.clear();
+  if (!rep.plan.empty())
+    for (const auto& jp : cycleStrokes(s, n, rep.plan.front(), 0.0).fast.joints) {
+      if (jp.isSpline()) c.splines.push_back(jp.spline());
+      else c.joints.push_back(jp.params());
+    }
+  renderCase(c, runs, (fs::path(out_dir) / "renders").string(), "open-loop plan (analytic)");
+  rep.files.push_back("renders/" + spec.name + ".mp4");
+}
+
+// Stage 8: summary.json.
+void writeManeuverSummary(const ManeuverSpec& spec, const ManeuverSettings& s, const std::string& out_dir,
+                          const ManeuverReport& rep) {
   nlohmann::json j;
   j["experiment"] = spec.name;
   j["source"] = spec.source_file;
@@ -536,6 +530,42 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;
   writeOwnedFile(out_dir, "summary.json", j.dump(2) + "\n");
+}
+
+}  // namespace
+
+// The stages in order: the plan (before anything is written), the folder's inputs, the runs, the CSV
+// files, the heading plot, the video, the summary.
+ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress) {
+  const auto w0 = std::chrono::steady_clock::now();
+  ManeuverSettings s = spec.settings;
+  const ExperimentCase& base = spec.base;
+  ManeuverReport rep;
+  if (!spec.min_scale_given) s.min_scale = derivedMinScale(base, s, minScaleFloor(s, base.robot.numLinks()));
+  rep.min_scale = s.min_scale;
+  const int n = base.robot.numLinks();
+  // Stage 1, the plan first: one that cannot be run leaves nothing in the folder.
+  rep.full_cycle = analyticCycleYaw(base, s, 1.0);
+  rep.map = analyticYawMap(base, s);
+  rep.plan = planOpenLoop(base, s, rep.map, spec.max_strokes_at);
+  fs::create_directories(fs::path(out_dir) / "plots");
+  // The folder's own inputs: it runs again after a move (tailsim maneuver DIR/maneuver.yaml).
+  for (const auto& [name, text] : designFolderInputs(spec.source_file, "maneuver.yaml", spec.base_file, spec.stroke_file)) {
+    writeOwnedFile(out_dir, name, text);
+    rep.files.push_back(name);
+  }
+  if (progress)
+    std::fprintf(stderr, "analytic cycle: stroke %+.4f deg, return %+.4f deg; plan: %zu cycles (last scale %.4f)\n",
+                 rep.full_cycle.fast_rad * kDegPerRad, rep.full_cycle.back_rad * kDegPerRad, rep.plan.size(),
+                 rep.plan.empty() ? 0.0 : rep.plan.back().scale);
+  runManeuverModels(base, s, progress, rep);
+  writeHeadings(base, out_dir, rep);
+  writeStrokes(s, n, out_dir, rep);
+  writeYawMap(out_dir, rep);
+  plotHeadings(spec, s, out_dir, rep);
+  if (video && s.mujoco) renderManeuverVideo(spec, s, n, out_dir, rep);
+  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  writeManeuverSummary(spec, s, out_dir, rep);
   rep.files.push_back("summary.json");
   return rep;
 }

@@ -13,11 +13,12 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
-constexpr double kRadPerDeg = M_PI / 180.0;
+using units::kRadPerDeg;
 using namespace design_yaml;
 
 // A joint limit given in the design file: one value for every joint, or a list of one per joint
@@ -93,104 +94,60 @@ void resolveJointLimits(const Reader& r, const Val& lv, const ExperimentCase& ba
   L.torque_max_Nm = a.torque_max_Nm;
   if (!uniform) L.joints = std::move(js);
 }
-}  // namespace
 
-bool isOptimizeFile(const std::string& path) {
-  try {
-    const YAML::Node doc = loadBoundedYaml(fs::absolute(path).lexically_normal().string());
-    return doc.IsMap() && doc["kind"] && doc["kind"].IsScalar() && doc["kind"].Scalar() == "optimize";
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
-double optimizeRunEstimate(const OptimizeSpec& s) {
-  const OptimizerSettings& o = s.optimizer;
-  auto restartRuns = [&](int r) {
-    const double pop = o.population * std::pow(static_cast<double>(o.restart_growth), r);
-    return o.islands * pop * (o.generations + 1.0 + o.refine_generations);
-  };
-  double later = 0;  // the restarts after the first, the local restarts and the polish
-  for (int r = 1; r < o.restarts; ++r) later += restartRuns(r);
-  later += o.local_restarts * static_cast<double>(o.islands) * o.population * (o.generations + 1.0);
-  if (o.polish != "none") later += o.polish_evaluations;
-  const double first = 2.0 + restartRuns(0);  // the start (base stroke and its box point) and restart 0
-  double per_search = first + later;
-  if (o.enumerate_directions) {
-    const double patterns = std::ldexp(1.0, std::min(s.problem.space.n_links, 1000));
-    const double kept = o.directions_kept > 0 ? std::min<double>(o.directions_kept, patterns) : patterns;
-    per_search = patterns * first + kept * later;
-    if (o.max_runs > 0) per_search = std::min(per_search, patterns * static_cast<double>(o.max_runs));
-  } else if (o.max_runs > 0) {
-    per_search = std::min(per_search, static_cast<double>(o.max_runs));
-  }
-  return per_search * static_cast<double>(s.seeds.size() + static_cast<std::size_t>(s.pareto_points));
-}
-
-OptimizeSpec loadOptimizeSpec(const std::string& path) {
-  OptimizeSpec s;
-  s.source_file = fs::absolute(path).lexically_normal().string();
-  const Reader r(s.source_file);
-  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "optimize", "optimize",
-                                                                      kMaxNameChars - (sizeof kBestNameSuffix - 1));
-  s.name = std::move(file.head.name);
-  s.description = std::move(file.head.description);
-  s.base_file = std::move(file.head.base_file);
-  auto need = [&](const design_yaml::Map& m, const Val& parent, const char* k) -> const Val& {
-    return design_yaml::need(r, m, parent, k);
-  };
-  const Val& base = file.base(r);  // the base experiment's own checks below point here
-  const Val& opt = file.section(r);
-  const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "max_runs", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
-  StrokeSpace& sp = s.problem.space;
-  sp.family = r.choice(need(o, opt, "family"), {"split_cycle", "spline"}) == "spline" ? StrokeFamily::kSpline
-                                                                                        : StrokeFamily::kSplitCycle;
-  if (const Val* k = Reader::get(o, "knots")) {
-    if (sp.family != StrokeFamily::kSpline) r.fail(*k, "only used with family: spline");
-    sp.knots = r.integer(*k, 0, kMaxKnots);
-  }
-  // objective: phi_net (the analytic model's), or {quantity: ..., model: analytic | perfoot | mujoco,
-  // search: analytic | perfoot (mujoco only; default perfoot), candidates: K (mujoco only; default 8)}.
-  if (const Val* v = Reader::get(o, "objective")) {
-    const Val* q = v;
-    if (v->node.IsMap()) {
-      const auto om = r.map(*v, {"quantity", "model", "search", "candidates"});
-      q = Reader::get(om, "quantity");
-      if (const Val* m = Reader::get(om, "model")) {
-        const std::string mn = r.choice(*m, {"analytic", "perfoot", "mujoco"});
-        s.objective_model = mn == "perfoot" ? ObjectiveModel::kPerFoot
-                            : mn == "mujoco" ? ObjectiveModel::kMujoco
-                                             : ObjectiveModel::kAnalytic;
-      }
-      s.problem.search_model =
-          s.objective_model == ObjectiveModel::kAnalytic ? ObjectiveModel::kAnalytic : ObjectiveModel::kPerFoot;
-      const Val* search = Reader::get(om, "search");
-      const Val* cand = Reader::get(om, "candidates");
-      if (s.objective_model != ObjectiveModel::kMujoco) {
-        if (search) r.fail(*search, "only used with model: mujoco (the model the candidates are searched on)");
-        if (cand) r.fail(*cand, "only used with model: mujoco (how many of the search's best MuJoCo re-ranks)");
-      } else {
-        if (search)
-          s.problem.search_model =
-              r.choice(*search, {"analytic", "perfoot"}) == "perfoot" ? ObjectiveModel::kPerFoot : ObjectiveModel::kAnalytic;
-        s.problem.keep_candidates = cand ? r.integer(*cand, 1, kMaxMujocoCandidates) : 8;
-      }
-    }
-    if (q) {
-      const std::string ob = r.choice(*q, {"phi_net", "phi_net_per_torque", "phi_net_per_energy"});
-      s.problem.objective = ob == "phi_net" ? StrokeObjective::kPhiNet
-                            : ob == "phi_net_per_torque" ? StrokeObjective::kPhiNetPerTorque
-                                                         : StrokeObjective::kPhiNetPerEnergy;
-    }
-  }
-  const Val& lv = need(o, opt, "limits");
-  const auto l = r.map(lv, {"theta_deg", "thetadot_max_dps", "torque_max_Nm", "end", "dT_s", "w_ss", "start_delay_s"});
-  StrokeLimits& L = sp.limits;
-  // The angle range, speed and torque limits: here (a value for every joint, or a list of one per
-  // joint), or the robot file's (each joint's tail-entry theta_min_deg/theta_max_deg,
-  // thetadot_max_dps, torque_max_Nm; resolved once the base is read).
+// The limits section as read, before the base is known.
+struct LimitKeys {
   FileLimit theta, speed, torque;
+  const Val* torque_key = nullptr;
+  bool torque_word = false;  // torque_max_Nm: base or none
+};
+
+// Stage: optimize.objective: phi_net (the analytic model's), or {quantity: ..., model: analytic |
+// perfoot | mujoco, search: analytic | perfoot (mujoco only; default perfoot), candidates: K (mujoco
+// only; default 8)}.
+void readObjective(const Reader& r, const Map& o, OptimizeSpec& s) {
+  const Val* v = Reader::get(o, "objective");
+  if (!v) return;
+  const Val* q = v;
+  if (v->node.IsMap()) {
+    const auto om = r.map(*v, {"quantity", "model", "search", "candidates"});
+    q = Reader::get(om, "quantity");
+    if (const Val* m = Reader::get(om, "model")) {
+      const std::string mn = r.choice(*m, {"analytic", "perfoot", "mujoco"});
+      s.objective_model = mn == "perfoot" ? ObjectiveModel::kPerFoot
+                          : mn == "mujoco" ? ObjectiveModel::kMujoco
+                                           : ObjectiveModel::kAnalytic;
+    }
+    s.problem.search_model =
+        s.objective_model == ObjectiveModel::kAnalytic ? ObjectiveModel::kAnalytic : ObjectiveModel::kPerFoot;
+    const Val* search = Reader::get(om, "search");
+    const Val* cand = Reader::get(om, "candidates");
+    if (s.objective_model != ObjectiveModel::kMujoco) {
+      if (search) r.fail(*search, "only used with model: mujoco (the model the candidates are searched on)");
+      if (cand) r.fail(*cand, "only used with model: mujoco (how many of the search's best MuJoCo re-ranks)");
+    } else {
+      if (search)
+        s.problem.search_model =
+            r.choice(*search, {"analytic", "perfoot"}) == "perfoot" ? ObjectiveModel::kPerFoot : ObjectiveModel::kAnalytic;
+      s.problem.keep_candidates = cand ? r.integer(*cand, 1, kMaxMujocoCandidates) : 8;
+    }
+  }
+  if (q) {
+    const std::string ob = r.choice(*q, {"phi_net", "phi_net_per_torque", "phi_net_per_energy"});
+    s.problem.objective = ob == "phi_net" ? StrokeObjective::kPhiNet
+                          : ob == "phi_net_per_torque" ? StrokeObjective::kPhiNetPerTorque
+                                                       : StrokeObjective::kPhiNetPerEnergy;
+  }
+}
+
+// Stage: optimize.limits (its map l). The angle range, speed and torque limits: here (a value for
+// every joint, or a list of one per joint), or the robot file's (each joint's tail-entry
+// theta_min_deg/theta_max_deg, thetadot_max_dps, torque_max_Nm; resolved once the base is read);
+// the others into sp.limits.
+LimitKeys readLimits(const Reader& r, const Map& l, StrokeSpace& sp) {
+  StrokeLimits& L = sp.limits;
+  LimitKeys k;
+  FileLimit& theta = k.theta;
   if ((theta.at = Reader::get(l, "theta_deg"))) {
     auto pair = [&](const Val& v) {
       const auto [lo, hi] = r.interval(v, -360.0, 360.0);
@@ -210,20 +167,20 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     else
       f.values.push_back(r.inRange(*f.at, lo, hi) * scale);
   };
-  if ((speed.at = Reader::get(l, "thetadot_max_dps"))) numbers(speed, 1.0, 36000.0, kRadPerDeg);
-  const Val* torque_key = Reader::get(l, "torque_max_Nm");
-  const bool torque_word = torque_key && torque_key->node.IsScalar() &&
-                           (torque_key->node.Scalar() == "base" || torque_key->node.Scalar() == "none");
-  if (torque_key && !torque_word) {
-    torque.at = torque_key;
-    torque.per_joint = torque_key->node.IsSequence();
-    for (const Val& e : torque.per_joint ? r.list(*torque_key, 1, 64) : std::vector<Val>{*torque_key}) {
+  if ((k.speed.at = Reader::get(l, "thetadot_max_dps"))) numbers(k.speed, 1.0, 36000.0, kRadPerDeg);
+  k.torque_key = Reader::get(l, "torque_max_Nm");
+  k.torque_word = k.torque_key && k.torque_key->node.IsScalar() &&
+                  (k.torque_key->node.Scalar() == "base" || k.torque_key->node.Scalar() == "none");
+  if (k.torque_key && !k.torque_word) {
+    k.torque.at = k.torque_key;
+    k.torque.per_joint = k.torque_key->node.IsSequence();
+    for (const Val& e : k.torque.per_joint ? r.list(*k.torque_key, 1, 64) : std::vector<Val>{*k.torque_key}) {
       const double v = r.number(e);
       if (!(v > 0.0)) r.fail(e, "must be > 0, base (the base stroke's peak) or none (no torque limit), got " + fmtG(v));
-      torque.values.push_back(v);
+      k.torque.values.push_back(v);
     }
   }
-  if (torque_word) L.torque_max_Nm = 0.0;  // none; base: set below from the base stroke
+  if (k.torque_word) L.torque_max_Nm = 0.0;  // none; base: set below from the base stroke
   if (const Val* e = Reader::get(l, "end")) {
     L.end = r.choice(*e, {"rest", "start"}) == "start" ? StrokeEnd::kAtStart : StrokeEnd::kAtRest;
     if (L.end == StrokeEnd::kAtStart && sp.family == StrokeFamily::kSplitCycle)
@@ -241,8 +198,11 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     L.w_ss_max = b;
   }
   if (const Val* t = Reader::get(l, "start_delay_s")) L.t0_max_s = r.inRange(*t, 0.0, 10.0);
+  return k;
+}
 
-  OptimizerSettings& os = s.optimizer;
+// Stage: the optimizer's settings (algorithm to max_runs) into os; returns the directions_kept key.
+const Val* readOptimizer(const Reader& r, const Map& o, const StrokeSpace& sp, OptimizerSettings& os) {
   if (const Val* v = Reader::get(o, "algorithm")) os.algorithm = r.choice(*v, {"cmaes", "de"});
   if (const Val* v = Reader::get(o, "islands")) os.islands = r.integer(*v, 1, kMaxIslands);
   if (const Val* v = Reader::get(o, "population")) os.population = r.integer(*v, 5, kMaxPopulation);
@@ -282,6 +242,11 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
                      " (the start, one population of every island and the polish's polish_evaluations), got " +
                      std::to_string(os.max_runs));
   }
+  return kept;
+}
+
+// Stage: seeds, pareto_points, min_turn_deg and mujoco_check.
+void readRunSettings(const Reader& r, const Map& o, OptimizeSpec& s) {
   if (const Val* v = Reader::get(o, "seeds")) {
     s.seeds.clear();
     for (const Val& e : r.list(*v, 1, kMaxSeeds)) {
@@ -301,8 +266,11 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     if (!s.mujoco_check && s.objective_model == ObjectiveModel::kMujoco)
       r.fail(*v, "objective model: mujoco runs MuJoCo on the candidates: leave mujoco_check true");
   }
+}
 
-  // The base experiment, through the loader (its errors name the base file).
+// Stage: the base experiment, through the loader (its errors name the base file): one split-cycle
+// simulate case, whose tail gives the search's n.
+void readBase(const Reader& r, const Val& base, OptimizeSpec& s) {
   const Experiment e = loadExperiment(s.base_file);
   if (e.cases.size() != 1)
     r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
@@ -310,14 +278,21 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
   if (!s.base.splines.empty())
     r.fail(base, "the base experiment's trajectory is the search's start and must be split-cycle (not family: spline)");
-  sp.n_links = s.base.robot.numLinks();
-  if (kept && sp.n_links <= kMaxKeptDirectionsLog2 && os.directions_kept > (1 << sp.n_links))
-    r.fail(*kept, "keeps " + std::to_string(os.directions_kept) + " patterns, but an n = " + std::to_string(sp.n_links) +
-                      " tail has only " + std::to_string(1 << sp.n_links));
-  if (os.enumerate_directions && sp.n_links > limits::kMaxEnumeratedLinks)
+  s.problem.space.n_links = s.base.robot.numLinks();
+}
+
+// Stage: the search's size within the work limits: the kept and enumerated direction patterns for
+// the base's n, the analytic runs and their solver steps.
+void checkSearchSize(const Reader& r, const Map& o, const Val& opt, const Val* kept, const OptimizeSpec& s) {
+  const OptimizerSettings& os = s.optimizer;
+  const int n = s.problem.space.n_links;
+  if (kept && n <= kMaxKeptDirectionsLog2 && os.directions_kept > (1 << n))
+    r.fail(*kept, "keeps " + std::to_string(os.directions_kept) + " patterns, but an n = " + std::to_string(n) +
+                      " tail has only " + std::to_string(1 << n));
+  if (os.enumerate_directions && n > limits::kMaxEnumeratedLinks)
     r.fail(*Reader::get(o, "directions"),
-           "enumerate would search 2^" + std::to_string(sp.n_links) + " = " + fmtG(std::ldexp(1.0, sp.n_links)) +
-               " joint-direction patterns for the base's n = " + std::to_string(sp.n_links) + " tail, more than 2^" +
+           "enumerate would search 2^" + std::to_string(n) + " = " + fmtG(std::ldexp(1.0, n)) +
+               " joint-direction patterns for the base's n = " + std::to_string(n) + " tail, more than 2^" +
                std::to_string(limits::kMaxEnumeratedLinks) + " = " +
                std::to_string(1 << limits::kMaxEnumeratedLinks) + " (n <= " +
                std::to_string(limits::kMaxEnumeratedLinks) + "): use directions: free");
@@ -337,55 +312,125 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
                     fmtG(limits::kMaxOptimizeSteps) +
                     " (docs/design-a-tail-stroke.md \"Limits\"): lower generations, population, islands, restarts or "
                     "seeds, or give the base a coarser analytic step (analytic.fixed_dt_s, analytic.max_step_s)");
-  if (torque_word && torque_key->node.Scalar() == "base") {  // the base stroke's own peak joint torque
+}
+
+// Stage: limits that leave no stroke to search are refused here, not after a whole search that could
+// only report "limits VIOLATED": a 1 deg split-cycle stroke of every joint over the longest duration
+// must keep them.
+void requireSearchableLimits(const Reader& r, const Val& lv, const OptimizeSpec& s) {
+  const StrokeLimits& L = s.problem.space.limits;
+  const double amp = 1.0 * kRadPerDeg;
+  TailTrajectory probe;
+  double narrowest = 1e300;
+  for (int i = 0; i < s.problem.space.n_links; ++i) {
+    const JointLimits J = L.joint(static_cast<std::size_t>(i));
+    SplitCycleParams p;
+    p.theta0_rad = std::max(J.theta_min_rad, std::min(0.0, J.theta_max_rad - amp));
+    p.dtheta_rad = amp;
+    p.dT_s = L.dT_max_s;
+    p.w_ss = std::max(L.w_ss_min, std::min(0.5, L.w_ss_max));
+    probe.joints.emplace_back(p);
+    narrowest = std::min(narrowest, J.theta_max_rad - J.theta_min_rad);
+  }
+  StrokeLimits at_rest = L;  // a stroke that must end where it started is a spline's: not this probe
+  at_rest.end = StrokeEnd::kAtRest;
+  const StrokeFigures f = strokeFigures(s.base.robot.tail, probe);
+  if (!(narrowest < amp || limitViolation(f, at_rest) > 0.0)) return;
+  std::string which;  // the joints whose limits the probe breaks; the first is described
+  std::size_t first = f.joints.size();
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    StrokeLimits one = at_rest;
+    StrokeFigures fi;
+    fi.joints = {f.joints[i]};
+    one.joints = {L.joint(i)};
+    if (L.joint(i).theta_max_rad - L.joint(i).theta_min_rad < amp || limitViolation(fi, one) > 0.0) {
+      which += (which.empty() ? "" : ", ") + std::to_string(i + 1);
+      first = std::min(first, i);
+    }
+  }
+  if (which.empty()) which = "1";
+  if (first == f.joints.size()) first = 0;
+  const JointLimits J = L.joint(first);
+  const JointFigures& g = f.joints.at(first);
+  r.fail(lv, "no stroke keeps these limits: 1 deg of every joint over the longest duration (dT_s " +
+                 fmtG(L.dT_max_s) + " s) breaks them at joint " + which +
+                 ": it needs a range of 1 deg (have " + fmtG((J.theta_max_rad - J.theta_min_rad) / kRadPerDeg) +
+                 "), peaks at " + fmtG(g.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
+                 fmtG(J.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(g.peak_torque_Nm) + " N m (limit " +
+                 (J.torque_max_Nm > 0 ? fmtG(J.torque_max_Nm) : std::string("none")) + "): widen them");
+}
+}  // namespace
+
+bool isOptimizeFile(const std::string& path) {
+  try {
+    const YAML::Node doc = loadBoundedYaml(fs::absolute(path).lexically_normal().string());
+    return doc.IsMap() && doc["kind"] && doc["kind"].IsScalar() && doc["kind"].Scalar() == "optimize";
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+double optimizeRunEstimate(const OptimizeSpec& s) {
+  const OptimizerSettings& o = s.optimizer;
+  auto restartRuns = [&](int r) {
+    const double pop = o.population * std::pow(static_cast<double>(o.restart_growth), r);
+    return o.islands * pop * (o.generations + 1.0 + o.refine_generations);
+  };
+  double later = 0;  // the restarts after the first, the local restarts and the polish
+  for (int r = 1; r < o.restarts; ++r) later += restartRuns(r);
+  later += o.local_restarts * static_cast<double>(o.islands) * o.population * (o.generations + 1.0);
+  if (o.polish != "none") later += o.polish_evaluations;
+  const double first = 2.0 + restartRuns(0);  // the start (base stroke and its box point) and restart 0
+  double per_search = first + later;
+  if (o.enumerate_directions) {
+    const double patterns = std::ldexp(1.0, std::min(s.problem.space.n_links, 1000));
+    const double kept = o.directions_kept > 0 ? std::min<double>(o.directions_kept, patterns) : patterns;
+    per_search = patterns * first + kept * later;
+    if (o.max_runs > 0) per_search = std::min(per_search, patterns * static_cast<double>(o.max_runs));
+  } else if (o.max_runs > 0) {
+    per_search = std::min(per_search, static_cast<double>(o.max_runs));
+  }
+  return per_search * static_cast<double>(s.seeds.size() + static_cast<std::size_t>(s.pareto_points));
+}
+
+// The stages in order: the file's head, family and knots, objective, limits, optimizer and run
+// settings, the base experiment, the search's size, the joint limits resolved on the base, the probe.
+OptimizeSpec loadOptimizeSpec(const std::string& path) {
+  OptimizeSpec s;
+  s.source_file = fs::absolute(path).lexically_normal().string();
+  const Reader r(s.source_file);
+  design_yaml::DesignFile file = design_yaml::openDesignFile(r, s.source_file, "optimize", "optimize",
+                                                                      kMaxNameChars - (sizeof kBestNameSuffix - 1));
+  s.name = std::move(file.head.name);
+  s.description = std::move(file.head.description);
+  s.base_file = std::move(file.head.base_file);
+  const Val& base = file.base(r);  // the base experiment's own checks below point here
+  const Val& opt = file.section(r);
+  const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
+                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "max_runs", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
+  StrokeSpace& sp = s.problem.space;
+  sp.family = r.choice(design_yaml::need(r, o, opt, "family"), {"split_cycle", "spline"}) == "spline"
+                  ? StrokeFamily::kSpline
+                  : StrokeFamily::kSplitCycle;
+  if (const Val* k = Reader::get(o, "knots")) {
+    if (sp.family != StrokeFamily::kSpline) r.fail(*k, "only used with family: spline");
+    sp.knots = r.integer(*k, 0, kMaxKnots);
+  }
+  readObjective(r, o, s);
+  const Val& lv = design_yaml::need(r, o, opt, "limits");
+  const auto l = r.map(lv, {"theta_deg", "thetadot_max_dps", "torque_max_Nm", "end", "dT_s", "w_ss", "start_delay_s"});
+  const LimitKeys lk = readLimits(r, l, sp);
+  const Val* kept = readOptimizer(r, o, sp, s.optimizer);
+  readRunSettings(r, o, s);
+  readBase(r, base, s);
+  checkSearchSize(r, o, opt, kept, s);
+  StrokeLimits& L = sp.limits;
+  if (lk.torque_word && lk.torque_key->node.Scalar() == "base") {  // the base stroke's own peak joint torque
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
-    if (!(L.torque_max_Nm > 0.0)) r.fail(*torque_key, "base: the base stroke has no joint torque to keep");
+    if (!(L.torque_max_Nm > 0.0)) r.fail(*lk.torque_key, "base: the base stroke has no joint torque to keep");
   }
-  resolveJointLimits(r, lv, s.base, theta, speed, torque, torque_word, L);
-  // Limits that leave no stroke to search are refused here, not after a whole search that could only
-  // report "limits VIOLATED": a 1 deg split-cycle stroke of every joint over the longest duration must keep them.
-  {
-    const double amp = 1.0 * kRadPerDeg;
-    TailTrajectory probe;
-    double narrowest = 1e300;
-    for (int i = 0; i < sp.n_links; ++i) {
-      const JointLimits J = L.joint(static_cast<std::size_t>(i));
-      SplitCycleParams p;
-      p.theta0_rad = std::max(J.theta_min_rad, std::min(0.0, J.theta_max_rad - amp));
-      p.dtheta_rad = amp;
-      p.dT_s = L.dT_max_s;
-      p.w_ss = std::max(L.w_ss_min, std::min(0.5, L.w_ss_max));
-      probe.joints.emplace_back(p);
-      narrowest = std::min(narrowest, J.theta_max_rad - J.theta_min_rad);
-    }
-    StrokeLimits at_rest = L;  // a stroke that must end where it started is a spline's: not this probe
-    at_rest.end = StrokeEnd::kAtRest;
-    const StrokeFigures f = strokeFigures(s.base.robot.tail, probe);
-    if (narrowest < amp || limitViolation(f, at_rest) > 0.0) {
-      std::string which;  // the joints whose limits the probe breaks; the first is described
-      std::size_t first = f.joints.size();
-      for (std::size_t i = 0; i < f.joints.size(); ++i) {
-        StrokeLimits one = at_rest;
-        StrokeFigures fi;
-        fi.joints = {f.joints[i]};
-        one.joints = {L.joint(i)};
-        if (L.joint(i).theta_max_rad - L.joint(i).theta_min_rad < amp || limitViolation(fi, one) > 0.0) {
-          which += (which.empty() ? "" : ", ") + std::to_string(i + 1);
-          first = std::min(first, i);
-        }
-      }
-      if (which.empty()) which = "1";
-      if (first == f.joints.size()) first = 0;
-      const JointLimits J = L.joint(first);
-      const JointFigures& g = f.joints.at(first);
-      r.fail(lv, "no stroke keeps these limits: 1 deg of every joint over the longest duration (dT_s " +
-                     fmtG(L.dT_max_s) + " s) breaks them at joint " + which +
-                     ": it needs a range of 1 deg (have " + fmtG((J.theta_max_rad - J.theta_min_rad) / kRadPerDeg) +
-                     "), peaks at " + fmtG(g.peak_speed_radps / kRadPerDeg) + " deg/s (limit " +
-                     fmtG(J.thetadot_max_radps / kRadPerDeg) + ") and " + fmtG(g.peak_torque_Nm) + " N m (limit " +
-                     (J.torque_max_Nm > 0 ? fmtG(J.torque_max_Nm) : std::string("none")) + "): widen them");
-    }
-  }
+  resolveJointLimits(r, lv, s.base, lk.theta, lk.speed, lk.torque, lk.torque_word, L);
+  requireSearchableLimits(r, lv, s);
   s.problem.base = s.base;
   return s;
 }

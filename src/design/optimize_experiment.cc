@@ -21,12 +21,13 @@
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
 #include "results/atomic_file.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kDegPerRad = 180.0 / M_PI;
+using units::kDegPerRad;
 
 std::string g17(double v) {
   char b[40];
@@ -70,7 +71,7 @@ TimeSeries trajectorySeries(const std::vector<TailLink>& links, const TailTrajec
 LimitCheck checkLimitsOnSeries(const std::vector<TailLink>& links, const TimeSeries& ts, const StrokeLimits& L) {
   LimitCheck c;
   const int n = static_cast<int>(links.size());
-  const double d2r = M_PI / 180.0;
+  const double d2r = units::kRadPerDeg;
   StrokeFigures& f = c.figures;
   f.theta_min_rad = std::numeric_limits<double>::infinity();
   f.theta_max_rad = -f.theta_min_rad;
@@ -289,65 +290,82 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
   return r;
 }
 
-OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress) {
-  const auto t0 = std::chrono::steady_clock::now();
-  OptimizeReport rep;
-  fs::create_directories(fs::path(out_dir) / "plots");
-  const StrokeProblem& prob = spec.problem;
-  // The folder's own inputs first: best.yaml names the robot copy, and is read back below.
-  for (const auto& [name, text] : designFolderInputs(spec.source_file, "optimize.yaml", spec.base_file)) {
-    writeOwnedFile(out_dir, name, text);
-    rep.files.push_back(name);
+namespace {
+
+// Progress of the seed searches on stderr: on a terminal one line redrawn with \r (every 0.5 s), in a
+// log a plain line every 5 s, as `tailsim run` does; a line per finished seed either way.
+class SeedProgress {
+ public:
+  SeedProgress(const OptimizeSpec& spec, std::chrono::steady_clock::time_point t0)
+      : spec_(spec), t0_(t0), tty_(::isatty(STDERR_FILENO) == 1),
+        period_(tty_ ? std::chrono::milliseconds(500) : std::chrono::milliseconds(5000)),
+        runs_estimate_(optimizeRunEstimate(spec) /
+                       static_cast<double>(spec.seeds.size() + static_cast<std::size_t>(spec.pareto_points)) *
+                       static_cast<double>(spec.seeds.size())),
+        unit_(objectiveUnit(spec.problem.objective)),
+        last_print_(std::chrono::steady_clock::now() - period_) {}  // the first line at once
+
+  // The running line during seed i's search; runs_before counts the earlier seeds' runs.
+  void during(std::size_t i, long runs_before, const SearchProgress& p) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_print_ < period_) return;
+    last_print_ = now;
+    const bool better = p.best_objective > best_obj_;
+    const double obj = better ? p.best_objective : best_obj_, phi = better ? p.best_phi_net_rad : best_phi_;
+    const double el = std::chrono::duration<double>(now - t0_).count();
+    std::fprintf(stderr, "%s[optimize %s] seed %llu (%zu/%zu), %s: %ld runs (about %.3g in all), best so far %s %+.6g %s "
+                 "(phi_net %+.4f deg), %.1f s elapsed%s",
+                 tty_ ? "\r" : "", spec_.name.c_str(), static_cast<unsigned long long>(spec_.seeds[i]), i + 1, spec_.seeds.size(),
+                 p.stage, runs_before + p.evaluations, runs_estimate_, objectiveName(spec_.problem.objective),
+                 signedObjectiveDeg(obj, phi), unit_, phi * kDegPerRad, el, tty_ ? "   " : "\n");
+    line_open_ = tty_;
+    std::fflush(stderr);
   }
 
-  // Progress: on a terminal one line redrawn with \r (every 0.5 s), in a log a plain line every 5 s,
-  // as `tailsim run` does; a line per finished seed either way.
-  const bool tty = ::isatty(STDERR_FILENO) == 1;
-  const auto period = tty ? std::chrono::milliseconds(500) : std::chrono::milliseconds(5000);
-  const double runs_estimate = optimizeRunEstimate(spec) /
-                               static_cast<double>(spec.seeds.size() + static_cast<std::size_t>(spec.pareto_points)) *
-                               static_cast<double>(spec.seeds.size());
-  const char* unit = objectiveUnit(prob.objective);
-  double best_obj = 0.0, best_phi = 0.0;  // over the finished seeds
-  bool line_open = false;
-  auto last_print = std::chrono::steady_clock::now() - period;  // the first line at once
+  // Keeps the best over the finished seeds; prints the seed's line when `print`.
+  void finished(std::uint64_t seed, const OptimizeResult& r, bool print) {
+    if (r.best.objective > best_obj_) {
+      best_obj_ = r.best.objective;
+      best_phi_ = r.best.phi_net_rad;
+    }
+    if (!print) return;
+    if (line_open_) std::fprintf(stderr, "\n");
+    line_open_ = false;
+    std::fprintf(stderr, "seed %llu: %s %+.6g %s (phi_net %+.4f deg), peak torque %.4g N m, %ld runs, %.2f s\n",
+                 static_cast<unsigned long long>(seed), objectiveName(spec_.problem.objective),
+                 signedObjectiveDeg(r.best.objective, r.best.phi_net_rad), unit_, r.best.phi_net_rad * kDegPerRad,
+                 r.best.figures.peak_torque_Nm, r.evaluations, r.wall_s);
+  }
+
+ private:
+  const OptimizeSpec& spec_;
+  std::chrono::steady_clock::time_point t0_;
+  bool tty_;
+  std::chrono::milliseconds period_;
+  double runs_estimate_;
+  const char* unit_;
+  double best_obj_ = 0.0, best_phi_ = 0.0;  // over the finished seeds
+  bool line_open_ = false;
+  std::chrono::steady_clock::time_point last_print_;
+};
+
+// Stage 1: one search per seed, into rep.per_seed and rep.evaluations.
+void searchSeeds(const OptimizeSpec& spec, bool progress, std::chrono::steady_clock::time_point t0, OptimizeReport& rep) {
+  SeedProgress line(spec, t0);
   for (std::size_t i = 0; i < spec.seeds.size(); ++i) {
-    const std::uint64_t seed = spec.seeds[i];
     OptimizerSettings os = spec.optimizer;
-    os.seed = seed;
+    os.seed = spec.seeds[i];
     ProgressFn show;
-    if (progress)
-      show = [&](const SearchProgress& p) {
-        const auto now = std::chrono::steady_clock::now();
-        if (now - last_print < period) return;
-        last_print = now;
-        const bool better = p.best_objective > best_obj;
-        const double obj = better ? p.best_objective : best_obj, phi = better ? p.best_phi_net_rad : best_phi;
-        const double el = std::chrono::duration<double>(now - t0).count();
-        std::fprintf(stderr, "%s[optimize %s] seed %llu (%zu/%zu), %s: %ld runs (about %.3g in all), best so far %s %+.6g %s "
-                     "(phi_net %+.4f deg), %.1f s elapsed%s",
-                     tty ? "\r" : "", spec.name.c_str(), static_cast<unsigned long long>(seed), i + 1, spec.seeds.size(),
-                     p.stage, rep.evaluations + p.evaluations, runs_estimate, objectiveName(prob.objective),
-                     signedObjectiveDeg(obj, phi), unit, phi * kDegPerRad, el, tty ? "   " : "\n");
-        line_open = tty;
-        std::fflush(stderr);
-      };
-    rep.per_seed.push_back(optimizeStroke(prob, os, show));
+    if (progress) show = [&line, &rep, i](const SearchProgress& p) { line.during(i, rep.evaluations, p); };
+    rep.per_seed.push_back(optimizeStroke(spec.problem, os, show));
     const OptimizeResult& r = rep.per_seed.back();
     rep.evaluations += r.evaluations;
-    if (r.best.objective > best_obj) {
-      best_obj = r.best.objective;
-      best_phi = r.best.phi_net_rad;
-    }
-    if (progress) {
-      if (line_open) std::fprintf(stderr, "\n");
-      line_open = false;
-      std::fprintf(stderr, "seed %llu: %s %+.6g %s (phi_net %+.4f deg), peak torque %.4g N m, %ld runs, %.2f s\n",
-                   static_cast<unsigned long long>(seed), objectiveName(prob.objective),
-                   signedObjectiveDeg(r.best.objective, r.best.phi_net_rad), unit, r.best.phi_net_rad * kDegPerRad,
-                   r.best.figures.peak_torque_Nm, r.evaluations, r.wall_s);
-    }
+    line.finished(spec.seeds[i], r, progress);
   }
+}
+
+// Stage 2: the best seed (rep.best_seed_index) and the seeds' spread; returns the best seed's result.
+OptimizeResult pickBestSeed(OptimizeReport& rep) {
   double lo = 1e300, hi = -1e300;
   for (std::size_t i = 0; i < rep.per_seed.size(); ++i) {
     const double v = rep.per_seed[i].best.objective;
@@ -356,68 +374,83 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
     if (rep.per_seed[i].best.betterThan(rep.per_seed[rep.best_seed_index].best)) rep.best_seed_index = i;
   }
   rep.spread = hi > 0 ? (hi - lo) / hi : 0.0;
-  OptimizeResult best = rep.per_seed[rep.best_seed_index];
-  if (spec.objective_model == ObjectiveModel::kMujoco) {
-    // MuJoCo re-ranks the search's best distinct candidates (over every seed); the one whose MuJoCo
-    // objective is largest is the optimum.
-    std::vector<Candidate> cands;
-    for (const OptimizeResult& r : rep.per_seed) cands.insert(cands.end(), r.candidates.begin(), r.candidates.end());
-    std::stable_sort(cands.begin(), cands.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.eval.objective > b.eval.objective; });
-    std::vector<Candidate> distinct;
-    for (Candidate& c : cands) {
-      bool same = false;
-      for (const Candidate& d : distinct) same = same || std::abs(d.eval.objective - c.eval.objective) <= 1e-6 * d.eval.objective;
-      if (!same && distinct.size() < static_cast<std::size_t>(prob.keep_candidates)) distinct.push_back(std::move(c));
-    }
-    if (distinct.empty()) distinct.push_back({best.trajectory, best.best});
-    for (std::size_t k = 0; k < distinct.size(); ++k) {
-      const Candidate& c = distinct[k];
-      RerankRow row;
-      row.search_phi_net_deg = c.eval.phi_net_rad * kDegPerRad;
-      const RunResult rm = simulateMujoco(spec.base.robot, c.trajectory, spec.base.mujoco, spec.base.effects,
-                                          fullOutput(spec.base, c.trajectory));
-      row.ok = rm.summary.ok && std::isfinite(rm.summary.phi_net_deg);
-      row.error = rm.summary.error;
-      if (row.ok) {
-        row.mujoco_phi_net_deg = rm.summary.phi_net_deg;
-        row.mujoco_objective = objectiveValue(prob.objective, rm.summary.phi_net_deg / kDegPerRad, c.eval.figures);
-      }
-      if (row.mujoco_objective > (rep.rerank.empty() ? -1.0 : rep.rerank[rep.rerank_chosen].mujoco_objective))
-        rep.rerank_chosen = k;
-      rep.rerank.push_back(row);
-      if (progress)
-        std::fprintf(stderr, "MuJoCo re-rank %zu/%zu: %s phi_net %+.4f deg, MuJoCo %s\n", k + 1, distinct.size(),
-                     objectiveModelName(prob.search_model), row.search_phi_net_deg,
-                     row.ok ? (std::to_string(row.mujoco_phi_net_deg) + " deg").c_str() : ("failed: " + row.error).c_str());
-    }
-    const Candidate& chosen = distinct[rep.rerank_chosen];
-    if (rep.rerank_chosen != 0 || chosen.eval.objective != best.best.objective) {
-      best.trajectory = chosen.trajectory;
-      best.best = chosen.eval;
-      best.x.clear();
-      best.directions.clear();  // the candidates' direction patterns are not kept
-    }
+  return rep.per_seed[rep.best_seed_index];
+}
+
+// The search's best distinct candidates over every seed, best first, at most keep_candidates.
+std::vector<Candidate> distinctCandidates(const OptimizeReport& rep, const OptimizeResult& best, int keep_candidates) {
+  std::vector<Candidate> cands;
+  for (const OptimizeResult& r : rep.per_seed) cands.insert(cands.end(), r.candidates.begin(), r.candidates.end());
+  std::stable_sort(cands.begin(), cands.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.eval.objective > b.eval.objective; });
+  std::vector<Candidate> distinct;
+  for (Candidate& c : cands) {
+    bool same = false;
+    for (const Candidate& d : distinct) same = same || std::abs(d.eval.objective - c.eval.objective) <= 1e-6 * d.eval.objective;
+    if (!same && distinct.size() < static_cast<std::size_t>(keep_candidates)) distinct.push_back(std::move(c));
   }
-  rep.infeasible = analyseInfeasible(prob, best.best, best.trajectory, spec.min_turn_deg * M_PI / 180.0);
-  // The re-simulations run the stroke as best.yaml writes it, read back by the experiment loader:
-  // its angles are decimal degrees there, which need not convert back to the search's radians to
-  // the last bit, and `tailsim run best.yaml` must give what summary.json reports.
-  // It cannot fail the search's work: if the loader refuses the file, the re-runs use the search's
-  // trajectory and the report says why (best.yaml is still written).
-  const std::string best_yaml = bestExperimentYaml(spec, best.trajectory);
-  TailTrajectory traj = best.trajectory;
+  if (distinct.empty()) distinct.push_back({best.trajectory, best.best});
+  return distinct;
+}
+
+// Stage 3 (objective model mujoco): MuJoCo re-ranks the search's best distinct candidates; the one
+// whose MuJoCo objective is largest replaces `best`.
+void rerankWithMujoco(const OptimizeSpec& spec, bool progress, OptimizeResult& best, OptimizeReport& rep) {
+  const StrokeProblem& prob = spec.problem;
+  const std::vector<Candidate> distinct = distinctCandidates(rep, best, prob.keep_candidates);
+  for (std::size_t k = 0; k < distinct.size(); ++k) {
+    const Candidate& c = distinct[k];
+    RerankRow row;
+    row.search_phi_net_deg = c.eval.phi_net_rad * kDegPerRad;
+    const RunResult rm = simulateMujoco(spec.base.robot, c.trajectory, spec.base.mujoco, spec.base.effects,
+                                        fullOutput(spec.base, c.trajectory));
+    row.ok = rm.summary.ok && std::isfinite(rm.summary.phi_net_deg);
+    row.error = rm.summary.error;
+    if (row.ok) {
+      row.mujoco_phi_net_deg = rm.summary.phi_net_deg;
+      row.mujoco_objective = objectiveValue(prob.objective, rm.summary.phi_net_deg / kDegPerRad, c.eval.figures);
+    }
+    if (row.mujoco_objective > (rep.rerank.empty() ? -1.0 : rep.rerank[rep.rerank_chosen].mujoco_objective))
+      rep.rerank_chosen = k;
+    rep.rerank.push_back(row);
+    if (progress)
+      std::fprintf(stderr, "MuJoCo re-rank %zu/%zu: %s phi_net %+.4f deg, MuJoCo %s\n", k + 1, distinct.size(),
+                   objectiveModelName(prob.search_model), row.search_phi_net_deg,
+                   row.ok ? (std::to_string(row.mujoco_phi_net_deg) + " deg").c_str() : ("failed: " + row.error).c_str());
+  }
+  const Candidate& chosen = distinct[rep.rerank_chosen];
+  if (rep.rerank_chosen != 0 || chosen.eval.objective != best.best.objective) {
+    best.trajectory = chosen.trajectory;
+    best.best = chosen.eval;
+    best.x.clear();
+    best.directions.clear();  // the candidates' direction patterns are not kept
+  }
+}
+
+// Stage 4: the stroke the re-simulations run, as best.yaml writes it, read back by the experiment
+// loader: its angles are decimal degrees there, which need not convert back to the search's radians
+// to the last bit, and `tailsim run best.yaml` must give what summary.json reports. It cannot fail
+// the search's work: if the loader refuses the file, the search's trajectory is returned and
+// rep.best_yaml_error says why (best.yaml is still written).
+TailTrajectory readBackBest(const std::string& best_yaml, const TailTrajectory& searched, const std::string& out_dir,
+                            OptimizeReport& rep) {
+  TailTrajectory traj = searched;
   try {
     traj = loadExperimentText(best_yaml, (fs::path(out_dir) / "best.yaml").string()).cases.at(0).trajectory();
   } catch (const std::exception& e) {
     rep.best_yaml_error = e.what();
   }
+  return traj;
+}
 
-  // Verification: re-simulate, check the limits on what the model ran, and run MuJoCo.
+// Stage 5: verification: re-simulate, check the limits on what the model ran, run the per-foot model
+// and (mujoco_check) MuJoCo; writes the series, the trajectory and best.yaml.
+void resimulateBest(const OptimizeSpec& spec, const TailTrajectory& traj, const std::string& best_yaml,
+                    const std::string& out_dir, OptimizeReport& rep) {
   const OutputSettings out = fullOutput(spec.base, traj);
   const RunResult ra = simulateAnalytic(spec.base.robot, traj, spec.base.analytic, spec.base.effects, out);
   rep.analytic = ra.summary;
-  rep.limits_analytic = checkLimitsOnSeries(spec.base.robot.tail, ra.series, prob.space.limits);
+  rep.limits_analytic = checkLimitsOnSeries(spec.base.robot.tail, ra.series, spec.problem.space.limits);
   writeOwnedFile(out_dir, "best_analytic.csv", toCsv(ra.series));
   rep.files.push_back("best_analytic.csv");
   // The per-foot friction model: milliseconds, always run; a failure (e.g. the robot
@@ -447,83 +480,91 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   rep.files.push_back("best_trajectory.csv");
   writeOwnedFile(out_dir, "best.yaml", best_yaml);
   rep.files.push_back("best.yaml");
+}
 
-  // Convergence history, in signed degrees (the objective's sign is phi_net's).
-  {
-    const std::string col = std::string("best_") + objectiveName(prob.objective) + "_" + objectiveUnitSuffix(prob.objective);
-    std::ostringstream csv;
-    csv << "seed,stage,generation,evaluations,wall_s," << col
-        << (prob.objective == StrokeObjective::kPhiNet ? "" : ",best_phi_net_deg") << "\n";
-    for (std::size_t i = 0; i < rep.per_seed.size(); ++i)
-      for (const HistoryRow& h : rep.per_seed[i].history) {
-        csv << spec.seeds[i] << "," << h.stage << "," << h.generation << "," << h.evaluations << "," << g17(h.wall_s) << ","
-            << g17(signedObjectiveDeg(h.best_objective, h.best_phi_net_rad));
-        if (prob.objective != StrokeObjective::kPhiNet) csv << "," << g17(h.best_phi_net_rad * kDegPerRad);
-        csv << "\n";
-      }
-    writeOwnedFile(out_dir, "history.csv", csv.str());
-    rep.files.push_back("history.csv");
-    GnuplotFigure fig;
-    fig.stem = "history";
-    std::ostringstream b;
-    b << "set datafile separator ','\nset key outside right\nset grid\n"
-      << "set title " << gpQuote("Convergence of " + spec.name + " (" + familyName(prob.space.family) + ")")
-      << " noenhanced\nset xlabel 'analytic model runs'\nset ylabel "
-      << gpQuote("best " + std::string(objectiveName(prob.objective)) + " so far [" + unit + "]")
-      << " noenhanced\nplot ";
-    const std::string data = gpFileName("../history.csv");
-    for (std::size_t i = 0; i < spec.seeds.size(); ++i)
-      b << (i ? ", " : "") << data << " every ::1 using ($1==" << spec.seeds[i]
-        << " ? $4 : 1/0):6 with steps lw 2 title " << gpQuote("seed " + std::to_string(spec.seeds[i]));
-    // The stages: a mark at every generation of each (all seeds), so the plot shows where the
-    // global search, the refine, the local restarts and the polish ran.
-    const char* stages[][2] = {{"global", "6"}, {"refine", "8"}, {"local", "4"}, {"polish", "7"}};
-    for (const auto& st : stages)
-      b << ", " << data << " every ::1 using (strcol(2) eq '" << st[0] << "' ? $4 : 1/0):6 with points pt " << st[1]
-        << " ps 0.6 lc rgb 'gray40' title '" << st[0] << "'";
-    b << "\n";
-    fig.body = b.str();
-    renderFigure((fs::path(out_dir) / "plots").string(), fig);
-    rep.files.push_back("plots/history.png");
-  }
-
-  // Pareto front: phi_net vs peak joint torque, by re-optimising under torque limits.
-  nlohmann::json pareto = nlohmann::json::array();
-  if (spec.pareto_points >= 2) {
-    const double tau_top = best.best.figures.peak_torque_Nm;
-    std::ostringstream csv;
-    csv << "torque_limit_Nm,peak_torque_Nm,phi_net_deg,evaluations\n";
-    for (int k = 0; k < spec.pareto_points; ++k) {
-      StrokeProblem p = prob;
-      p.objective = StrokeObjective::kPhiNet;
-      const double lim = tau_top * (0.2 + 0.8 * k / (spec.pareto_points - 1));
-      p.space.limits.torque_max_Nm = prob.space.limits.torque_max_Nm > 0 ? std::min(lim, prob.space.limits.torque_max_Nm) : lim;
-      for (JointLimits& jl : p.space.limits.joints) jl.torque_max_Nm = jl.torque_max_Nm > 0 ? std::min(lim, jl.torque_max_Nm) : lim;
-      OptimizerSettings os = spec.optimizer;
-      os.seed = spec.seeds.front();
-      const OptimizeResult r = optimizeStroke(p, os);
-      rep.evaluations += r.evaluations;
-      csv << g17(p.space.limits.torque_max_Nm) << "," << g17(r.best.figures.peak_torque_Nm) << ","
-          << g17(r.best.phi_net_rad * kDegPerRad) << "," << r.evaluations << "\n";
-      pareto.push_back({{"torque_limit_Nm", p.space.limits.torque_max_Nm}, {"peak_torque_Nm", r.best.figures.peak_torque_Nm},
-                        {"phi_net_deg", r.best.phi_net_rad * kDegPerRad}, {"feasible", r.best.feasible()}});
-      if (progress)
-        std::fprintf(stderr, "pareto %d/%d: torque <= %.4g N m: phi_net %+.4f deg\n", k + 1, spec.pareto_points,
-                     p.space.limits.torque_max_Nm, r.best.phi_net_rad * kDegPerRad);
+// Stage 6: the convergence history, in signed degrees (the objective's sign is phi_net's): history.csv
+// and plots/history.png.
+void writeHistory(const OptimizeSpec& spec, const std::string& out_dir, OptimizeReport& rep) {
+  const StrokeProblem& prob = spec.problem;
+  const std::string col = std::string("best_") + objectiveName(prob.objective) + "_" + objectiveUnitSuffix(prob.objective);
+  std::ostringstream csv;
+  csv << "seed,stage,generation,evaluations,wall_s," << col
+      << (prob.objective == StrokeObjective::kPhiNet ? "" : ",best_phi_net_deg") << "\n";
+  for (std::size_t i = 0; i < rep.per_seed.size(); ++i)
+    for (const HistoryRow& h : rep.per_seed[i].history) {
+      csv << spec.seeds[i] << "," << h.stage << "," << h.generation << "," << h.evaluations << "," << g17(h.wall_s) << ","
+          << g17(signedObjectiveDeg(h.best_objective, h.best_phi_net_rad));
+      if (prob.objective != StrokeObjective::kPhiNet) csv << "," << g17(h.best_phi_net_rad * kDegPerRad);
+      csv << "\n";
     }
-    writeOwnedFile(out_dir, "pareto.csv", csv.str());
-    rep.files.push_back("pareto.csv");
-    GnuplotFigure fig;
-    fig.stem = "pareto";
-    fig.body = "set datafile separator ','\nset grid\nset key off\nset title " +
-               gpQuote("Net yaw vs peak joint torque (" + spec.name + ")") + " noenhanced\nset xlabel 'peak joint torque [N m]'\nset ylabel '|{/Symbol f}_{net}| [deg]'\n"
-               "plot " + gpFileName("../pareto.csv") + " every ::1 using 2:(abs($3)) with linespoints lw 2 pt 7\n";
-    renderFigure((fs::path(out_dir) / "plots").string(), fig);
-    rep.files.push_back("plots/pareto.png");
-  }
+  writeOwnedFile(out_dir, "history.csv", csv.str());
+  rep.files.push_back("history.csv");
+  GnuplotFigure fig;
+  fig.stem = "history";
+  std::ostringstream b;
+  b << "set datafile separator ','\nset key outside right\nset grid\n"
+    << "set title " << gpQuote("Convergence of " + spec.name + " (" + familyName(prob.space.family) + ")")
+    << " noenhanced\nset xlabel 'analytic model runs'\nset ylabel "
+    << gpQuote("best " + std::string(objectiveName(prob.objective)) + " so far [" + objectiveUnit(prob.objective) + "]")
+    << " noenhanced\nplot ";
+  const std::string data = gpFileName("../history.csv");
+  for (std::size_t i = 0; i < spec.seeds.size(); ++i)
+    b << (i ? ", " : "") << data << " every ::1 using ($1==" << spec.seeds[i]
+      << " ? $4 : 1/0):6 with steps lw 2 title " << gpQuote("seed " + std::to_string(spec.seeds[i]));
+  // The stages: a mark at every generation of each (all seeds), so the plot shows where the
+  // global search, the refine, the local restarts and the polish ran.
+  const char* stages[][2] = {{"global", "6"}, {"refine", "8"}, {"local", "4"}, {"polish", "7"}};
+  for (const auto& st : stages)
+    b << ", " << data << " every ::1 using (strcol(2) eq '" << st[0] << "' ? $4 : 1/0):6 with points pt " << st[1]
+      << " ps 0.6 lc rgb 'gray40' title '" << st[0] << "'";
+  b << "\n";
+  fig.body = b.str();
+  renderFigure((fs::path(out_dir) / "plots").string(), fig);
+  rep.files.push_back("plots/history.png");
+}
 
-  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  nlohmann::json j;
+// Stage 7 (pareto_points >= 2): the Pareto front, phi_net vs peak joint torque, by re-optimising under
+// torque limits: pareto.csv and plots/pareto.png; returns summary.json's "pareto" rows.
+nlohmann::json paretoFront(const OptimizeSpec& spec, const OptimizeResult& best, bool progress, const std::string& out_dir,
+                           OptimizeReport& rep) {
+  const StrokeProblem& prob = spec.problem;
+  nlohmann::json pareto = nlohmann::json::array();
+  const double tau_top = best.best.figures.peak_torque_Nm;
+  std::ostringstream csv;
+  csv << "torque_limit_Nm,peak_torque_Nm,phi_net_deg,evaluations\n";
+  for (int k = 0; k < spec.pareto_points; ++k) {
+    StrokeProblem p = prob;
+    p.objective = StrokeObjective::kPhiNet;
+    const double lim = tau_top * (0.2 + 0.8 * k / (spec.pareto_points - 1));
+    p.space.limits.torque_max_Nm = prob.space.limits.torque_max_Nm > 0 ? std::min(lim, prob.space.limits.torque_max_Nm) : lim;
+    for (JointLimits& jl : p.space.limits.joints) jl.torque_max_Nm = jl.torque_max_Nm > 0 ? std::min(lim, jl.torque_max_Nm) : lim;
+    OptimizerSettings os = spec.optimizer;
+    os.seed = spec.seeds.front();
+    const OptimizeResult r = optimizeStroke(p, os);
+    rep.evaluations += r.evaluations;
+    csv << g17(p.space.limits.torque_max_Nm) << "," << g17(r.best.figures.peak_torque_Nm) << ","
+        << g17(r.best.phi_net_rad * kDegPerRad) << "," << r.evaluations << "\n";
+    pareto.push_back({{"torque_limit_Nm", p.space.limits.torque_max_Nm}, {"peak_torque_Nm", r.best.figures.peak_torque_Nm},
+                      {"phi_net_deg", r.best.phi_net_rad * kDegPerRad}, {"feasible", r.best.feasible()}});
+    if (progress)
+      std::fprintf(stderr, "pareto %d/%d: torque <= %.4g N m: phi_net %+.4f deg\n", k + 1, spec.pareto_points,
+                   p.space.limits.torque_max_Nm, r.best.phi_net_rad * kDegPerRad);
+  }
+  writeOwnedFile(out_dir, "pareto.csv", csv.str());
+  rep.files.push_back("pareto.csv");
+  GnuplotFigure fig;
+  fig.stem = "pareto";
+  fig.body = "set datafile separator ','\nset grid\nset key off\nset title " +
+             gpQuote("Net yaw vs peak joint torque (" + spec.name + ")") + " noenhanced\nset xlabel 'peak joint torque [N m]'\nset ylabel '|{/Symbol f}_{net}| [deg]'\n"
+             "plot " + gpFileName("../pareto.csv") + " every ::1 using 2:(abs($3)) with linespoints lw 2 pt 7\n";
+  renderFigure((fs::path(out_dir) / "plots").string(), fig);
+  rep.files.push_back("plots/pareto.png");
+  return pareto;
+}
+
+// summary.json's description of the search: the spec's names and optimizer settings.
+void summarizeSettings(const OptimizeSpec& spec, nlohmann::json& j) {
+  const StrokeProblem& prob = spec.problem;
   j["experiment"] = spec.name;
   j["source"] = spec.source_file;
   j["base"] = spec.base_file;
@@ -531,7 +572,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["objective"] = objectiveName(prob.objective);
   j["objective_model"] = objectiveModelName(spec.objective_model);
   j["search_model"] = objectiveModelName(prob.search_model);
-  j["objective_unit"] = unit;  // of every "objective_signed" (signed like phi_net); "objective": |.| in radians
+  j["objective_unit"] = objectiveUnit(prob.objective);  // of every "objective_signed" (signed like phi_net); "objective": |.| in radians
   j["n_links"] = prob.space.n_links;
   j["dimensions"] = prob.space.dim();
   j["algorithm"] = spec.optimizer.algorithm;
@@ -544,6 +585,11 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
   j["directions"] = spec.optimizer.enumerate_directions ? "enumerate" : "free";
   j["directions_kept"] = spec.optimizer.directions_kept;
   j["polish"] = spec.optimizer.polish;
+}
+
+// summary.json's search results: start, seeds, directions, the best stroke and its joints.
+void summarizeSearch(const OptimizeSpec& spec, const OptimizeReport& rep, const OptimizeResult& best,
+                     const TailTrajectory& traj, nlohmann::json& j) {
   j["start"] = {{"phi_net_deg", best.start.phi_net_rad * kDegPerRad}, {"objective", best.start.objective},
                 {"objective_signed", signedObjectiveDeg(best.start.objective, best.start.phi_net_rad)},
                 {"peak_torque_Nm", best.start.figures.peak_torque_Nm}, {"feasible", best.start.feasible()}};
@@ -584,6 +630,11 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                {"peak_speed_dps", b.figures.peak_speed_radps * kDegPerRad}, {"peak_torque_Nm", b.figures.peak_torque_Nm},
                {"energy_J", b.figures.energy_J}, {"joints", joints}};
   j["improvement_over_start"] = best.start.objective > 0 ? b.objective / best.start.objective - 1.0 : 0.0;
+}
+
+// summary.json's re-runs: the analytic re-run and its limits per joint, MuJoCo, the per-foot model.
+void summarizeResimulation(const OptimizeSpec& spec, const OptimizeReport& rep, nlohmann::json& j) {
+  const StrokeProblem& prob = spec.problem;
   const LimitCheck& lc = rep.limits_analytic;
   j["resimulated"]["analytic"] = {{"ok", rep.analytic.ok}, {"phi_net_deg", rep.analytic.phi_net_deg},
                                   {"limits_kept", lc.ok}, {"violations", lc.violations},
@@ -592,41 +643,40 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                                   {"peak_speed_dps", lc.figures.peak_speed_radps * kDegPerRad},
                                   {"peak_torque_Nm", lc.figures.peak_torque_Nm},
                                   {"binding", bindingLimits(lc.figures, prob.space.limits)}};
-  {
-    nlohmann::json per = nlohmann::json::array();
-    for (std::size_t i = 0; i < static_cast<std::size_t>(prob.space.n_links); ++i) {
-      const JointLimits J = prob.space.limits.joint(i);
-      nlohmann::json row = {{"joint", i + 1},
-                            {"theta_min_deg", J.theta_min_rad * kDegPerRad},
-                            {"theta_max_deg", J.theta_max_rad * kDegPerRad},
-                            {"thetadot_max_dps", J.thetadot_max_radps * kDegPerRad},
-                            {"torque_max_Nm", J.torque_max_Nm > 0 ? nlohmann::json(J.torque_max_Nm) : nlohmann::json()}};
-      if (i < lc.figures.joints.size()) {
-        const JointFigures& g = lc.figures.joints[i];
-        row["peak_torque_Nm"] = g.peak_torque_Nm;
-        row["peak_speed_dps"] = g.peak_speed_radps * kDegPerRad;
-        row["theta_range_deg"] = {g.theta_min_rad * kDegPerRad, g.theta_max_rad * kDegPerRad};
-      }
-      per.push_back(row);
+  nlohmann::json per = nlohmann::json::array();
+  for (std::size_t i = 0; i < static_cast<std::size_t>(prob.space.n_links); ++i) {
+    const JointLimits J = prob.space.limits.joint(i);
+    nlohmann::json row = {{"joint", i + 1},
+                          {"theta_min_deg", J.theta_min_rad * kDegPerRad},
+                          {"theta_max_deg", J.theta_max_rad * kDegPerRad},
+                          {"thetadot_max_dps", J.thetadot_max_radps * kDegPerRad},
+                          {"torque_max_Nm", J.torque_max_Nm > 0 ? nlohmann::json(J.torque_max_Nm) : nlohmann::json()}};
+    if (i < lc.figures.joints.size()) {
+      const JointFigures& g = lc.figures.joints[i];
+      row["peak_torque_Nm"] = g.peak_torque_Nm;
+      row["peak_speed_dps"] = g.peak_speed_radps * kDegPerRad;
+      row["theta_range_deg"] = {g.theta_min_rad * kDegPerRad, g.theta_max_rad * kDegPerRad};
     }
-    j["limits"] = per;  // per joint: the limits and the re-run's figures
+    per.push_back(row);
   }
+  j["limits"] = per;  // per joint: the limits and the re-run's figures
   if (spec.mujoco_check)
     j["resimulated"]["mujoco"] = {{"ok", rep.mujoco.ok}, {"phi_net_deg", rep.mujoco.phi_net_deg}, {"error", rep.mujoco.error},
                                   {"difference_deg", rep.mujoco.phi_net_deg - rep.analytic.phi_net_deg},
                                   {"relative_difference", rep.analytic.phi_net_deg != 0
                                                               ? (rep.mujoco.phi_net_deg - rep.analytic.phi_net_deg) / std::abs(rep.analytic.phi_net_deg)
                                                               : 0.0}};
-  {
-    const double d = rep.perfoot.phi_net_deg - rep.analytic.phi_net_deg;
-    j["resimulated"]["perfoot"] = {{"ok", rep.perfoot.ok}, {"error", rep.perfoot.error},
-                                   {"phi_net_deg", rep.perfoot.ok ? nlohmann::json(rep.perfoot.phi_net_deg) : nlohmann::json()},
-                                   {"difference_deg", rep.perfoot.ok ? nlohmann::json(d) : nlohmann::json()},
-                                   {"relative_difference", rep.perfoot.ok && rep.analytic.phi_net_deg != 0
-                                                               ? nlohmann::json(d / std::abs(rep.analytic.phi_net_deg))
-                                                               : nlohmann::json()}};
-  }
-  if (!pareto.empty()) j["pareto"] = pareto;
+  const double d = rep.perfoot.phi_net_deg - rep.analytic.phi_net_deg;
+  j["resimulated"]["perfoot"] = {{"ok", rep.perfoot.ok}, {"error", rep.perfoot.error},
+                                 {"phi_net_deg", rep.perfoot.ok ? nlohmann::json(rep.perfoot.phi_net_deg) : nlohmann::json()},
+                                 {"difference_deg", rep.perfoot.ok ? nlohmann::json(d) : nlohmann::json()},
+                                 {"relative_difference", rep.perfoot.ok && rep.analytic.phi_net_deg != 0
+                                                             ? nlohmann::json(d / std::abs(rep.analytic.phi_net_deg))
+                                                             : nlohmann::json()}};
+}
+
+// summary.json's MuJoCo re-rank rows and the infeasibility diagnosis, when there are.
+void summarizeRerankAndInfeasible(const OptimizeSpec& spec, const OptimizeReport& rep, nlohmann::json& j) {
   if (!rep.rerank.empty()) {
     nlohmann::json rr = nlohmann::json::array();
     for (std::size_t k = 0; k < rep.rerank.size(); ++k) {
@@ -654,11 +704,49 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
                        {"check", {{"ok", inf.check_ok}, {"peak_torque_Nm", inf.check_torque_Nm},
                                   {"peak_speed_dps", inf.check_speed_dps}, {"phi_net_deg", inf.check_phi_net_deg}}}};
   }
+}
+
+// Stage 8: summary.json, the keys in the order readers have always seen them.
+void writeSummary(const OptimizeSpec& spec, const OptimizeReport& rep, const OptimizeResult& best, const TailTrajectory& traj,
+                  const nlohmann::json& pareto, const std::string& out_dir) {
+  nlohmann::json j;
+  summarizeSettings(spec, j);
+  summarizeSearch(spec, rep, best, traj, j);
+  summarizeResimulation(spec, rep, j);
+  if (!pareto.empty()) j["pareto"] = pareto;
+  summarizeRerankAndInfeasible(spec, rep, j);
   j["evaluations"] = rep.evaluations;
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;
   if (!rep.best_yaml_error.empty()) j["best_yaml_error"] = rep.best_yaml_error;
   writeOwnedFile(out_dir, "summary.json", j.dump(2) + "\n");
+}
+
+}  // namespace
+
+// The stages in order: the folder's inputs, the seeds' searches, the best seed, the MuJoCo re-rank,
+// the infeasibility diagnosis, the read-back and re-simulation, the history, the Pareto front, the summary.
+OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  OptimizeReport rep;
+  fs::create_directories(fs::path(out_dir) / "plots");
+  // The folder's own inputs first: best.yaml names the robot copy, and is read back below.
+  for (const auto& [name, text] : designFolderInputs(spec.source_file, "optimize.yaml", spec.base_file)) {
+    writeOwnedFile(out_dir, name, text);
+    rep.files.push_back(name);
+  }
+  searchSeeds(spec, progress, t0, rep);
+  OptimizeResult best = pickBestSeed(rep);
+  if (spec.objective_model == ObjectiveModel::kMujoco) rerankWithMujoco(spec, progress, best, rep);
+  rep.infeasible = analyseInfeasible(spec.problem, best.best, best.trajectory, units::radians(spec.min_turn_deg));
+  const std::string best_yaml = bestExperimentYaml(spec, best.trajectory);
+  const TailTrajectory traj = readBackBest(best_yaml, best.trajectory, out_dir, rep);
+  resimulateBest(spec, traj, best_yaml, out_dir, rep);
+  writeHistory(spec, out_dir, rep);
+  nlohmann::json pareto = nlohmann::json::array();
+  if (spec.pareto_points >= 2) pareto = paretoFront(spec, best, progress, out_dir, rep);
+  rep.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  writeSummary(spec, rep, best, traj, pareto, out_dir);
   rep.files.push_back("summary.json");
   return rep;
 }

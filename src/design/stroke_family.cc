@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "models/planar/tail_dynamics.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
@@ -190,7 +191,7 @@ std::vector<std::string> bindingLimits(const StrokeFigures& f, const StrokeLimit
     std::snprintf(b, sizeof b, "%.4g", v);
     return std::string(b);
   };
-  constexpr double kDeg = 180.0 / M_PI;
+  constexpr double kDeg = units::kDegPerRad;
   for (std::size_t i = 0; i < f.joints.size(); ++i) {
     const JointLimits J = L.joint(i);
     const JointFigures& g = f.joints[i];
@@ -255,7 +256,7 @@ const char* objectiveModelName(ObjectiveModel m) {
 }
 
 double signedObjectiveDeg(double objective, double phi_net_rad) {
-  return (phi_net_rad < 0.0 ? -objective : objective) * (180.0 / M_PI);
+  return (phi_net_rad < 0.0 ? -objective : objective) * units::kDegPerRad;
 }
 
 const char* objectiveUnit(StrokeObjective o) {

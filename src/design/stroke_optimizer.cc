@@ -22,6 +22,7 @@
 #include "models/perfoot/per_foot_model.h"
 #include "design/stiction_reach.h"
 #include "results/work_limits.h"
+#include "settings/units.h"
 
 namespace tailsim {
 
@@ -67,7 +68,7 @@ StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& tr
   e.ok = r.summary.ok && std::isfinite(r.summary.phi_net_deg);
   e.error = r.summary.error;
   if (e.ok) {
-    e.phi_net_rad = r.summary.phi_net_deg * M_PI / 180.0;
+    e.phi_net_rad = units::radians(r.summary.phi_net_deg);
     e.objective = objectiveValue(p.objective, e.phi_net_rad, e.figures);
     if (e.phi_net_rad == 0.0) e.stiction_ratio = stictionReach(p.base, traj).ratio;
   }

@@ -236,18 +236,15 @@ void removeStaleStages(const fs::path& out) {
     fs::remove_all(it->path(), e2);
   }
 }
-}  // namespace
+// Throws MergeStopped when SIGINT, SIGTERM or SIGHUP arrived.
+void checkStop(StopSignals& signals) {
+  if (const int sig = signals.pending()) throw MergeStopped{sig};
+}
 
-MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
-                       bool allow_other_build) {
-  if (shard_dirs.empty()) throw std::runtime_error("merge: no shard folders given");
-  MergeStats st;
-  st.shards = static_cast<int>(shard_dirs.size());
-  const fs::path out = fs::absolute(out_dir).lexically_normal();
+// Stage 1: every shard is a result folder outside `out`, and every shard comes from the same inputs:
+// their experiment.yaml copies are byte-identical.
+void checkShards(const std::vector<std::string>& shard_dirs, const fs::path& out, const std::string& out_dir) {
   std::error_code ec;
-  if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
-    throw std::runtime_error("merge: " + out_dir + " exists and is not empty (merge into a new folder)");
-  // Every shard must come from the same inputs: their experiment.yaml copies are byte-identical.
   std::string exp_text;
   for (const std::string& d : shard_dirs) {
     const fs::path e = fs::path(d) / "experiment.yaml";
@@ -268,122 +265,171 @@ MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::st
       throw std::runtime_error("merge: " + d + "/experiment.yaml differs from " + shard_dirs.front() +
                                "/experiment.yaml: the shards are not of the same run");
   }
+}
+
+// What the copy of the shards has gathered so far.
+struct MergeState {
+  fs::path stage;                                                            // the staging folder
+  std::vector<fs::path> taken_cases;                                         // case folders of the earlier shards
+  std::map<fs::path, std::string> taken_by;                                  // case folder -> the shard folder it was taken from
+  std::map<std::string, std::pair<std::string, std::string>> journal_lines;  // name -> {line, shard}
+  std::set<fs::path> merged_h5;                                              // the staging folder's time_series.h5 files
+};
+
+// A cases.jsonl (finished cases without a folder): every shard's lines, appended; the same case in
+// two shards must have the same result.
+void mergeJournal(const fs::path& file, const fs::path& rel, const std::string& d, MergeState& ms) {
+  const fs::path dst = ms.stage / rel;
+  const std::string text = readResultFile(file.string()).value_or(std::string());
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+    if (!j.is_object() || !j.contains("name") || !j["name"].is_string()) continue;
+    const std::string name = (rel.parent_path() / j["name"].get<std::string>()).string();
+    const auto [at, first] = ms.journal_lines.emplace(name, std::make_pair(line, d));
+    if (!first) requireSameResult(at->second.first, line, j["name"].get<std::string>(), at->second.second, d);
+  }
+  fs::create_directories(dst.parent_path());
+  std::ofstream(dst, std::ios::binary | std::ios::app) << text;
+}
+
+// One file of shard d (rel: its path in the shard) into the staging folder: journals appended,
+// time_series.h5 merged group by group, a case's files from the first shard that has the case, the
+// inputs checked equal to the earlier shards'. this_shard_cases collects the shard's case folders.
+void mergeShardFile(const fs::path& file, const fs::path& rel, const std::string& d, MergeState& ms,
+                    std::vector<fs::path>& this_shard_cases, MergeStats& st) {
+  std::error_code ec;
+  const fs::path dst = ms.stage / rel;
+  if (rel.filename() == "cases.jsonl") return mergeJournal(file, rel, d, ms);
+  if (rel.filename() == "time_series.h5") {  // every shard's case groups (the first shard's win)
+    requireIntactH5(file, d);  // libhdf5 crashes on some damaged files
+    fs::create_directories(dst.parent_path());
+    runHdf5Isolated(file.string() + " (shard " + d + ")", [&] { mergeTimeSeriesH5(file.string(), dst.string()); });
+    ms.merged_h5.insert(dst);
+    return;
+  }
+  if (rel.parent_path().filename() == "time_series.h5.d" && rel.extension() == ".h5") {  // an unjoined case
+    requireIntactH5(file, d);
+    fs::create_directories(dst.parent_path());
+    fs::copy_file(file, dst, fs::copy_options::overwrite_existing);
+    recordInManifest(dst.parent_path().string(), rel.filename().string(), readAll(dst));
+    ++st.files_copied;
+    return;
+  }
+  if (perCase(rel)) {
+    const fs::path cf = caseFolderOf(rel);
+    if (std::find(ms.taken_cases.begin(), ms.taken_cases.end(), cf) != ms.taken_cases.end()) {  // earlier shard's
+      if (rel.filename() == "result.json" && fs::exists(ms.stage / rel, ec))
+        requireSameResult(readResultFile((ms.stage / rel).string()).value_or(""), readResultFile(file.string()).value_or(""),
+                          cf.filename().string(), ms.taken_by[cf], d);
+      return;
+    }
+    ms.taken_by.emplace(cf, d);
+    if (std::find(this_shard_cases.begin(), this_shard_cases.end(), cf) == this_shard_cases.end())
+      this_shard_cases.push_back(cf);
+  } else if (fs::exists(dst, ec)) {  // inputs and MJCF copies: the same in every shard
+    if (readAll(dst) != readAll(file))
+      throw std::runtime_error("merge: " + (fs::path(d) / rel).string() + " differs from the same file of an earlier shard");
+    return;
+  }
+  fs::create_directories(dst.parent_path());
+  fs::copy_file(file, dst, fs::copy_options::overwrite_existing);
+  if (!perCase(rel) && rel.parent_path().filename() != "mjcf")  // an input copy: the merge wrote it
+    recordInManifest(dst.parent_path().string(), rel.filename().string(), readAll(dst));
+  ++st.files_copied;
+}
+
+// Stage 2: every shard's files into the staging folder, shard by shard; then the merged
+// time_series.h5 files named in their manifests as tailsim wrote them, for the runner's check.
+void copyShards(const std::vector<std::string>& shard_dirs, StopSignals& signals, MergeState& ms, MergeStats& st) {
+  for (const std::string& d : shard_dirs) {
+    const fs::path root(d);
+    std::vector<fs::path> this_shard_cases;
+    for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
+      checkStop(signals);
+      if (!it->is_regular_file()) continue;
+      const fs::path rel = it->path().lexically_relative(root);
+      if (rebuiltOrTransient(rel)) continue;
+      mergeShardFile(it->path(), rel, d, ms, this_shard_cases, st);
+    }
+    ms.taken_cases.insert(ms.taken_cases.end(), this_shard_cases.begin(), this_shard_cases.end());
+  }
+  for (const fs::path& h5 : ms.merged_h5) {
+    const std::optional<std::string> hash = sha256OfFile(h5.string());
+    if (!hash) throw std::runtime_error("merge: cannot read back " + h5.string());
+    recordHashInManifest(h5.parent_path().string(), h5.filename().string(), *hash);
+  }
+}
+
+// Stage 3: the summary and results table, written by the runner itself, resuming every case and
+// running none (a case in no shard is an error): the same code as a single-process run. Returns the
+// suite; st.cases counts its cases.
+std::vector<Experiment> rebuildSummary(const MergeState& ms, const std::string& out_dir, int threads, bool allow_other_build,
+                                       StopSignals& signals, MergeStats& st) {
+  std::vector<Experiment> suite = loadExperimentSuite((ms.stage / "experiment.yaml").string());
+  resolveRobotModels(suite);  // the cases' keys include the derived robot
+  RunOptions o;
+  o.out_dir = ms.stage.string();
+  o.threads = threads;
+  o.progress = false;
+  o.render = true;
+  o.merge_only = true;
+  o.allow_other_build = allow_other_build;
+  o.case_origin = [&](const std::string& experiment, const std::string& name, const std::string& dir) -> std::string {
+    for (const fs::path& prefix : {fs::path(experiment), fs::path()}) {
+      if (const auto it = ms.journal_lines.find((prefix / name).string()); it != ms.journal_lines.end()) return it->second.second;
+      if (const auto it = ms.taken_by.find(prefix / "cases" / dir); it != ms.taken_by.end()) return it->second;
+    }
+    return out_dir;
+  };
+  checkStop(signals);
+  const RunStats rs = runSuite(suite, o);
+  st.cases = rs.total;
+  checkStop(signals);
+  return suite;
+}
+
+// Stage 4: the staging folder, cleaned of its locks and marker, becomes `out` (empty or absent).
+void publishStage(const fs::path& stage, const std::vector<Experiment>& suite, const fs::path& out) {
+  std::error_code ec;
+  fs::remove(stage / ".tailsim.lock", ec);
+  for (const Experiment& e : suite) fs::remove(stage / e.name / ".tailsim.lock", ec);
+  fs::remove(stage / kStageMarker);
+  compactManifest(stage.string());
+  if (fs::exists(out, ec)) fs::remove(out);  // empty (checked above)
+  fs::rename(stage, out);
+}
+}  // namespace
+
+// The stages in order: check the shards, copy them into a staging folder beside --out, let the runner
+// write the summary there, and rename the staging folder to --out; a signal or an error removes it.
+MergeStats mergeShards(const std::vector<std::string>& shard_dirs, const std::string& out_dir, int threads,
+                       bool allow_other_build) {
+  if (shard_dirs.empty()) throw std::runtime_error("merge: no shard folders given");
+  MergeStats st;
+  st.shards = static_cast<int>(shard_dirs.size());
+  const fs::path out = fs::absolute(out_dir).lexically_normal();
+  std::error_code ec;
+  if (fs::exists(out, ec) && !(fs::is_directory(out, ec) && fs::is_empty(out, ec)))
+    throw std::runtime_error("merge: " + out_dir + " exists and is not empty (merge into a new folder)");
+  checkShards(shard_dirs, out, out_dir);
   StopSignals signals;
   removeStaleStages(out);
-  const fs::path stage = out.parent_path() / (out.filename().string() + ".merge.tmp." + std::to_string(::getpid()));
-  fs::remove_all(stage, ec);
-  auto checkStop = [&signals]() {
-    if (const int sig = signals.pending()) throw MergeStopped{sig};
-  };
+  MergeState ms;
+  ms.stage = out.parent_path() / (out.filename().string() + ".merge.tmp." + std::to_string(::getpid()));
+  fs::remove_all(ms.stage, ec);
   try {
-    fs::create_directories(stage);
-    recordInManifest(stage.string(), kStageMarker, kStageMarkerText);
-    writeFileAtomic((stage / kStageMarker).string(), kStageMarkerText);
-    std::vector<fs::path> taken_cases;
-    std::map<fs::path, std::string> taken_by;  // case folder -> the shard folder it was taken from
-    std::map<std::string, std::pair<std::string, std::string>> journal_lines;  // name -> {line, shard}
-    std::set<fs::path> merged_h5;  // the staging folder's time_series.h5 files
-    for (const std::string& d : shard_dirs) {
-      const fs::path root(d);
-      std::vector<fs::path> this_shard_cases;
-      for (auto it = fs::recursive_directory_iterator(root); it != fs::recursive_directory_iterator(); ++it) {
-        checkStop();
-        if (!it->is_regular_file()) continue;
-        const fs::path rel = it->path().lexically_relative(root);
-        if (rebuiltOrTransient(rel)) continue;
-        const fs::path dst = stage / rel;
-        if (rel.filename() == "cases.jsonl") {  // finished cases without a folder: every shard's lines
-          const std::string text = readResultFile(it->path().string()).value_or(std::string());
-          std::istringstream lines(text);
-          for (std::string line; std::getline(lines, line);) {
-            const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
-            if (!j.is_object() || !j.contains("name") || !j["name"].is_string()) continue;
-            const std::string name = (rel.parent_path() / j["name"].get<std::string>()).string();
-            const auto [at, first] = journal_lines.emplace(name, std::make_pair(line, d));
-            if (!first) requireSameResult(at->second.first, line, j["name"].get<std::string>(), at->second.second, d);
-          }
-          fs::create_directories(dst.parent_path());
-          std::ofstream(dst, std::ios::binary | std::ios::app) << text;
-          continue;
-        }
-        if (rel.filename() == "time_series.h5") {  // every shard's case groups (the first shard's win)
-          requireIntactH5(it->path(), d);  // libhdf5 crashes on some damaged files
-          fs::create_directories(dst.parent_path());
-          runHdf5Isolated(it->path().string() + " (shard " + d + ")",
-                          [&] { mergeTimeSeriesH5(it->path().string(), dst.string()); });
-          merged_h5.insert(dst);
-          continue;
-        }
-        if (rel.parent_path().filename() == "time_series.h5.d" && rel.extension() == ".h5") {  // an unjoined case
-          requireIntactH5(it->path(), d);
-          fs::create_directories(dst.parent_path());
-          fs::copy_file(it->path(), dst, fs::copy_options::overwrite_existing);
-          recordInManifest(dst.parent_path().string(), rel.filename().string(), readAll(dst));
-          ++st.files_copied;
-          continue;
-        }
-        if (perCase(rel)) {
-          const fs::path cf = caseFolderOf(rel);
-          if (std::find(taken_cases.begin(), taken_cases.end(), cf) != taken_cases.end()) {  // earlier shard's
-            if (rel.filename() == "result.json" && fs::exists(stage / rel, ec))
-              requireSameResult(readResultFile((stage / rel).string()).value_or(""),
-                                readResultFile(it->path().string()).value_or(""), cf.filename().string(), taken_by[cf], d);
-            continue;
-          }
-          taken_by.emplace(cf, d);
-          if (std::find(this_shard_cases.begin(), this_shard_cases.end(), cf) == this_shard_cases.end())
-            this_shard_cases.push_back(cf);
-        } else if (fs::exists(dst, ec)) {  // inputs and MJCF copies: the same in every shard
-          if (readAll(dst) != readAll(it->path()))
-            throw std::runtime_error("merge: " + (root / rel).string() + " differs from the same file of an earlier shard");
-          continue;
-        }
-        fs::create_directories(dst.parent_path());
-        fs::copy_file(it->path(), dst, fs::copy_options::overwrite_existing);
-        if (!perCase(rel) && rel.parent_path().filename() != "mjcf")  // an input copy: the merge wrote it
-          recordInManifest(dst.parent_path().string(), rel.filename().string(), readAll(dst));
-        ++st.files_copied;
-      }
-      taken_cases.insert(taken_cases.end(), this_shard_cases.begin(), this_shard_cases.end());
-    }
-    for (const fs::path& h5 : merged_h5) {  // named as tailsim wrote them, for the runner's check
-      const std::optional<std::string> hash = sha256OfFile(h5.string());
-      if (!hash) throw std::runtime_error("merge: cannot read back " + h5.string());
-      recordHashInManifest(h5.parent_path().string(), h5.filename().string(), *hash);
-    }
-    // The summary and results table are written by the runner itself, resuming every case and
-    // running none (a case in no shard is an error): the same code as a single-process run.
-    std::vector<Experiment> suite = loadExperimentSuite((stage / "experiment.yaml").string());
-    resolveRobotModels(suite);  // the cases' keys include the derived robot
-    RunOptions o;
-    o.out_dir = stage.string();
-    o.threads = threads;
-    o.progress = false;
-    o.render = true;
-    o.merge_only = true;
-    o.allow_other_build = allow_other_build;
-    o.case_origin = [&](const std::string& experiment, const std::string& name, const std::string& dir) -> std::string {
-      for (const fs::path& prefix : {fs::path(experiment), fs::path()}) {
-        if (const auto it = journal_lines.find((prefix / name).string()); it != journal_lines.end()) return it->second.second;
-        if (const auto it = taken_by.find(prefix / "cases" / dir); it != taken_by.end()) return it->second;
-      }
-      return out_dir;
-    };
-    checkStop();
-    const RunStats rs = runSuite(suite, o);
-    st.cases = rs.total;
-    checkStop();
-    fs::remove(stage / ".tailsim.lock", ec);
-    for (const Experiment& e : suite) fs::remove(stage / e.name / ".tailsim.lock", ec);
-    fs::remove(stage / kStageMarker);
-    compactManifest(stage.string());
-    if (fs::exists(out, ec)) fs::remove(out);  // empty (checked above)
-    fs::rename(stage, out);
+    fs::create_directories(ms.stage);
+    recordInManifest(ms.stage.string(), kStageMarker, kStageMarkerText);
+    writeFileAtomic((ms.stage / kStageMarker).string(), kStageMarkerText);
+    copyShards(shard_dirs, signals, ms, st);
+    const std::vector<Experiment> suite = rebuildSummary(ms, out_dir, threads, allow_other_build, signals, st);
+    publishStage(ms.stage, suite, out);
   } catch (const MergeStopped& m) {
-    fs::remove_all(stage, ec);
+    fs::remove_all(ms.stage, ec);
     st.stop_signal = m.sig;
   } catch (...) {
-    fs::remove_all(stage, ec);
+    fs::remove_all(ms.stage, ec);
     throw;
   }
   return st;

@@ -12,6 +12,7 @@
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
+#include "settings/units.h"
 
 namespace {
 void copyMessage(const char* what, char* err, size_t err_len) {
@@ -65,7 +66,7 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
     else if (L.torque_max_Nm > 0) std::snprintf(tau_lim, sizeof tau_lim, "%.4g N m", L.torque_max_Nm);
     char speed_lim[32];
     if (!L.joints.empty()) std::snprintf(speed_lim, sizeof speed_lim, "per joint");
-    else std::snprintf(speed_lim, sizeof speed_lim, "%.4g", L.thetadot_max_radps * 180 / M_PI);
+    else std::snprintf(speed_lim, sizeof speed_lim, "%.4g", units::degrees(L.thetadot_max_radps));
     // The limits the optimum uses up, joint by joint (the constraint that binds).
     const std::vector<std::string> binding = bindingLimits(r.limits_analytic.figures, L);
     std::string binds;
@@ -77,11 +78,11 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
                 "%zu seeds, spread %.3g %%; %ld runs, %.2f s wall\n",
                 spec.name.c_str(), familyName(spec.problem.space.family), objectiveName(spec.problem.objective),
                 signedObjectiveDeg(b.objective, b.phi_net_rad), objectiveUnit(spec.problem.objective),
-                b.phi_net_rad * 180 / M_PI, objectiveModelName(spec.problem.search_model),
+                units::degrees(b.phi_net_rad), objectiveModelName(spec.problem.search_model),
                 r.rerank.empty() ? "" : (", MuJoCo re-rank of " + std::to_string(r.rerank.size()) + " candidates").c_str(),
                 deg(r.analytic, true).c_str(), deg(r.perfoot, true).c_str(),
                 deg(r.mujoco, spec.mujoco_check).c_str(), r.limits_analytic.figures.peak_torque_Nm, tau_lim,
-                r.limits_analytic.figures.peak_speed_radps * 180 / M_PI, speed_lim,
+                units::degrees(r.limits_analytic.figures.peak_speed_radps), speed_lim,
                 r.infeasible.infeasible ? "kept, but the turn is below min_turn_deg" : r.limits_analytic.ok ? "kept" : "VIOLATED",
                 binds.c_str(),
                 r.per_seed.size(), 100.0 * r.spread, r.evaluations, r.wall_s);
@@ -119,8 +120,8 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
     std::vector<std::string> reasons;  // why the exit is not 0, one line each
     std::printf("%s: target %.4g deg, tolerance %.4g deg, min_scale %.4g (%s); analytic cycle %+.4f deg (stroke %+.4f, return %+.4f)\n",
                 spec.name.c_str(), spec.settings.heading_deg, spec.settings.tolerance_deg, r.min_scale,
-                spec.min_scale_given ? "given" : "derived from the tolerance", r.full_cycle.total() * 180 / M_PI,
-                r.full_cycle.fast_rad * 180 / M_PI, r.full_cycle.back_rad * 180 / M_PI);
+                spec.min_scale_given ? "given" : "derived from the tolerance", units::degrees(r.full_cycle.total()),
+                units::degrees(r.full_cycle.fast_rad), units::degrees(r.full_cycle.back_rad));
     for (const ManeuverRun& m : r.runs) {
       const bool reached = m.ok && std::abs(m.final_error_rad) <= spec.settings.tolerance();
       const bool counts = m.label != "mujoco_open_loop";  // the open-loop MuJoCo run may miss: that is what is measured
@@ -128,7 +129,7 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
       all_ok = all_ok && run_ok;
       std::printf("  %-20s %s strokes %zu, final error %+.4f deg, overshoot %.4f deg, within tolerance from %s\n",
                   m.label.c_str(), m.ok ? (run_ok ? "ok    " : "MISSED") : "FAILED", m.strokes.size(),
-                  m.final_error_rad * 180 / M_PI, m.overshoot_rad * 180 / M_PI,
+                  units::degrees(m.final_error_rad), units::degrees(m.overshoot_rad),
                   m.t_within_s >= 0 ? (std::to_string(m.t_within_s) + " s").c_str() : "never");
       if (!m.ok) {
         std::printf("    error: %s\n", m.error.c_str());
@@ -136,7 +137,7 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
       } else if (!run_ok) {
         char b[256];
         std::snprintf(b, sizeof b, "%s ended %+.4f deg from the target, outside the tolerance %.4g deg", m.label.c_str(),
-                      m.final_error_rad * 180 / M_PI, spec.settings.tolerance_deg);
+                      units::degrees(m.final_error_rad), spec.settings.tolerance_deg);
         reasons.push_back(b);
       }
       for (const std::string& w : m.warnings) std::printf("    warning: %s\n", w.c_str());

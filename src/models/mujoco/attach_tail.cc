@@ -13,6 +13,7 @@
 #include "results/columns.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/run_uncertainty.h"
+#include "settings/units.h"
 
 namespace tailsim {
 namespace {
@@ -40,7 +41,7 @@ XMLElement* findBody(XMLElement* e, const std::string& name) {
   return nullptr;
 }
 
-double angleDeg(double cosine) { return std::acos(std::max(-1.0, std::min(1.0, cosine))) * 180.0 / kPi; }
+double angleDeg(double cosine) { return units::degrees(std::acos(std::max(-1.0, std::min(1.0, cosine)))); }
 
 // The body's z axis in the world (column 2 of its row-major xmat).
 std::array<double, 3> bodyZ(const mjData* d, int body) {
@@ -254,14 +255,14 @@ ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, c
       trajectory.evaluate(t, ref);
       row[colT] = nextRow * sample_dt_s;
       for (int i = 0; i < n; ++i) {
-        row[colTheta[i]] = d->qpos[qadr[i]] * 180.0 / kPi;
-        row[colThetadot[i]] = d->qvel[vadr[i]] * 180.0 / kPi;
-        row[colTrack[i]] = (d->qpos[qadr[i]] - ref[i].theta) * 180.0 / kPi;
+        row[colTheta[i]] = units::degrees(d->qpos[qadr[i]]);
+        row[colThetadot[i]] = units::degrees(d->qvel[vadr[i]]);
+        row[colTrack[i]] = units::degrees(d->qpos[qadr[i]] - ref[i].theta);
       }
       row[colX] = root[0] - x0;
       row[colY] = root[1] - y0;
-      row[colPhi] = phi * 180.0 / kPi;
-      row[colPhidot] = d->cvel[6 * body + 2] * 180.0 / kPi;  // world-frame angular velocity z (com-based)
+      row[colPhi] = units::degrees(phi);
+      row[colPhidot] = units::degrees(d->cvel[6 * body + 2]);  // world-frame angular velocity z (com-based)
       out.series.appendRow(row);
       ++nextRow;
     }
@@ -278,10 +279,10 @@ ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, c
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
   }
   out.run_s = t_end;
-  out.phi_net_deg = phi * 180.0 / kPi;
+  out.phi_net_deg = units::degrees(phi);
   {
     const double* v = d->cvel + 6 * body;  // [angular; linear] at the subtree COM, world frame
-    out.at_rest = std::abs(v[2]) * 180.0 / kPi < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
+    out.at_rest = units::degrees(std::abs(v[2])) < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
   }
   if (out.stand_max_rel_tilt_deg >= kStandingTiltLimitDeg)
     out.warnings.push_back("the body tilted up to " + std::to_string(out.stand_max_rel_tilt_deg) + " deg from its stance (" +

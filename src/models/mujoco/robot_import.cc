@@ -13,14 +13,14 @@
 #include <set>
 #include <sstream>
 
+#include "settings/units.h"
+
 namespace tailsim {
 namespace {
 
 namespace fs = std::filesystem;
 using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string g6(double v) {
   char b[48];
@@ -196,16 +196,9 @@ std::string urdfToMjcf(const std::string& file) {
   return printer.CStr();
 }
 
-}  // namespace
-
-PreparedModel prepareRobotModel(const std::string& file_in) {
-  PreparedModel out;
-  out.source = fs::absolute(file_in).lexically_normal().string();
-  const std::string& file = out.source;
-  if (!isFile(file)) fail(file, "model file not found");
-  const fs::path dir = fs::path(file).parent_path();
-
-  XMLDocument doc;
+// Stage 1: the file parsed into doc as MJCF (a URDF through MuJoCo's URDF reader), its includes
+// inlined; returns the <mujoco> root.
+XMLElement* loadModelXml(XMLDocument& doc, const std::string& file, PreparedModel& out) {
   loadXmlFile(doc, file);
   if (!doc.RootElement()) fail(file, "empty XML file");
   if (std::string(doc.RootElement()->Name()) == "robot") {
@@ -219,9 +212,19 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
     fail(file, "neither MJCF (<mujoco>) nor URDF (<robot>)");
   }
   XMLElement* root = doc.RootElement();
-  inlineIncludes(doc, root, dir, 0);
+  inlineIncludes(doc, root, fs::path(file).parent_path(), 0);
+  return root;
+}
 
-  // Asset folders made absolute, so the compiled text finds the files the user's file names.
+// Where the model's asset files are, and whether bodies without <inertial> take their mass from geoms.
+struct AssetDirs {
+  fs::path meshdir, texturedir;
+  bool inertia_from_geom = false;
+};
+
+// Stage 2: the compiler's asset folders made absolute, so the compiled text finds the files the
+// user's file names.
+AssetDirs absoluteAssetDirs(XMLDocument& doc, XMLElement* root, const fs::path& dir) {
   XMLElement* compiler = root->FirstChildElement("compiler");
   if (!compiler) {
     compiler = doc.NewElement("compiler");
@@ -236,23 +239,33 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
     compiler->SetAttribute(attr, text.c_str());
     return a;
   };
+  AssetDirs d;
   const char* assetdir = compiler->Attribute("assetdir");
-  const fs::path meshdir = compiler->Attribute("meshdir") || !assetdir ? absDir("meshdir") : absDir("assetdir");
-  const fs::path texturedir =
+  d.meshdir = compiler->Attribute("meshdir") || !assetdir ? absDir("meshdir") : absDir("assetdir");
+  d.texturedir =
       compiler->Attribute("texturedir") || !assetdir ? absDir("texturedir") : fs::path(compiler->Attribute("assetdir"));
   if (assetdir) absDir("assetdir");
-  const bool inertiaFromGeom = compiler->Attribute("inertiafromgeom") &&
-                               std::string(compiler->Attribute("inertiafromgeom")) == "true";
+  d.inertia_from_geom = compiler->Attribute("inertiafromgeom") &&
+                        std::string(compiler->Attribute("inertiafromgeom")) == "true";
+  return d;
+}
 
-  // Missing mesh and texture files.
-  std::map<std::string, std::string> missingMesh;     // mesh name -> the missing file
-  std::set<std::string> missingTexture;
-  std::vector<XMLElement*> dropAssets;
+// The assets whose files are missing.
+struct MissingAssets {
+  std::map<std::string, std::string> mesh;  // mesh name -> the missing file
+  std::set<std::string> texture;
+  std::vector<XMLElement*> elements;  // their <mesh> and <texture> elements, to drop
+};
+
+// Stage 3: the missing mesh and texture files (a missing hfield or skin file is an error); the
+// materials lose their missing textures.
+MissingAssets findMissingAssets(XMLElement* root, const AssetDirs& dirs, const std::string& file) {
+  MissingAssets m;
   for (XMLElement* asset = root->FirstChildElement("asset"); asset; asset = asset->NextSiblingElement("asset")) {
     for (XMLElement* e = asset->FirstChildElement(); e; e = e->NextSiblingElement()) {
       const std::string tag = e->Name();
       if (tag != "mesh" && tag != "texture" && tag != "hfield" && tag != "skin") continue;
-      const fs::path base = tag == "texture" ? texturedir : meshdir;
+      const fs::path base = tag == "texture" ? dirs.texturedir : dirs.meshdir;
       std::vector<std::string> files;
       for (const char* a : {"file", "fileright", "fileleft", "fileup", "filedown", "filefront", "fileback"})
         if (const char* f = e->Attribute(a)) files.push_back(f);
@@ -260,42 +273,39 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
         const fs::path p = fs::path(f).is_absolute() ? fs::path(f) : base / f;
         if (isFile(p)) continue;
         const std::string name = e->Attribute("name") ? e->Attribute("name") : stemOf(f);
-        if (tag == "mesh") missingMesh[name] = p.string();
-        else if (tag == "texture") missingTexture.insert(name);
+        if (tag == "mesh") m.mesh[name] = p.string();
+        else if (tag == "texture") m.texture.insert(name);
         else fail(file, "<" + tag + "> '" + name + "': file " + p.string() + " is missing");
-        dropAssets.push_back(e);
+        m.elements.push_back(e);
         break;
       }
     }
   }
-  if (!missingTexture.empty()) {
+  if (!m.texture.empty()) {
     std::vector<XMLElement*> materials;
     forEachElement(root, [&](XMLElement* e) {
-      if (std::string(e->Name()) == "material" && e->Attribute("texture") && missingTexture.count(e->Attribute("texture")))
+      if (std::string(e->Name()) == "material" && e->Attribute("texture") && m.texture.count(e->Attribute("texture")))
         materials.push_back(e);
     });
-    for (XMLElement* m : materials) m->DeleteAttribute("texture");
+    for (XMLElement* mat : materials) mat->DeleteAttribute("texture");
   }
+  return m;
+}
 
-  // Geoms that use a missing mesh: dropped when they cannot collide; otherwise an error.
-  const Defaults defaults(root);
-  XMLElement* world = root->FirstChildElement("worldbody");
-  if (!world) fail(file, "no <worldbody>");
-  std::vector<XMLElement*> geoms;
-  forEachElement(world, [&](XMLElement* e) {
-    if (std::string(e->Name()) == "geom") geoms.push_back(e);
-  });
+bool isPlane(const Defaults& defaults, XMLElement* gm) {
+  const char* type = defaults.geomAttr(gm, "type");
+  return type && std::string(type) == "plane";
+}
+
+// Stage 4: the geoms that use a missing mesh: returned to be dropped when they cannot collide;
+// otherwise an error (also when their body's mass comes from its geoms).
+std::vector<XMLElement*> geomsWithoutMesh(const std::vector<XMLElement*>& geoms, const Defaults& defaults,
+                                          MissingAssets& missing, const AssetDirs& dirs, const std::string& file) {
   std::vector<std::string> colliding;
-  std::vector<XMLElement*> dropGeoms;
-  bool hasPlane = false;
+  std::vector<XMLElement*> drop;
   for (XMLElement* gm : geoms) {
-    const char* type = defaults.geomAttr(gm, "type");
-    if (type && std::string(type) == "plane") {
-      hasPlane = true;
-      if (out.floor_geom.empty()) out.floor_geom = gm->Attribute("name") ? gm->Attribute("name") : "";
-    }
     const char* mesh = defaults.geomAttr(gm, "mesh");
-    if (!mesh || !missingMesh.count(mesh)) continue;
+    if (!mesh || !missing.mesh.count(mesh)) continue;
     const char* ct = defaults.geomAttr(gm, "contype");
     const char* ca = defaults.geomAttr(gm, "conaffinity");
     const bool collides = (ct ? std::atoi(ct) : 1) != 0 || (ca ? std::atoi(ca) : 1) != 0;
@@ -305,63 +315,103 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
         gm->Attribute("name") ? "'" + std::string(gm->Attribute("name")) + "'" : "(unnamed, mesh '" + std::string(mesh) + "')";
     if (collides) {
       colliding.push_back("geom " + geomName + " in body '" + bodyName + "' collides but its mesh file " +
-                          missingMesh[mesh] + " is missing");
+                          missing.mesh[mesh] + " is missing");
       continue;
     }
-    const bool massFromGeoms = inertiaFromGeom || (body && !body->FirstChildElement("inertial"));
+    const bool massFromGeoms = dirs.inertia_from_geom || (body && !body->FirstChildElement("inertial"));
     if (massFromGeoms && std::string(body ? body->Name() : "") == "body")
-      fail(file, "geom " + geomName + " in body '" + bodyName + "' has a missing mesh file " + missingMesh[mesh] +
+      fail(file, "geom " + geomName + " in body '" + bodyName + "' has a missing mesh file " + missing.mesh[mesh] +
                      " and the body's mass and inertia come from its geoms (no <inertial>): supply the file");
-    dropGeoms.push_back(gm);
+    drop.push_back(gm);
   }
   if (!colliding.empty()) {
     std::string msg = std::to_string(colliding.size()) + " colliding geom" + (colliding.size() > 1 ? "s have" : " has") +
                       " a missing mesh file: ";
     for (std::size_t i = 0; i < colliding.size() && i < 5; ++i) msg += (i ? "; " : "") + colliding[i];
     if (colliding.size() > 5) msg += "; and " + std::to_string(colliding.size() - 5) + " more";
-    fail(file, msg + ". Supply the mesh files (meshdir " + meshdir.string() +
+    fail(file, msg + ". Supply the mesh files (meshdir " + dirs.meshdir.string() +
                    "), or make such geoms visual-only (contype=\"0\" conaffinity=\"0\")");
   }
-  for (XMLElement* gm : dropGeoms) gm->Parent()->DeleteChild(gm);
-  for (XMLElement* a : dropAssets) a->Parent()->DeleteChild(a);
-  out.dropped_geoms = static_cast<int>(dropGeoms.size());
-  out.dropped_textures = static_cast<int>(missingTexture.size());
-  if (out.dropped_geoms || out.dropped_textures)
-    out.notes.push_back("dropped " + std::to_string(out.dropped_geoms) + " non-colliding geom" +
-                        (out.dropped_geoms == 1 ? "" : "s") + " whose mesh file is missing and " +
-                        std::to_string(out.dropped_textures) + " texture" + (out.dropped_textures == 1 ? "" : "s") +
-                        " whose file is missing (their materials keep their colour)");
+  return drop;
+}
 
-  // Every joint named (the stance is carried by name into a model with a tail).
+// Stage 5: every joint named (the stance is carried by name into a model with a tail).
+void nameJoints(XMLElement* world) {
   int unnamed = 0;
   forEachElement(world, [&](XMLElement* e) {
     const std::string tag = e->Name();
     if ((tag == "joint" || tag == "freejoint") && !e->Attribute("name"))
       e->SetAttribute("name", ("tailsim_joint" + std::to_string(++unnamed)).c_str());
   });
+}
 
-  // A floor when the model has none (a robot file without its scene).
-  if (!hasPlane || out.floor_geom.empty()) {
-    if (hasPlane) {
-      // The model's plane has no name: name it.
-      for (XMLElement* gm : geoms) {
-        const char* type = defaults.geomAttr(gm, "type");
-        if (type && std::string(type) == "plane") {
-          gm->SetAttribute("name", "tailsim_floor");
-          break;
-        }
-      }
-    } else {
-      XMLElement* floor = doc.NewElement("geom");
-      floor->SetAttribute("name", "tailsim_floor");
-      floor->SetAttribute("type", "plane");
-      floor->SetAttribute("size", "0 0 1");
-      world->InsertFirstChild(floor);
-      out.notes.push_back("added a floor (plane, MuJoCo's default friction 1): the model has none");
+// Whether the model has a plane; out.floor_geom names the first (empty when unnamed).
+bool findFloor(const std::vector<XMLElement*>& geoms, const Defaults& defaults, PreparedModel& out) {
+  bool hasPlane = false;
+  for (XMLElement* gm : geoms)
+    if (isPlane(defaults, gm)) {
+      hasPlane = true;
+      if (out.floor_geom.empty()) out.floor_geom = gm->Attribute("name") ? gm->Attribute("name") : "";
     }
-    out.floor_geom = "tailsim_floor";
-  }
+  return hasPlane;
+}
 
+// Stage 6: a floor when the model has none (a robot file without its scene), or a name for its
+// unnamed plane; out.floor_geom names it.
+void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLElement*>& geoms, const Defaults& defaults,
+                 bool hasPlane, PreparedModel& out) {
+  if (hasPlane && !out.floor_geom.empty()) return;
+  if (hasPlane) {
+    // The model's plane has no name: name it.
+    for (XMLElement* gm : geoms)
+      if (isPlane(defaults, gm)) {
+        gm->SetAttribute("name", "tailsim_floor");
+        break;
+      }
+  } else {
+    XMLElement* floor = doc.NewElement("geom");
+    floor->SetAttribute("name", "tailsim_floor");
+    floor->SetAttribute("type", "plane");
+    floor->SetAttribute("size", "0 0 1");
+    world->InsertFirstChild(floor);
+    out.notes.push_back("added a floor (plane, MuJoCo's default friction 1): the model has none");
+  }
+  out.floor_geom = "tailsim_floor";
+}
+
+}  // namespace
+
+// The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
+// joint names, floor, print.
+PreparedModel prepareRobotModel(const std::string& file_in) {
+  PreparedModel out;
+  out.source = fs::absolute(file_in).lexically_normal().string();
+  const std::string& file = out.source;
+  if (!isFile(file)) fail(file, "model file not found");
+  XMLDocument doc;
+  XMLElement* root = loadModelXml(doc, file, out);
+  const AssetDirs dirs = absoluteAssetDirs(doc, root, fs::path(file).parent_path());
+  MissingAssets missing = findMissingAssets(root, dirs, file);
+  const Defaults defaults(root);
+  XMLElement* world = root->FirstChildElement("worldbody");
+  if (!world) fail(file, "no <worldbody>");
+  std::vector<XMLElement*> geoms;
+  forEachElement(world, [&](XMLElement* e) {
+    if (std::string(e->Name()) == "geom") geoms.push_back(e);
+  });
+  const bool hasPlane = findFloor(geoms, defaults, out);
+  const std::vector<XMLElement*> dropGeoms = geomsWithoutMesh(geoms, defaults, missing, dirs, file);
+  for (XMLElement* gm : dropGeoms) gm->Parent()->DeleteChild(gm);
+  for (XMLElement* a : missing.elements) a->Parent()->DeleteChild(a);
+  out.dropped_geoms = static_cast<int>(dropGeoms.size());
+  out.dropped_textures = static_cast<int>(missing.texture.size());
+  if (out.dropped_geoms || out.dropped_textures)
+    out.notes.push_back("dropped " + std::to_string(out.dropped_geoms) + " non-colliding geom" +
+                        (out.dropped_geoms == 1 ? "" : "s") + " whose mesh file is missing and " +
+                        std::to_string(out.dropped_textures) + " texture" + (out.dropped_textures == 1 ? "" : "s") +
+                        " whose file is missing (their materials keep their colour)");
+  nameJoints(world);
+  ensureFloor(doc, world, geoms, defaults, hasPlane, out);
   tinyxml2::XMLPrinter printer;
   doc.Print(&printer);
   out.xml = printer.CStr();
@@ -431,8 +481,267 @@ int rootBody(const mjModel* m, const std::string& file) {
   fail(file, "no free joint: a standing robot needs a floating base (<freejoint/>)");
 }
 
+// How the legs are held in the stance.
+struct LegHold {
+  std::vector<int> by_actuator;  // per joint: 1 when a position actuator of the model holds it
+  std::vector<double> ctrl;      // the actuators' ctrl: the stance angle for position actuators
+  std::vector<int> pd;           // hinge and slide joints held by tailsim's PD
+  int position_servos = 0;
+};
+
+// Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
+// ctrl; a joint without one is held by a PD tailsim adds through qfrc_applied.
+LegHold holdLegs(const mjModel* m, const Stance& stance) {
+  LegHold h;
+  h.by_actuator.assign(m->njnt, 0);
+  h.ctrl.assign(m->nu, 0.0);
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
+    const int j = m->actuator_trnid[2 * a];
+    const bool position = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
+    if (!position) continue;
+    h.ctrl[a] = stance.qpos[m->jnt_qposadr[j]];
+    h.by_actuator[j] = 1;
+    ++h.position_servos;
+  }
+  for (int j = 0; j < m->njnt; ++j)
+    if ((m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) && !h.by_actuator[j]) h.pd.push_back(j);
+  return h;
+}
+
+// Stage: the stance lifted (or lowered) until the lowest colliding geom is 1 mm above the floor, then
+// settled for spec.settle_s with the legs held; r.tilt_deg is the root body's tilt afterwards.
+void stand(const mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stance, const LegHold& hold, int root,
+           int floor, const std::string& file, DerivedRobot& r) {
+  constexpr double kPdKp = kStancePdKp, kPdKv = kStancePdKv;
+  mju_copy(d->qpos, stance.qpos.data(), m->nq);
+  mj_kinematics(m, d);
+  const double floorZ = floor >= 0 ? d->geom_xpos[3 * floor + 2] : 0.0;
+  double low = 1e300;
+  for (int g = 0; g < m->ngeom; ++g)
+    if (m->geom_bodyid[g] != 0 && m->body_rootid[m->geom_bodyid[g]] == root && (m->geom_contype[g] || m->geom_conaffinity[g])) low = std::min(low, lowestZ(m, d, g));
+  const int freeq = m->jnt_qposadr[m->body_jntadr[root]];
+  const double lift = floorZ + 1e-3 - low;
+  d->qpos[freeq + 2] += lift;
+  r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
+                    g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(spec.settle_s) + " s");
+  mju_copy(d->ctrl, hold.ctrl.data(), m->nu);
+  const int steps = static_cast<int>(std::ceil(spec.settle_s / m->opt.timestep));
+  for (int i = 0; i < steps; ++i) {
+    for (int j : hold.pd) {
+      const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
+      d->qfrc_applied[va] = kPdKp * (stance.qpos[qa] - d->qpos[qa]) - kPdKv * d->qvel[va];
+    }
+    mj_step(m, d);
+  }
+  mj_forward(m, d);
+  if (warningCount(d) > 0) fail(file, "MuJoCo warnings while standing: " + describeWarnings(d));
+  const double* Rroot = d->xmat + 9 * root;
+  r.tilt_deg = units::degrees(std::acos(std::clamp(Rroot[8], -1.0, 1.0)));
+}
+
+// A geom's name, or "geom #k of body 'b'" for an unnamed one.
+std::string geomName(const mjModel* m, int g) {
+  const char* n = mj_id2name(m, mjOBJ_GEOM, g);
+  return n ? std::string(n) : "geom #" + std::to_string(g) + " of body '" +
+                                  std::string(mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) ? mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) : "?") + "'";
+}
+
+// Stage: the feet: the named geoms, or the robot's geoms touching the floor; exactly 4 of them.
+std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int floor, const std::string& file,
+                          const DerivedRobot& r) {
+  std::vector<int> feet;
+  if (!spec.feet.empty()) {
+    for (const std::string& n : spec.feet) {
+      const int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
+      if (g < 0) fail(file, "feet: no geom named '" + n + "'", "robot.feet");
+      feet.push_back(g);
+    }
+  } else {
+    for (int i = 0; i < d->ncon; ++i) {
+      const mjContact& c = d->contact[i];
+      const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
+      if (other < 0 || c.dist > 1e-3) continue;
+      if (std::find(feet.begin(), feet.end(), other) == feet.end()) feet.push_back(other);
+    }
+  }
+  if (feet.size() < 3 || feet.size() > 4) {
+    std::string names;
+    for (int g : feet) names += (names.empty() ? "" : ", ") + geomName(m, g);
+    fail(file, "after standing " + g6(spec.settle_s) + " s in " + r.stance + ", the robot touches the floor with " +
+                   std::to_string(feet.size()) + " geom" + (feet.size() == 1 ? "" : "s") +
+                   (names.empty() ? "" : " (" + names + ")") +
+                   "; a quadruped stands on 3 or 4 feet: check the stance (tilt " + g6(r.tilt_deg) +
+                   " deg) or name the feet with feet: [...]",
+         "robot.feet");
+  }
+  if (feet.size() != 4)
+    fail(file, "the robot stands on " + std::to_string(feet.size()) +
+                   " feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet, so a 3-foot stance is "
+                   "refused: name 4 feet with feet: [...] or change the stance",
+         "robot.feet");
+  return feet;
+}
+
+// The robot's mass and COM (world frame).
+struct MassCentre {
+  double M = 0.0, c[3] = {0, 0, 0};
+};
+
+// Stage: mass, COM and composite I_zz about the COM of the robot's bodies (the root body's tree, not
+// the world nor other bodies of a scene), into r.quadruped; MuJoCo's own figures for comparison.
+MassCentre massProperties(const mjModel* m, const mjData* d, int root, DerivedRobot& r) {
+  auto robotBody = [&](int b) { return b > 0 && m->body_rootid[b] == root; };
+  MassCentre mc;
+  double& M = mc.M;
+  double* c = mc.c;
+  for (int b = 1; b < m->nbody; ++b) {
+    if (!robotBody(b)) continue;
+    M += m->body_mass[b];
+    for (int k = 0; k < 3; ++k) c[k] += m->body_mass[b] * d->xipos[3 * b + k];
+  }
+  for (int k = 0; k < 3; ++k) c[k] /= M;
+  double izz = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    if (!robotBody(b)) continue;
+    const double* R = d->ximat + 9 * b;
+    const double* I = m->body_inertia + 3 * b;
+    const double dx = d->xipos[3 * b] - c[0], dy = d->xipos[3 * b + 1] - c[1];
+    izz += R[6] * R[6] * I[0] + R[7] * R[7] * I[1] + R[8] * R[8] * I[2] + m->body_mass[b] * (dx * dx + dy * dy);
+  }
+  r.mujoco_subtreemass_kg = m->body_subtreemass[root];
+  for (int b = 1; b < m->nbody; ++b)
+    if (robotBody(b)) r.mujoco_cinert_izz_kgm2 += d->cinert[10 * b + 2];
+  r.quadruped.mass_kg = M;
+  r.quadruped.izz_kgm2 = izz;
+  return mc;
+}
+
+// Stage: the planar frame (the mount body's x axis turned by the mount yaw, projected on the floor,
+// origin at the COM), the feet ordered FL, FR, RR, RL in it, and the quadruped's lengths. Returns
+// the difference of the left and right foot spacings.
+double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int root, const std::vector<int>& feet,
+                      const MassCentre& mc, const std::string& file, DerivedRobot& r) {
+  const double* c = mc.c;
+  const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
+  if (mount < 0) fail(file, "tail mount: no body named '" + spec.mount.body + "'", "tail.mount.body");
+  r.mount_body = mj_id2name(m, mjOBJ_BODY, mount) ? mj_id2name(m, mjOBJ_BODY, mount) : "";
+  const double* Rm = d->xmat + 9 * mount;
+  const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
+  const double ex[2] = {std::cos(psi), std::sin(psi)}, ey[2] = {-std::sin(psi), std::cos(psi)};
+  auto planar = [&](const double* p) {
+    const double dx = p[0] - c[0], dy = p[1] - c[1];
+    return std::array<double, 2>{dx * ex[0] + dy * ex[1], dx * ey[0] + dy * ey[1]};
+  };
+  std::vector<std::array<double, 2>> fp;
+  for (int g : feet) fp.push_back(planar(d->geom_xpos + 3 * g));
+  double mx = 0.0, my = 0.0;
+  for (const auto& p : fp) mx += p[0] / 4, my += p[1] / 4;
+  // FL, FR, RR, RL: front = x above the centroid, left = y above it.
+  std::vector<int> order(4, -1);
+  for (int i = 0; i < 4; ++i) {
+    const bool front = fp[i][0] > mx, left = fp[i][1] > my;
+    const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
+    if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
+                                         std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
+                            "robot.feet");
+    order[slot] = i;
+  }
+  for (int s = 0; s < 4; ++s) {
+    const int g = feet[order[s]], b = m->geom_bodyid[g];
+    r.feet.push_back(geomName(m, g));
+    r.foot_geoms.emplace_back(mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "", g - m->body_geomadr[b]);
+  }
+  const auto& FL = fp[order[0]];
+  const auto& FR = fp[order[1]];
+  const auto& RR = fp[order[2]];
+  const auto& RL = fp[order[3]];
+  QuadrupedParams& q = r.quadruped;
+  q.l_F_m = 0.5 * (FL[0] + FR[0]) - 0.5 * (RL[0] + RR[0]);
+  q.w_F_m = 0.5 * (FL[1] + RL[1]) - 0.5 * (FR[1] + RR[1]);
+  q.d_Q2C_m = mx;
+  r.lateral_com_to_feet_m = my;
+  double footZ = 0.0;
+  for (int g : feet) footZ += lowestZ(m, d, g) / 4;
+  q.com_height_m = c[2] - footZ;
+  double base[3];
+  mju_rotVecMat(base, spec.mount.pos_m.data(), d->xmat + 9 * mount);
+  for (int k = 0; k < 3; ++k) base[k] += d->xpos[3 * mount + k];
+  const auto b = planar(base);
+  q.d_Q2B_m = -b[0];
+  r.lateral_mount_m = b[1];
+  const bool mountGiven = !spec.mount.body.empty() || spec.mount.pos_m != std::array<double, 3>{};
+  if (!mountGiven)
+    r.notes.push_back("no tail mount given: d_Q2B_m is that of the root body's origin (--mount-pos X,Y,Z sets the tail base)");
+  else if (q.d_Q2B_m < 0.0)
+    r.notes.push_back("the tail base is in front of the COM (d_Q2B_m < 0): check the mount (pos_m, yaw_deg)");
+  return std::abs((FL[0] - RL[0]) - (FR[0] - RR[0]));
+}
+
+// Stage: the friction coefficient into r.mu: given, else the contacts' own (MuJoCo mixes the
+// foot's and the floor's: priority, else the larger), else the foot geoms'. Returns its source.
+std::string footFriction(const mjModel* m, const mjData* d, const RobotModelSpec& spec, const std::vector<int>& feet,
+                         DerivedRobot& r) {
+  double mu_sum = 0.0;
+  int nmu = 0;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& ct = d->contact[i];
+    if (std::find(feet.begin(), feet.end(), ct.geom1) != feet.end() || std::find(feet.begin(), feet.end(), ct.geom2) != feet.end()) {
+      mu_sum += ct.friction[0];
+      ++nmu;
+    }
+  }
+  if (spec.mu >= 0.0) {
+    r.mu = spec.mu;
+    r.mu_given = true;
+    return "given (overrides the foot contacts)";
+  }
+  if (nmu > 0) {
+    r.mu = mu_sum / nmu;
+    return "MuJoCo's foot-floor contacts (friction[0], " + std::to_string(nmu) + " contacts)";
+  }
+  r.mu = 0.0;
+  for (int g : feet) r.mu += m->geom_friction[3 * g] / feet.size();
+  return "the foot geoms' friction (no contact after standing)";
+}
+
+// Stage: r.values, the derived settings with the source of each.
+void listValues(const RobotModelSpec& spec, const std::string& muSource, DerivedRobot& r) {
+  const QuadrupedParams& q = r.quadruped;
+  const std::string stood = " (stance after standing " + g6(spec.settle_s) + " s)";
+  const std::string frame = "planar frame: body '" + r.mount_body + "' x" +
+                            (spec.mount.yaw_rad != 0.0 ? " turned by " + g6(units::degrees(spec.mount.yaw_rad)) + " deg" : "");
+  r.values = {
+      {"quadruped.mass_kg", q.mass_kg, "kg", "sum of the model's body masses (MuJoCo body_subtreemass of '" + r.root_body + "': " + g6(r.mujoco_subtreemass_kg) + ")"},
+      {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2", "composite I_zz about the COM, legs held" + stood + "; MuJoCo cinert sum " + g6(r.mujoco_cinert_izz_kgm2)},
+      {"quadruped.d_Q2C_m", q.d_Q2C_m, "m", "x of the foot centroid from the COM, " + frame},
+      {"quadruped.d_Q2B_m", q.d_Q2B_m, "m", "tail base (body '" + r.mount_body + "' + pos_m) behind the COM, " + frame},
+      {"quadruped.l_F_m", q.l_F_m, "m", "front feet x - rear feet x (means of each pair)"},
+      {"quadruped.w_F_m", q.w_F_m, "m", "left feet y - right feet y (means of each pair)"},
+      {"quadruped.com_height_m", q.com_height_m, "m", "COM above the feet's lowest points" + stood},
+      {"friction.mu_s = mu_d", r.mu, "-", muSource},
+      {"gravity_mps2", r.gravity_mps2, "m/s^2", "the model's option gravity"},
+  };
+}
+
+// Stage: every named joint's settled qpos, hold target and (held by tailsim's PD) name.
+void settledJoints(const mjModel* m, const mjData* d, const Stance& stance, const LegHold& hold, DerivedRobot& r) {
+  for (int j = 0; j < m->njnt; ++j) {
+    const int n = m->jnt_type[j] == mjJNT_FREE ? 7 : m->jnt_type[j] == mjJNT_BALL ? 4 : 1;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (!name) continue;
+    r.settled_qpos[name].assign(d->qpos + m->jnt_qposadr[j], d->qpos + m->jnt_qposadr[j] + n);
+    if (m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) {
+      r.hold_target_rad[name] = stance.qpos[m->jnt_qposadr[j]];
+      if (!hold.by_actuator[j]) r.pd_joints.push_back(name);
+    }
+  }
+}
+
 }  // namespace
 
+// The stages in order: prepare and compile the model, the stance and how the legs are held, stand,
+// the feet, mass properties, the planar geometry, friction, the values and notes, the settled joints.
 DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   DerivedRobot r;
   r.model = prepareRobotModel(spec.file);
@@ -452,225 +761,26 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   if (spec.legs != "servos" && spec.legs != "locked")
     fail(file, "legs: '" + spec.legs + "' is neither servos nor locked", "robot.legs");
   r.legs_locked = spec.legs == "locked";
+  const LegHold hold = holdLegs(m, stance);
+  r.stance += ", legs held by " + std::to_string(hold.position_servos) + " position actuator" +
+              (hold.position_servos == 1 ? "" : "s") + " of the model" +
+              (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints");
 
-  // Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
-  // ctrl; a joint without one is held by a PD tailsim adds through qfrc_applied.
-  std::vector<int> heldByActuator(m->njnt, 0);
-  std::vector<double> ctrl(m->nu, 0.0);
-  int positionServos = 0;
-  for (int a = 0; a < m->nu; ++a) {
-    if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
-    const int j = m->actuator_trnid[2 * a];
-    const bool position = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
-    if (!position) continue;
-    ctrl[a] = stance.qpos[m->jnt_qposadr[j]];
-    heldByActuator[j] = 1;
-    ++positionServos;
-  }
-  std::vector<int> pd;  // joints held by tailsim's PD
-  for (int j = 0; j < m->njnt; ++j)
-    if ((m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) && !heldByActuator[j]) pd.push_back(j);
-  constexpr double kPdKp = kStancePdKp, kPdKv = kStancePdKv;
-  r.stance += ", legs held by " + std::to_string(positionServos) + " position actuator" + (positionServos == 1 ? "" : "s") +
-              " of the model" + (pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(pd.size()) + " joints");
-
-  // Lifted (or lowered) until the lowest colliding geom is 1 mm above the floor, then settled.
-  mju_copy(d->qpos, stance.qpos.data(), m->nq);
-  mj_kinematics(m, d);
   const int floor = mj_name2id(m, mjOBJ_GEOM, r.model.floor_geom.c_str());
-  const double floorZ = floor >= 0 ? d->geom_xpos[3 * floor + 2] : 0.0;
-  double low = 1e300;
-  for (int g = 0; g < m->ngeom; ++g)
-    if (m->geom_bodyid[g] != 0 && m->body_rootid[m->geom_bodyid[g]] == root && (m->geom_contype[g] || m->geom_conaffinity[g])) low = std::min(low, lowestZ(m, d, g));
-  const int freeq = m->jnt_qposadr[m->body_jntadr[root]];
-  const double lift = floorZ + 1e-3 - low;
-  d->qpos[freeq + 2] += lift;
-  r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
-                    g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(spec.settle_s) + " s");
-  mju_copy(d->ctrl, ctrl.data(), m->nu);
-  const int steps = static_cast<int>(std::ceil(spec.settle_s / m->opt.timestep));
-  for (int i = 0; i < steps; ++i) {
-    for (int j : pd) {
-      const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
-      d->qfrc_applied[va] = kPdKp * (stance.qpos[qa] - d->qpos[qa]) - kPdKv * d->qvel[va];
-    }
-    mj_step(m, d);
-  }
-  mj_forward(m, d);
-  if (warningCount(d) > 0) fail(file, "MuJoCo warnings while standing: " + describeWarnings(d));
-  const double* Rroot = d->xmat + 9 * root;
-  r.tilt_deg = std::acos(std::clamp(Rroot[8], -1.0, 1.0)) * 180.0 / kPi;
-
-  // Feet: the named geoms, or the robot's geoms touching the floor.
-  std::vector<int> feet;
-  if (!spec.feet.empty()) {
-    for (const std::string& n : spec.feet) {
-      const int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
-      if (g < 0) fail(file, "feet: no geom named '" + n + "'", "robot.feet");
-      feet.push_back(g);
-    }
-  } else {
-    for (int i = 0; i < d->ncon; ++i) {
-      const mjContact& c = d->contact[i];
-      const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
-      if (other < 0 || c.dist > 1e-3) continue;
-      if (std::find(feet.begin(), feet.end(), other) == feet.end()) feet.push_back(other);
-    }
-  }
-  auto geomName = [&](int g) {
-    const char* n = mj_id2name(m, mjOBJ_GEOM, g);
-    return n ? std::string(n) : "geom #" + std::to_string(g) + " of body '" +
-                                    std::string(mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) ? mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) : "?") + "'";
-  };
-  if (feet.size() < 3 || feet.size() > 4) {
-    std::string names;
-    for (int g : feet) names += (names.empty() ? "" : ", ") + geomName(g);
-    fail(file, "after standing " + g6(spec.settle_s) + " s in " + r.stance + ", the robot touches the floor with " +
-                   std::to_string(feet.size()) + " geom" + (feet.size() == 1 ? "" : "s") +
-                   (names.empty() ? "" : " (" + names + ")") +
-                   "; a quadruped stands on 3 or 4 feet: check the stance (tilt " + g6(r.tilt_deg) +
-                   " deg) or name the feet with feet: [...]",
-         "robot.feet");
-  }
-  if (feet.size() != 4)
-    fail(file, "the robot stands on " + std::to_string(feet.size()) +
-                   " feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet, so a 3-foot stance is "
-                   "refused: name 4 feet with feet: [...] or change the stance",
-         "robot.feet");
-
-  // Robot bodies: the root body's tree (not the world, nor other bodies of a scene).
-  auto robotBody = [&](int b) { return b > 0 && m->body_rootid[b] == root; };
-  double M = 0.0, c[3] = {0, 0, 0};
-  for (int b = 1; b < m->nbody; ++b) {
-    if (!robotBody(b)) continue;
-    M += m->body_mass[b];
-    for (int k = 0; k < 3; ++k) c[k] += m->body_mass[b] * d->xipos[3 * b + k];
-  }
-  for (double& x : c) x /= M;
-  double izz = 0.0;
-  for (int b = 1; b < m->nbody; ++b) {
-    if (!robotBody(b)) continue;
-    const double* R = d->ximat + 9 * b;
-    const double* I = m->body_inertia + 3 * b;
-    const double dx = d->xipos[3 * b] - c[0], dy = d->xipos[3 * b + 1] - c[1];
-    izz += R[6] * R[6] * I[0] + R[7] * R[7] * I[1] + R[8] * R[8] * I[2] + m->body_mass[b] * (dx * dx + dy * dy);
-  }
-  r.mujoco_subtreemass_kg = m->body_subtreemass[root];
-  for (int b = 1; b < m->nbody; ++b)
-    if (robotBody(b)) r.mujoco_cinert_izz_kgm2 += d->cinert[10 * b + 2];
-
-  // The planar frame: the mount body's x axis turned by the mount yaw, projected on the floor.
-  const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
-  if (mount < 0) fail(file, "tail mount: no body named '" + spec.mount.body + "'", "tail.mount.body");
-  r.mount_body = mj_id2name(m, mjOBJ_BODY, mount) ? mj_id2name(m, mjOBJ_BODY, mount) : "";
-  const double* Rm = d->xmat + 9 * mount;
-  const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
-  const double ex[2] = {std::cos(psi), std::sin(psi)}, ey[2] = {-std::sin(psi), std::cos(psi)};
-  auto planar = [&](const double* p) {
-    const double dx = p[0] - c[0], dy = p[1] - c[1];
-    return std::array<double, 2>{dx * ex[0] + dy * ex[1], dx * ey[0] + dy * ey[1]};
-  };
-  std::vector<std::array<double, 2>> fp;
-  for (int g : feet) fp.push_back(planar(d->geom_xpos + 3 * g));
-  double mu_sum = 0.0, mx = 0.0, my = 0.0;
-  for (const auto& p : fp) mx += p[0] / 4, my += p[1] / 4;
-  // FL, FR, RR, RL: front = x above the centroid, left = y above it.
-  std::vector<int> order(4, -1);
-  for (int i = 0; i < 4; ++i) {
-    const bool front = fp[i][0] > mx, left = fp[i][1] > my;
-    const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
-    if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
-                                         std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
-                            "robot.feet");
-    order[slot] = i;
-  }
-  for (int s = 0; s < 4; ++s) {
-    const int g = feet[order[s]], b = m->geom_bodyid[g];
-    r.feet.push_back(geomName(g));
-    r.foot_geoms.emplace_back(mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "", g - m->body_geomadr[b]);
-  }
-  const auto& FL = fp[order[0]];
-  const auto& FR = fp[order[1]];
-  const auto& RR = fp[order[2]];
-  const auto& RL = fp[order[3]];
-  QuadrupedParams& q = r.quadruped;
-  q.mass_kg = M;
-  q.izz_kgm2 = izz;
-  q.l_F_m = 0.5 * (FL[0] + FR[0]) - 0.5 * (RL[0] + RR[0]);
-  q.w_F_m = 0.5 * (FL[1] + RL[1]) - 0.5 * (FR[1] + RR[1]);
-  q.d_Q2C_m = mx;
-  r.lateral_com_to_feet_m = my;
-  double footZ = 0.0;
-  for (int g : feet) footZ += lowestZ(m, d, g) / 4;
-  q.com_height_m = c[2] - footZ;
-  double base[3];
-  mju_rotVecMat(base, spec.mount.pos_m.data(), d->xmat + 9 * mount);
-  for (int k = 0; k < 3; ++k) base[k] += d->xpos[3 * mount + k];
-  const auto b = planar(base);
-  q.d_Q2B_m = -b[0];
-  r.lateral_mount_m = b[1];
-  const bool mountGiven = !spec.mount.body.empty() || spec.mount.pos_m != std::array<double, 3>{};
-  if (!mountGiven)
-    r.notes.push_back("no tail mount given: d_Q2B_m is that of the root body's origin (--mount-pos X,Y,Z sets the tail base)");
-  else if (q.d_Q2B_m < 0.0)
-    r.notes.push_back("the tail base is in front of the COM (d_Q2B_m < 0): check the mount (pos_m, yaw_deg)");
-
-  // Friction: the contacts' own (MuJoCo mixes the foot's and the floor's: priority, else the larger).
-  int nmu = 0;
-  for (int i = 0; i < d->ncon; ++i) {
-    const mjContact& ct = d->contact[i];
-    if (std::find(feet.begin(), feet.end(), ct.geom1) != feet.end() || std::find(feet.begin(), feet.end(), ct.geom2) != feet.end()) {
-      mu_sum += ct.friction[0];
-      ++nmu;
-    }
-  }
-  std::string muSource;
-  if (spec.mu >= 0.0) {
-    r.mu = spec.mu;
-    r.mu_given = true;
-    muSource = "given (overrides the foot contacts)";
-  } else if (nmu > 0) {
-    r.mu = mu_sum / nmu;
-    muSource = "MuJoCo's foot-floor contacts (friction[0], " + std::to_string(nmu) + " contacts)";
-  } else {
-    r.mu = 0.0;
-    for (int g : feet) r.mu += m->geom_friction[3 * g] / feet.size();
-    muSource = "the foot geoms' friction (no contact after standing)";
-  }
-
-  const std::string stood = " (stance after standing " + g6(spec.settle_s) + " s)";
-  const std::string frame = "planar frame: body '" + r.mount_body + "' x" +
-                            (spec.mount.yaw_rad != 0.0 ? " turned by " + g6(spec.mount.yaw_rad * 180 / kPi) + " deg" : "");
-  r.values = {
-      {"quadruped.mass_kg", q.mass_kg, "kg", "sum of the model's body masses (MuJoCo body_subtreemass of '" + r.root_body + "': " + g6(r.mujoco_subtreemass_kg) + ")"},
-      {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2", "composite I_zz about the COM, legs held" + stood + "; MuJoCo cinert sum " + g6(r.mujoco_cinert_izz_kgm2)},
-      {"quadruped.d_Q2C_m", q.d_Q2C_m, "m", "x of the foot centroid from the COM, " + frame},
-      {"quadruped.d_Q2B_m", q.d_Q2B_m, "m", "tail base (body '" + r.mount_body + "' + pos_m) behind the COM, " + frame},
-      {"quadruped.l_F_m", q.l_F_m, "m", "front feet x - rear feet x (means of each pair)"},
-      {"quadruped.w_F_m", q.w_F_m, "m", "left feet y - right feet y (means of each pair)"},
-      {"quadruped.com_height_m", q.com_height_m, "m", "COM above the feet's lowest points" + stood},
-      {"friction.mu_s = mu_d", r.mu, "-", muSource},
-      {"gravity_mps2", r.gravity_mps2, "m/s^2", "the model's option gravity"},
-  };
+  stand(m, d, spec, stance, hold, root, floor, file, r);
+  const std::vector<int> feet = findFeet(m, d, spec, floor, file, r);
+  const MassCentre mc = massProperties(m, d, root, r);
+  const double asym = planarGeometry(m, d, spec, root, feet, mc, file, r);
+  listValues(spec, footFriction(m, d, spec, feet, r), r);
   if (std::abs(r.lateral_com_to_feet_m) > 1e-3)
     r.notes.push_back("the foot centroid is " + g6(1e3 * r.lateral_com_to_feet_m) +
                       " mm to the side of the COM; the planar models take 0");
   if (std::abs(r.lateral_mount_m) > 1e-3)
     r.notes.push_back("the tail base is " + g6(1e3 * r.lateral_mount_m) + " mm to the side of the COM; the planar models take 0");
-  const double asym = std::abs((FL[0] - RL[0]) - (FR[0] - RR[0]));
   if (asym > 1e-3) r.notes.push_back("left and right foot spacings differ by " + g6(1e3 * asym) + " mm; l_F_m is their mean");
   r.notes.push_back("tilt after standing: " + g6(r.tilt_deg) + " deg");
   if (!messages.text().empty()) r.notes.push_back(messages.text());
-  for (int j = 0; j < m->njnt; ++j) {
-    const int n = m->jnt_type[j] == mjJNT_FREE ? 7 : m->jnt_type[j] == mjJNT_BALL ? 4 : 1;
-    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
-    if (!name) continue;
-    r.settled_qpos[name].assign(d->qpos + m->jnt_qposadr[j], d->qpos + m->jnt_qposadr[j] + n);
-    if (m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) {
-      r.hold_target_rad[name] = stance.qpos[m->jnt_qposadr[j]];
-      if (!heldByActuator[j]) r.pd_joints.push_back(name);
-    }
-  }
+  settledJoints(m, d, stance, hold, r);
   return r;
 }
 
