@@ -86,6 +86,8 @@ class Model {
   const Effects& effects() const { return e_; }
   // loadTransferNewton calls are counted into *counter (it outlives the Model: a failed run reports it too).
   void countNewtonSolvesInto(long* counter) const { newton_counter_ = counter; }
+  // loadFactor calls (the held wrench's load factor, most of a held run's cost) are counted into *counter.
+  void countLoadFactorsInto(long* counter) const { load_factor_counter_ = counter; }
   // Whether the load transfer's support margin must be scanned (see the constructor), and the
   // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
   bool scansSupport() const { return scan_support_; }
@@ -140,6 +142,7 @@ class Model {
       const double Fn = req.F.norm();
       normalLoads(ev, t, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
       for (int i = 0; i < 4; ++i) ev.discs.c[i] = mu_break_ * ev.N[i];
+      if (load_factor_counter_) ++*load_factor_counter_;
       ev.load_factor = loadFactor(ev.discs, req).s;
       ev.Ff = heldFootForces(ev.discs, req);
       ev.friction = req;
@@ -367,6 +370,7 @@ class Model {
   mutable LoadScratch scratch_;
   mutable TailKinematics kin_;
   mutable long* newton_counter_ = nullptr;  // loadTransferNewton calls (summary extra), or null
+  mutable long* load_factor_counter_ = nullptr;  // loadFactor calls (summary extra), or null
 };
 
 // Event margin: > 0 no switch. Stuck: 1 - s (the discs hold the required wrench while s < 1).
@@ -584,7 +588,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   plan.h_scan = shortest / 32.0;
   plan.h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
 
-  long newton_solves = 0;
+  long newton_solves = 0, load_factors = 0;
   try {
     // Every evaluation with friction takes the paper's arm L_F at the system COM, which fails outside
     // the support rectangle: checked along the whole trajectory first (support_check.h). The load
@@ -595,6 +599,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads, t_end);
     model.countNewtonSolvesInto(&newton_solves);
+    model.countLoadFactorsInto(&load_factors);
     PerFootStickSlip ss(model, robot, settings, robot.numLinks());
     PlanarRun<PerFootStickSlip> run(ss, plan, trajectory.breakpoints(), output.sample_dt_s,
                                     output.time_series == TimeSeriesOutput::kThin);
@@ -633,6 +638,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   }
   if (settings.normal_loads == NormalLoadModel::kLoadTransfer)
     sum.extra["load_transfer_newton_solves"] = static_cast<double>(newton_solves);
+  sum.extra["load_factor_evaluations"] = static_cast<double>(load_factors);
   sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
 }
