@@ -1,5 +1,6 @@
 // The per-foot model as a search objective: runs per second, and loadFactor calls per run
-// (extra.load_factor_evaluations, a deterministic work count), each run as `tailsim optimize` runs a
+// (extra.load_factor_evaluations, a deterministic work count) and of them those that ran the
+// start scan (extra.load_factor_start_scans; the others are warm-started), each run as `tailsim optimize` runs a
 // search point (evaluateStroke: two rows, t = 0 and the end, no M_z,T decomposition), on two sets:
 //  * RandomRobots: 50 seeded random robots and strokes (tests/random_robots.h, seed 35, cases 0..49);
 //  * DesignBox: 50 seeded random points (mt19937 seed 35) of the split-cycle box of the 12 kg robot's
@@ -96,18 +97,20 @@ double extra(const RunResult& r, const char* key) {
 }
 
 void runAll(benchmark::State& state, const std::vector<Case>& cs) {
-  double load_factors = 0, runs = 0;
+  double load_factors = 0, start_scans = 0, runs = 0;
   for (auto _ : state) {
-    load_factors = 0;
+    load_factors = start_scans = 0;
     for (const Case& c : cs) {
       const RunResult r = runCase(c);
       benchmark::DoNotOptimize(r.summary.phi_net_deg);
       load_factors += extra(r, "load_factor_evaluations");
+      start_scans += extra(r, "load_factor_start_scans");
     }
     runs += cs.size();
   }
   state.counters["runs_per_s"] = benchmark::Counter(runs, benchmark::Counter::kIsRate);
   state.counters["loadFactor_per_run"] = load_factors / cs.size();
+  state.counters["start_scans_per_run"] = start_scans / cs.size();
 }
 void BM_PerFootRandomRobots(benchmark::State& state) { runAll(state, randomRobots()); }
 void BM_PerFootDesignBox(benchmark::State& state) { runAll(state, designBox()); }
@@ -120,13 +123,14 @@ int writePhi(const char* path) {
     std::perror(path);
     return 2;
   }
-  std::fprintf(f, "set,case,ok,phi_net_deg,load_factor_evaluations,solver_steps,description\n");
+  std::fprintf(f, "set,case,ok,phi_net_deg,load_factor_evaluations,load_factor_start_scans,solver_steps,description\n");
   for (const auto& [name, cs] : {std::make_pair("random_robots", randomRobots()), std::make_pair("design_box", designBox())}) {
     int k = 0;
     for (const Case& c : cs) {
       const RunResult r = runCase(c);
-      std::fprintf(f, "%s,%d,%d,%.17g,%.0f,%ld,\"%s\"\n", name, k++, r.summary.ok ? 1 : 0, r.summary.phi_net_deg,
-                   extra(r, "load_factor_evaluations"), r.summary.solver_steps, c.description.c_str());
+      std::fprintf(f, "%s,%d,%d,%.17g,%.0f,%.0f,%ld,\"%s\"\n", name, k++, r.summary.ok ? 1 : 0,
+                   r.summary.phi_net_deg, extra(r, "load_factor_evaluations"), extra(r, "load_factor_start_scans"),
+                   r.summary.solver_steps, c.description.c_str());
     }
   }
   return std::fclose(f) == 0 ? 0 : 2;
