@@ -467,3 +467,53 @@ TEST(PerFootModel, MaxLoadFactorWhileHeldIsAtMostOne) {
   }
   EXPECT_GT(checked, 100);
 }
+
+// A warm start (the result for a nearby wrench) finds the start scan's load factor: along slowly
+// turning random wrenches on random discs, each warm-started from the last, s agrees to round-off
+// and the breakaway twist's sense and centre agree.
+TEST(PerFootLimitSurface, WarmStartFindsTheScannedMaximum) {
+  std::mt19937 rng(35);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int rotations = 0;
+  for (int n = 0; n < 200; ++n) {
+    const Vec2 p_QC(-0.0155 + 0.12 * u(rng), 0.1 * u(rng));
+    const FootDiscs d = paperDiscs(p_QC, 0.3 + 0.2 * u(rng), 100.0);
+    const Vec2 F0(20 * u(rng), 20 * u(rng)), dF(2 * u(rng), 2 * u(rng));
+    const double M0 = 5 * u(rng), dM = 0.5 * u(rng);
+    LoadFactor last = loadFactor(d, {F0, M0});
+    for (int k = 1; k <= 20; ++k) {
+      const Wrench2 w{F0 + 0.05 * k * dF, M0 + 0.05 * k * dM};
+      const LoadFactor cold = loadFactor(d, w);
+      const LoadFactor warm = loadFactor(d, w, &last);
+      ASSERT_NEAR(warm.s, cold.s, 1e-12 * cold.s) << n << " " << k;
+      if (cold.sigma != 0.0 && cold.pivot_foot < 0 && cold.s > (w.F.norm() / (d.c[0] + d.c[1] + d.c[2] + d.c[3])) * 1.001) {
+        ++rotations;
+        EXPECT_EQ(warm.sigma, cold.sigma) << n << " " << k;
+        EXPECT_LT((warm.centre - cold.centre).norm(), 1e-5) << n << " " << k;
+      }
+      last = warm;
+    }
+  }
+  EXPECT_GT(rotations, 1000);
+}
+
+// Work count: a held stroke's stick/slip scan warm-starts the load factor instead of scanning
+// candidate centres at every sample; the start scan runs only at the first sample and where a
+// margin is near 0. Its answer is the start scan's: phi_net 0, and the same largest load factor.
+TEST(PerFootModel, HeldScanWarmStartsTheLoadFactor) {
+  RobotParams r = paperRobot(2);
+  r.friction.mu_s = r.friction.mu_d = 5.0;  // holds throughout
+  const TailTrajectory tr = sameMove(2, 10, -40, 0.3, 0.3);
+  OutputSettings out;  // two rows, t = 0 and the end, as a search runs it
+  out.sample_dt_s = tr.endTime() + out.settle_s;
+  const RunResult run = simulatePerFoot(r, tr, {}, {}, out);
+  ASSERT_TRUE(run.summary.ok) << run.summary.error;
+  ASSERT_EQ(run.summary.stick_slip_events, 0);
+  EXPECT_EQ(run.summary.phi_net_deg, 0.0);
+  const double evaluations = run.summary.extra.at("load_factor_evaluations");
+  const double scans = run.summary.extra.at("load_factor_start_scans");
+  EXPECT_GT(evaluations, 100);
+  // The first sample, the two rows (not warm) and the few samples held by a pure translation run
+  // the start scan; the other samples are warm-started (before: every one scanned).
+  EXPECT_LT(scans, 0.1 * evaluations) << evaluations << " load factors";
+}

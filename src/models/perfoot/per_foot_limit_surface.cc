@@ -136,7 +136,7 @@ bool minimizePhi(const FootDiscs& d, const Wrench2& W, double sigma, double s, d
 
 }  // namespace
 
-LoadFactor loadFactor(const FootDiscs& d, const Wrench2& W) {
+LoadFactor loadFactor(const FootDiscs& d, const Wrench2& W, const LoadFactor* warm) {
   // The start rings' directions (cos, sin)(a pi / 12), the same libm values computed once: these
   // 288 sincos calls a call were 12 % of a per-foot run.
   static const std::array<Vec2, 24> kRing = [] {
@@ -158,24 +158,36 @@ LoadFactor loadFactor(const FootDiscs& d, const Wrench2& W) {
     return best;
   }
   best.s = Fn / C;
-  for (double sigma : {1.0, -1.0}) {
+  // A warm start (a rotation's centre from a nearby wrench) replaces the start scan: that sense
+  // of rotation first, from its centre; the other from the reference point, at the first's value.
+  const bool warm_start = warm && warm->sigma != 0.0 && std::isfinite(warm->s) && warm->centre.allFinite();
+  const double first = warm_start ? warm->sigma : 1.0;
+  best.start_scan = !warm_start;
+  for (double sigma : {first, -first}) {
     auto L = [&](const Vec2& p) { return sigma * (W.M - cross2(p, W.F)); };
     auto R = [&](const Vec2& p) {
       const double D = weberSum(d, p);
       return D > 0 ? L(p) / D : (L(p) > 0 ? std::numeric_limits<double>::infinity() : 0.0);
     };
-    // Start: the best of the reference point, the feet, and instantaneous centres on rings out to
-    // 16 foot spans (a far centre is nearly the translation).
     Vec2 p = Vec2::Zero();
     double s = R(p);
-    for (int j = 0; j < 4; ++j)
-      if (R(d.r[j]) > s) { s = R(d.r[j]); p = d.r[j]; }
-    for (double rad : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0})
-      for (int a = 0; a < 24; ++a) {
-        const Vec2 q = rad * scale * kRing[a];
-        if (R(q) > s) { s = R(q); p = q; }
+    if (warm_start) {
+      if (sigma == first) {
+        p = warm->centre;
+        s = R(p);
       }
-    if (!std::isfinite(s)) return {s, rotationAbout(p, sigma), -1};
+    } else {
+      // Start: the best of the reference point, the feet, and instantaneous centres on rings out
+      // to 16 foot spans (a far centre is nearly the translation).
+      for (int j = 0; j < 4; ++j)
+        if (R(d.r[j]) > s) { s = R(d.r[j]); p = d.r[j]; }
+      for (double rad : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0})
+        for (int a = 0; a < 24; ++a) {
+          const Vec2 q = rad * scale * kRing[a];
+          if (R(q) > s) { s = R(q); p = q; }
+        }
+    }
+    if (!std::isfinite(s)) return {s, rotationAbout(p, sigma), -1, p, sigma, !warm_start};
     if (!(s > 0.0) && !(best.s > 0.0)) continue;
     // Phi must grow at infinity (s C > |F|) for its minimum to be finite: start just above the
     // translation's value when that is the best so far (an optimum closer to it than 1e-12 is
@@ -206,6 +218,8 @@ LoadFactor loadFactor(const FootDiscs& d, const Wrench2& W) {
       best.s = s;
       best.direction = rotationAbout(p_best, sigma);
       best.pivot_foot = pivot_best;
+      best.centre = p_best;
+      best.sigma = sigma;
     }
   }
   // Unit twist: |v|^2 + (w scale)^2 = 1.

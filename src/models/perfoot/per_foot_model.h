@@ -129,13 +129,20 @@ Wrench2 maxDissipationWrench(const FootDiscs& d, const Twist2& xi);
 // iff s <= 1, and it breaks away along `direction` (unit twist, the maximizer: the slip that
 // Coulomb's law at every foot and maximum dissipation give). Exact up to round-off: the maximum is
 // at a pure translation, at a rotation about one foot (checked by its subgradient), or at a smooth
-// instantaneous centre found by Dinkelbach's method with Newton steps.
+// instantaneous centre found by Dinkelbach's method with Newton steps, from the best of a scan of
+// candidate centres, or (`warm`: the result for a nearby wrench, e.g. the previous time sample)
+// from that result's centre. The maximum does not depend on the start: R is quasi-concave where
+// it is positive (its superlevel sets are convex), and each Dinkelbach round minimizes a convex
+// function globally, so every start reaches the same maximum, up to round-off (about 1e-15 of s).
 struct LoadFactor {
   double s = 0.0;
   Twist2 direction;
   int pivot_foot = -1;  // 0..3: the breakaway twist turns about that foot; -1: it does not
+  Vec2 centre = Vec2::Zero();  // the breakaway twist's instantaneous centre (when sigma != 0)
+  double sigma = 0.0;          // its sense of rotation, +1 or -1; 0: a pure translation
+  bool start_scan = false;     // this call scanned the candidate centres (it was not warm-started)
 };
-LoadFactor loadFactor(const FootDiscs& d, const Wrench2& W);
+LoadFactor loadFactor(const FootDiscs& d, const Wrench2& W, const LoadFactor* warm = nullptr);
 
 // Per-foot forces of a held (stuck) wrench: statically indeterminate, written as the distribution
 // sum |F_i|^2 / c_i minimal (F_i = c_i (a + b z x r_i): a rigid viscous twist, the limit of the

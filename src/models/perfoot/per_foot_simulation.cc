@@ -86,6 +86,13 @@ class Model {
   const Effects& effects() const { return e_; }
   // loadTransferNewton calls are counted into *counter (it outlives the Model: a failed run reports it too).
   void countNewtonSolvesInto(long* counter) const { newton_counter_ = counter; }
+  // loadFactor calls (the held wrench's load factor, most of a held run's cost) are counted into *counter.
+  // Of them, those that ran loadFactor's start scan (heldLoadFactor: not warm-started, or near
+  // breakaway) into *start_scans.
+  void countLoadFactorsInto(long* counter, long* start_scans) const {
+    load_factor_counter_ = counter;
+    start_scan_counter_ = start_scans;
+  }
   // Whether the load transfer's support margin must be scanned (see the constructor), and the
   // largest shift of the centre of pressure (h max(mu_s, mu_d))  [m].
   bool scansSupport() const { return scan_support_; }
@@ -93,8 +100,9 @@ class Model {
   void joints(double t, std::vector<JointState>& js) const { traj_.evaluate(t, js); }
 
   // stuck: the body is held (twist zero); the friction is the wrench that holds it and
-  // load_factor says whether the discs can supply it. Otherwise per-foot sliding friction.
-  Eval evaluate(double t, const State& y, bool stuck, bool decompose = false) const {
+  // load_factor says whether the discs can supply it (warm: warm-started, heldLoadFactor; else
+  // from loadFactor's start scan). Otherwise per-foot sliding friction.
+  Eval evaluate(double t, const State& y, bool stuck, bool decompose = false, bool warm = false) const {
     Eval ev;
     std::vector<JointState>& js = js_;
     traj_.evaluate(t, js);
@@ -140,7 +148,7 @@ class Model {
       const double Fn = req.F.norm();
       normalLoads(ev, t, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
       for (int i = 0; i < 4; ++i) ev.discs.c[i] = mu_break_ * ev.N[i];
-      ev.load_factor = loadFactor(ev.discs, req).s;
+      ev.load_factor = heldLoadFactor(ev.discs, req, warm);
       ev.Ff = heldFootForces(ev.discs, req);
       ev.friction = req;
       return ev;
@@ -326,6 +334,22 @@ class Model {
     throw std::runtime_error(os.str());
   }
 
+  // The held wrench's load factor. warm (the stick/slip scan's margins): warm-started from the
+  // last one computed (the wrench changes continuously between the scan's samples); where that
+  // gives s >= kColdLoadFactor (a margin 1 - s within 0.1 of 0, where the switches are decided) it
+  // is computed again from the start scan, so those margins are the start scan's to the last bit,
+  // and the warm ones further from 0 equal them to round-off (loadFactor, per_foot_model.h).
+  // Not warm (rows, perFootHeldLoadFactor): the start scan alone.
+  double heldLoadFactor(const FootDiscs& discs, const Wrench2& req, bool warm) const {
+    constexpr double kColdLoadFactor = 0.9;
+    if (load_factor_counter_) ++*load_factor_counter_;
+    LoadFactor lf = loadFactor(discs, req, warm ? &last_load_factor_ : nullptr);
+    if (!lf.start_scan && lf.s >= kColdLoadFactor) lf = loadFactor(discs, req);
+    if (lf.start_scan && start_scan_counter_) ++*start_scan_counter_;
+    last_load_factor_ = lf;
+    return lf.s;
+  }
+
   // The planar multibody with the base moving (paper-notes point 3, as analytic.coupling: exact):
   // A z = r0 + E f with z = (a_Qx, a_Qy, phi_ddot), angular momentum about the quadruped COM.
   void exactCoupling(const std::vector<JointState>& js, double phi, double w, Eval& ev, Eigen::Matrix3d& A,
@@ -367,15 +391,18 @@ class Model {
   mutable LoadScratch scratch_;
   mutable TailKinematics kin_;
   mutable long* newton_counter_ = nullptr;  // loadTransferNewton calls (summary extra), or null
+  mutable long* load_factor_counter_ = nullptr;  // loadFactor calls (summary extra), or null
+  mutable long* start_scan_counter_ = nullptr;  // of them, those from the start scan (not warm)
+  mutable LoadFactor last_load_factor_;   // heldLoadFactor's warm start (sigma 0: none yet)
 };
 
 // Event margin: > 0 no switch. Stuck: 1 - s (the discs hold the required wrench while s < 1).
 // Sliding: max(fastest foot - v_stop, s_probe - 1), s_probe of the wrench that would hold it now.
 double margin(const Model& model, double t, const State& y, bool stuck, double v_stop) {
-  if (stuck) return 1.0 - model.evaluate(t, y, true).load_factor;
+  if (stuck) return 1.0 - model.evaluate(t, y, true, false, true).load_factor;
   const double fast = model.maxFootSpeed(y) - v_stop;
   if (fast > 0) return fast;
-  return std::max(fast, model.evaluate(t, y, true).load_factor - 1.0);
+  return std::max(fast, model.evaluate(t, y, true, false, true).load_factor - 1.0);
 }
 
 // First switch in [ta, tb], or +inf: the analytic model's scan (stick_slip.h findSwitch) on this
@@ -401,14 +428,14 @@ Margins scanMargins(const Model& model, double t, const State& y, bool stuck, do
   const bool sup = model.scansSupport();
   auto capped = [&](const Eval& ev) { return sup ? std::min(ev.support, model.shiftMax()) : 1.0; };
   if (stuck) {
-    const Eval ev = model.evaluate(t, y, true);
+    const Eval ev = model.evaluate(t, y, true, false, true);
     return {1.0 - ev.load_factor, capped(ev)};
   }
   const double g_sup = sup ? capped(model.evaluate(t, y, false)) : 1.0;
   if (!model.stiction()) return {1.0, g_sup};  // the continuous law: no switches
   const double fast = model.maxFootSpeed(y) - v_stop;
   if (fast > 0) return {fast, g_sup};
-  return {std::max(fast, model.evaluate(t, y, true).load_factor - 1.0), g_sup};
+  return {std::max(fast, model.evaluate(t, y, true, false, true).load_factor - 1.0), g_sup};
 }
 
 // The centre of pressure left the support at t (a located exit): the TippingError, with the time.
@@ -584,7 +611,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   plan.h_scan = shortest / 32.0;
   plan.h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
 
-  long newton_solves = 0;
+  long newton_solves = 0, load_factors = 0, start_scans = 0;
   try {
     // Every evaluation with friction takes the paper's arm L_F at the system COM, which fails outside
     // the support rectangle: checked along the whole trajectory first (support_check.h). The load
@@ -595,6 +622,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
       requireSupport(robot, trajectory, t_end);
     const Model model(robot, trajectory, settings, effects, loads, t_end);
     model.countNewtonSolvesInto(&newton_solves);
+    model.countLoadFactorsInto(&load_factors, &start_scans);
     PerFootStickSlip ss(model, robot, settings, robot.numLinks());
     PlanarRun<PerFootStickSlip> run(ss, plan, trajectory.breakpoints(), output.sample_dt_s,
                                     output.time_series == TimeSeriesOutput::kThin);
@@ -633,6 +661,8 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   }
   if (settings.normal_loads == NormalLoadModel::kLoadTransfer)
     sum.extra["load_transfer_newton_solves"] = static_cast<double>(newton_solves);
+  sum.extra["load_factor_evaluations"] = static_cast<double>(load_factors);
+  sum.extra["load_factor_start_scans"] = static_cast<double>(start_scans);
   sum.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
 }
