@@ -86,9 +86,9 @@ class Model {
   const Effects& effects() const { return e_; }
   // loadTransferNewton calls are counted into *counter (it outlives the Model: a failed run reports it too).
   void countNewtonSolvesInto(long* counter) const { newton_counter_ = counter; }
-  // loadFactor calls (the held wrench's load factor, most of a held run's cost) are counted into *counter.
-  // Of them, those that ran loadFactor's start scan (heldLoadFactor: not warm-started, or near
-  // breakaway) into *start_scans.
+  // The stick/slip scan's loadFactor calls (the held wrench's load factor, most of a held run's
+  // cost) are counted into *counter; of them, those that ran loadFactor's start scan (near
+  // breakaway, or no warm start yet) into *start_scans. Rows' calls are not counted (heldLoadFactor).
   void countLoadFactorsInto(long* counter, long* start_scans) const {
     load_factor_counter_ = counter;
     start_scan_counter_ = start_scans;
@@ -339,11 +339,14 @@ class Model {
   // gives s >= kColdLoadFactor (a margin 1 - s within 0.1 of 0, where the switches are decided) it
   // is computed again from the start scan, so those margins are the start scan's to the last bit,
   // and the warm ones further from 0 equal them to round-off (loadFactor, per_foot_model.h).
-  // Not warm (rows, perFootHeldLoadFactor): the start scan alone.
+  // Not warm (rows, one-off evaluations, perFootHeldLoadFactor): the start scan alone, neither
+  // counted nor kept as the warm start, so what a run computes and counts does not depend on
+  // which rows its output asks for.
   double heldLoadFactor(const FootDiscs& discs, const Wrench2& req, bool warm) const {
     constexpr double kColdLoadFactor = 0.9;
+    if (!warm) return loadFactor(discs, req).s;
     if (load_factor_counter_) ++*load_factor_counter_;
-    LoadFactor lf = loadFactor(discs, req, warm ? &last_load_factor_ : nullptr);
+    LoadFactor lf = loadFactor(discs, req, &last_load_factor_);
     if (!lf.start_scan && lf.s >= kColdLoadFactor) lf = loadFactor(discs, req);
     if (lf.start_scan && start_scan_counter_) ++*start_scan_counter_;
     last_load_factor_ = lf;
