@@ -31,6 +31,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "models/planar/planar_recorder.h"
@@ -230,7 +231,9 @@ void adaptiveSegment(PlanarRun<Model>& run, double seg_end) {
     const double t_now = stepper.current_time(), dt_now = stepper.current_time_step();
     if (t_now + dt_now > seg_end && seg_end - t_now > 1e-12)
       stepper.initialize(stepper.current_state(), t_now, seg_end - t_now);
-    const auto [ta, tb_raw] = stepper.do_step(rhs);
+    // (two names, not a structured binding: C++17 lambdas cannot capture those; clang refuses)
+    const std::pair<double, double> step = stepper.do_step(rhs);
+    const double ta = step.first, tb_raw = step.second;
     countStep(run, false);
     const double tb = std::min(tb_raw, seg_end);
     auto& carry = run.carry;
