@@ -3,7 +3,13 @@
 // ships none; a test that needs them skips when the folder is absent.
 #pragma once
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
 
 namespace tailsim_test {
 
@@ -18,5 +24,23 @@ inline std::filesystem::path menagerieDir() {
   }
   return {};
 }
+
+// A scratch folder under the test temp dir, named PREFIX_<pid>, removed when the test ends.
+struct Scratch {
+  std::filesystem::path dir;
+  explicit Scratch(const std::string& prefix)
+      : dir(std::filesystem::path(::testing::TempDir()) / (prefix + "_" + std::to_string(::getpid()))) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  ~Scratch() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(dir / name) << text;
+    return (dir / name).string();
+  }
+};
 
 }  // namespace tailsim_test

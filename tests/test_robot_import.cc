@@ -150,21 +150,7 @@ TEST(RobotImport, AnymalWithATailStandsTurnsAndAllModelsRun) {
   expectFourModelsRun(s);
 }
 
-struct Scratch {
-  fs::path dir;
-  Scratch() : dir(fs::path(::testing::TempDir()) / ("robot_import_" + std::to_string(::getpid()))) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(dir / name) << text;
-    return (dir / name).string();
-  }
-};
+using tailsim_test::Scratch;
 
 const char* kBoxRobot = R"(<mujoco model="box">
   <default><default class="vis"><geom contype="0" conaffinity="0" group="2"/></default></default>
@@ -192,7 +178,7 @@ std::string boxRobot(const std::string& leg) {
 }
 
 TEST(RobotImport, MissingMeshDroppedWhenItCannotCollideElseAnError) {
-  Scratch t;
+  Scratch t("robot_import");
   RobotModelSpec s;
   s.file = t.write("ok.xml", boxRobot(""));
   s.joint_angles_rad = {};
@@ -219,7 +205,7 @@ TEST(RobotImport, MissingMeshDroppedWhenItCannotCollideElseAnError) {
 }
 
 TEST(RobotImport, FeetAndPlanarNumbersOfARigidBox) {
-  Scratch t;
+  Scratch t("robot_import");
   std::string xml = boxRobot("");
   xml.replace(xml.find("</worldbody>"), 12,
               "</worldbody>\n<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
@@ -244,7 +230,7 @@ TEST(RobotImport, FeetAndPlanarNumbersOfARigidBox) {
 
 // `tailsim robot FILE.yaml`: a robot given by its size prints the values derived from its box.
 TEST(RobotImport, YamlRobotPrintsItsValues) {
-  Scratch t;
+  Scratch t("robot_import");
   const std::string f = t.write("box.yaml",
                                 "quadruped: {mass_kg: 12, size_m: [0.5, 0.3, 0.2], foot_inset_m: 0.03}\n"
                                 "friction: {mu_s: 0.5, mu_d: 0.4}\ngravity_mps2: 9.81\n"
@@ -261,7 +247,7 @@ TEST(RobotImport, YamlRobotPrintsItsValues) {
 // --write-robot: the derived values as a tailsim robot file, read back exactly by the loader (so
 // an experiment on it runs the planar models on them and records them in each result.json).
 TEST(RobotImport, DerivedRobotFileLoadsBackExactly) {
-  Scratch t;
+  Scratch t("robot_import");
   std::string xml = boxRobot("");
   xml.replace(xml.find("</worldbody>"), 12,
               "</worldbody>\n<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
@@ -296,7 +282,7 @@ TEST(RobotImport, DerivedRobotFileLoadsBackExactly) {
 // must give the same phi_net: the heading is measured from where the robot stood.
 TEST(RobotImport, AnymalWithLockedLegsTurnsLikeTheRigidBoxWhicheverWayItFaces) {
   REQUIRE_MENAGERIE(dir);
-  Scratch t;
+  Scratch t("robot_import");
   RobotModelSpec s = anymalSpec(dir);
   std::string xml;
   {
@@ -343,7 +329,7 @@ TEST(RobotImport, AnymalWithLockedLegsTurnsLikeTheRigidBoxWhicheverWayItFaces) {
 // tailsim keeps it a body (fusestatic off) and gives it the free joint. A 10 kg box base and four
 // 0.5 kg legs, two on revolute joints (held by tailsim's PD), two on fixed joints (their own bodies).
 TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
-  Scratch t;
+  Scratch t("robot_import");
   std::string legs;
   const struct {
     const char* name;
@@ -393,7 +379,7 @@ TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
 // rigid box robot whose front feet are 40 mm shorter stands pitched by atan(0.04 / 0.4) = 5.7 deg
 // with or without a tail; holding the tail must not tilt it further, and no tilt warning is given.
 TEST(RobotImport, TiltWithTheTailIsMeasuredFromTheStance) {
-  Scratch t;
+  Scratch t("robot_import");
   std::string xml = boxRobot("");
   for (const char* front : {"pos=\"0.2 0.12 -0.28\"", "pos=\"0.2 -0.12 -0.28\""}) {
     std::string shorter = front;

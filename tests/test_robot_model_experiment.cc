@@ -29,21 +29,7 @@ namespace {
 
 using tailsim_test::menagerieDir;
 
-struct Scratch {
-  fs::path dir;
-  Scratch() : dir(fs::path(::testing::TempDir()) / ("robot_model_exp_" + std::to_string(::getpid()))) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(dir / name) << text;
-    return (dir / name).string();
-  }
-};
+using tailsim_test::Scratch;
 
 // A 10 kg box on four sphere feet; `key` its keyframe element ("" for none), `extra` more feet or geoms.
 std::string boxRobot(const std::string& key, const std::string& feet = "") {
@@ -96,7 +82,7 @@ void expectAt(const std::string& msg, const std::string& file, int line, const s
 
 // The loader reads the keys without MuJoCo: nothing is derived until resolveRobotModels.
 TEST(RobotModelExperiment, LoaderReadsTheKeysAndDerivesNothing) {
-  Scratch t;
+  Scratch t("robot_model_exp");
   t.write("box.xml", boxRobot(kHome));
   const std::string f = t.write(
       "e.yaml", experiment("{mjcf: box.xml, mu: 0.4, stance: {keyframe: home, joints_deg: {}}, feet: [f1, f2, f3, f4]}"));
@@ -138,7 +124,7 @@ TEST(RobotModelExperiment, LoaderReadsTheKeysAndDerivesNothing) {
 
 // Each error: a ConfigError naming the experiment file, the line and the key, before any case runs.
 TEST(RobotModelExperiment, ErrorsNameFileLineAndKey) {
-  Scratch t;
+  Scratch t("robot_model_exp");
   t.write("box.xml", boxRobot(kHome));
   t.write("nokey.xml", boxRobot(""));
   t.write("three.xml", boxRobot(kHome, R"(
@@ -218,7 +204,7 @@ TEST(RobotModelExperiment, ErrorsNameFileLineAndKey) {
 TEST(RobotModelExperiment, Go1ExperimentRunsTheThreeModelsArticulated) {
   const fs::path men = menagerieDir();
   if (men.empty()) GTEST_SKIP() << "no shared/robots/menagerie beside the source tree or its parents";
-  Scratch t;
+  Scratch t("robot_model_exp");
   const fs::path go1 = men / "go1" / "go1.xml";
   const std::string rel = fs::relative(go1, t.dir).string();
   const std::string f = t.write(
@@ -281,7 +267,7 @@ TEST(RobotModelExperiment, Go1ExperimentRunsTheThreeModelsArticulated) {
 TEST(RobotModelExperiment, StandingTiltWithTheTailOnServosAndLockedLegs) {
   const fs::path men = menagerieDir();
   if (men.empty()) GTEST_SKIP() << "no shared/robots/menagerie beside the source tree or its parents";
-  Scratch t;
+  Scratch t("robot_model_exp");
   const std::string go1 = "{mjcf: " + (men / "go1" / "go1.xml").string() + ", legs: {sweep: [servos, locked]}}";
   const std::string anymal = "{mjcf: " + (men / "anymal_c" / "anymal_c.xml").string() +
                              ", legs: {sweep: [servos, locked]}, stance: {joints_deg: {LF_HFE: 23, LF_KFE: -46, "
@@ -325,7 +311,7 @@ TEST(RobotModelExperiment, StandingTiltWithTheTailOnServosAndLockedLegs) {
 TEST(RobotModelExperiment, ArticulatedRunCarriesItsOwnUncertainty) {
   const fs::path men = menagerieDir();
   if (men.empty()) GTEST_SKIP() << "no shared/robots/menagerie beside the source tree or its parents";
-  Scratch t;
+  Scratch t("robot_model_exp");
   for (const bool on : {true, false}) {
     const std::string f = t.write(
         "go1_u.yaml", "name: go1_u\nrobot: {mjcf: " + (men / "go1" / "go1.xml").string() +
