@@ -76,6 +76,10 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
   ModelRow art = rowOf(c.robot.legs_locked ? "mujoco (articulated, legs locked)" : "mujoco (articulated)",
                        articulated.summary);
   const ArticulatedRun& a = c.articulated;
+  if (a.trim.rounds > 0)
+    art.warnings.push_back("legs' set-points trimmed for the tail's weight in " + std::to_string(a.trim.rounds) +
+                           " rounds of " + f3(kTrimRoundS) + " s (moved up to " + f3(a.trim.max_offset_deg) +
+                           " deg; tilt from the stance after trimming " + f3(a.trim.end_tilt_deg) + " deg)");
   art.warnings.push_back("tilt (absolute / from the stance): stance " + f3(a.stance_tilt_deg) + " deg; after standing " +
                          f3(choice.stand_s) + " s with the tail " + f3(a.stand_end_tilt_deg) + " / " +
                          f3(a.stand_end_rel_tilt_deg) + " deg (at most " + f3(a.stand_max_tilt_deg) + " / " +

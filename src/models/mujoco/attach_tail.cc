@@ -152,141 +152,277 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
 
 namespace {
 
-// The articulated run at s.timestep_s (the model's own, or the check run's twice that): the tail's
-// servo gains from s, the model's option timestep replaced by s.timestep_s.
-ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
-                                const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
-                                double settle_after_s, double sample_dt_s) {
-  ArticulatedRun out;
-  MujocoMessages messages;
-  ModelPtr mp = loadModelFromXml(attachTail(r, mount, tail, s));
-  mjModel* m = mp.get();
+// The articulated model in its stance, with the indices every stage needs.
+struct ArticulatedSim {
+  ModelPtr model;
+  DataPtr data;
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  int n = 0;                              // tail links
+  int body = -1;                          // the root body
+  std::vector<int> qadr, vadr, act;       // the tail's joints and actuators
+  std::vector<int> pdq, pdv;              // joints held by tailsim's PD
+  std::vector<double> pdTarget;           // their set-points [rad]
+  std::vector<double> pdStance;           // their angles in the settled stance [rad]
+  std::vector<int> servoAct, servoQ;      // leg joints held by the model's position actuators
+  std::vector<double> servoStance;        // their angles in the settled stance [rad]
+  std::vector<double> servoHold, pdHold;  // the set-points the robot stood with (the stance's angles) [rad]
+  std::array<double, 3> stanceZ{};        // the root body's z axis in the settled stance
+};
+
+// Stage: the model with the tail at s.timestep_s, in the settled stance, legs held at their stance
+// angles, the tail at theta(0), friction from the user's mu.
+void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                      const TailTrajectory& trajectory, const MujocoSettings& s) {
+  a.model = loadModelFromXml(attachTail(r, mount, tail, s));
+  mjModel* m = a.m = a.model.get();
   m->opt.timestep = s.timestep_s;
-  DataPtr dp = makeData(m);
-  mjData* d = dp.get();
-  const int n = static_cast<int>(tail.size());
+  a.data = makeData(m);
+  mjData* d = a.d = a.data.get();
+  a.n = static_cast<int>(tail.size());
   for (const auto& [name, q] : r.settled_qpos) {
     const int j = jointId(m, name);
     for (std::size_t k = 0; k < q.size(); ++k) d->qpos[m->jnt_qposadr[j] + k] = q[k];
   }
-  for (int a = 0; a < m->nu; ++a) {
-    if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
-    const char* jn = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * a]);
+  for (int u = 0; u < m->nu; ++u) {
+    if (m->actuator_trntype[u] != mjTRN_JOINT) continue;
+    const char* jn = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * u]);
     const auto t = jn ? r.hold_target_rad.find(jn) : r.hold_target_rad.end();
-    if (t != r.hold_target_rad.end()) d->ctrl[a] = t->second;
+    if (t == r.hold_target_rad.end()) continue;
+    d->ctrl[u] = t->second;
+    a.servoAct.push_back(u);
+    a.servoQ.push_back(m->jnt_qposadr[m->actuator_trnid[2 * u]]);
+    a.servoStance.push_back(r.settled_qpos.at(jn).at(0));
+    a.servoHold.push_back(t->second);
   }
-  std::vector<int> qadr, vadr, act, pdq, pdv;
-  std::vector<double> pdTarget;
-  for (int i = 1; i <= n; ++i) {
+  for (int i = 1; i <= a.n; ++i) {
     const int j = jointId(m, mjcf::tailJointName(i));
-    qadr.push_back(m->jnt_qposadr[j]);
-    vadr.push_back(m->jnt_dofadr[j]);
-    act.push_back(actuatorId(m, mjcf::tailActuatorName(i)));
+    a.qadr.push_back(m->jnt_qposadr[j]);
+    a.vadr.push_back(m->jnt_dofadr[j]);
+    a.act.push_back(actuatorId(m, mjcf::tailActuatorName(i)));
   }
   for (const std::string& name : r.pd_joints) {
     const int j = jointId(m, name);
-    pdq.push_back(m->jnt_qposadr[j]);
-    pdv.push_back(m->jnt_dofadr[j]);
-    pdTarget.push_back(r.hold_target_rad.at(name));
+    a.pdq.push_back(m->jnt_qposadr[j]);
+    a.pdv.push_back(m->jnt_dofadr[j]);
+    a.pdTarget.push_back(r.hold_target_rad.at(name));
+    a.pdStance.push_back(r.settled_qpos.at(name).at(0));
+    a.pdHold.push_back(a.pdTarget.back());
   }
   std::vector<JointState> ref0;
   trajectory.evaluate(0.0, ref0);
-  for (int i = 0; i < n; ++i) d->qpos[qadr[i]] = ref0[i].theta;
-  TailController ctrl(m, trajectory, qadr, vadr, act, {s.velocity_feedforward, s.inverse_dynamics_feedforward});
+  for (int i = 0; i < a.n; ++i) d->qpos[a.qadr[i]] = ref0[i].theta;
   mj_forward(m, d);
-  const int body = bodyId(m, r.root_body);
-  const std::array<double, 3> stanceZ = bodyZ(d, body);
-  out.stance_tilt_deg = tiltDeg(d, body);
+  a.body = bodyId(m, r.root_body);
+  a.stanceZ = bodyZ(d, a.body);
   if (r.mu_given) {
     for (const auto& [bodyName, k] : r.foot_geoms) m->geom_friction[3 * (m->body_geomadr[bodyId(m, bodyName)] + k)] = r.mu;
     m->geom_friction[3 * geomId(m, r.model.floor_geom)] = r.mu;
   }
-  auto step = [&](double t_ref) {
-    mj_step1(m, d);
-    for (std::size_t k = 0; k < pdq.size(); ++k)
-      d->qfrc_applied[pdv[k]] = kStancePdKp * (pdTarget[k] - d->qpos[pdq[k]]) - kStancePdKv * d->qvel[pdv[k]];
-    ctrl.apply(m, d, t_ref, false);
-    mj_step2(m, d);
-    ++out.steps;
+}
+
+// One step: the legs' PD (for joints no actuator holds), the tail's controller at t_ref.
+void stepArticulated(ArticulatedSim& a, TailController& ctrl, double t_ref, long& steps) {
+  mj_step1(a.m, a.d);
+  for (std::size_t k = 0; k < a.pdq.size(); ++k)
+    a.d->qfrc_applied[a.pdv[k]] = kStancePdKp * (a.pdTarget[k] - a.d->qpos[a.pdq[k]]) - kStancePdKv * a.d->qvel[a.pdv[k]];
+  ctrl.apply(a.m, a.d, t_ref, false);
+  mj_step2(a.m, a.d);
+  ++steps;
+}
+
+// Stage: the legs' set-points trimmed for the tail's weight. A position servo holding a static load
+// tau sags by tau / kp. Each round stands kTrimRoundS, then moves every held joint's set-point (the
+// model's actuator's ctrl, or tailsim's PD target) by kTrimGain times that joint's remaining error
+// from its settled-stance angle. With the feet on the floor the legs form closed chains, so a full
+// step (gain 1) overshoots and diverges on ANYmal C; half a step converges on Go1 and ANYmal C.
+// The body's tilt from the stance decides: the rounds end when it is below kTrimTiltTolDeg, when a
+// round improved it by less than 10 %, or after kTrimRounds; a round that made it worse is undone
+// (state and set-points as before it; its steps still count as work). An actuator's ctrlrange
+// clamps its set-point. With legs locked by equality constraints there is nothing to trim. The
+// ctrl change is how a robot's own controller (gravity compensation, or an integrator) holds a pose
+// under a new load.
+StanceTrim trimStance(ArticulatedSim& a, TailController& ctrl, bool legs_locked, long& steps, std::string& error) {
+  StanceTrim t;
+  if (legs_locked || (a.servoAct.empty() && a.pdq.empty())) return t;
+  const long roundSteps = std::max(1L, std::lround(kTrimRoundS / a.m->opt.timestep));
+  auto jointError = [&] {
+    double e = 0.0;
+    for (std::size_t k = 0; k < a.servoQ.size(); ++k) e = std::max(e, std::abs(a.servoStance[k] - a.d->qpos[a.servoQ[k]]));
+    for (std::size_t k = 0; k < a.pdq.size(); ++k) e = std::max(e, std::abs(a.pdStance[k] - a.d->qpos[a.pdq[k]]));
+    return e;
   };
-  const double dt = m->opt.timestep;
-  const long standSteps = std::lround(stand_s / dt);
+  double prevTilt = 1e300;
+  DataPtr before = makeData(a.m);  // the state before the last change of the set-points
+  std::vector<double> prevPd = a.pdTarget;
+  while (t.rounds < kTrimRounds) {
+    for (long k = 0; k < roundSteps; ++k) {
+      stepArticulated(a, ctrl, 0.0, steps);
+      t.max_rel_tilt_deg = std::max(t.max_rel_tilt_deg, tiltFromDeg(a.d, a.body, a.stanceZ));
+      if (warningCount(a.d)) {
+        error = "MuJoCo warnings while trimming the legs' set-points for the tail: " + describeWarnings(a.d);
+        return t;
+      }
+    }
+    ++t.rounds;
+    t.trim_s += roundSteps * a.m->opt.timestep;
+    const double tilt = tiltFromDeg(a.d, a.body, a.stanceZ);
+    if (tilt > prevTilt) {  // the last change made it worse: the round is undone
+      mj_copyData(a.d, a.m, before.get());
+      a.pdTarget = prevPd;
+      t.trim_s -= roundSteps * a.m->opt.timestep;
+      break;
+    }
+    t.end_tilt_deg = tilt;
+    if (tilt < kTrimTiltTolDeg || tilt > 0.9 * prevTilt) break;
+    prevTilt = tilt;
+    mj_copyData(before.get(), a.m, a.d);
+    prevPd = a.pdTarget;
+    for (std::size_t k = 0; k < a.servoAct.size(); ++k) {
+      const int u = a.servoAct[k];
+      double c = a.d->ctrl[u] + kTrimGain * (a.servoStance[k] - a.d->qpos[a.servoQ[k]]);
+      if (a.m->actuator_ctrllimited[u]) c = std::clamp(c, a.m->actuator_ctrlrange[2 * u], a.m->actuator_ctrlrange[2 * u + 1]);
+      a.d->ctrl[u] = c;
+    }
+    for (std::size_t k = 0; k < a.pdq.size(); ++k) a.pdTarget[k] += kTrimGain * (a.pdStance[k] - a.d->qpos[a.pdq[k]]);
+  }
+  for (std::size_t k = 0; k < a.servoAct.size(); ++k)
+    t.max_offset_deg = std::max(t.max_offset_deg, units::degrees(std::abs(a.d->ctrl[a.servoAct[k]] - a.servoHold[k])));
+  for (std::size_t k = 0; k < a.pdq.size(); ++k)
+    t.max_offset_deg = std::max(t.max_offset_deg, units::degrees(std::abs(a.pdTarget[k] - a.pdHold[k])));
+  t.residual_deg = units::degrees(jointError());
+  return t;
+}
+
+// Stage: stand stand_s with the tail held at theta(0): the tilt figures and the feet in contact at the end.
+void standWithTail(ArticulatedSim& a, TailController& ctrl, const DerivedRobot& r, double stand_s, ArticulatedRun& out) {
+  const mjModel* m = a.m;
+  const mjData* d = a.d;
+  const long standSteps = std::lround(stand_s / m->opt.timestep);
   for (long k = 0; k < standSteps && out.ok; ++k) {
-    step(0.0);
-    out.stand_max_tilt_deg = std::max(out.stand_max_tilt_deg, tiltDeg(d, body));
-    out.stand_max_rel_tilt_deg = std::max(out.stand_max_rel_tilt_deg, tiltFromDeg(d, body, stanceZ));
+    stepArticulated(a, ctrl, 0.0, out.steps);
+    out.stand_max_tilt_deg = std::max(out.stand_max_tilt_deg, tiltDeg(d, a.body));
+    out.stand_max_rel_tilt_deg = std::max(out.stand_max_rel_tilt_deg, tiltFromDeg(d, a.body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings while standing: " + describeWarnings(d);
   }
   out.stand_s = stand_s;
-  out.stand_end_tilt_deg = tiltDeg(d, body);
-  out.stand_end_rel_tilt_deg = tiltFromDeg(d, body, stanceZ);
+  out.stand_end_tilt_deg = tiltDeg(d, a.body);
+  out.stand_end_rel_tilt_deg = tiltFromDeg(d, a.body, a.stanceZ);
   for (const auto& [bodyName, k] : r.foot_geoms) {
     const int g = m->body_geomadr[bodyId(m, bodyName)] + k;
     bool touching = false;
     for (int i = 0; i < d->ncon; ++i) touching = touching || d->contact[i].geom1 == g || d->contact[i].geom2 == g;
     out.feet_in_contact += touching;
   }
+}
+
+// The rows of the articulated run's time series (ArticulatedRun::series) on the output grid: the
+// sample nearest each grid time is the step that reaches it.
+class StrokeRecorder {
+ public:
+  StrokeRecorder(const ArticulatedSim& a, const TailTrajectory& trajectory, TimeSeries& series, double sample_dt_s,
+                 double t_end)
+      : a_(a), trajectory_(trajectory), series_(series), sample_dt_s_(sample_dt_s), t_end_(t_end),
+        dt_(a.m->opt.timestep), x0_(a.d->xpos[3 * a.body]), y0_(a.d->xpos[3 * a.body + 1]) {
+    if (sample_dt_s_ <= 0.0) return;
+    colT_ = series_.addColumn(col::kT);
+    for (int i = 1; i <= a_.n; ++i) colTheta_.push_back(series_.addColumn(col::theta(i)));
+    for (int i = 1; i <= a_.n; ++i) colThetadot_.push_back(series_.addColumn(col::thetadot(i)));
+    colX_ = series_.addColumn(col::kX);
+    colY_ = series_.addColumn(col::kY);
+    colPhi_ = series_.addColumn(col::kPhi);
+    colPhidot_ = series_.addColumn(col::kPhidot);
+    for (int i = 1; i <= a_.n; ++i) colTrack_.push_back(series_.addColumn(col::trackErr(i)));
+    row_.resize(series_.numColumns());
+  }
+
+  // The rows up to time t of the stroke, phi the heading change so far [rad].
+  void record(double t, double phi) {
+    if (sample_dt_s_ <= 0.0) return;
+    const mjData* d = a_.d;
+    const double* root = d->xpos + 3 * a_.body;
+    while (nextRow_ * sample_dt_s_ <= t + 0.5 * dt_ && nextRow_ * sample_dt_s_ <= t_end_ + 1e-9 * sample_dt_s_) {
+      trajectory_.evaluate(t, ref_);
+      row_[colT_] = nextRow_ * sample_dt_s_;
+      for (int i = 0; i < a_.n; ++i) {
+        row_[colTheta_[i]] = units::degrees(d->qpos[a_.qadr[i]]);
+        row_[colThetadot_[i]] = units::degrees(d->qvel[a_.vadr[i]]);
+        row_[colTrack_[i]] = units::degrees(d->qpos[a_.qadr[i]] - ref_[i].theta);
+      }
+      row_[colX_] = root[0] - x0_;
+      row_[colY_] = root[1] - y0_;
+      row_[colPhi_] = units::degrees(phi);
+      row_[colPhidot_] = units::degrees(d->cvel[6 * a_.body + 2]);  // world-frame angular velocity z (com-based)
+      series_.appendRow(row_);
+      ++nextRow_;
+    }
+  }
+
+ private:
+  const ArticulatedSim& a_;
+  const TailTrajectory& trajectory_;
+  TimeSeries& series_;
+  double sample_dt_s_, t_end_, dt_, x0_, y0_;
+  std::vector<int> colTheta_, colThetadot_, colTrack_;
+  int colT_ = -1, colX_ = -1, colY_ = -1, colPhi_ = -1, colPhidot_ = -1;
+  long nextRow_ = 0;
+  std::vector<double> row_;
+  std::vector<JointState> ref_;
+};
+
+// Stage: the stroke and settle_after_s after it: phi_net (the root body's heading change, unwrapped
+// step by step), the tilt during it, the rows, and whether the body is at rest at the end.
+void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& trajectory, double settle_after_s,
+               double sample_dt_s, ArticulatedRun& out) {
+  const mjData* d = a.d;
+  const int body = a.body;
+  const double dt = a.m->opt.timestep;
   auto yaw = [&] { return std::atan2(d->xmat[9 * body + 3], d->xmat[9 * body]); };
-  const double yaw0 = yaw();
-  double phi = 0.0, prev = yaw0;
+  double phi = 0.0, prev = yaw();
   const double t_end = trajectory.endTime() + settle_after_s;
   const long runSteps = std::lround(t_end / dt);
-  // Rows on the output grid (the sample nearest each grid time: the step that reaches it).
-  std::vector<int> colTheta, colThetadot, colTrack;
-  int colT = -1, colX = -1, colY = -1, colPhi = -1, colPhidot = -1;
-  if (sample_dt_s > 0.0) {
-    colT = out.series.addColumn(col::kT);
-    for (int i = 1; i <= n; ++i) colTheta.push_back(out.series.addColumn(col::theta(i)));
-    for (int i = 1; i <= n; ++i) colThetadot.push_back(out.series.addColumn(col::thetadot(i)));
-    colX = out.series.addColumn(col::kX);
-    colY = out.series.addColumn(col::kY);
-    colPhi = out.series.addColumn(col::kPhi);
-    colPhidot = out.series.addColumn(col::kPhidot);
-    for (int i = 1; i <= n; ++i) colTrack.push_back(out.series.addColumn(col::trackErr(i)));
-  }
-  const double* root = d->xpos + 3 * body;
-  const double x0 = root[0], y0 = root[1];
-  long nextRow = 0;
-  std::vector<double> row(out.series.numColumns());
-  std::vector<JointState> ref;
-  auto record = [&](double t) {
-    if (sample_dt_s <= 0.0) return;
-    while (nextRow * sample_dt_s <= t + 0.5 * dt && nextRow * sample_dt_s <= t_end + 1e-9 * sample_dt_s) {
-      trajectory.evaluate(t, ref);
-      row[colT] = nextRow * sample_dt_s;
-      for (int i = 0; i < n; ++i) {
-        row[colTheta[i]] = units::degrees(d->qpos[qadr[i]]);
-        row[colThetadot[i]] = units::degrees(d->qvel[vadr[i]]);
-        row[colTrack[i]] = units::degrees(d->qpos[qadr[i]] - ref[i].theta);
-      }
-      row[colX] = root[0] - x0;
-      row[colY] = root[1] - y0;
-      row[colPhi] = units::degrees(phi);
-      row[colPhidot] = units::degrees(d->cvel[6 * body + 2]);  // world-frame angular velocity z (com-based)
-      out.series.appendRow(row);
-      ++nextRow;
-    }
-  };
-  record(0.0);
+  StrokeRecorder rec(a, trajectory, out.series, sample_dt_s, t_end);
+  rec.record(0.0, phi);
   for (long k = 0; k < runSteps && out.ok; ++k) {
-    step((k + 1) * dt);
+    stepArticulated(a, ctrl, (k + 1) * dt, out.steps);
     const double y = yaw();
     phi += std::remainder(y - prev, 2 * kPi);
     prev = y;
-    record((k + 1) * dt);
+    rec.record((k + 1) * dt, phi);
     out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
-    out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, stanceZ));
+    out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
   }
   out.run_s = t_end;
   out.phi_net_deg = units::degrees(phi);
-  {
-    const double* v = d->cvel + 6 * body;  // [angular; linear] at the subtree COM, world frame
-    out.at_rest = units::degrees(std::abs(v[2])) < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
-  }
+  const double* v = d->cvel + 6 * body;  // [angular; linear] at the subtree COM, world frame
+  out.at_rest = units::degrees(std::abs(v[2])) < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
+}
+
+// Stage: the run's warnings: a tilt from the stance while standing with the tail.
+void judgeArticulated(ArticulatedRun& out) {
   if (out.stand_max_rel_tilt_deg >= kStandingTiltLimitDeg)
     out.warnings.push_back("the body tilted up to " + std::to_string(out.stand_max_rel_tilt_deg) + " deg from its stance (" +
                            std::to_string(out.stand_max_tilt_deg) + " deg absolute) while standing with the tail");
+}
+
+// The articulated run at s.timestep_s (the model's own, or the check run's twice that): the tail's
+// servo gains from s, the model's option timestep replaced by s.timestep_s. Stages: build, trim the
+// legs for the tail's weight, stand stand_s, the stroke and settle_after_s (sampled), judge.
+ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                                const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
+                                double settle_after_s, double sample_dt_s) {
+  ArticulatedRun out;
+  MujocoMessages messages;
+  ArticulatedSim a;
+  buildArticulated(a, r, mount, tail, trajectory, s);
+  TailController ctrl(a.m, trajectory, a.qadr, a.vadr, a.act, {s.velocity_feedforward, s.inverse_dynamics_feedforward});
+  out.stance_tilt_deg = tiltDeg(a.d, a.body);
+  out.trim = trimStance(a, ctrl, r.legs_locked, out.steps, out.error);
+  out.ok = out.error.empty();
+  standWithTail(a, ctrl, r, stand_s, out);
+  runStroke(a, ctrl, trajectory, settle_after_s, sample_dt_s, out);
+  judgeArticulated(out);
   if (!messages.text().empty()) out.warnings.push_back(messages.text());
   return out;
 }
@@ -322,6 +458,11 @@ RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model
   s.extra["stand_max_tilt_from_stance_deg"] = a.stand_max_rel_tilt_deg;
   s.extra["stroke_max_tilt_from_stance_deg"] = a.max_rel_tilt_deg;
   s.extra["feet_in_contact"] = a.feet_in_contact;
+  s.extra["stance_trim_rounds"] = a.trim.rounds;
+  s.extra["stance_trim_max_offset_deg"] = a.trim.max_offset_deg;
+  s.extra["stance_trim_residual_deg"] = a.trim.residual_deg;
+  s.extra["stance_trim_end_tilt_from_stance_deg"] = a.trim.end_tilt_deg;
+  s.extra["stance_trim_max_tilt_from_stance_deg"] = a.trim.max_rel_tilt_deg;
   r.series = a.series;
   return r;
 }

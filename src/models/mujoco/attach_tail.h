@@ -23,12 +23,30 @@ namespace tailsim {
 std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                        const MujocoSettings& s);
 
+// The legs' set-points trimmed for the tail's weight before standing (attach_tail.cc trimStance):
+// rounds of kTrimRoundS, each moving every held joint's set-point by kTrimGain times its error from
+// the settled stance, until the body's tilt from the stance is below kTrimTiltTolDeg, stops improving
+// by 10 % a round, or after kTrimRounds.
+inline constexpr double kTrimRoundS = 0.5;       // [s]
+inline constexpr double kTrimGain = 0.5;         // share of the error moved per round
+inline constexpr double kTrimTiltTolDeg = 0.2;   // [deg]
+inline constexpr int kTrimRounds = 8;
+struct StanceTrim {
+  int rounds = 0;                  // rounds stood (0: legs locked, or none held)
+  double trim_s = 0.0;             // simulated time spent trimming [s]
+  double max_offset_deg = 0.0;     // largest set-point change from the stance's set-point [deg]
+  double residual_deg = 0.0;       // largest held joint's error from its settled-stance angle at the end [deg]
+  double end_tilt_deg = 0.0;       // the body's tilt from the stance after the last kept round [deg]
+  double max_rel_tilt_deg = 0.0;   // largest tilt from the stance while trimming [deg]
+};
+
 struct ArticulatedRun {
   bool ok = true;
   std::string error;
   // Tilt: the angle of the root body's z axis from the world's z (absolute), or from its own z in
   // the settled stance the run starts from, before the tail's weight acts (from the stance).
   double stance_tilt_deg = 0.0;         // the settled stance's own tilt [deg]
+  StanceTrim trim;                      // the legs' set-points trimmed for the tail, before standing
   double stand_max_tilt_deg = 0.0;      // largest body tilt while standing with the tail held [deg]
   double stand_end_tilt_deg = 0.0;      // body tilt at the end of standing (the stroke's start) [deg]
   double stand_max_rel_tilt_deg = 0.0;  // largest tilt from the stance while standing with the tail [deg]
