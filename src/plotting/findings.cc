@@ -314,6 +314,90 @@ Finding eq25(const std::vector<ExperimentResults>& all) {
   return f;
 }
 
+// One model's fig08 poses: theta and the tangential, centripetal and total tail moments as run,
+// and Eq. (24) from the analytic model's code with each pose's robot and rates (when it applies).
+struct Fig08Poses {
+  bool cols = true;  // every pose's CSV read, with MzT_tan_Nm and MzT_cen_Nm
+  std::vector<double> th, tan, cen, tot;
+  std::vector<Eq24Terms> want;
+  std::string why_no_eq24;
+  double Ieff = kNaN, d_Q2B = kNaN;
+};
+
+// Stage 1 of fig08Findings: model m's poses over the theta axis a.
+Fig08Poses readFig08Poses(const ExperimentResults& r, const SweepAxis& a, const std::string& m) {
+  Fig08Poses p;
+  for (size_t i = 0; i < a.values.size(); ++i) {
+    const CaseRecord* c = r.find({{a.key, a.values[i]}});
+    try {
+      if (!c) throw std::runtime_error("missing");
+      const TimeSeries s = r.series(*c, m);
+      if (!s.has(col::kMzTTan) || !s.has(col::kMzTCen) || s.numRows() == 0) { p.cols = false; break; }
+      p.th.push_back(units::radians(a.number(i)));
+      const ExperimentCase* rc = r.resolvedCase(*c);
+      if (!rc) p.why_no_eq24 = unresolved(r);
+      else if (rc->robot.numLinks() != 1 || rc->pose.theta_rad.size() != 1)
+        p.why_no_eq24 = "Eq. (24) is for a one-link tail; case " + c->name + " has " +
+                        std::to_string(rc->robot.numLinks()) + " links";
+      else {
+        p.want.push_back(eq24OneLinkMoment(rc->robot, rc->pose.theta_rad[0], rc->pose.thetadot_radps[0],
+                                           rc->pose.thetaddot_radps2[0]));
+        p.Ieff = eq24OneLinkMoment(rc->robot, 0, 0, -1).tangential;  // -Ieff thetaddot cos(theta) at 0, -1
+        p.d_Q2B = rc->robot.quadruped.d_Q2B_m;
+      }
+      p.tan.push_back(s.values(col::kMzTTan)[0]);
+      p.cen.push_back(s.values(col::kMzTCen)[0]);
+      p.tot.push_back(s.has(col::kMzT) ? s.values(col::kMzT)[0] : kNaN);
+    } catch (const std::exception&) {
+      p.cols = false;
+      break;
+    }
+  }
+  return p;
+}
+
+// Stage 2: Fig. 8's peaks, |M_zT,tan| largest at theta = 0 and |M_zT,cen| at theta = +-90 deg.
+ModelVerdict fig08PeaksVerdict(const std::string& m, const Fig08Poses& p, const SweepAxis& a) {
+  auto argmaxAbs = [](const std::vector<double>& v) {
+    size_t b = 0;
+    for (size_t i = 1; i < v.size(); ++i)
+      if (std::fabs(v[i]) > std::fabs(v[b])) b = i;
+    return b;
+  };
+  const size_t it = argmaxAbs(p.tan), ic = argmaxAbs(p.cen);
+  const double th_t = units::degrees(p.th[it]), th_c = units::degrees(p.th[ic]);
+  // |cen| is symmetric: both ends count; tolerate ties within 1e-9 relative.
+  const bool cen_ok = std::fabs(std::fabs(th_c) - 90) < 1e-6 ||
+                      std::fabs(std::fabs(p.cen[ic]) - std::max(std::fabs(p.cen.front()), std::fabs(p.cen.back()))) <=
+                          1e-9 * std::fabs(p.cen[ic]);
+  const bool tan_ok = std::fabs(th_t) < 1e-6;
+  return {m, tan_ok && cen_ok ? Verdict::kYes : Verdict::kNo,
+          "max |M_zT,tan| = " + formatNumber("%.4g", std::fabs(p.tan[it])) + " N m at theta = " +
+              formatNumber("%.1f", th_t) + " deg; max |M_zT,cen| = " + formatNumber("%.4g", std::fabs(p.cen[ic])) +
+              " N m at theta = " + formatNumber("%.1f", th_c) + " deg (grid " + a.values.front() + " .. " +
+              a.values.back() + " deg)"};
+}
+
+// Stage 3: the moments as run against Eq. (24), relative to its largest term (tolerance 1e-6).
+ModelVerdict eq24Verdict(const std::string& m, const Fig08Poses& p) {
+  double err = 0, scale = 1e-12;
+  bool have_total = true;
+  for (size_t i = 0; i < p.th.size(); ++i) {
+    const double wt = p.want[i].tangential, wc = p.want[i].centripetal, rot = p.want[i].rotational;
+    err = std::max({err, std::fabs(p.tan[i] - wt), std::fabs(p.cen[i] - wc)});
+    scale = std::max({scale, std::fabs(wt), std::fabs(wc), std::fabs(rot)});
+    if (std::isfinite(p.tot[i])) err = std::max(err, std::fabs(p.tot[i] - p.want[i].total()));
+    else have_total = false;
+  }
+  const double rel = err / scale;
+  return {m, rel <= 1e-6 ? Verdict::kYes : Verdict::kNo,
+          "max deviation from Eq. (24) " + formatNumber("%.3g", err) + " N m = " + formatNumber("%.2g", rel) +
+              " of the largest term (I_eff = " + formatNumber("%.5g", p.Ieff) + " kg m^2, d_Q2B = " +
+              formatNumber("%.4g", p.d_Q2B) + " m; " + std::to_string(p.th.size()) + " poses" +
+              (have_total ? ", tangential, centripetal and total" : ", tangential and centripetal") +
+              "; tolerance 1e-6)"};
+}
+
 std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
   Finding eq{"eq24_closed_form", "Sec. 4.4, Eq. (24)",
              "for the 1-link tail the general recursion reduces to M_zT = -(I_zz,L + 0.25 m_L L_L^2 m_Q/m) thetaddot "
@@ -337,82 +421,15 @@ std::vector<Finding> fig08Findings(const std::vector<ExperimentResults>& all) {
       peaks.verdicts.push_back(na(m, why));
       continue;
     }
-    // Eq. (24) from the analytic model's code, with each pose's robot and rates as run.
-    std::vector<double> th, tan, cen, tot;
-    std::vector<Eq24Terms> want;
-    std::string why_no_eq24;
-    double Ieff = kNaN, d_Q2B = kNaN;
-    bool cols = true;
-    for (size_t i = 0; i < a->values.size(); ++i) {
-      const CaseRecord* c = r->find({{a->key, a->values[i]}});
-      try {
-        if (!c) throw std::runtime_error("missing");
-        const TimeSeries s = r->series(*c, m);
-        if (!s.has(col::kMzTTan) || !s.has(col::kMzTCen) || s.numRows() == 0) { cols = false; break; }
-        th.push_back(units::radians(a->number(i)));
-        const ExperimentCase* rc = r->resolvedCase(*c);
-        if (!rc) why_no_eq24 = unresolved(*r);
-        else if (rc->robot.numLinks() != 1 || rc->pose.theta_rad.size() != 1)
-          why_no_eq24 = "Eq. (24) is for a one-link tail; case " + c->name + " has " +
-                        std::to_string(rc->robot.numLinks()) + " links";
-        else {
-          want.push_back(eq24OneLinkMoment(rc->robot, rc->pose.theta_rad[0], rc->pose.thetadot_radps[0],
-                                           rc->pose.thetaddot_radps2[0]));
-          Ieff = eq24OneLinkMoment(rc->robot, 0, 0, -1).tangential;  // -Ieff thetaddot cos(theta) at 0, -1
-          d_Q2B = rc->robot.quadruped.d_Q2B_m;
-        }
-        tan.push_back(s.values(col::kMzTTan)[0]);
-        cen.push_back(s.values(col::kMzTCen)[0]);
-        tot.push_back(s.has(col::kMzT) ? s.values(col::kMzT)[0] : kNaN);
-      } catch (const std::exception&) {
-        cols = false;
-        break;
-      }
-    }
-    if (!cols || th.empty()) {
+    const Fig08Poses p = readFig08Poses(*r, *a, m);
+    if (!p.cols || p.th.empty()) {
       eq.verdicts.push_back(na(m, "pose CSVs missing or without MzT_tan_Nm / MzT_cen_Nm"));
       peaks.verdicts.push_back(na(m, "pose CSVs missing or without MzT_tan_Nm / MzT_cen_Nm"));
       continue;
     }
-    // Peaks of |tan| and |cen| over theta.
-    auto argmaxAbs = [](const std::vector<double>& v) {
-      size_t b = 0;
-      for (size_t i = 1; i < v.size(); ++i)
-        if (std::fabs(v[i]) > std::fabs(v[b])) b = i;
-      return b;
-    };
-    const size_t it = argmaxAbs(tan), ic = argmaxAbs(cen);
-    const double th_t = units::degrees(th[it]), th_c = units::degrees(th[ic]);
-    // |cen| is symmetric: both ends count; tolerate ties within 1e-9 relative.
-    const bool cen_ok = std::fabs(std::fabs(th_c) - 90) < 1e-6 ||
-                        std::fabs(std::fabs(cen[ic]) - std::max(std::fabs(cen.front()), std::fabs(cen.back()))) <=
-                            1e-9 * std::fabs(cen[ic]);
-    const bool tan_ok = std::fabs(th_t) < 1e-6;
-    peaks.verdicts.push_back({m, tan_ok && cen_ok ? Verdict::kYes : Verdict::kNo,
-                              "max |M_zT,tan| = " + formatNumber("%.4g", std::fabs(tan[it])) + " N m at theta = " +
-                                  formatNumber("%.1f", th_t) + " deg; max |M_zT,cen| = " + formatNumber("%.4g", std::fabs(cen[ic])) +
-                                  " N m at theta = " + formatNumber("%.1f", th_c) + " deg (grid " + a->values.front() + " .. " +
-                                  a->values.back() + " deg)"});
-    if (!why_no_eq24.empty() || want.size() != th.size()) {
-      eq.verdicts.push_back(na(m, why_no_eq24));
-      continue;
-    }
-    double err = 0, scale = 1e-12;
-    bool have_total = true;
-    for (size_t i = 0; i < th.size(); ++i) {
-      const double wt = want[i].tangential, wc = want[i].centripetal, rot = want[i].rotational;
-      err = std::max({err, std::fabs(tan[i] - wt), std::fabs(cen[i] - wc)});
-      scale = std::max({scale, std::fabs(wt), std::fabs(wc), std::fabs(rot)});
-      if (std::isfinite(tot[i])) err = std::max(err, std::fabs(tot[i] - want[i].total()));
-      else have_total = false;
-    }
-    const double rel = err / scale;
-    eq.verdicts.push_back({m, rel <= 1e-6 ? Verdict::kYes : Verdict::kNo,
-                           "max deviation from Eq. (24) " + formatNumber("%.3g", err) + " N m = " + formatNumber("%.2g", rel) +
-                               " of the largest term (I_eff = " + formatNumber("%.5g", Ieff) + " kg m^2, d_Q2B = " +
-                               formatNumber("%.4g", d_Q2B) + " m; " + std::to_string(th.size()) + " poses" +
-                               (have_total ? ", tangential, centripetal and total" : ", tangential and centripetal") +
-                               "; tolerance 1e-6)"});
+    peaks.verdicts.push_back(fig08PeaksVerdict(m, p, *a));
+    if (!p.why_no_eq24.empty() || p.want.size() != p.th.size()) eq.verdicts.push_back(na(m, p.why_no_eq24));
+    else eq.verdicts.push_back(eq24Verdict(m, p));
   }
   return {eq, peaks};
 }

@@ -259,33 +259,8 @@ void verdict(std::ostringstream& o, const std::vector<LadderCase>& cs) {
   o << "\n";
 }
 
-}  // namespace
-
-std::vector<LadderCase> loadLadder(const std::string& dir) {
-  std::vector<LadderCase> out;
-  for (const ExperimentResults& r : loadResultTree(dir)) addExperiment(r, out);
-  if (out.empty()) throw std::runtime_error(dir + ": no ladder experiment results (configs/ladder/)");
-  return out;
-}
-
-std::vector<std::string> writeLadder(const std::string& dir) {
-  const std::vector<LadderCase> cs = loadLadder(dir);
-  // ladder.csv and ladder.md only over tailsim's own (an earlier tailsim's without a manifest: by their first line)
-  const auto earlier = [](const char* head) {
-    return [h = std::string(head)](const std::string& text) { return text.compare(0, h.size(), h) == 0; };
-  };
-  const EarlierOwnFile earlier_csv = earlier("experiment,case,"), earlier_md = earlier("# The gap ladder\n");
-  checkOwnedFile(dir, "ladder.csv", std::nullopt, earlier_csv);  // before anything is written
-  checkOwnedFile(dir, "ladder.md", std::nullopt, earlier_md);
-  std::vector<std::string> files;
-  const std::string plots = (std::filesystem::path(dir) / "plots").string();
-  std::filesystem::create_directories(plots);
-
-  std::vector<std::string> exps;
-  for (const LadderCase& c : cs)
-    if (std::find(exps.begin(), exps.end(), c.experiment) == exps.end()) exps.push_back(c.experiment);
-
-  // CSV: one row a case.
+// ladder.csv: one row a case, phi_net on each rung and the paper model with the ADAMS law.
+std::string ladderCsv(const std::vector<LadderCase>& cs) {
   std::ostringstream csv;
   csv << "experiment,case";
   for (const Rung& g : rungs()) csv << "," << g.key << "_deg";
@@ -295,20 +270,12 @@ std::vector<std::string> writeLadder(const std::string& dir) {
     for (const Rung& g : rungs()) csv << "," << fmt("%.9g", c.*g.value);
     csv << "," << fmt("%.9g", c.paper_adams) << "\n";
   }
-  const std::string csv_path = (std::filesystem::path(dir) / "ladder.csv").string();
-  writeOwnedFile(dir, "ladder.csv", csv.str(), earlier_csv);
-  files.push_back(csv_path);
+  return csv.str();
+}
 
-  std::ostringstream o;
-  o << "# The gap ladder\n\n"
-    << "phi_net [deg] of every case on six rungs: paper model (analytic, coupling paper, stiction) -> exact "
-       "coupling (analytic, coupling exact) -> per-foot Coulomb (perfoot, stiction) -> per-foot ADAMS law "
-       "(perfoot, continuous) -> MuJoCo (ADAMS law: effects.friction continuous) -> MuJoCo (constant mu: "
-       "effects.friction stiction, today's default). Each step is the next rung minus this one, with its "
-       "share of the total gap (MuJoCo constant mu - paper model); the steps add up to the total. "
-       "Written by `tailsim ladder` from the result folder (configs/ladder/all.yaml).\n\n";
-
-  // Agreement, over all cases.
+// ladder.md's agreement of the per-foot model with MuJoCo over all cases: the table, the cases
+// where they differ most, and the cases with |MuJoCo phi_net| >= 1 deg only.
+void agreementSection(std::ostringstream& o, const std::vector<LadderCase>& cs) {
   const Agreement a = agreement(cs);
   o << "## Per-foot model vs MuJoCo, same friction law (" << cs.size() << " cases)\n\n"
     << "|difference| in % of MuJoCo's |phi_net| (and in deg):\n\n"
@@ -339,18 +306,19 @@ std::vector<std::string> writeLadder(const std::string& dir) {
     }
     o << ".\n\n";
   }
-  {
-    // Cases with |MuJoCo phi_net| >= 1 deg only (the percentages of the near-zero ones say little).
-    std::vector<double> c1, a1;
-    for (const LadderCase& c : cs) {
-      if (std::abs(c.mujoco_const) >= 1.0) c1.push_back(relPct(c.perfoot_coulomb, c.mujoco_const));
-      if (std::abs(c.mujoco_adams) >= 1.0) a1.push_back(relPct(c.perfoot_adams, c.mujoco_adams));
-    }
-    o << "Cases with |MuJoCo phi_net| >= 1 deg only: Coulomb median " << fmt("%.1f %%", median(c1)) << ", max "
-      << fmt("%.1f %%", maxOf(c1)) << " (" << c1.size() << " cases); ADAMS law median " << fmt("%.1f %%", median(a1))
-      << ", max " << fmt("%.1f %%", maxOf(a1)) << " (" << a1.size() << " cases).\n\n";
+  // Cases with |MuJoCo phi_net| >= 1 deg only (the percentages of the near-zero ones say little).
+  std::vector<double> c1, a1;
+  for (const LadderCase& c : cs) {
+    if (std::abs(c.mujoco_const) >= 1.0) c1.push_back(relPct(c.perfoot_coulomb, c.mujoco_const));
+    if (std::abs(c.mujoco_adams) >= 1.0) a1.push_back(relPct(c.perfoot_adams, c.mujoco_adams));
   }
-  // Per figure: the median |step|.
+  o << "Cases with |MuJoCo phi_net| >= 1 deg only: Coulomb median " << fmt("%.1f %%", median(c1)) << ", max "
+    << fmt("%.1f %%", maxOf(c1)) << " (" << c1.size() << " cases); ADAMS law median " << fmt("%.1f %%", median(a1))
+    << ", max " << fmt("%.1f %%", maxOf(a1)) << " (" << a1.size() << " cases).\n\n";
+}
+
+// ladder.md's table of the median |step| of each experiment.
+void medianStepsSection(std::ostringstream& o, const std::vector<LadderCase>& cs, const std::vector<std::string>& exps) {
   o << "## Median |step| per figure [deg]\n\n| experiment | cases | median |total gap| |";
   for (const std::string& s : stepNames()) o << " " << s << " |";
   o << "\n|---|---:|---:|";
@@ -372,8 +340,11 @@ std::vector<std::string> writeLadder(const std::string& dir) {
     o << "\n";
   }
   o << "\n";
-  verdict(o, cs);
+}
 
+// ladder.md's last section: each experiment's figure (drawn into plots/, added to files) and table.
+void everyCaseSection(std::ostringstream& o, const std::vector<LadderCase>& cs, const std::vector<std::string>& exps,
+                      const std::string& plots, std::vector<std::string>& files) {
   o << "## Every case\n\n";
   for (const std::string& e : exps) {
     std::vector<LadderCase> sub;
@@ -384,6 +355,49 @@ std::vector<std::string> writeLadder(const std::string& dir) {
     o << "### " << e << "\n\n![" << e << "](plots/" << std::filesystem::path(png).filename().string() << ")\n\n";
     tableOf(o, sub);
   }
+}
+
+}  // namespace
+
+std::vector<LadderCase> loadLadder(const std::string& dir) {
+  std::vector<LadderCase> out;
+  for (const ExperimentResults& r : loadResultTree(dir)) addExperiment(r, out);
+  if (out.empty()) throw std::runtime_error(dir + ": no ladder experiment results (configs/ladder/)");
+  return out;
+}
+
+std::vector<std::string> writeLadder(const std::string& dir) {
+  const std::vector<LadderCase> cs = loadLadder(dir);
+  // ladder.csv and ladder.md only over tailsim's own (an earlier tailsim's without a manifest: by their first line)
+  const auto earlier = [](const char* head) {
+    return [h = std::string(head)](const std::string& text) { return text.compare(0, h.size(), h) == 0; };
+  };
+  const EarlierOwnFile earlier_csv = earlier("experiment,case,"), earlier_md = earlier("# The gap ladder\n");
+  checkOwnedFile(dir, "ladder.csv", std::nullopt, earlier_csv);  // before anything is written
+  checkOwnedFile(dir, "ladder.md", std::nullopt, earlier_md);
+  std::vector<std::string> files;
+  const std::string plots = (std::filesystem::path(dir) / "plots").string();
+  std::filesystem::create_directories(plots);
+
+  std::vector<std::string> exps;
+  for (const LadderCase& c : cs)
+    if (std::find(exps.begin(), exps.end(), c.experiment) == exps.end()) exps.push_back(c.experiment);
+
+  writeOwnedFile(dir, "ladder.csv", ladderCsv(cs), earlier_csv);
+  files.push_back((std::filesystem::path(dir) / "ladder.csv").string());
+
+  std::ostringstream o;
+  o << "# The gap ladder\n\n"
+    << "phi_net [deg] of every case on six rungs: paper model (analytic, coupling paper, stiction) -> exact "
+       "coupling (analytic, coupling exact) -> per-foot Coulomb (perfoot, stiction) -> per-foot ADAMS law "
+       "(perfoot, continuous) -> MuJoCo (ADAMS law: effects.friction continuous) -> MuJoCo (constant mu: "
+       "effects.friction stiction, today's default). Each step is the next rung minus this one, with its "
+       "share of the total gap (MuJoCo constant mu - paper model); the steps add up to the total. "
+       "Written by `tailsim ladder` from the result folder (configs/ladder/all.yaml).\n\n";
+  agreementSection(o, cs);
+  medianStepsSection(o, cs, exps);
+  verdict(o, cs);
+  everyCaseSection(o, cs, exps, plots, files);
   const std::string md = (std::filesystem::path(dir) / "ladder.md").string();
   writeOwnedFile(dir, "ladder.md", o.str(), earlier_md);
   files.insert(files.begin(), md);

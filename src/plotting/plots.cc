@@ -104,6 +104,44 @@ std::string range(const char* axis, double lo, double hi) {
   return std::string("set ") + axis + "range [" + fmt("%.6g", lo) + ":" + fmt("%.6g", hi) + "]\n";
 }
 
+// A panel's y range, or gnuplot's autoscale when the panel has no finite value.
+std::string yRangeOrAuto(const std::pair<double, double>& r) {
+  return std::isfinite(r.first) ? range("y", r.first, r.second) : std::string("set autoscale y\n");
+}
+
+// The start of a figure of panels: a multiplot of rows x cols under the figure's title.
+std::string multiplotHead(const Ctx& ctx, const Txt& title, int width_px, size_t rows, size_t cols = 1) {
+  std::ostringstream o;
+  o << "reset\nset multiplot layout " << rows << "," << cols << " title " << ctx.figTitle(title, width_px, 17)
+    << " font 'Sans,17'\n";
+  return o.str();
+}
+
+// Tics at the index of every `every`-th value of a, labelled with the value: "set xtics (...)", no newline.
+std::string indexTics(const SweepAxis& a, const char* axis = "x", size_t every = 1) {
+  std::ostringstream o;
+  o << "set " << axis << "tics (";
+  for (size_t i = 0; i < a.values.size(); i += every) o << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
+  o << ")";
+  return o.str();
+}
+
+// A categorical x axis: one tic a value at its index, 0.3 of a step of margin on both sides.
+std::string categoricalXAxis(const SweepAxis& a) {
+  std::ostringstream o;
+  o << "set xrange [-0.3:" << a.values.size() - 0.7 << "]\n" << indexTics(a) << "\n";
+  return o.str();
+}
+
+// One series' phi(t) as a data file (t_s, phi_deg).
+void writePhiData(const Ctx& ctx, const std::string& stem, const TimeSeries& s) {
+  std::vector<std::vector<double>> rows;
+  const auto& t = s.values(col::kT);
+  const auto& phi = s.values(col::kPhi);
+  for (size_t k = 0; k < t.size(); ++k) rows.push_back({t[k], phi[k]});
+  writeDataFile(ctx.data(stem), {col::kT, col::kPhi}, rows);
+}
+
 // [lo, hi] of the finite values, widened by `margin` of the span on both sides.
 std::pair<double, double> span(const std::vector<double>& v, double margin) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -266,52 +304,61 @@ std::string phaseCaption(const Phases& p) {
 
 // ---- simulate, one case: phi(t) and moments ------------------------------------------------
 
-void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefix) {
-  const ExperimentResults& r = ctx.r;
+// One case's readable series (with t and phi), the models that have one in the experiment's
+// order, the end of their time axis and the analytic run's phases.
+struct CaseSeries {
   std::vector<std::string> models;
   std::map<std::string, TimeSeries> ts;
+  double t_end = 0;
+  Phases phases;
+};
+
+// Stage 1 of plotSingleCase: the series, their time axis and phases.
+CaseSeries loadCaseSeries(const ExperimentResults& r, const CaseRecord& c) {
+  CaseSeries cs;
   for (const std::string& m : r.models) {
     try {
       TimeSeries s = r.series(c, m);
       if (s.has(col::kT) && s.has(col::kPhi)) {
-        ts[m] = std::move(s);
-        models.push_back(m);
+        cs.ts[m] = std::move(s);
+        cs.models.push_back(m);
       }
     } catch (const std::exception&) {
     }
   }
-  if (models.empty()) return;
+  if (cs.models.empty()) return cs;
   std::vector<const TimeSeries*> all;
   std::vector<double> stops;
-  for (const std::string& m : models) {
-    all.push_back(&ts[m]);
+  for (const std::string& m : cs.models) {
+    all.push_back(&cs.ts.at(m));
     if (auto it = c.runs.find(m); it != c.runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
   }
-  const double t_end = timeAxisEnd(all, stops);
-  const Phases phases = ts.count(kAnalyticModel) ? findPhases(ts[kAnalyticModel]) : Phases{};
+  cs.t_end = timeAxisEnd(all, stops);
+  cs.phases = cs.ts.count(kAnalyticModel) ? findPhases(cs.ts.at(kAnalyticModel)) : Phases{};
+  return cs;
+}
 
-  Txt vs = {"", ""};
-  if (models.size() == 2 && ts.count(kAnalyticModel) && ts.count(kMujocoModel)) {
+// The title's ": analytic vs MuJoCo" or ": <model>", when the figure shows those.
+Txt modelsInTitle(const CaseSeries& cs) {
+  if (cs.models.size() == 2 && cs.ts.count(kAnalyticModel) && cs.ts.count(kMujocoModel)) {
     const std::string v = ": " + modelShortTitle(kAnalyticModel) + " vs " + modelShortTitle(kMujocoModel);
-    vs = {v, v};
+    return {v, v};
   }
-  else if (models.size() == 1) vs = {": " + gpText(modelTitle(models[0])), ": " + modelTitle(models[0])};
+  if (cs.models.size() == 1) return {": " + gpText(modelTitle(cs.models[0])), ": " + modelTitle(cs.models[0])};
+  return {"", ""};
+}
 
-  // phi(t), all models overlaid (Figs. 6, 7a).
-  const Txt phi_title = ctx.title(W("body yaw phi(t)") + ctx.tail + vs);
+// Stage 2: phi(t), all models overlaid (Figs. 6, 7a).
+void plotPhiOfTime(Ctx& ctx, const CaseRecord& c, const CaseSeries& cs, const std::string& stem_prefix) {
+  const Txt phi_title = ctx.title(W("body yaw phi(t)") + ctx.tail + modelsInTitle(cs));
   std::ostringstream body;
-  body << header(ctx, phi_title, "t [s]", "φ [deg]") << range("x", 0, t_end) << phaseObjects(phases, t_end);
+  body << header(ctx, phi_title, "t [s]", "φ [deg]") << range("x", 0, cs.t_end) << phaseObjects(cs.phases, cs.t_end);
   body << "set key bottom right box opaque\nplot ";  // phi rises from 0 and settles: bottom right is free
-  for (size_t i = 0; i < models.size(); ++i) {
-    const std::string& m = models[i];
-    const TimeSeries& s = ts[m];
+  for (size_t i = 0; i < cs.models.size(); ++i) {
+    const std::string& m = cs.models[i];
     const std::string stem = stem_prefix + "_phi_" + m;
-    std::vector<std::vector<double>> rows;
-    const auto& t = s.values(col::kT);
-    const auto& phi = s.values(col::kPhi);
-    for (size_t k = 0; k < t.size(); ++k) rows.push_back({t[k], phi[k]});
-    writeDataFile(ctx.data(stem), {col::kT, col::kPhi}, rows);
-    const double net = r.phiNet(c, m);
+    writePhiData(ctx, stem, cs.ts.at(m));
+    const double net = ctx.r.phiNet(c, m);
     std::string title = gpText(modelTitle(m));
     if (std::isfinite(net)) title += ", φ_{net} = " + fmt("%.2f", net) + "°";
     body << (i ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using 1:2 with lines lw 2.5 lc rgb "
@@ -320,70 +367,83 @@ void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefi
   body << "\n";
   ctx.render(stem_prefix + "_phi", body.str(), phi_title,
              phi_title.plain + ". Body yaw angle over time" +
-                 (models.size() > 1 ? std::string(", both models overlaid") : std::string()) +
-                 "; the legend gives each model's net rotation φ_net." + phaseCaption(phases));
+                 (cs.models.size() > 1 ? std::string(", both models overlaid") : std::string()) +
+                 "; the legend gives each model's net rotation φ_net." + phaseCaption(cs.phases));
+}
 
-  // Moments over time, one panel per model, one y scale (Fig. 7b).
+// The moment columns of Fig. 7b and their legend titles.
+const std::vector<std::pair<std::string, std::string>>& momentColumns() {
   static const std::vector<std::pair<std::string, std::string>> cols = {
       {col::kMzT, "M_{z,T} (tail)"}, {col::kMzF, "M_{z,F} (friction)"}, {col::kIzzPhiddot, "I_{zz} φ̈ (inertial)"}};
+  return cols;
+}
+
+// One moments panel: its y range (its values up to t_end with a margin, nothing clipped: one
+// model's spikes, MuJoCo's impulse averages in docs/mujoco-model.md "Force and moment columns",
+// never squash another model's curves), its data file and its plot.
+std::string momentsPanel(const Ctx& ctx, const TimeSeries& s, const std::string& m, const std::string& stem,
+                         double t_end) {
+  const auto& cols = momentColumns();
+  std::vector<double> yv;
+  for (const auto& [col, label] : cols)
+    if (s.has(col))
+      for (size_t k = 0; k < s.numRows(); ++k)
+        if (s.values(col::kT)[k] <= t_end) yv.push_back(s.values(col)[k]);
+  std::ostringstream mb;
+  mb << yRangeOrAuto(span(yv, 0.12));
+  std::vector<std::string> names = {col::kT};
+  for (const auto& [col, label] : cols) names.push_back(col);
+  std::vector<std::vector<double>> rows;
+  for (size_t k = 0; k < s.numRows(); ++k) {
+    std::vector<double> row = {s.values(col::kT)[k]};
+    for (const auto& [col, label] : cols) row.push_back(s.has(col) ? s.values(col)[k] : kNaN);
+    rows.push_back(row);
+  }
+  writeDataFile(ctx.data(stem), names, rows);
+  std::string panel = gpText(modelTitle(m));
+  if (const ModelEntry* e = findModel(m); e && !e->moments_note.empty()) panel += ": " + e->moments_note;
+  // the legend beside the panel: inside, it hid curves wherever it was put
+  mb << "set grid\nset key outside right top vertical box\nset title " << gpTitle(panel, 1000)
+     << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
+  int n = 0;
+  for (size_t j = 0; j < cols.size(); ++j) {
+    if (!s.has(cols[j].first)) continue;
+    mb << (n++ ? ", " : "") << gpFileName(stem + ".dat") << " using 1:" << j + 2 << " with lines lw 2 lc rgb "
+       << gpQuote(quantityColor(j)) << " title " << gpQuote(cols[j].second);
+  }
+  mb << "\n";
+  return mb.str();
+}
+
+// Stage 3: moments over time, one panel per model that has any, one time scale (Fig. 7b).
+void plotMoments(Ctx& ctx, const CaseSeries& cs, const std::string& stem_prefix) {
   std::vector<std::string> mm;
-  for (const std::string& m : models)
-    for (const auto& [col, label] : cols)
-      if (ts[m].has(col)) {
+  for (const std::string& m : cs.models)
+    for (const auto& [col, label] : momentColumns())
+      if (cs.ts.at(m).has(col)) {
         mm.push_back(m);
         break;
       }
   if (mm.empty()) return;
-  // Each panel its own y range (its values up to t_end with a margin, nothing clipped): one
-  // model's spikes (MuJoCo's impulse averages, docs/mujoco-model.md "Force and moment columns")
-  // never squash another model's curves.
-  auto panelRange = [&](const TimeSeries& s) {
-    std::vector<double> yv;
-    for (const auto& [col, label] : cols)
-      if (s.has(col))
-        for (size_t k = 0; k < s.numRows(); ++k)
-          if (s.values(col::kT)[k] <= t_end) yv.push_back(s.values(col)[k]);
-    return span(yv, 0.12);
-  };
   const Txt mom_title = ctx.title(W("moments about the system COM") + ctx.tail);
   std::ostringstream mb;
-  mb << "reset\nset multiplot layout " << mm.size() << ",1 title " << ctx.figTitle(mom_title, 1200, 17) << " font 'Sans,17'\n"
-     << range("x", 0, t_end) << phaseObjects(phases, t_end);
-  for (const std::string& m : mm) {
-    const TimeSeries& s = ts[m];
-    const auto [ylo, yhi] = panelRange(s);
-    mb << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string("set autoscale y\n"));
-    const std::string stem = stem_prefix + "_moments_" + m;
-    std::vector<std::string> names = {col::kT};
-    for (const auto& [col, label] : cols) names.push_back(col);
-    std::vector<std::vector<double>> rows;
-    for (size_t k = 0; k < s.numRows(); ++k) {
-      std::vector<double> row = {s.values(col::kT)[k]};
-      for (const auto& [col, label] : cols) row.push_back(s.has(col) ? s.values(col)[k] : kNaN);
-      rows.push_back(row);
-    }
-    writeDataFile(ctx.data(stem), names, rows);
-    std::string panel = gpText(modelTitle(m));
-    if (const ModelEntry* e = findModel(m); e && !e->moments_note.empty()) panel += ": " + e->moments_note;
-    // the legend beside the panel: inside, it hid curves wherever it was put
-    mb << "set grid\nset key outside right top vertical box\nset title " << gpTitle(panel, 1000)
-       << "\nset xlabel 't [s]'\nset ylabel 'moment [N m]'\nplot ";
-    int n = 0;
-    for (size_t j = 0; j < cols.size(); ++j) {
-      if (!s.has(cols[j].first)) continue;
-      mb << (n++ ? ", " : "") << gpFileName(stem + ".dat") << " using 1:" << j + 2 << " with lines lw 2 lc rgb "
-         << gpQuote(quantityColor(j)) << " title " << gpQuote(cols[j].second);
-    }
-    mb << "\n";
-  }
+  mb << multiplotHead(ctx, mom_title, 1200, mm.size()) << range("x", 0, cs.t_end) << phaseObjects(cs.phases, cs.t_end);
+  for (const std::string& m : mm) mb << momentsPanel(ctx, cs.ts.at(m), m, stem_prefix + "_moments_" + m, cs.t_end);
   mb << "unset multiplot\n";
   std::string cap = mom_title.plain +
                     ". Tail moment M_z,T (Eq. 13), friction moment M_z,F and inertial moment I_zz φ̈ over time, one "
                     "panel per model, one time scale; each panel has its own moment scale (read the y tics).";
   for (const std::string& m : mm)
     if (const ModelEntry* e = findModel(m); e && !e->moments_caption.empty()) cap += " " + e->moments_caption;
-  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(phases), 1200,
+  ctx.render(stem_prefix + "_moments", mb.str(), mom_title, cap + phaseCaption(cs.phases), 1200,
              60 + 430 * static_cast<int>(mm.size()));
+}
+
+void plotSingleCase(Ctx& ctx, const CaseRecord& c, const std::string& stem_prefix) {
+  const CaseSeries cs = loadCaseSeries(ctx.r, c);
+  if (cs.models.empty()) return;
+  plotPhiOfTime(ctx, c, cs, stem_prefix);
+  plotMoments(ctx, cs, stem_prefix);
 }
 
 // ---- heat maps ------------------------------------------------------------------------------
@@ -427,129 +487,131 @@ HeatMapLayout heatMapLayout(size_t nx, size_t ny) {
 
 namespace {
 
+// One heat-map panel: its data file, title, colour bar and colour scale.
+struct HeatPanel {
+  std::string dstem, title, cblabel;
+  std::vector<std::vector<double>> grid;
+  bool diverging = false;
+  bool negative = false;  // sequential with every value <= 0: dark at the most negative
+  double cblo = 0, cbhi = 1;
+};
+
+// A panel's colour scale over [lo, hi]: diverging (centred on zero) when forced or when the
+// values have both signs, else sequential.
+void setColourScale(HeatPanel& p, double lo, double hi, bool force_diverging) {
+  p.diverging = force_diverging || (lo < 0 && hi > 0);
+  p.negative = !p.diverging && hi <= 0 && lo < 0;
+  p.cblo = lo, p.cbhi = hi;
+  if (p.diverging) p.cbhi = std::max(std::fabs(lo), std::fabs(hi)), p.cblo = -p.cbhi;
+  if (p.cbhi <= p.cblo) p.cbhi = p.cblo + 1.0;
+}
+
+using ModelGrids = std::vector<std::pair<std::string, std::vector<std::vector<double>>>>;
+
+// Stage of heatMap: one difference panel per model after the first (the reference), that model
+// minus the first, all on one diverging scale; appended to panels. Returns the caption's
+// sentence about them (empty when no difference is finite).
+std::string addDifferencePanels(std::vector<HeatPanel>& panels, const std::string& stem, const std::string& cblabel,
+                                const ModelGrids& values) {
+  const auto& [m0, g0] = values[0];
+  std::vector<HeatPanel> diffs;
+  double dlo = std::numeric_limits<double>::infinity(), dhi = -dlo;
+  for (size_t k = 1; k < values.size(); ++k) {
+    const auto& [mk, gk] = values[k];
+    HeatPanel d{stem + (values.size() == 2 ? std::string("_difference") : "_difference_" + mk),
+                gpText(modelShortTitle(mk)) + " − " + gpText(modelShortTitle(m0)), "difference " + cblabel, g0};
+    for (size_t iy = 0; iy < g0.size(); ++iy)
+      for (size_t ix = 0; ix < g0[iy].size(); ++ix) {
+        d.grid[iy][ix] = gk[iy][ix] - g0[iy][ix];
+        if (std::isfinite(d.grid[iy][ix])) dlo = std::min(dlo, d.grid[iy][ix]), dhi = std::max(dhi, d.grid[iy][ix]);
+      }
+    diffs.push_back(d);
+  }
+  if (!std::isfinite(dlo)) return {};
+  for (HeatPanel& d : diffs) setColourScale(d, dlo, dhi, true), panels.push_back(d);
+  if (values.size() == 2)
+    return " The last panel is " + modelShortTitle(values[1].first) + " minus " + modelShortTitle(m0) +
+           " on its own scale (diverging, centred on zero: blue where " + modelShortTitle(values[1].first) +
+           " is lower, vermillion where it is higher).";
+  return " The last " + std::to_string(diffs.size()) + " panels are each other model minus " + modelShortTitle(m0) +
+         ", on one scale of their own (diverging, centred on zero: blue where the model is lower than " +
+         modelShortTitle(m0) + ", vermillion where it is higher).";
+}
+
+// Stage of heatMap: one panel's data file (ix, iy, value) and its plot: cells with their values
+// printed when they fit, else one pixel block per cell.
+std::string heatPanelPlot(const Ctx& ctx, const HeatPanel& p, const SweepAxis& ax, const SweepAxis& ay,
+                          const HeatMapLayout& lay) {
+  std::vector<std::vector<double>> rows;
+  for (size_t iy = 0; iy < p.grid.size(); ++iy)
+    for (size_t ix = 0; ix < p.grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), p.grid[iy][ix]});
+  writeDataFile(ctx.data(p.dstem), {"ix", "iy", "value"}, rows);
+  const std::string text = "(abs($3) < 0.05 ? '0.0' : sprintf('%.1f', $3))";
+  // Dark cells: |value| beyond 60 % of the scale (diverging), the darkest 40 % (sequential).
+  const std::string dark =
+      p.diverging ? "(abs($3) > " + fmt("%.6g", 0.6 * p.cbhi) + ")"
+      : p.negative ? "($3 < " + fmt("%.6g", p.cbhi - 0.6 * (p.cbhi - p.cblo)) + ")"
+                   : "($3 > " + fmt("%.6g", p.cblo + 0.6 * (p.cbhi - p.cblo)) + ")";
+  std::ostringstream b;
+  b << "set title " << gpTitle(p.title, lay.panel_w - 120) << "\n"
+    << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel " << gpQuote(gpAxisLabel(ay.key)) << "\n"
+    << "set xrange [-0.5:" << ax.values.size() - 0.5 << "]\nset yrange [-0.5:" << ay.values.size() - 0.5 << "]\n"
+    << indexTics(ax, "x", lay.xtic_every) << "\n" << indexTics(ay, "y", lay.ytic_every) << "\n"
+    << range("cb", p.cblo, p.cbhi) << "set cblabel " << gpQuote(p.cblabel)
+    << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
+    << (p.diverging ? divergingPalette() : sequentialPalette(p.negative));
+  if (lay.values_in_cells)
+    b << "plot " << gpFileName(p.dstem + ".dat")
+      << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
+      << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
+      << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
+  else  // one pixel block per cell (the rows are a full grid, ix fastest); NaN cells stay empty
+    b << "set xtics rotate by -45\nplot " << gpFileName(p.dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
+  return b.str();
+}
+
 // values[model][iy][ix]; x = axes[1], y = axes[0]. The models share one colour scale: sequential
 // (white to dark) when every value has one sign, dark at the largest magnitude; diverging centred on
 // zero only when the values have both signs. with_difference and two or more models: one panel per
 // model after the first, that model minus the first, on one diverging scale of their own centred on
 // zero. Cell text is white on dark cells; a value that rounds to zero prints unsigned.
 void heatMap(Ctx& ctx, const std::string& stem, const Txt& what, const std::string& cblabel, const SweepAxis& ax,
-             const SweepAxis& ay, const std::vector<std::pair<std::string, std::vector<std::vector<double>>>>& values,
-             const std::string& caption_more, bool with_difference) {
-  struct Panel {
-    std::string dstem, title, cblabel;
-    std::vector<std::vector<double>> grid;
-    bool diverging = false;
-    bool negative = false;  // sequential with every value <= 0: dark at the most negative
-    double cblo = 0, cbhi = 1;
-  };
-  auto scale = [](Panel& p, double lo, double hi, bool force_diverging) {
-    p.diverging = force_diverging || (lo < 0 && hi > 0);
-    p.negative = !p.diverging && hi <= 0 && lo < 0;
-    p.cblo = lo, p.cbhi = hi;
-    if (p.diverging) p.cbhi = std::max(std::fabs(lo), std::fabs(hi)), p.cblo = -p.cbhi;
-    if (p.cbhi <= p.cblo) p.cbhi = p.cblo + 1.0;
-  };
+             const SweepAxis& ay, const ModelGrids& values, const std::string& caption_more, bool with_difference) {
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const auto& [m, grid] : values)
     for (const auto& row : grid)
       for (double v : row)
         if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
   if (!std::isfinite(lo)) return;
-  std::vector<Panel> panels;
+  std::vector<HeatPanel> panels;
   for (const auto& [m, grid] : values) {
-    Panel p{stem + "_" + m, gpPanelTitle(m, {ax, ay}), cblabel, grid};
-    scale(p, lo, hi, false);
+    HeatPanel p{stem + "_" + m, gpPanelTitle(m, {ax, ay}), cblabel, grid};
+    setColourScale(p, lo, hi, false);
     panels.push_back(p);
   }
-  std::string diff_caption;
-  if (with_difference && values.size() >= 2) {
-    // One difference panel per model after the first (the reference), all on one diverging scale.
-    const auto& [m0, g0] = values[0];
-    std::vector<Panel> diffs;
-    double dlo = std::numeric_limits<double>::infinity(), dhi = -dlo;
-    for (size_t k = 1; k < values.size(); ++k) {
-      const auto& [mk, gk] = values[k];
-      Panel d{stem + (values.size() == 2 ? std::string("_difference") : "_difference_" + mk),
-              gpText(modelShortTitle(mk)) + " − " + gpText(modelShortTitle(m0)), "difference " + cblabel, g0};
-      for (size_t iy = 0; iy < g0.size(); ++iy)
-        for (size_t ix = 0; ix < g0[iy].size(); ++ix) {
-          d.grid[iy][ix] = gk[iy][ix] - g0[iy][ix];
-          if (std::isfinite(d.grid[iy][ix])) dlo = std::min(dlo, d.grid[iy][ix]), dhi = std::max(dhi, d.grid[iy][ix]);
-        }
-      diffs.push_back(d);
-    }
-    if (std::isfinite(dlo)) {
-      for (Panel& d : diffs) scale(d, dlo, dhi, true), panels.push_back(d);
-      if (values.size() == 2)
-        diff_caption = " The last panel is " + modelShortTitle(values[1].first) + " minus " + modelShortTitle(m0) +
-                       " on its own scale (diverging, centred on zero: blue where " + modelShortTitle(values[1].first) +
-                       " is lower, vermillion where it is higher).";
-      else
-        diff_caption = " The last " + std::to_string(diffs.size()) + " panels are each other model minus " +
-                       modelShortTitle(m0) + ", on one scale of their own (diverging, centred on zero: blue where the "
-                       "model is lower than " + modelShortTitle(m0) + ", vermillion where it is higher).";
-    }
-  }
+  const std::string diff_caption =
+      with_difference && values.size() >= 2 ? addDifferencePanels(panels, stem, cblabel, values) : std::string();
   const HeatMapLayout lay = heatMapLayout(ax.values.size(), ay.values.size());
-  auto tics = [](const SweepAxis& a, const char* axis, size_t every) {
-    std::ostringstream o;
-    o << "set " << axis << "tics (";
-    for (size_t i = 0; i < a.values.size(); i += every)
-      o << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
-    o << ")\n";
-    return o.str();
-  };
-  const std::string text = "(abs($3) < 0.05 ? '0.0' : sprintf('%.1f', $3))";
   // Up to three panels in a row (a column when the maps are wider than tall); more in two columns:
   // with differences, each model in the left column and its difference from the first model
   // beside it (the first model's right cell empty).
   const int n = static_cast<int>(panels.size());
   const bool stacked = ax.values.size() > ay.values.size() && n > 1;
   const int cols = n > 3 ? 2 : stacked ? 1 : n;
-  std::vector<const Panel*> cells;  // in gnuplot's order (rows first); nullptr: an empty cell
+  std::vector<const HeatPanel*> cells;  // in gnuplot's order (rows first); nullptr: an empty cell
   const size_t nm = values.size();
   if (n > 3 && !diff_caption.empty()) {
     cells = {&panels[0], nullptr};
     for (size_t k = 1; k < nm; ++k) cells.push_back(&panels[k]), cells.push_back(&panels[nm + k - 1]);
   } else {
-    for (const Panel& p : panels) cells.push_back(&p);
+    for (const HeatPanel& p : panels) cells.push_back(&p);
   }
   const int rows = (static_cast<int>(cells.size()) + cols - 1) / cols;
-  const int pw = lay.panel_w, ph = lay.panel_h;
-  const int w = pw * cols, h = ph * rows + 40;
+  const int w = lay.panel_w * cols, h = lay.panel_h * rows + 40;
   const Txt title = ctx.title(what + ctx.tail);
   std::ostringstream b;
-  b << "reset\nset multiplot layout " << rows << "," << cols
-    << " title " << ctx.figTitle(title, w, 17) << " font 'Sans,17'\n";
-  for (const Panel* cell : cells) {
-    if (!cell) {
-      b << "set multiplot next\n";
-      continue;
-    }
-    const Panel& p = *cell;
-    std::vector<std::vector<double>> rows;
-    for (size_t iy = 0; iy < p.grid.size(); ++iy)
-      for (size_t ix = 0; ix < p.grid[iy].size(); ++ix) rows.push_back({double(ix), double(iy), p.grid[iy][ix]});
-    writeDataFile(ctx.data(p.dstem), {"ix", "iy", "value"}, rows);
-    // Dark cells: |value| beyond 60 % of the scale (diverging), the darkest 40 % (sequential).
-    const std::string dark =
-        p.diverging ? "(abs($3) > " + fmt("%.6g", 0.6 * p.cbhi) + ")"
-        : p.negative ? "($3 < " + fmt("%.6g", p.cbhi - 0.6 * (p.cbhi - p.cblo)) + ")"
-                     : "($3 > " + fmt("%.6g", p.cblo + 0.6 * (p.cbhi - p.cblo)) + ")";
-    b << "set title " << gpTitle(p.title, pw - 120) << "\n"
-      << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel " << gpQuote(gpAxisLabel(ay.key)) << "\n"
-      << "set xrange [-0.5:" << ax.values.size() - 0.5 << "]\nset yrange [-0.5:" << ay.values.size() - 0.5 << "]\n"
-      << tics(ax, "x", lay.xtic_every) << tics(ay, "y", lay.ytic_every) << range("cb", p.cblo, p.cbhi)
-      << "set cblabel " << gpQuote(p.cblabel) << " offset char 2.5,0\nset rmargin 16\nset cbtics format '%g'\n"
-      << (p.diverging ? divergingPalette() : sequentialPalette(p.negative));
-    if (lay.values_in_cells)
-      b << "plot " << gpFileName(p.dstem + ".dat")
-        << " using 1:2:(0.5):(0.5):3 with boxxyerror fs solid 1.0 noborder fc palette notitle, \\\n"
-        << "     '' using 1:2:(" << dark << " ? '' : " << text << ") with labels font 'Sans,15' tc rgb 'black' notitle, \\\n"
-        << "     '' using 1:2:(" << dark << " ? " << text << " : '') with labels font 'Sans,15' tc rgb 'white' notitle\n";
-    else  // one pixel block per cell (the rows are a full grid, ix fastest); NaN cells stay empty
-      b << "set xtics rotate by -45\nplot " << gpFileName(p.dstem + ".dat") << " using 1:2:3 with image pixels notitle\n";
-  }
+  b << multiplotHead(ctx, title, w, rows, cols);
+  for (const HeatPanel* cell : cells) b << (cell ? heatPanelPlot(ctx, *cell, ax, ay, lay) : "set multiplot next\n");
   b << "unset multiplot\n";
   std::string cap = title.plain + ". " + caption_more;
   if (!lay.values_in_cells)
@@ -586,7 +648,9 @@ bool curvesCoincide(const TimeSeries& a, const TimeSeries& b, double t_end, doub
   return true;
 }
 
-void plotOneKey(Ctx& ctx) {
+// Stage 1 of plotOneKey: phi_net over the key, one colour per model; bars for the number of links
+// or a categorical key, else lines.
+void plotPhiNetOverKey(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
   const SweepAxis& a = r.axes[0];
   const KeyDisplay kd = keyDisplay(a.key);
@@ -609,9 +673,8 @@ void plotOneKey(Ctx& ctx) {
   const bool bars = leafKey(a.key) == "links" || !a.numeric;
   if (bars) {
     b << "set style data histogram\nset style histogram cluster gap 1\nset style fill solid 0.85 border -1\n"
-      << "set boxwidth 0.9\nset offsets 0, 0, graph 0.1, 0\nset xzeroaxis lt -1\nset grid noxtics\nset xtics (";
-    for (size_t i = 0; i < a.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(a.key, a.values[i])) << " " << i;
-    b << ")\nplot ";
+      << "set boxwidth 0.9\nset offsets 0, 0, graph 0.1, 0\nset xzeroaxis lt -1\nset grid noxtics\n"
+      << indexTics(a) << "\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
       b << (j ? ", " : "") << gpFileName(stem + ".dat") << " using " << j + 2 << " lc rgb "
         << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(modelTitle(r.models[j])));
@@ -626,9 +689,11 @@ void plotOneKey(Ctx& ctx) {
   ctx.render(stem, b.str(), title,
              title.plain + ". Net body rotation φ_net of each case" + (bars ? " (bars)" : "") + ", one colour per model.",
              1300, 700);
+}
 
-  // phi(t) of every case, one panel per model, one time and one angle scale (few cases only).
-  if (r.cases.size() > 12) return;
+// phi(t) curves of one key's cases, one panel per model: each curve's data file, value index and
+// series; the series, their stop times and each panel's phi values.
+struct CurvePanels {
   struct Curve {
     std::string dat;
     size_t i;
@@ -638,9 +703,16 @@ void plotOneKey(Ctx& ctx) {
   std::vector<TimeSeries> loaded;
   std::vector<double> stops;
   std::vector<std::vector<double>> phis;  // per panel
-  loaded.reserve(r.cases.size() * r.models.size());
+};
+
+// Stage 2 of plotOneKey: every case's readable phi(t) per model, each written as a data file.
+CurvePanels loadCurvePanels(const Ctx& ctx) {
+  const ExperimentResults& r = ctx.r;
+  const SweepAxis& a = r.axes[0];
+  CurvePanels cp;
+  cp.loaded.reserve(r.cases.size() * r.models.size());
   for (const std::string& m : r.models) {
-    std::vector<Curve> curves;
+    std::vector<CurvePanels::Curve> curves;
     std::vector<double> mine;
     for (size_t i = 0; i < a.values.size(); ++i) {
       const CaseRecord* c = r.find({{a.key, a.values[i]}});
@@ -653,29 +725,34 @@ void plotOneKey(Ctx& ctx) {
       }
       if (!s.has(col::kT) || !s.has(col::kPhi)) continue;
       const std::string dstem = r.name + "_phi_t_" + m + "_" + std::to_string(i);
-      std::vector<std::vector<double>> rr;
-      for (size_t k = 0; k < s.numRows(); ++k) rr.push_back({s.values(col::kT)[k], s.values(col::kPhi)[k]});
-      writeDataFile(ctx.data(dstem), {col::kT, col::kPhi}, rr);
+      writePhiData(ctx, dstem, s);
       for (double v : s.values(col::kPhi)) mine.push_back(v);
-      if (auto it = c->runs.find(m); it != c->runs.end() && it->second.ok) stops.push_back(it->second.t_stop_s);
-      loaded.push_back(std::move(s));
-      curves.push_back({dstem + ".dat", i, loaded.size() - 1});
+      if (auto it = c->runs.find(m); it != c->runs.end() && it->second.ok) cp.stops.push_back(it->second.t_stop_s);
+      cp.loaded.push_back(std::move(s));
+      curves.push_back({dstem + ".dat", i, cp.loaded.size() - 1});
     }
-    if (!curves.empty()) panels.emplace_back(m, curves), phis.push_back(mine);
+    if (!curves.empty()) cp.panels.emplace_back(m, curves), cp.phis.push_back(mine);
   }
-  if (panels.empty()) return;
+  return cp;
+}
+
+// Stage 3 of plotOneKey: phi(t) of every case, one panel per model, one time and one angle scale.
+void plotPhiOfTimePerValue(Ctx& ctx) {
+  const ExperimentResults& r = ctx.r;
+  const SweepAxis& a = r.axes[0];
+  const CurvePanels cp = loadCurvePanels(ctx);
+  if (cp.panels.empty()) return;
   std::vector<const TimeSeries*> all;
-  for (const TimeSeries& s : loaded) all.push_back(&s);
-  const double t_end = timeAxisEnd(all, stops);
-  const auto [yr, shared] = panelRanges(phis, 0.06);
+  for (const TimeSeries& s : cp.loaded) all.push_back(&s);
+  const double t_end = timeAxisEnd(all, cp.stops);
+  const auto [yr, shared] = panelRanges(cp.phis, 0.06);
   const Txt ttitle = ctx.title(W("body yaw phi(t) for each ") + K(a.key) + ctx.tail);
   bool any_dashed = false;
   std::ostringstream t;
-  t << "reset\nset multiplot layout " << panels.size() << ",1 title " << ctx.figTitle(ttitle, 1150, 17) << " font 'Sans,17'\n"
-    << range("x", 0, t_end);
-  for (size_t p = 0; p < panels.size(); ++p) {
-    const auto& [m, curves] = panels[p];
-    t << (std::isfinite(yr[p].first) ? range("y", yr[p].first, yr[p].second) : std::string("set autoscale y\n"));
+  t << multiplotHead(ctx, ttitle, 1150, cp.panels.size()) << range("x", 0, t_end);
+  for (size_t p = 0; p < cp.panels.size(); ++p) {
+    const auto& [m, curves] = cp.panels[p];
+    t << yRangeOrAuto(yr[p]);
     t << "set grid\nset key outside right box\nset title " << gpTitle(gpPanelTitle(m, {a}), 900)
       << "\nset xlabel 't [s]'\nset ylabel 'φ [deg]'\nplot ";
     // A curve that lies on an earlier one (within 1 % of the panel's range) is drawn dashed, so the
@@ -684,7 +761,7 @@ void plotOneKey(Ctx& ctx) {
     for (size_t n = 0; n < curves.size(); ++n) {
       bool on_earlier = false;
       for (size_t e = 0; e < n && !on_earlier; ++e)
-        on_earlier = curvesCoincide(loaded[curves[e].series], loaded[curves[n].series], t_end, tol);
+        on_earlier = curvesCoincide(cp.loaded[curves[e].series], cp.loaded[curves[n].series], t_end, tol);
       t << (n ? ", \\\n     " : "") << gpFileName(curves[n].dat) << " using 1:2 with lines lw 2 dt "
         << (on_earlier ? "(12,9)" : std::to_string(seriesDash(curves[n].i))) << " lc rgb "
         << gpQuote(seriesColor(curves[n].i)) << " title " << gpQuote(V(a.key, a.values[curves[n].i]).gp);
@@ -699,7 +776,88 @@ void plotOneKey(Ctx& ctx) {
                  (shared ? std::string("one angle scale.")
                          : std::string("each panel its own angle scale (the models' ranges differ more than threefold).")) +
                  (any_dashed ? " A dashed curve lies on an earlier one of the legend (drawn under it)." : ""),
-             1150, 60 + 430 * static_cast<int>(panels.size()));
+             1150, 60 + 430 * static_cast<int>(cp.panels.size()));
+}
+
+void plotOneKey(Ctx& ctx) {
+  plotPhiNetOverKey(ctx);
+  if (ctx.r.cases.size() <= 12) plotPhiOfTimePerValue(ctx);  // few cases only
+}
+
+// The cluster key of plotGroupedBars: read by every model first, then categorical, then the first.
+size_t clusterAxis(const ExperimentResults& r) {
+  auto readByAll = [&](const SweepAxis& a) {
+    for (const std::string& m : r.models)
+      if (!modelReads(m, a.key)) return false;
+    return true;
+  };
+  size_t ic = 0;
+  int best = -1;
+  for (size_t i = 0; i < 2; ++i) {
+    const int score = (readByAll(r.axes[i]) ? 2 : 0) + (r.axes[i].numeric ? 0 : 1);
+    if (score > best) best = score, ic = i;
+  }
+  return ic;
+}
+
+// One bar of each group: a model and a value of the bar key.
+struct BarSeries {
+  std::string model;
+  int ib;  // value of the bar key, -1: the model does not read it (its first case per cluster)
+};
+
+// The bars of each group: per model, one per value of ab, or one when the model does not read ab.
+std::vector<BarSeries> barSeries(const ExperimentResults& r, const SweepAxis& ab) {
+  std::vector<BarSeries> series;
+  for (const std::string& m : r.models) {
+    if (!modelReads(m, ab.key)) series.push_back({m, -1});
+    else
+      for (size_t j = 0; j < ab.values.size(); ++j) series.push_back({m, static_cast<int>(j)});
+  }
+  return series;
+}
+
+// Stage of plotGroupedBars: one row per cluster value, its index and each bar's phi_net.
+std::vector<std::vector<double>> barRows(const ExperimentResults& r, const SweepAxis& ac, const SweepAxis& ab,
+                                         const std::vector<BarSeries>& series) {
+  const auto cells = caseGrid(r, ac, ab);  // [cluster value][bar value]
+  std::vector<std::vector<double>> rows;
+  for (size_t i = 0; i < ac.values.size(); ++i) {
+    std::vector<double> row = {double(i)};
+    for (const BarSeries& sr : series) {
+      const CaseRecord* c = nullptr;
+      if (sr.ib >= 0) c = cells[i][sr.ib];
+      else
+        for (size_t j = 0; j < ab.values.size() && !c; ++j) c = cells[i][j];
+      row.push_back(c ? r.phiNet(*c, sr.model) : kNaN);
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// Stage of plotGroupedBars: the bars (colour = model, fill = value of ab) and each bar's value
+// above it (below a negative bar), `pad` from its end.
+std::string barPlot(const std::string& dat, const SweepAxis& ab, const std::vector<BarSeries>& series, double pad) {
+  std::ostringstream b;
+  // shades of the other key's values: solid, light, hatched two ways, then open
+  static const char* const fills[] = {"fs solid 1.0 border -1", "fs solid 0.4 border -1", "fs pattern 4 border -1",
+                                      "fs pattern 5 border -1", "fs empty border -1"};
+  for (size_t k = 0; k < series.size(); ++k) {
+    const BarSeries& sr = series[k];
+    std::string t = gpText(modelShortTitle(sr.model));
+    if (sr.ib >= 0) t += ", " + gpValueLabel(ab.key, ab.values[sr.ib]);
+    else t += " (" + keyDisplay(ab.key).symbol + " not used)";
+    b << (k ? ", \\\n     " : "") << dat << " using " << k + 2 << " "
+      << fills[sr.ib < 0 ? 0 : sr.ib % 5] << " lc rgb " << gpQuote(modelColor(sr.model)) << " title " << gpQuote(t);
+  }
+  // Bar k of a cluster of nb (gap 1) is centred at cluster + (k + 0.5 - nb / 2) / (nb + 1).
+  const size_t nb = series.size();
+  for (size_t k = 0; k < nb; ++k)
+    b << ", \\\n     " << dat << " using ($1 + " << fmt("%.6g", (k + 0.5 - 0.5 * nb) / (nb + 1.0))
+      << "):($" << k + 2 << " + ($" << k + 2 << " < 0 ? -1 : 1) * " << fmt("%.6g", 0.35 * pad) << "):(sprintf('%.2f', $"
+      << k + 2 << ")) with labels font 'Sans,12' notitle";
+  return b.str();
 }
 
 // Two swept keys of which one or both are categorical (friction law, coupling, foot shape):
@@ -709,45 +867,14 @@ void plotOneKey(Ctx& ctx) {
 // the other key's values are fill shades (solid, light, hatched, ...), named in the legend.
 void plotGroupedBars(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
-  auto readByAll = [&](const SweepAxis& a) {
-    for (const std::string& m : r.models)
-      if (!modelReads(m, a.key)) return false;
-    return true;
-  };
-  size_t ic = 0;  // the cluster key
-  int best = -1;
-  for (size_t i = 0; i < 2; ++i) {
-    const int score = (readByAll(r.axes[i]) ? 2 : 0) + (r.axes[i].numeric ? 0 : 1);
-    if (score > best) best = score, ic = i;
-  }
+  const size_t ic = clusterAxis(r);
   const SweepAxis& ac = r.axes[ic];
   const SweepAxis& ab = r.axes[1 - ic];
-  const auto cells = caseGrid(r, ac, ab);  // [cluster value][bar value]
-  struct Series {
-    std::string model;
-    int ib;  // value of ab, -1: the model does not read ab (its first case per cluster)
-  };
-  std::vector<Series> series;
-  for (const std::string& m : r.models) {
-    if (!modelReads(m, ab.key)) series.push_back({m, -1});
-    else
-      for (size_t j = 0; j < ab.values.size(); ++j) series.push_back({m, static_cast<int>(j)});
-  }
+  const std::vector<BarSeries> series = barSeries(r, ab);
   const std::string stem = r.name + "_phi_net_bars";
-  std::vector<std::vector<double>> rows;
-  for (size_t i = 0; i < ac.values.size(); ++i) {
-    std::vector<double> row = {double(i)};
-    for (const Series& sr : series) {
-      const CaseRecord* c = nullptr;
-      if (sr.ib >= 0) c = cells[i][sr.ib];
-      else
-        for (size_t j = 0; j < ab.values.size() && !c; ++j) c = cells[i][j];
-      row.push_back(c ? r.phiNet(*c, sr.model) : kNaN);
-    }
-    rows.push_back(row);
-  }
+  const std::vector<std::vector<double>> rows = barRows(r, ac, ab, series);
   std::vector<std::string> names = {leafKey(ac.key)};
-  for (const Series& sr : series)
+  for (const BarSeries& sr : series)
     names.push_back(sr.model + (sr.ib >= 0 ? "_" + leafKey(ab.key) + "=" + ab.values[sr.ib] : std::string()));
   writeDataFile(ctx.data(stem), names, rows);
 
@@ -759,34 +886,13 @@ void plotGroupedBars(Ctx& ctx) {
     for (size_t k = 1; k < row.size(); ++k)
       if (std::isfinite(row[k])) lo = std::min(lo, row[k]), hi = std::max(hi, row[k]);
   const double pad = 0.12 * std::max(hi - lo, 1e-3);
-  const size_t nb = series.size();
   std::ostringstream b;
   b << header(ctx, title, gpAxisLabel(ac.key), "φ_{net} [deg]", w)
     << "set style data histogram\nset style histogram cluster gap 1\nset boxwidth 0.9\n"
     << range("y", lo < 0 ? lo - pad : 0.0, hi > 0 ? hi + pad : 0.0)
     << "set xrange [-0.6:" << ac.values.size() - 0.4 << "]\n"
     << "set xzeroaxis lt -1\nset grid noxtics\nset key outside right top box\n"
-    << "set xtics (";
-  for (size_t i = 0; i < ac.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ac.key, ac.values[i])) << " " << i;
-  b << ")\nplot ";
-  // shades of the other key's values: solid, light, hatched two ways, then open
-  static const char* const fills[] = {"fs solid 1.0 border -1", "fs solid 0.4 border -1", "fs pattern 4 border -1",
-                                      "fs pattern 5 border -1", "fs empty border -1"};
-  for (size_t k = 0; k < series.size(); ++k) {
-    const Series& sr = series[k];
-    std::string t = gpText(modelShortTitle(sr.model));
-    if (sr.ib >= 0) t += ", " + gpValueLabel(ab.key, ab.values[sr.ib]);
-    else t += " (" + keyDisplay(ab.key).symbol + " not used)";
-    b << (k ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using " << k + 2 << " "
-      << fills[sr.ib < 0 ? 0 : sr.ib % 5] << " lc rgb " << gpQuote(modelColor(sr.model)) << " title " << gpQuote(t);
-  }
-  // Each bar's value above it (below a negative bar): bar k of a cluster of nb (gap 1) is centred
-  // at cluster + (k + 0.5 - nb / 2) / (nb + 1).
-  for (size_t k = 0; k < nb; ++k)
-    b << ", \\\n     " << gpFileName(stem + ".dat") << " using ($1 + " << fmt("%.6g", (k + 0.5 - 0.5 * nb) / (nb + 1.0))
-      << "):($" << k + 2 << " + ($" << k + 2 << " < 0 ? -1 : 1) * " << fmt("%.6g", 0.35 * pad) << "):(sprintf('%.2f', $"
-      << k + 2 << ")) with labels font 'Sans,12' notitle";
-  b << "\n";
+    << indexTics(ac) << "\nplot " << barPlot(gpFileName(stem + ".dat"), ab, series, pad) << "\n";
   std::string cap = title.plain + ". φ_net of each case as bars, grouped by " + K(ac.key).plain +
                     "; colour = model, fill = " + K(ab.key).plain + " (solid, light, hatched, in the legend's order).";
   for (const std::string& m : r.models)
@@ -803,7 +909,7 @@ void plotTwoKeys(Ctx& ctx) {
   }
   const SweepAxis& ay = r.axes[0];  // slowest-varying key (first in the file)
   const SweepAxis& ax = r.axes[1];
-  std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
+  ModelGrids grids;
   const auto cells = caseGrid(r, ay, ax);
   for (const std::string& m : r.models) {
     std::vector<std::vector<double>> g(ay.values.size(), std::vector<double>(ax.values.size(), kNaN));
@@ -829,15 +935,11 @@ void plotTwoKeys(Ctx& ctx) {
   // One panel per model, stacked: the figure keeps the width of figures.html's column, so its text
   // stays legible there (figures.html shows images at most 1100 px wide).
   const int panel_w = 1150, fig_w = panel_w, fig_h = 60 + 430 * static_cast<int>(grids.size());
-  b << "reset\nset multiplot layout " << grids.size() << ",1 title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n";
-  if (!ax.numeric) {
-    b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
-    for (size_t i = 0; i < ax.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ax.key, ax.values[i])) << " " << i;
-    b << ")\n";
-  }
+  b << multiplotHead(ctx, title, fig_w, grids.size());
+  if (!ax.numeric) b << categoricalXAxis(ax);
   for (size_t p = 0; p < grids.size(); ++p) {
     const auto& [m, g] = grids[p];
-    b << (std::isfinite(yr[p].first) ? range("y", yr[p].first, yr[p].second) : std::string("set autoscale y\n"));
+    b << yRangeOrAuto(yr[p]);
     const std::string dstem = r.name + "_phi_net_lines_" + m;
     std::vector<std::vector<double>> rows;
     for (size_t ix = 0; ix < ax.values.size(); ++ix) {
@@ -864,17 +966,8 @@ void plotTwoKeys(Ctx& ctx) {
              fig_w, fig_h);
 }
 
-// Small multiples for 3 or more swept keys (facetKeys): one figure per model, one panel per
-// combination of the facet keys' values (a grid: rows and columns are the two facet keys when
-// there are two), in each panel phi_net over the x key with one curve per value of the series key.
-// Every panel of a figure has the same axes, so panels compare by eye.
-void plotManyKeys(Ctx& ctx) {
-  const ExperimentResults& r = ctx.r;
-  const FacetKeys fk = facetKeys(r.axes);
-  const SweepAxis& ax = r.axes[fk.x];
-  const SweepAxis& as = r.axes[fk.series];
-  const KeyDisplay kx = keyDisplay(ax.key);
-  // The cases by their values of every axis, in axes order.
+// The cases by their values of every axis, in axes order ("" for a key a case does not set).
+std::map<std::vector<std::string>, const CaseRecord*> caseIndex(const ExperimentResults& r) {
   std::map<std::vector<std::string>, const CaseRecord*> index;
   for (const CaseRecord& c : r.cases) {
     std::vector<std::string> k;
@@ -884,7 +977,11 @@ void plotManyKeys(Ctx& ctx) {
     }
     index.emplace(k, &c);
   }
-  // Every combination of the facet keys' values, the last facet key fastest.
+  return index;
+}
+
+// Every combination of the facet keys' values (indices), the last facet key fastest.
+std::vector<std::vector<size_t>> facetCombos(const ExperimentResults& r, const FacetKeys& fk) {
   std::vector<std::vector<size_t>> combos(1);
   for (size_t f : fk.facets) {
     std::vector<std::vector<size_t>> next;
@@ -895,107 +992,156 @@ void plotManyKeys(Ctx& ctx) {
       }
     combos = std::move(next);
   }
-  const size_t np = combos.size();
+  return combos;
+}
+
+// The small multiples' grid: rows and columns of panels, their size and the figure's.
+struct FacetGrid {
   size_t cols = 1, rows = 1;
+  int panel_w = 0, panel_h = 0, legend_w = 260, fig_w = 0, fig_h = 0;
+};
+
+// Rows and columns are the two facet keys when there are two, else a near-square grid; panels
+// shrink with their number, the whole figure within about 3000 x 2400 px.
+FacetGrid facetGrid(const ExperimentResults& r, const FacetKeys& fk, size_t np) {
+  FacetGrid g;
   if (fk.facets.size() == 2) {
-    rows = r.axes[fk.facets[0]].values.size();
-    cols = r.axes[fk.facets[1]].values.size();
+    g.rows = r.axes[fk.facets[0]].values.size();
+    g.cols = r.axes[fk.facets[1]].values.size();
   } else {
-    cols = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(np))));
-    rows = (np + cols - 1) / cols;
+    g.cols = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(np))));
+    g.rows = (np + g.cols - 1) / g.cols;
   }
-  // Panel size shrinks with their number, the whole figure within about 3000 x 2400 px.
-  const int panel_w = std::clamp(3000 / static_cast<int>(cols), 380, 620);
-  const int panel_h = std::clamp(2400 / static_cast<int>(rows), 300, 440);
-  const int legend_w = 260;
-  const int fig_w = panel_w * static_cast<int>(cols) + legend_w, fig_h = panel_h * static_cast<int>(rows) + 90;
+  g.panel_w = std::clamp(3000 / static_cast<int>(g.cols), 380, 620);
+  g.panel_h = std::clamp(2400 / static_cast<int>(g.rows), 300, 440);
+  g.fig_w = g.panel_w * static_cast<int>(g.cols) + g.legend_w, g.fig_h = g.panel_h * static_cast<int>(g.rows) + 90;
+  return g;
+}
+
+// Stage of plotManyKeys: model m's data file of each panel (phi_net over the x key, a column per
+// series value); the finite values go to `all`. Returns the files' names.
+std::vector<std::string> writeFacetData(const Ctx& ctx, const std::string& m, const FacetKeys& fk,
+                                        const std::map<std::vector<std::string>, const CaseRecord*>& index,
+                                        const std::vector<std::vector<size_t>>& combos, std::vector<double>& all) {
+  const ExperimentResults& r = ctx.r;
+  const SweepAxis& ax = r.axes[fk.x];
+  const SweepAxis& as = r.axes[fk.series];
+  const KeyDisplay kx = keyDisplay(ax.key);
+  std::vector<std::string> dats;
+  for (size_t p = 0; p < combos.size(); ++p) {
+    std::vector<std::vector<double>> rowsd;
+    for (size_t ix = 0; ix < ax.values.size(); ++ix) {
+      std::vector<double> row = {ax.numeric ? ax.number(ix) * kx.scale : double(ix)};
+      for (size_t is = 0; is < as.values.size(); ++is) {
+        std::vector<std::string> k(r.axes.size());
+        k[fk.x] = ax.values[ix];
+        k[fk.series] = as.values[is];
+        for (size_t f = 0; f < fk.facets.size(); ++f) k[fk.facets[f]] = r.axes[fk.facets[f]].values[combos[p][f]];
+        const auto it = index.find(k);
+        const double v = it == index.end() ? kNaN : r.phiNet(*it->second, m);
+        row.push_back(v);
+        if (std::isfinite(v)) all.push_back(v);
+      }
+      rowsd.push_back(row);
+    }
+    const std::string dstem = r.name + "_phi_net_facets_" + m + "_" + std::to_string(p);
+    std::vector<std::string> names = {leafKey(ax.key)};
+    for (const std::string& v : as.values) names.push_back(leafKey(as.key) + "=" + v);
+    writeDataFile(ctx.data(dstem), names, rowsd);
+    dats.push_back(dstem + ".dat");
+  }
+  return dats;
+}
+
+// Stage of plotManyKeys: the figure's title, with the keys model m does not read
+// ("mujoco.foot_shape" for the analytic model).
+Txt facetTitle(const Ctx& ctx, const std::string& m, const FacetKeys& fk, const std::string& facet_words) {
+  const ExperimentResults& r = ctx.r;
+  std::string unused;
+  for (const SweepAxis& a : r.axes)
+    if (!modelReads(m, a.key)) unused += (unused.empty() ? "" : ", ") + keyDisplay(a.key).plain;
+  Txt who{gpText(modelTitle(m)), modelTitle(m)};
+  if (!unused.empty()) who = who + Txt{gpText(" (" + unused + " not used)"), " (" + unused + " not used)"};
+  return ctx.title(W("phi_net over ") + K(r.axes[fk.x].key) + W(", one curve per ") + K(r.axes[fk.series].key) +
+                   Txt{", one panel per " + gpText(facet_words), ", one panel per " + facet_words} + ctx.tail +
+                   W(": ") + who);
+}
+
+// Stage of plotManyKeys: panel p at its place in the grid, titled with its facet values, one curve
+// per series value; the first panel carries the legend beside the top-right panel.
+std::string facetPanel(const ExperimentResults& r, const FacetKeys& fk, const FacetGrid& g, size_t p,
+                       const std::vector<size_t>& combo, const std::string& dat, double right, double top) {
+  const SweepAxis& as = r.axes[fk.series];
+  std::ostringstream b;
+  const size_t row = p / g.cols, col = p % g.cols;
+  const double w = right / g.cols, h = top / g.rows;
+  std::string ptitle;
+  for (size_t f = 0; f < fk.facets.size(); ++f) {
+    const SweepAxis& fa = r.axes[fk.facets[f]];
+    ptitle += (f ? ", " : "") + gpValueLabel(fa.key, fa.values[combo[f]]);
+  }
+  b << "set origin " << fmt("%.5f", col * w) << "," << fmt("%.5f", top - (row + 1) * h) << "\nset size "
+    << fmt("%.5f", w) << "," << fmt("%.5f", h) << "\nset title " << gpQuote(ptitle) << "\n";
+  if (p == 0) {
+    b << "set key at screen " << fmt("%.5f", right + 0.01) << ", screen " << fmt("%.5f", top)
+      << " left top box opaque title " << gpQuote(keyDisplay(as.key).symbol) << "\n";
+  } else if (p == 1) {
+    b << "unset key\n";
+  }
+  b << "plot ";
+  for (size_t is = 0; is < as.values.size(); ++is)
+    b << (is ? ", \\\n     " : "") << gpFileName(dat) << " using 1:" << is + 2 << " with linespoints lw 2 pt "
+      << seriesPoint(is) << " ps 1.1 dt " << seriesDash(is) << " lc rgb " << gpQuote(seriesColor(is))
+      << " title " << gpQuote(gpValueLabel(as.key, as.values[is], false));
+  b << "\n";
+  return b.str();
+}
+
+// Small multiples for 3 or more swept keys (facetKeys): one figure per model, one panel per
+// combination of the facet keys' values (a grid: rows and columns are the two facet keys when
+// there are two), in each panel phi_net over the x key with one curve per value of the series key.
+// Every panel of a figure has the same axes, so panels compare by eye.
+void plotManyKeys(Ctx& ctx) {
+  const ExperimentResults& r = ctx.r;
+  const FacetKeys fk = facetKeys(r.axes);
+  const SweepAxis& ax = r.axes[fk.x];
+  const SweepAxis& as = r.axes[fk.series];
+  const KeyDisplay kx = keyDisplay(ax.key);
+  const auto index = caseIndex(r);
+  const std::vector<std::vector<size_t>> combos = facetCombos(r, fk);
+  const FacetGrid g = facetGrid(r, fk, combos.size());
   std::string facet_words;
   for (size_t f = 0; f < fk.facets.size(); ++f)
     facet_words += std::string(f ? " and " : "") + keyDisplay(r.axes[fk.facets[f]].key).plain;
 
   for (const std::string& m : r.models) {
     std::vector<double> all;
-    std::vector<std::string> dats;
-    for (size_t p = 0; p < np; ++p) {
-      std::vector<std::vector<double>> rowsd;
-      for (size_t ix = 0; ix < ax.values.size(); ++ix) {
-        std::vector<double> row = {ax.numeric ? ax.number(ix) * kx.scale : double(ix)};
-        for (size_t is = 0; is < as.values.size(); ++is) {
-          std::vector<std::string> k(r.axes.size());
-          k[fk.x] = ax.values[ix];
-          k[fk.series] = as.values[is];
-          for (size_t f = 0; f < fk.facets.size(); ++f) k[fk.facets[f]] = r.axes[fk.facets[f]].values[combos[p][f]];
-          const auto it = index.find(k);
-          const double v = it == index.end() ? kNaN : r.phiNet(*it->second, m);
-          row.push_back(v);
-          if (std::isfinite(v)) all.push_back(v);
-        }
-        rowsd.push_back(row);
-      }
-      const std::string dstem = r.name + "_phi_net_facets_" + m + "_" + std::to_string(p);
-      std::vector<std::string> names = {leafKey(ax.key)};
-      for (const std::string& v : as.values) names.push_back(leafKey(as.key) + "=" + v);
-      writeDataFile(ctx.data(dstem), names, rowsd);
-      dats.push_back(dstem + ".dat");
-    }
+    const std::vector<std::string> dats = writeFacetData(ctx, m, fk, index, combos, all);
     if (all.empty()) continue;
     const auto [ylo, yhi] = span(all, 0.08);
-    // keys this model does not read ("mujoco.foot_shape" for the analytic model): said in the title
-    std::string unused;
-    for (const SweepAxis& a : r.axes)
-      if (!modelReads(m, a.key)) unused += (unused.empty() ? "" : ", ") + keyDisplay(a.key).plain;
-    Txt who{gpText(modelTitle(m)), modelTitle(m)};
-    if (!unused.empty()) who = who + Txt{gpText(" (" + unused + " not used)"), " (" + unused + " not used)"};
-    const Txt title = ctx.title(W("phi_net over ") + K(ax.key) + W(", one curve per ") + K(as.key) +
-                                Txt{", one panel per " + gpText(facet_words), ", one panel per " + facet_words} +
-                                ctx.tail + W(": ") + who);
-    const std::string stem = r.name + "_phi_net_facets_" + m;
+    const Txt title = facetTitle(ctx, m, fk, facet_words);
     std::ostringstream b;
     // Panels leave room on the right for one legend beside the top-right panel.
-    const double right = 1.0 - static_cast<double>(legend_w) / fig_w;
-    const double top = 1.0 - 70.0 / fig_h;
-    b << "reset\nset multiplot title " << ctx.figTitle(title, fig_w, 17) << " font 'Sans,17'\n"
+    const double right = 1.0 - static_cast<double>(g.legend_w) / g.fig_w;
+    const double top = 1.0 - 70.0 / g.fig_h;
+    b << "reset\nset multiplot title " << ctx.figTitle(title, g.fig_w, 17) << " font 'Sans,17'\n"
       << (std::isfinite(ylo) ? range("y", ylo, yhi) : std::string()) << "set grid\nset xzeroaxis lt -1\n"
       << "set xlabel " << gpQuote(gpAxisLabel(ax.key)) << "\nset ylabel 'φ_{net} [deg]'\n";
     if (!ax.numeric) {
-      b << "set xrange [-0.3:" << ax.values.size() - 0.7 << "]\nset xtics (";
-      for (size_t i = 0; i < ax.values.size(); ++i) b << (i ? ", " : "") << gpQuote(ticLabel(ax.key, ax.values[i])) << " " << i;
-      b << ")\n";
+      b << categoricalXAxis(ax);
     } else {  // the swept values and a 3 % margin, not gnuplot's rounded tics
       std::vector<double> xs;
       for (size_t i = 0; i < ax.values.size(); ++i) xs.push_back(ax.number(i) * kx.scale);
       const auto [xlo, xhi] = span(xs, 0.03);
       if (std::isfinite(xlo)) b << range("x", xlo, xhi);
     }
-    for (size_t p = 0; p < np; ++p) {
-      const size_t row = p / cols, col = p % cols;
-      const double w = right / cols, h = top / rows;
-      std::string ptitle;
-      for (size_t f = 0; f < fk.facets.size(); ++f) {
-        const SweepAxis& fa = r.axes[fk.facets[f]];
-        ptitle += (f ? ", " : "") + gpValueLabel(fa.key, fa.values[combos[p][f]]);
-      }
-      b << "set origin " << fmt("%.5f", col * w) << "," << fmt("%.5f", top - (row + 1) * h) << "\nset size "
-        << fmt("%.5f", w) << "," << fmt("%.5f", h) << "\nset title " << gpQuote(ptitle) << "\n";
-      if (p == 0) {
-        b << "set key at screen " << fmt("%.5f", right + 0.01) << ", screen " << fmt("%.5f", top)
-          << " left top box opaque title " << gpQuote(keyDisplay(as.key).symbol) << "\n";
-      } else if (p == 1) {
-        b << "unset key\n";
-      }
-      b << "plot ";
-      for (size_t is = 0; is < as.values.size(); ++is)
-        b << (is ? ", \\\n     " : "") << gpFileName(dats[p]) << " using 1:" << is + 2 << " with linespoints lw 2 pt "
-          << seriesPoint(is) << " ps 1.1 dt " << seriesDash(is) << " lc rgb " << gpQuote(seriesColor(is))
-          << " title " << gpQuote(gpValueLabel(as.key, as.values[is], false));
-      b << "\n";
-    }
+    for (size_t p = 0; p < combos.size(); ++p) b << facetPanel(r, fk, g, p, combos[p], dats[p], right, top);
     b << "unset multiplot\n";
-    ctx.render(stem, b.str(), title,
+    ctx.render(r.name + "_phi_net_facets_" + m, b.str(), title,
                title.plain + ". φ_net of " + modelTitle(m) + " over " + K(ax.key).plain + ", one curve per value of " +
                    K(as.key).plain + ", one panel per value of " + facet_words +
                    "; every panel has the same axes. A missing point is a case that was not run or failed.",
-               fig_w, fig_h);
+               g.fig_w, g.fig_h);
   }
 }
 
@@ -1056,7 +1202,7 @@ void plotPoseOneKey(Ctx& ctx) {
     const std::string ylabel = perIzz ? "contribution to φ̈ [rad/s^2]" : "moment [N m]";
     const Txt title = ctx.title(Txt{"tail moment contributions over ", "tail moment contributions over "} + K(a.key) + ctx.tail);
     std::ostringstream b;
-    b << "reset\nset multiplot layout 1,2 title " << ctx.figTitle(title, 1600, 17) << " font 'Sans,17'\n";
+    b << multiplotHead(ctx, title, 1600, 1, 2);
     for (int j = 0; j < 2; ++j)
       b << "set grid\nunset key\nset xzeroaxis lt -1\nset title " << gpTitle(parts[j].gp, 800) << "\nset xlabel "
         << gpQuote(gpAxisLabel(a.key)) << "\nset ylabel " << gpQuote(ylabel) << "\nplot " << gpFileName(stem + ".dat")
@@ -1085,7 +1231,7 @@ void plotPoseTwoKeys(Ctx& ctx) {
   const ExperimentResults& r = ctx.r;
   const SweepAxis& ay = r.axes[0];
   const SweepAxis& ax = r.axes[1];
-  std::vector<std::pair<std::string, std::vector<std::vector<double>>>> grids;
+  ModelGrids grids;
   const auto cells = caseGrid(r, ay, ax);
   for (const std::string& m : r.models) {
     std::vector<std::vector<double>> g(ay.values.size(), std::vector<double>(ax.values.size(), kNaN));

@@ -254,13 +254,10 @@ void checkCaseDir(const CaseRecord& c, const fs::path& file) {
                              "with '.' or '-'; this folder was not written by tailsim as it is)");
 }
 
-}  // namespace
-
-ExperimentResults loadResults(const std::string& dir) {
-  ExperimentResults r;
-  r.dir = dir;
-  const fs::path root(dir);
-  std::vector<std::string> keys;
+// Stage 1 of loadResults: the experiment's name, source, kind, swept keys and cases from
+// summary.json, or, from an interrupted run, its journal or its case folders.
+void readCaseRecords(const fs::path& root, const std::string& dir, ExperimentResults& r,
+                     std::vector<std::string>& keys) {
   if (fs::exists(root / "summary.json")) {
     const json s = readJson(root / "summary.json");
     r.name = s.value("experiment", std::string());
@@ -302,29 +299,35 @@ ExperimentResults loadResults(const std::string& dir) {
   } else {
     throw std::runtime_error(dir + " is not a result folder (no summary.json, no cases/, no cases.jsonl)");
   }
+}
+
+// Stage 2: the cases as run, from the folder's own copies (experiment.yaml -> robot.yaml); fills
+// in the kind, description, name and link count the records left open, or says why it cannot.
+void resolveCases(const fs::path& root, ExperimentResults& r) {
   const bool kind_given = !r.kind.empty();
   if (!kind_given) r.kind = "simulate";
-  // The cases as run, from the folder's own copies (experiment.yaml -> robot.yaml).
-  if (fs::exists(root / "experiment.yaml")) {
-    try {
-      Experiment e = loadExperiment((root / "experiment.yaml").string());
-      resolveRobotModels(e);  // a robot from its model file: the values the run used
-      for (const ExperimentCase& c : e.cases) r.resolved.emplace(c.name, c);
-      if (!kind_given && !e.cases.empty()) r.kind = name(e.cases.front().kind);
-      if (r.description.empty()) r.description = e.description;
-      if (r.name.empty()) r.name = e.name;
-      r.links = e.cases.empty() ? 0 : e.cases.front().robot.numLinks();
-      for (const ExperimentCase& c : e.cases)
-        if (c.robot.numLinks() != e.cases.front().robot.numLinks()) r.links = 0;
-    } catch (const std::exception& ex) {
-      r.resolve_error = ex.what();
-    }
-  } else {
+  if (!fs::exists(root / "experiment.yaml")) {
     r.resolve_error = (root / "experiment.yaml").string() + " is missing";
+    return;
   }
-  if (r.name.empty()) r.name = root.filename().string();
+  try {
+    Experiment e = loadExperiment((root / "experiment.yaml").string());
+    resolveRobotModels(e);  // a robot from its model file: the values the run used
+    for (const ExperimentCase& c : e.cases) r.resolved.emplace(c.name, c);
+    if (!kind_given && !e.cases.empty()) r.kind = name(e.cases.front().kind);
+    if (r.description.empty()) r.description = e.description;
+    if (r.name.empty()) r.name = e.name;
+    r.links = e.cases.empty() ? 0 : e.cases.front().robot.numLinks();
+    for (const ExperimentCase& c : e.cases)
+      if (c.robot.numLinks() != e.cases.front().robot.numLinks()) r.links = 0;
+  } catch (const std::exception& ex) {
+    r.resolve_error = ex.what();
+  }
+}
 
-  // Keys: summary order first, then any others found in the cases.
+// Stage 3: one axis per key with two or more values (summary order first, then any others found
+// in the cases); a numeric axis's values in increasing order.
+void findAxes(ExperimentResults& r, std::vector<std::string> keys) {
   for (const CaseRecord& c : r.cases)
     for (const auto& [k, v] : c.sweep)
       if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
@@ -342,6 +345,10 @@ ExperimentResults loadResults(const std::string& dir) {
                        [](const std::string& x, const std::string& y) { return *parseNumber(x) < *parseNumber(y); });
     r.axes.push_back(a);
   }
+}
+
+// Stage 4: the models that ran any case, in the registry's order (unknown ones last).
+void findModels(const std::string& dir, ExperimentResults& r) {
   for (const CaseRecord& c : r.cases)
     for (const auto& [m, run] : c.runs)
       if (!r.hasModel(m)) {
@@ -356,6 +363,20 @@ ExperimentResults loadResults(const std::string& dir) {
     auto rank = [&](const std::string& m) { return std::find(names.begin(), names.end(), m) - names.begin(); };
     return rank(a) < rank(b);
   });
+}
+
+}  // namespace
+
+ExperimentResults loadResults(const std::string& dir) {
+  ExperimentResults r;
+  r.dir = dir;
+  const fs::path root(dir);
+  std::vector<std::string> keys;
+  readCaseRecords(root, dir, r, keys);
+  resolveCases(root, r);
+  if (r.name.empty()) r.name = root.filename().string();
+  findAxes(r, keys);
+  findModels(dir, r);
   return r;
 }
 

@@ -258,7 +258,6 @@ std::vector<std::string> figuresOf(const ExperimentResults& r, const fs::path& r
   return out;
 }
 
-// One experiment's entry of data.js; writes the replay file of each case that kept time series.
 // Writes DIR/name of the page's own files: replaced only when tailsim wrote them (DIR's manifest,
 // or the data of an earlier tailsim's page, recognised by its first call).
 void writePageFile(const fs::path& dir, const std::string& name, const std::string& text) {
@@ -267,6 +266,90 @@ void writePageFile(const fs::path& dir, const std::string& name, const std::stri
   });
 }
 
+// One model's per-case columns of data.js, in case order; ok/warnings/error as JS literals.
+struct RunColumns {
+  std::vector<double> phi, tstop, events, wall;
+  std::vector<std::string> ok, warn, err;
+};
+
+// Appends case c's run of model m (or its absence) to the model's columns.
+void addRun(RunColumns& cols, const CaseRecord& c, const std::string& m) {
+  const auto run = c.runs.find(m);
+  const bool has = run != c.runs.end();
+  cols.phi.push_back(has ? run->second.phi_net_deg : NAN);
+  cols.tstop.push_back(has ? run->second.t_stop_s : NAN);
+  cols.events.push_back(has ? run->second.stick_slip_events : NAN);
+  cols.wall.push_back(has ? run->second.wall_time_s : NAN);
+  cols.ok.push_back(!has ? "null" : run->second.ok ? "1" : "0");
+  cols.warn.push_back(has ? jsString(joined(run->second.warnings, "; ")) : "\"\"");
+  cols.err.push_back(has ? jsString(run->second.error) : "\"\"");
+}
+
+// Case k's replay: writes page/cases/e<index>c<k>.js with every model's series that can be read
+// and returns its URL as a JS string, or "null" when the case kept no series.
+std::string caseReplay(const ExperimentResults& r, size_t k, int index, const fs::path& cases_dir,
+                       GeometryCache& geometry, std::vector<std::string>& notes) {
+  const CaseRecord& c = r.cases[k];
+  const ExperimentCase* rc = r.resolvedCase(c);
+  if (rc && rc->output.time_series == TimeSeriesOutput::kNone) return "null";
+  std::string models;
+  for (const std::string& m : r.models) {
+    if (!c.runs.count(m)) continue;
+    try {
+      const TimeSeries ts = r.series(c, m);
+      if (ts.numRows() == 0) continue;
+      models += (models.empty() ? "" : ",") + jsString(m) + ":" + seriesJson(ts);
+    } catch (const std::exception&) {  // a failed run or a missing file: the case has no replay of it
+    }
+  }
+  if (models.empty()) return "null";
+  const std::string id = "e" + std::to_string(index) + "c" + std::to_string(k);
+  std::vector<double> phases;  // t0, t1, t2 of each joint's stroke (accelerating / decelerating)
+  if (rc)
+    for (const SplitCycleParams& j : rc->joints) {
+      phases.push_back(j.t0_s);
+      phases.push_back(j.t0_s + j.w_ss * j.dT_s);
+      phases.push_back(j.t0_s + j.dT_s);
+    }
+  std::string text = "tailsim.caseLoaded({\"id\":" + jsString(id) + ",\"name\":" + jsString(c.name) +
+                     ",\"geometry\":" + geometry.of(r, rc, &notes) + ",\"links\":" +
+                     std::to_string(rc ? rc->robot.numLinks() : 0) + ",\"strokes\":" + numArray(phases) +
+                     ",\"models\":{" + models + "}});\n";
+  writePageFile(cases_dir, id + ".js", text);
+  return jsString("page/cases/" + id + ".js");
+}
+
+// The "axes" entries of data.js: each swept key, its values and each case's index into them.
+std::vector<std::string> axesJson(const ExperimentResults& r, const std::vector<std::vector<int>>& axis_index) {
+  std::vector<std::string> a;
+  for (size_t i = 0; i < r.axes.size(); ++i) {
+    const SweepAxis& ax = r.axes[i];
+    std::vector<double> numbers;
+    for (size_t v = 0; v < ax.values.size(); ++v) numbers.push_back(ax.number(v));
+    a.push_back("{\"key\":" + jsString(ax.key) + ",\"label\":" + jsString(axisLabel(leafKey(ax.key))) +
+                ",\"numeric\":" + (ax.numeric ? "true" : "false") + ",\"values\":" + strArray(ax.values) +
+                ",\"numbers\":" + numArray(numbers) + ",\"index\":" +
+                array(axis_index[i], [](int v) { return std::to_string(v); }) + "}");
+  }
+  return a;
+}
+
+// The "runs" object of data.js: per model, its columns over the cases.
+std::string runsJson(const std::vector<std::string>& models, std::map<std::string, RunColumns>& runs) {
+  std::ostringstream o;
+  const auto raw = [](const std::string& s) { return s; };
+  for (size_t i = 0; i < models.size(); ++i) {
+    const std::string& m = models[i];
+    const RunColumns& c = runs[m];
+    o << (i ? "," : "") << jsString(m) << ":{\"phi_net_deg\":" << numArray(c.phi) << ",\"t_stop_s\":" << numArray(c.tstop)
+      << ",\"stick_slip_events\":" << numArray(c.events) << ",\"wall_time_s\":" << numArray(c.wall)
+      << ",\"ok\":" << array(c.ok, raw) << ",\"warnings\":" << array(c.warn, raw) << ",\"error\":" << array(c.err, raw)
+      << "}";
+  }
+  return o.str();
+}
+
+// One experiment's entry of data.js; writes the replay file of each case that kept time series.
 std::string experimentJson(const ExperimentResults& r, int index, const fs::path& root, GeometryCache& geometry) {
   std::vector<std::string> notes;
   if (!r.resolve_error.empty()) notes.push_back(r.resolve_error);
@@ -274,90 +357,22 @@ std::string experimentJson(const ExperimentResults& r, int index, const fs::path
   const size_t n = r.cases.size();
   std::vector<std::string> names, replay;
   std::vector<std::vector<int>> axis_index(r.axes.size(), std::vector<int>(n, -1));
-  std::map<std::string, std::vector<double>> phi, tstop, events, wall;
-  std::map<std::string, std::vector<std::string>> ok, warn, err;
-  const fs::path cases_dir = root / "page" / "cases";
+  std::map<std::string, RunColumns> runs;
   for (size_t k = 0; k < n; ++k) {
     const CaseRecord& c = r.cases[k];
     names.push_back(c.name);
     for (size_t a = 0; a < r.axes.size(); ++a)
       if (auto it = c.sweep.find(r.axes[a].key); it != c.sweep.end()) axis_index[a][k] = r.axes[a].indexOf(it->second);
-    for (const std::string& m : r.models) {
-      const auto run = c.runs.find(m);
-      const bool has = run != c.runs.end();
-      phi[m].push_back(has ? run->second.phi_net_deg : NAN);
-      tstop[m].push_back(has ? run->second.t_stop_s : NAN);
-      events[m].push_back(has ? run->second.stick_slip_events : NAN);
-      wall[m].push_back(has ? run->second.wall_time_s : NAN);
-      ok[m].push_back(!has ? "null" : run->second.ok ? "1" : "0");
-      warn[m].push_back(has ? jsString(joined(run->second.warnings, "; ")) : "\"\"");
-      err[m].push_back(has ? jsString(run->second.error) : "\"\"");
-    }
-    // The replay: every model's series that can be read.
-    const ExperimentCase* rc = r.resolvedCase(c);
-    if (rc && rc->output.time_series == TimeSeriesOutput::kNone) {
-      replay.push_back("null");
-      continue;
-    }
-    std::string models;
-    for (const std::string& m : r.models) {
-      if (!c.runs.count(m)) continue;
-      try {
-        const TimeSeries ts = r.series(c, m);
-        if (ts.numRows() == 0) continue;
-        models += (models.empty() ? "" : ",") + jsString(m) + ":" + seriesJson(ts);
-      } catch (const std::exception&) {  // a failed run or a missing file: the case has no replay of it
-      }
-    }
-    if (models.empty()) {
-      replay.push_back("null");
-      continue;
-    }
-    const std::string id = "e" + std::to_string(index) + "c" + std::to_string(k);
-    std::vector<double> phases;  // t0, t1, t2 of each joint's stroke (accelerating / decelerating)
-    if (rc)
-      for (const SplitCycleParams& j : rc->joints) {
-        phases.push_back(j.t0_s);
-        phases.push_back(j.t0_s + j.w_ss * j.dT_s);
-        phases.push_back(j.t0_s + j.dT_s);
-      }
-    std::string text = "tailsim.caseLoaded({\"id\":" + jsString(id) + ",\"name\":" + jsString(c.name) +
-                       ",\"geometry\":" + geometry.of(r, rc, &notes) + ",\"links\":" +
-                       std::to_string(rc ? rc->robot.numLinks() : 0) + ",\"strokes\":" + numArray(phases) +
-                       ",\"models\":{" + models + "}});\n";
-    writePageFile(cases_dir, id + ".js", text);
-    replay.push_back(jsString("page/cases/" + id + ".js"));
+    for (const std::string& m : r.models) addRun(runs[m], c, m);
+    replay.push_back(caseReplay(r, k, index, root / "page" / "cases", geometry, notes));
   }
   std::ostringstream o;
   o << "{\"name\":" << jsString(r.name) << ",\"description\":" << jsString(r.description)
     << ",\"kind\":" << jsString(r.kind) << ",\"dir\":" << jsString(relUrl(r.dir, root.string()))
     << ",\"models\":" << modelsJson(r.models) << ",\"notes\":" << strArray(notes)
-    << ",\"figures\":" << strArray(figuresOf(r, root)) << ",\"axes\":["
-    << joined([&] {
-         std::vector<std::string> a;
-         for (size_t i = 0; i < r.axes.size(); ++i) {
-           const SweepAxis& ax = r.axes[i];
-           std::vector<double> numbers;
-           for (size_t v = 0; v < ax.values.size(); ++v) numbers.push_back(ax.number(v));
-           a.push_back("{\"key\":" + jsString(ax.key) + ",\"label\":" + jsString(axisLabel(leafKey(ax.key))) +
-                       ",\"numeric\":" + (ax.numeric ? "true" : "false") + ",\"values\":" + strArray(ax.values) +
-                       ",\"numbers\":" + numArray(numbers) + ",\"index\":" +
-                       array(axis_index[i], [](int v) { return std::to_string(v); }) + "}");
-         }
-         return a;
-       }(),
-              ",")
+    << ",\"figures\":" << strArray(figuresOf(r, root)) << ",\"axes\":[" << joined(axesJson(r, axis_index), ",")
     << "],\"cases\":{\"name\":" << strArray(names) << ",\"replay\":" << array(replay, [](const std::string& s) { return s; })
-    << ",\"runs\":{";
-  const auto raw = [](const std::string& s) { return s; };
-  for (size_t i = 0; i < r.models.size(); ++i) {
-    const std::string& m = r.models[i];
-    o << (i ? "," : "") << jsString(m) << ":{\"phi_net_deg\":" << numArray(phi[m]) << ",\"t_stop_s\":" << numArray(tstop[m])
-      << ",\"stick_slip_events\":" << numArray(events[m]) << ",\"wall_time_s\":" << numArray(wall[m])
-      << ",\"ok\":" << array(ok[m], raw) << ",\"warnings\":" << array(warn[m], raw) << ",\"error\":" << array(err[m], raw)
-      << "}";
-  }
-  o << "}}}";
+    << ",\"runs\":{" << runsJson(r.models, runs) << "}}}";
   return o.str();
 }
 

@@ -547,6 +547,149 @@ std::string robotHeader(const RobotParams& p, const MujocoSettings& s, const Eff
   return t + "  ";
 }
 
+// The Menagerie robot file's comments: the paper's symbols next to the elements that carry them.
+void annotateMenagerieRobot(XMLElement* root, XMLElement* dmain, XMLElement* body, const RobotParams& p,
+                            const MujocoSettings& s, double mu) {
+  const QuadrupedParams& q = p.quadruped;
+  XMLElement* foot_default = dmain->FirstChildElement("default")->NextSiblingElement("default");
+  noteBefore(foot_default->FirstChildElement("geom"),
+             "mu = " + g6(mu) + ": the paper's foot friction. priority=\"1\": a foot's contact takes the foot's "
+             "friction, condim, solref and solimp, whatever the floor's (equal priorities would take the larger "
+             "friction: a floor of friction 1 would win).");
+  XMLElement* tail_default = foot_default->NextSiblingElement("default");
+  noteBefore(tail_default->FirstChildElement("general"),
+             "PD position servo: force = kp (ctrl - theta) - kv theta_dot (gainprm kp, biasprm 0 -kp -kv)");
+  const std::array<double, 3> Iq = quadrupedDiagInertia(q);
+  noteBefore(body->FirstChildElement("inertial"),
+             "Q: quadruped COM, frame origin, h = " + g6(s.body_height_m) + " m above the ground, x forward, z up. m_Q = " +
+                 g6(q.mass_kg) + " kg, I_zz,Q = " + g6(q.izz_kgm2) + " kg m^2; Ixx, Iyy = " + g6(Iq[0]) + ", " +
+                 g6(Iq[1]) + " kg m^2 from a 0.1 m high box of the same I_zz (only I_zz enters the planar model)");
+  noteBefore(childNamed(body, "geom", mjcf::footGeomName(1)),
+             "feet k = 1..4 (FL, FR, RR, RL) at (d_Q2C +- l_F/2, +-w_F/2), Eq. 17: d_Q2C = " + g6(q.d_Q2C_m) +
+                 " m, l_F = " + g6(q.l_F_m) + " m, w_F = " + g6(q.w_F_m) + " m; " + footNote(s) + " touching z = 0. Only the feet collide.");
+  XMLElement* link = childNamed(body, "body", mjcf::tailBodyName(1));
+  noteBefore(link, "tail base B at -d_Q2B along x, d_Q2B = " + g6(q.d_Q2B_m) +
+                       " m (Eq. 2); R_B = R_Q R_Z(180 deg) (Eq. 1): theta_i = 0 is the tail straight back");
+  const std::vector<double> I = tailJointInertias(p);
+  for (int i = 1; i <= p.numLinks(); ++i) {
+    const TailLink& l = p.tail[i - 1];
+    noteBefore(link->FirstChildElement("joint"),
+               "link " + std::to_string(i) + ": m_L," + std::to_string(i) + " = " + g6(l.mass_kg) + " kg, I_zz,L," +
+                   std::to_string(i) + " = " + g6(l.izz_kgm2) + " kg m^2 about its COM, L_L," + std::to_string(i) +
+                   " = " + g6(l.length_m) + " m (joint " + std::to_string(i) + " to joint " + std::to_string(i + 1) +
+                   "), COM " + g6(l.com_offset_m) + " m from joint " + std::to_string(i) + "; joint " +
+                   std::to_string(i) + ": theta_" + std::to_string(i) + ", relative to link " + std::to_string(i - 1));
+    if (i < p.numLinks()) link = childNamed(link, "body", mjcf::tailBodyName(i + 1));
+  }
+  XMLElement* actuator = root->FirstChildElement("actuator");
+  noteBefore(actuator->FirstChildElement("general"),
+             "drive the tail: ctrl_i = theta_ref,i(t), the split-cycle profile (Eqs. 20-23), plus (kv/kp) "
+             "theta_dot_ref,i for velocity feed-forward (mjcf/README.md). kp_i = I_i w_n^2, kv_i = 2 I_i w_n "
+             "(critically damped), w_n = " + g6(s.servo_wn_dt / s.timestep_s) + " rad/s, I_i = " + g6s(I) +
+                 " kg m^2: links i..n about joint i, tail straight");
+  noteBefore(root->FirstChildElement("keyframe")->FirstChildElement("key"),
+             "home: Q at h = " + g6(s.body_height_m) + " m, upright, heading 0, tail straight (theta = 0), at rest");
+}
+
+// The Menagerie robot file: the model under one "tailsim" default class, no floor, annotated.
+std::string menagerieRobotXml(const RobotParams& p, const MujocoSettings& s, const Effects& e,
+                              const MenagerieFiles& f, const std::string& model, double mu) {
+  const int condim = e.friction == FrictionLaw::kNone ? 1 : s.condim;
+  tinyxml2::XMLDocument doc;
+  doc.InsertEndChild(doc.NewComment(robotHeader(p, s, e, f.scene_file, mu).c_str()));
+  XMLElement* root = doc.NewElement("mujoco");
+  doc.InsertEndChild(root);
+  root->SetAttribute("model", model.c_str());
+  addCompilerAndOptions(root, p, s, e);
+  XMLElement* dmain = child(child(root, "default"), "default");
+  dmain->SetAttribute("class", "tailsim");
+  addVisualDefault(dmain);
+  addFootDefault(dmain, s, mu, condim, /*priority=*/true);
+  addTailDefault(dmain, kMenagerieCtrlRange);
+  XMLElement* world = child(root, "worldbody");
+  XMLElement* body = addQuadruped(world, p.quadruped, s, e);
+  addTail(body, p);
+  addActuators(root, tailServoGains(p, s));
+  addHomeKey(root, p.numLinks(), s.body_height_m, e);
+  annotateMenagerieRobot(root, dmain, body, p, s, mu);
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
+}
+
+// The scene's look: camera statistic, headlight, haze, skybox and the checker ground's texture.
+void addSceneLookAndAssets(XMLElement* root, const RobotParams& p, const MujocoSettings& s) {
+  const QuadrupedParams& q = p.quadruped;
+  double tail_len = 0.0;
+  for (const TailLink& l : p.tail) tail_len += l.length_m;
+  const double front = q.d_Q2C_m + 0.5 * q.l_F_m + 0.04, back = -(q.d_Q2B_m + tail_len);
+  XMLElement* stat = child(root, "statistic");
+  stat->SetAttribute("center", nums({0.5 * (front + back), 0.0, 0.5 * s.body_height_m}).c_str());
+  stat->SetAttribute("extent", num(front - back).c_str());
+  XMLElement* visual = child(root, "visual");
+  XMLElement* head = child(visual, "headlight");
+  head->SetAttribute("diffuse", "0.6 0.6 0.6");
+  head->SetAttribute("ambient", "0.3 0.3 0.3");
+  head->SetAttribute("specular", "0 0 0");
+  child(visual, "rgba")->SetAttribute("haze", "0.15 0.25 0.35 1");
+  XMLElement* global = child(visual, "global");
+  global->SetAttribute("azimuth", 120);
+  global->SetAttribute("elevation", -25);
+  XMLElement* asset = child(root, "asset");
+  XMLElement* sky = child(asset, "texture");
+  sky->SetAttribute("type", "skybox");
+  sky->SetAttribute("builtin", "gradient");
+  sky->SetAttribute("rgb1", "0.3 0.5 0.7");
+  sky->SetAttribute("rgb2", "0 0 0");
+  sky->SetAttribute("width", 512);
+  sky->SetAttribute("height", 3072);
+  XMLElement* tex = child(asset, "texture");
+  tex->SetAttribute("type", "2d");
+  tex->SetAttribute("name", "groundplane");
+  tex->SetAttribute("builtin", "checker");
+  tex->SetAttribute("mark", "edge");
+  tex->SetAttribute("rgb1", "0.2 0.3 0.4");
+  tex->SetAttribute("rgb2", "0.1 0.2 0.3");
+  tex->SetAttribute("markrgb", "0.8 0.8 0.8");
+  tex->SetAttribute("width", 300);
+  tex->SetAttribute("height", 300);
+  XMLElement* mtl = child(asset, "material");
+  mtl->SetAttribute("name", "groundplane");
+  mtl->SetAttribute("texture", "groundplane");
+  mtl->SetAttribute("texuniform", "true");
+  mtl->SetAttribute("texrepeat", "5 5");
+  mtl->SetAttribute("reflectance", "0.2");
+}
+
+// The Menagerie scene file: includes the robot file, adds the look, a light and the floor.
+std::string menagerieSceneXml(const RobotParams& p, const MujocoSettings& s, const MenagerieFiles& f,
+                              const std::string& model, double mu) {
+  tinyxml2::XMLDocument doc;
+  doc.InsertEndChild(doc.NewComment(
+      (" Scene for " + f.robot_file + ": floor, light, skybox (MuJoCo Menagerie layout). Generated by tailsim "
+       "(src/mujoco_model/mjcf_generator.cc); do not edit by hand. The floor keeps MuJoCo's default friction (1): "
+       "the feet's priority gives the paper's mu = " + g6(mu) + " here and in any other scene. mjcf/README.md. ")
+          .c_str()));
+  XMLElement* root = doc.NewElement("mujoco");
+  doc.InsertEndChild(root);
+  root->SetAttribute("model", (model + " scene").c_str());
+  child(root, "include")->SetAttribute("file", f.robot_file.c_str());
+  addSceneLookAndAssets(root, p, s);
+  XMLElement* world = child(root, "worldbody");
+  XMLElement* light = child(world, "light");
+  light->SetAttribute("pos", "0 0 1.5");
+  light->SetAttribute("dir", "0 0 -1");
+  light->SetAttribute("directional", "true");
+  XMLElement* floor = child(world, "geom");
+  floor->SetAttribute("name", mjcf::kFloorGeom);
+  floor->SetAttribute("size", "0 0 0.05");
+  floor->SetAttribute("type", "plane");
+  floor->SetAttribute("material", "groundplane");
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
+}
+
 }  // namespace
 
 MenagerieFiles generateMenagerie(const RobotParams& p, const MujocoSettings& s, const Effects& e,
@@ -558,135 +701,9 @@ MenagerieFiles generateMenagerie(const RobotParams& p, const MujocoSettings& s, 
   f.robot_file = "tailsim_" + stem + ".xml";
   f.scene_file = "scene_" + stem + ".xml";
   const std::string model = "tailsim_" + stem;
-  const int condim = e.friction == FrictionLaw::kNone ? 1 : s.condim;
   const double mu = menagerieFootFriction(p, s, e);
-  const ServoGains gains = tailServoGains(p, s);
-  const QuadrupedParams& q = p.quadruped;
-  {
-    tinyxml2::XMLDocument doc;
-    doc.InsertEndChild(doc.NewComment(robotHeader(p, s, e, f.scene_file, mu).c_str()));
-    XMLElement* root = doc.NewElement("mujoco");
-    doc.InsertEndChild(root);
-    root->SetAttribute("model", model.c_str());
-    addCompilerAndOptions(root, p, s, e);
-    XMLElement* dmain = child(child(root, "default"), "default");
-    dmain->SetAttribute("class", "tailsim");
-    addVisualDefault(dmain);
-    addFootDefault(dmain, s, mu, condim, /*priority=*/true);
-    addTailDefault(dmain, kMenagerieCtrlRange);
-    XMLElement* world = child(root, "worldbody");
-    XMLElement* body = addQuadruped(world, q, s, e);
-    addTail(body, p);
-    addActuators(root, gains);
-    addHomeKey(root, p.numLinks(), s.body_height_m, e);
-
-    // Comments naming the paper's symbols next to the elements that carry them.
-    XMLElement* foot_default = dmain->FirstChildElement("default")->NextSiblingElement("default");
-    noteBefore(foot_default->FirstChildElement("geom"),
-               "mu = " + g6(mu) + ": the paper's foot friction. priority=\"1\": a foot's contact takes the foot's "
-               "friction, condim, solref and solimp, whatever the floor's (equal priorities would take the larger "
-               "friction: a floor of friction 1 would win).");
-    XMLElement* tail_default = foot_default->NextSiblingElement("default");
-    noteBefore(tail_default->FirstChildElement("general"),
-               "PD position servo: force = kp (ctrl - theta) - kv theta_dot (gainprm kp, biasprm 0 -kp -kv)");
-    const std::array<double, 3> Iq = quadrupedDiagInertia(q);
-    noteBefore(body->FirstChildElement("inertial"),
-               "Q: quadruped COM, frame origin, h = " + g6(s.body_height_m) + " m above the ground, x forward, z up. m_Q = " +
-                   g6(q.mass_kg) + " kg, I_zz,Q = " + g6(q.izz_kgm2) + " kg m^2; Ixx, Iyy = " + g6(Iq[0]) + ", " +
-                   g6(Iq[1]) + " kg m^2 from a 0.1 m high box of the same I_zz (only I_zz enters the planar model)");
-    noteBefore(childNamed(body, "geom", mjcf::footGeomName(1)),
-               "feet k = 1..4 (FL, FR, RR, RL) at (d_Q2C +- l_F/2, +-w_F/2), Eq. 17: d_Q2C = " + g6(q.d_Q2C_m) +
-                   " m, l_F = " + g6(q.l_F_m) + " m, w_F = " + g6(q.w_F_m) + " m; " + footNote(s) + " touching z = 0. Only the feet collide.");
-    XMLElement* link = childNamed(body, "body", mjcf::tailBodyName(1));
-    noteBefore(link, "tail base B at -d_Q2B along x, d_Q2B = " + g6(q.d_Q2B_m) +
-                         " m (Eq. 2); R_B = R_Q R_Z(180 deg) (Eq. 1): theta_i = 0 is the tail straight back");
-    const std::vector<double> I = tailJointInertias(p);
-    for (int i = 1; i <= p.numLinks(); ++i) {
-      const TailLink& l = p.tail[i - 1];
-      noteBefore(link->FirstChildElement("joint"),
-                 "link " + std::to_string(i) + ": m_L," + std::to_string(i) + " = " + g6(l.mass_kg) + " kg, I_zz,L," +
-                     std::to_string(i) + " = " + g6(l.izz_kgm2) + " kg m^2 about its COM, L_L," + std::to_string(i) +
-                     " = " + g6(l.length_m) + " m (joint " + std::to_string(i) + " to joint " + std::to_string(i + 1) +
-                     "), COM " + g6(l.com_offset_m) + " m from joint " + std::to_string(i) + "; joint " +
-                     std::to_string(i) + ": theta_" + std::to_string(i) + ", relative to link " + std::to_string(i - 1));
-      if (i < p.numLinks()) link = childNamed(link, "body", mjcf::tailBodyName(i + 1));
-    }
-    XMLElement* actuator = root->FirstChildElement("actuator");
-    noteBefore(actuator->FirstChildElement("general"),
-               "drive the tail: ctrl_i = theta_ref,i(t), the split-cycle profile (Eqs. 20-23), plus (kv/kp) "
-               "theta_dot_ref,i for velocity feed-forward (mjcf/README.md). kp_i = I_i w_n^2, kv_i = 2 I_i w_n "
-               "(critically damped), w_n = " + g6(s.servo_wn_dt / s.timestep_s) + " rad/s, I_i = " + g6s(I) +
-                   " kg m^2: links i..n about joint i, tail straight");
-    noteBefore(root->FirstChildElement("keyframe")->FirstChildElement("key"),
-               "home: Q at h = " + g6(s.body_height_m) + " m, upright, heading 0, tail straight (theta = 0), at rest");
-    tinyxml2::XMLPrinter printer;
-    doc.Print(&printer);
-    f.robot_xml = printer.CStr();
-  }
-  {
-    double tail_len = 0.0;
-    for (const TailLink& l : p.tail) tail_len += l.length_m;
-    const double front = q.d_Q2C_m + 0.5 * q.l_F_m + 0.04, back = -(q.d_Q2B_m + tail_len);
-    tinyxml2::XMLDocument doc;
-    doc.InsertEndChild(doc.NewComment(
-        (" Scene for " + f.robot_file + ": floor, light, skybox (MuJoCo Menagerie layout). Generated by tailsim "
-         "(src/mujoco_model/mjcf_generator.cc); do not edit by hand. The floor keeps MuJoCo's default friction (1): "
-         "the feet's priority gives the paper's mu = " + g6(mu) + " here and in any other scene. mjcf/README.md. ")
-            .c_str()));
-    XMLElement* root = doc.NewElement("mujoco");
-    doc.InsertEndChild(root);
-    root->SetAttribute("model", (model + " scene").c_str());
-    child(root, "include")->SetAttribute("file", f.robot_file.c_str());
-    XMLElement* stat = child(root, "statistic");
-    stat->SetAttribute("center", nums({0.5 * (front + back), 0.0, 0.5 * s.body_height_m}).c_str());
-    stat->SetAttribute("extent", num(front - back).c_str());
-    XMLElement* visual = child(root, "visual");
-    XMLElement* head = child(visual, "headlight");
-    head->SetAttribute("diffuse", "0.6 0.6 0.6");
-    head->SetAttribute("ambient", "0.3 0.3 0.3");
-    head->SetAttribute("specular", "0 0 0");
-    child(visual, "rgba")->SetAttribute("haze", "0.15 0.25 0.35 1");
-    XMLElement* global = child(visual, "global");
-    global->SetAttribute("azimuth", 120);
-    global->SetAttribute("elevation", -25);
-    XMLElement* asset = child(root, "asset");
-    XMLElement* sky = child(asset, "texture");
-    sky->SetAttribute("type", "skybox");
-    sky->SetAttribute("builtin", "gradient");
-    sky->SetAttribute("rgb1", "0.3 0.5 0.7");
-    sky->SetAttribute("rgb2", "0 0 0");
-    sky->SetAttribute("width", 512);
-    sky->SetAttribute("height", 3072);
-    XMLElement* tex = child(asset, "texture");
-    tex->SetAttribute("type", "2d");
-    tex->SetAttribute("name", "groundplane");
-    tex->SetAttribute("builtin", "checker");
-    tex->SetAttribute("mark", "edge");
-    tex->SetAttribute("rgb1", "0.2 0.3 0.4");
-    tex->SetAttribute("rgb2", "0.1 0.2 0.3");
-    tex->SetAttribute("markrgb", "0.8 0.8 0.8");
-    tex->SetAttribute("width", 300);
-    tex->SetAttribute("height", 300);
-    XMLElement* mtl = child(asset, "material");
-    mtl->SetAttribute("name", "groundplane");
-    mtl->SetAttribute("texture", "groundplane");
-    mtl->SetAttribute("texuniform", "true");
-    mtl->SetAttribute("texrepeat", "5 5");
-    mtl->SetAttribute("reflectance", "0.2");
-    XMLElement* world = child(root, "worldbody");
-    XMLElement* light = child(world, "light");
-    light->SetAttribute("pos", "0 0 1.5");
-    light->SetAttribute("dir", "0 0 -1");
-    light->SetAttribute("directional", "true");
-    XMLElement* floor = child(world, "geom");
-    floor->SetAttribute("name", mjcf::kFloorGeom);
-    floor->SetAttribute("size", "0 0 0.05");
-    floor->SetAttribute("type", "plane");
-    floor->SetAttribute("material", "groundplane");
-    tinyxml2::XMLPrinter printer;
-    doc.Print(&printer);
-    f.scene_xml = printer.CStr();
-  }
+  f.robot_xml = menagerieRobotXml(p, s, e, f, model, mu);
+  f.scene_xml = menagerieSceneXml(p, s, f, model, mu);
   return f;
 }
 
