@@ -377,6 +377,23 @@ TEST_F(SyntheticSuite, PlotsAndReportAreWritten) {
     EXPECT_TRUE(fs::exists(fs::path(p.png).replace_extension(".gp")));
     stems.insert(png.stem().string());
   }
+  // Each plots/ manifest names only files that are there, with the content it names (gnuplot's
+  // empty log, which is removed, is not named).
+  for (const fs::directory_entry& e : fs::recursive_directory_iterator(root_)) {
+    if (e.path().filename() != ".tailsim-manifest" || e.path().parent_path().filename() != "plots") continue;
+    const std::string dir = e.path().parent_path().string();
+    std::ifstream man(e.path());
+    int lines = 0;
+    for (std::string line; std::getline(man, line); ++lines) {
+      const std::string name = line.substr(line.find("  ") + 2);
+      ASSERT_TRUE(fs::exists(fs::path(dir) / name)) << dir << ": the manifest names " << name << ", which is not there";
+      std::ifstream f(fs::path(dir) / name, std::ios::binary);
+      std::stringstream ss;
+      ss << f.rdbuf();
+      EXPECT_TRUE(manifestNames(dir, name, ss.str())) << dir << "/" << name;
+    }
+    EXPECT_GT(lines, 0) << e.path();
+  }
   for (const char* s : {"fig06a_model_comparison_1dof_phi", "fig06a_model_comparison_1dof_moments",
                         "fig07_loading_phi", "fig08_moment_contributions_contributions",
                         "fig08_moment_contributions_LF", "fig09_theta0_dQ2B_phi_net_map",

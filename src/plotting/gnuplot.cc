@@ -174,7 +174,6 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
     removeTemps();
     throw;
   }
-  recordWrittenFile(dir.string(), fig.stem + ".log");
   std::string err;
   {
     std::ifstream in(log);
@@ -182,6 +181,9 @@ std::string renderFigure(const std::string& plots_dir, const GnuplotFigure& fig)
     ss << in.rdbuf();
     err = ss.str();
   }
+  // Only a log with something in it is kept, so only that one is named in the manifest (an empty one
+  // is removed below; a stray one beside this script is taken as tailsim's, as `ours` says).
+  if (!err.empty()) recordWrittenFile(dir.string(), fig.stem + ".log");
   std::string missing;  // the first figure that is not whole
   for (const char* ext : {".png", ".svg"})
     if (missing.empty() && !wholeFigure(dir / (temp_stem + ext), ext[1] == 'p')) missing = (user_dir / (fig.stem + ext)).string();
