@@ -172,15 +172,15 @@ TEST(RobotModelExperiment, ErrorsNameFileLineAndKey) {
   m = run("{mjcf: box.xml}", "{mount: {body: tailbone, pos_m: [-0.25, 0, 0]}, links: 1}");
   expectAt(m, f, 3, "tail.mount.body");
   EXPECT_NE(m.find("no body named 'tailbone'"), std::string::npos) << m;
-  // Not 4 feet: 3 named, 3 standing, an unknown foot geom.
+  // 3 feet (named, or standing): only the articulated MuJoCo model runs on them, so asking the planar
+  // models is an error naming the feet; an unknown foot geom.
   m = run("{mjcf: box.xml, feet: [f1, f2, f3]}");
-  expectAt(m, f, 2, "robot.feet");
-  EXPECT_NE(m.find("planar models (analytic, perfoot) take a body on 4 feet"), std::string::npos) << m;
+  expectAt(m, f, 2, "robot.mjcf");
+  EXPECT_NE(m.find("models: analytic cannot run this robot: the robot stands on 3 feet (f1, f2, f3)"), std::string::npos) << m;
   m = run("{mjcf: three.xml}");
-  expectAt(m, f, 2, "robot");
-  EXPECT_NE(m.find("stands on 3 feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet"),
-            std::string::npos)
-      << m;
+  expectAt(m, f, 2, "robot.mjcf");
+  EXPECT_NE(m.find("models: analytic cannot run this robot: the robot stands on 3 feet"), std::string::npos) << m;
+  EXPECT_NE(m.find("(models: [mujoco])"), std::string::npos) << m;
   m = run("{mjcf: box.xml, feet: [f1, f2, f3, toe]}");
   expectAt(m, f, 2, "robot.feet");
   EXPECT_NE(m.find("no geom named 'toe'"), std::string::npos) << m;
@@ -348,4 +348,33 @@ TEST(RobotModelExperiment, ArticulatedRunCarriesItsOwnUncertainty) {
       EXPECT_EQ(warned, c.name.find("1200") != std::string::npos) << c.name << ": U " << u;
     }
   }
+}
+
+// A robot on 3 feet runs as the articulated MuJoCo model (`models: [mujoco]`): it stands, the tail
+// turns it, and the feet are found one per body even when a foot body has two touching geoms.
+TEST(RobotModelExperiment, ThreeFeetRunArticulatedAndFeetAreOnePerBody) {
+  Scratch t("robot_model_exp");
+  t.write("three.xml", boxRobot(kHome, R"(
+      <geom name="f1" type="sphere" size="0.02" pos="0.2 0.12 -0.28"/>
+      <geom name="f2" type="sphere" size="0.02" pos="0.2 -0.12 -0.28"/>
+      <body name="rear"><geom name="f3" type="sphere" size="0.02" pos="-0.2 0 -0.28"/>
+        <geom name="f3b" type="sphere" size="0.02" pos="-0.19 0 -0.28"/></body>)"));
+  const std::string f = t.write("e.yaml", "name: tripod\nrobot: {mjcf: three.xml}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, "
+                                          "links: 1}\ntrajectory: {rule: eq25, thetadot_max_dps: 600}\nmodels: [mujoco]\n"
+                                          "output: {settle_s: 1.0, time_series: none}\n");
+  std::vector<Experiment> s = loadExperimentSuite(f);
+  resolveRobotModels(s);
+  const ExperimentCase& c = s.front().cases.front();
+  ASSERT_TRUE(c.robot_derived);
+  EXPECT_EQ(c.robot_derived->foot_count, 3);
+  EXPECT_EQ(c.robot_derived->feet.size(), 3u);  // f3 and f3b are one foot: the body's lowest geom
+  EXPECT_EQ(c.robot_derived->feet.front().rfind("f1", 0) == 0 || c.robot_derived->feet.front().rfind("f2", 0) == 0, true);
+  const RunSummary r = runCase(c, nullptr).front().summary;
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(r.extra.at("feet_in_contact"), 3.0);
+  EXPECT_LT(r.extra.at("stand_max_tilt_from_stance_deg"), 1.0);
+  EXPECT_GT(std::abs(r.phi_net_deg), 0.0);
+  const std::string shown = describeDerivedRobot(*c.robot_derived);
+  EXPECT_NE(shown.find("feet (front to back): "), std::string::npos) << shown;
+  EXPECT_NE(shown.find("only the articulated MuJoCo model runs on it"), std::string::npos) << shown;
 }

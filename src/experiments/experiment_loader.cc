@@ -1283,9 +1283,7 @@ void readRobotModel(const Reader& r, const Item& item, const std::string& source
   if (const Item* f = m.get("feet")) {
     at("robot.feet", *f);
     const std::vector<Item> v = r.list(*f);
-    if (v.size() == 3)
-      r.fail(*f, "names 3 feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet: name 4 feet");
-    if (v.size() != 4) r.fail(*f, "needs the 4 foot geoms' names, got " + std::to_string(v.size()));
+    if (v.size() < 3 || v.size() > 4) r.fail(*f, "needs 3 or 4 foot geoms' names, got " + std::to_string(v.size()));
     for (const Item& x : v) {
       const std::string g = r.string(x);
       if (g.empty()) r.fail(x, "a geom name must not be empty");

@@ -23,7 +23,7 @@ std::string f3(double v) {
 }
 // A run as a row of the comparison: the error first among the warnings.
 ModelRow rowOf(const std::string& title, const RunSummary& r) {
-  ModelRow row{title, r.ok, r.phi_net_deg, std::nullopt, r.warnings};
+  ModelRow row{title, r.ok, false, r.phi_net_deg, std::nullopt, r.warnings};
   if (const auto u = r.extra.find("phi_net_uncertainty_deg"); u != r.extra.end()) row.phi_net_uncertainty_deg = u->second;
   if (!r.ok) row.warnings.insert(row.warnings.begin(), r.error);
   return row;
@@ -32,6 +32,7 @@ ModelRow rowOf(const std::string& title, const RunSummary& r) {
 // A row's phi_net: "6.123", a MuJoCo row with its estimate "6.123 +- 0.050", with a failed check run
 // "6.123 +- n/a (check run failed)"; "(uncertain)" after it when a warning says so.
 std::string phiCell(const ModelRow& r) {
+  if (r.not_run) return "not run";
   if (!r.ok) return "failed";
   std::string t = f3(r.phi_net_deg);
   if (r.phi_net_uncertainty_deg)
@@ -86,6 +87,15 @@ RobotComparison compareRobotModels(const RobotModelSpec& spec, const RobotTailCh
                          f3(a.stand_max_rel_tilt_deg) + "); during the stroke at most " + f3(a.max_tilt_deg) + " / " +
                          f3(a.max_rel_tilt_deg) + " deg; " + std::to_string(a.feet_in_contact) + " feet on the floor");
   c.rows.push_back(art);
+  if (c.robot.foot_count != 4) {  // the other models take 4 feet: one row says why they did not run
+    ModelRow skipped;
+    skipped.model = "mujoco (rigid box), perfoot, analytic";
+    skipped.ok = false;
+    skipped.not_run = true;
+    skipped.warnings.push_back("not run: " + threeFeetNote(c.robot));
+    c.rows.push_back(skipped);
+    return c;
+  }
   for (const char* name : {"mujoco", "perfoot", "analytic"}) {
     const ModelEntry* e = findModel(name);
     if (!e) continue;

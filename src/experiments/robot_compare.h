@@ -25,6 +25,7 @@ struct RobotTailChoice {
 struct ModelRow {
   std::string model;  // "mujoco (articulated)", "mujoco (rigid box)", "perfoot", "analytic"
   bool ok = true;
+  bool not_run = false;  // a model that does not take this robot (3 feet: only the articulated run)
   double phi_net_deg = 0.0;
   // The MuJoCo rows' own estimate (phi_net_uncertainty_deg: NaN when their check run failed);
   // absent for the planar rows, which estimate none.

@@ -53,6 +53,11 @@ void resolveRobotModels(Experiment& e) {
         throw ConfigError(where(c, "robot.mjcf") + x.what());
       }
     }
+    if (d->foot_count != 4)
+      for (const std::string& model : c.models)
+        if (model != "mujoco")
+          throw ConfigError(where(c, "robot.mjcf") + "models: " + model + " cannot run this robot: " + threeFeetNote(*d) +
+                            " (models: [mujoco])");
     c.robot.quadruped = d->quadruped;
     c.robot.friction.mu_s = c.robot.friction.mu_d = d->mu;
     c.robot.gravity_mps2 = d->gravity_mps2;

@@ -547,7 +547,9 @@ std::string geomName(const mjModel* m, int g) {
                                   std::string(mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) ? mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[g]) : "?") + "'";
 }
 
-// Stage: the feet: the named geoms, or the robot's geoms touching the floor; exactly 4 of them.
+// Stage: the feet: the named geoms, or the robot's geoms touching the floor (a foot body's geoms within
+// kFootMergeM of each other count once, its lowest); 3 or 4 of them.
+constexpr double kFootMergeM = 0.05;  // [m] horizontal, between geom centres
 std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int floor, const std::string& file,
                           const DerivedRobot& r) {
   std::vector<int> feet;
@@ -557,12 +559,18 @@ std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpe
       if (g < 0) fail(file, "feet: no geom named '" + n + "'", "robot.feet");
       feet.push_back(g);
     }
-  } else {
+  } else {  // the touching geoms; two of one body within kFootMergeM of each other are one foot (its lowest)
     for (int i = 0; i < d->ncon; ++i) {
       const mjContact& c = d->contact[i];
       const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
       if (other < 0 || c.dist > 1e-3) continue;
-      if (std::find(feet.begin(), feet.end(), other) == feet.end()) feet.push_back(other);
+      const auto same = std::find_if(feet.begin(), feet.end(), [&](int g) {
+        const double* a = d->geom_xpos + 3 * g;
+        const double* b = d->geom_xpos + 3 * other;
+        return g == other || (m->geom_bodyid[g] == m->geom_bodyid[other] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
+      });
+      if (same == feet.end()) feet.push_back(other);
+      else if (lowestZ(m, d, other) < lowestZ(m, d, *same)) *same = other;
     }
   }
   if (feet.size() < 3 || feet.size() > 4) {
@@ -575,11 +583,6 @@ std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpe
                    " deg) or name the feet with feet: [...]",
          "robot.feet");
   }
-  if (feet.size() != 4)
-    fail(file, "the robot stands on " + std::to_string(feet.size()) +
-                   " feet; tailsim's planar models (analytic, perfoot) take a body on 4 feet, so a 3-foot stance is "
-                   "refused: name 4 feet with feet: [...] or change the stance",
-         "robot.feet");
   return feet;
 }
 
@@ -618,8 +621,8 @@ MassCentre massProperties(const mjModel* m, const mjData* d, int root, DerivedRo
 }
 
 // Stage: the planar frame (the mount body's x axis turned by the mount yaw, projected on the floor,
-// origin at the COM), the feet ordered FL, FR, RR, RL in it, and the quadruped's lengths. Returns
-// the difference of the left and right foot spacings.
+// origin at the COM), the feet ordered FL, FR, RR, RL in it (3 feet: front to back), and the
+// quadruped's lengths. Returns the difference of the left and right foot spacings.
 double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int root, const std::vector<int>& feet,
                       const MassCentre& mc, const std::string& file, DerivedRobot& r) {
   const double* c = mc.c;
@@ -635,34 +638,50 @@ double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& s
   };
   std::vector<std::array<double, 2>> fp;
   for (int g : feet) fp.push_back(planar(d->geom_xpos + 3 * g));
+  const int nf = static_cast<int>(feet.size());
   double mx = 0.0, my = 0.0;
-  for (const auto& p : fp) mx += p[0] / 4, my += p[1] / 4;
-  // FL, FR, RR, RL: front = x above the centroid, left = y above it.
-  std::vector<int> order(4, -1);
-  for (int i = 0; i < 4; ++i) {
-    const bool front = fp[i][0] > mx, left = fp[i][1] > my;
-    const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
-    if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
-                                         std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
-                            "robot.feet");
-    order[slot] = i;
+  for (const auto& p : fp) mx += p[0] / nf, my += p[1] / nf;
+  r.foot_count = nf;
+  std::vector<int> order(nf);
+  if (nf == 4) {  // FL, FR, RR, RL: front = x above the centroid, left = y above it.
+    std::fill(order.begin(), order.end(), -1);
+    for (int i = 0; i < 4; ++i) {
+      const bool front = fp[i][0] > mx, left = fp[i][1] > my;
+      const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
+      if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
+                                           std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
+                              "robot.feet");
+      order[slot] = i;
+    }
+  } else {  // 3 feet: front to back
+    for (int i = 0; i < nf; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return fp[a][0] > fp[b][0]; });
   }
-  for (int s = 0; s < 4; ++s) {
+  for (int s = 0; s < nf; ++s) {
     const int g = feet[order[s]], b = m->geom_bodyid[g];
     r.feet.push_back(geomName(m, g));
     r.foot_geoms.emplace_back(mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "", g - m->body_geomadr[b]);
   }
-  const auto& FL = fp[order[0]];
-  const auto& FR = fp[order[1]];
-  const auto& RR = fp[order[2]];
-  const auto& RL = fp[order[3]];
   QuadrupedParams& q = r.quadruped;
-  q.l_F_m = 0.5 * (FL[0] + FR[0]) - 0.5 * (RL[0] + RR[0]);
-  q.w_F_m = 0.5 * (FL[1] + RL[1]) - 0.5 * (FR[1] + RR[1]);
+  double asym = 0.0;
+  if (nf == 4) {
+    const auto& FL = fp[order[0]];
+    const auto& FR = fp[order[1]];
+    const auto& RR = fp[order[2]];
+    const auto& RL = fp[order[3]];
+    q.l_F_m = 0.5 * (FL[0] + FR[0]) - 0.5 * (RL[0] + RR[0]);
+    q.w_F_m = 0.5 * (FL[1] + RL[1]) - 0.5 * (FR[1] + RR[1]);
+    asym = std::abs((FL[0] - RL[0]) - (FR[0] - RR[0]));
+  } else {  // the support triangle's extents: the planar models, which take 4 feet, are not run on it
+    q.l_F_m = fp[order[0]][0] - fp[order[2]][0];
+    double ylo = 1e300, yhi = -1e300;
+    for (const auto& p : fp) ylo = std::min(ylo, p[1]), yhi = std::max(yhi, p[1]);
+    q.w_F_m = yhi - ylo;
+  }
   q.d_Q2C_m = mx;
   r.lateral_com_to_feet_m = my;
   double footZ = 0.0;
-  for (int g : feet) footZ += lowestZ(m, d, g) / 4;
+  for (int g : feet) footZ += lowestZ(m, d, g) / nf;
   q.com_height_m = c[2] - footZ;
   double base[3];
   mju_rotVecMat(base, spec.mount.pos_m.data(), d->xmat + 9 * mount);
@@ -675,7 +694,7 @@ double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& s
     r.notes.push_back("no tail mount given: d_Q2B_m is that of the root body's origin (--mount-pos X,Y,Z sets the tail base)");
   else if (q.d_Q2B_m < 0.0)
     r.notes.push_back("the tail base is in front of the COM (d_Q2B_m < 0): check the mount (pos_m, yaw_deg)");
-  return std::abs((FL[0] - RL[0]) - (FR[0] - RR[0]));
+  return asym;
 }
 
 // Stage: the friction coefficient into r.mu: given, else the contacts' own (MuJoCo mixes the
@@ -716,8 +735,8 @@ void listValues(const RobotModelSpec& spec, const std::string& muSource, Derived
       {"quadruped.izz_kgm2", q.izz_kgm2, "kg m^2", "composite I_zz about the COM, legs held" + stood + "; MuJoCo cinert sum " + g6(r.mujoco_cinert_izz_kgm2)},
       {"quadruped.d_Q2C_m", q.d_Q2C_m, "m", "x of the foot centroid from the COM, " + frame},
       {"quadruped.d_Q2B_m", q.d_Q2B_m, "m", "tail base (body '" + r.mount_body + "' + pos_m) behind the COM, " + frame},
-      {"quadruped.l_F_m", q.l_F_m, "m", "front feet x - rear feet x (means of each pair)"},
-      {"quadruped.w_F_m", q.w_F_m, "m", "left feet y - right feet y (means of each pair)"},
+      {"quadruped.l_F_m", q.l_F_m, "m", r.foot_count == 4 ? "front feet x - rear feet x (means of each pair)" : "front foot x - rear foot x (3 feet)"},
+      {"quadruped.w_F_m", q.w_F_m, "m", r.foot_count == 4 ? "left feet y - right feet y (means of each pair)" : "left-most foot y - right-most foot y (3 feet)"},
       {"quadruped.com_height_m", q.com_height_m, "m", "COM above the feet's lowest points" + stood},
       {"friction.mu_s = mu_d", r.mu, "-", muSource},
       {"gravity_mps2", r.gravity_mps2, "m/s^2", "the model's option gravity"},
@@ -778,17 +797,27 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   if (std::abs(r.lateral_mount_m) > 1e-3)
     r.notes.push_back("the tail base is " + g6(1e3 * r.lateral_mount_m) + " mm to the side of the COM; the planar models take 0");
   if (asym > 1e-3) r.notes.push_back("left and right foot spacings differ by " + g6(1e3 * asym) + " mm; l_F_m is their mean");
+  if (r.foot_count == 3) r.notes.push_back(threeFeetNote(r));
   r.notes.push_back("tilt after standing: " + g6(r.tilt_deg) + " deg");
   if (!messages.text().empty()) r.notes.push_back(messages.text());
   settledJoints(m, d, stance, hold, r);
   return r;
 }
 
+std::string threeFeetNote(const DerivedRobot& r) {
+  std::string names;
+  for (const std::string& f : r.feet) names += (names.empty() ? "" : ", ") + f;
+  return "the robot stands on 3 feet (" + names +
+         "): only the articulated MuJoCo model runs on it; the planar models (analytic, perfoot) and MuJoCo's rigid "
+         "box take a body on 4 feet at a rectangle's corners, so l_F_m and w_F_m above are the support triangle's "
+         "extents, not their input";
+}
+
 std::string describeDerivedRobot(const DerivedRobot& r) {
   std::ostringstream o;
   o << "robot: " << r.model.source << (r.model.from_urdf ? " (URDF)" : "") << "\n";
   o << "stance: " << r.stance << "\n";
-  o << "feet (FL, FR, RR, RL): ";
+  o << (r.foot_count == 4 ? "feet (FL, FR, RR, RL): " : "feet (front to back): ");
   for (std::size_t i = 0; i < r.feet.size(); ++i) o << (i ? ", " : "") << r.feet[i];
   o << "\n\n";
   std::size_t w = 0;

@@ -58,7 +58,8 @@ struct DerivedRobot {
   double mu = 0.0;                      // foot-floor friction (contacts' mu, or the spec's)
   bool mu_given = false;                // the spec's mu: the articulated run sets it on the feet and floor
   double gravity_mps2 = 9.81;
-  std::vector<std::string> feet;        // foot geom names, ordered FL, FR, RR, RL (planar frame)
+  std::vector<std::string> feet;        // foot geom names, ordered FL, FR, RR, RL (planar frame); 3 feet: front to back
+  int foot_count = 4;                   // 3 or 4: on 3 feet only the articulated MuJoCo model runs (threeFeetNote)
   std::string root_body, mount_body;
   std::string stance;                   // how the stance was set, in words
   bool legs_locked = false;             // the spec's legs: locked (attachTail adds the joint equalities)
@@ -88,6 +89,10 @@ inline constexpr double kStancePdKv = 5.0;    // [N m s/rad]
 // Loads, stands (settle_s with the legs held) and measures the robot. Throws RobotImportError with
 // a message for the user (no stance, not on 3-4 feet, ...), MujocoError when MuJoCo refuses the file.
 DerivedRobot deriveRobot(const RobotModelSpec& spec);
+
+// Why a robot on 3 feet runs only as the articulated MuJoCo model (a note of deriveRobot, and the
+// error of an experiment that asks another model of it).
+std::string threeFeetNote(const DerivedRobot& r);
 
 // The table `tailsim robot` prints: every derived value with its unit and source, then the notes.
 std::string describeDerivedRobot(const DerivedRobot& r);
