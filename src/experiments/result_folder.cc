@@ -175,23 +175,23 @@ void writeOwnFile(const fs::path& root, const std::string& name, const std::stri
   writeFileAtomic((root / name).string(), text);
 }
 
-// The entries tailsim writes into a result folder (docs/ARCHITECTURE.md) are deleted, and in them
-// only what tailsim writes: its top-level files when they are its own (ownFile), a case folder's
-// result.json and <model>.csv, mjcf/<hash>.xml, renders/<case dir>.{mp4,png}, time_series.h5(.d),
-// its temporary files, and the files of `tailsim plot` / `report` (plots/, page/, report.md,
-// figures.html, index.html) that their folder's manifest names unchanged. Anything else stays
-// (named on stderr).
-void clearResultFolder(const fs::path& root) {
+namespace {
+
+// What --fresh deletes and keeps as it goes through a folder: removeIf deletes one entry when it
+// is tailsim's, else notes it as kept; clearDir does so for the files of a folder, then removes
+// the folder when it is empty.
+struct FolderClearing {
   std::error_code ec;
   std::vector<std::string> kept;
-  const auto removeIf = [&](const fs::path& p, bool own) {
+
+  void removeIf(const fs::path& p, bool own) {
     if (!fs::exists(fs::symlink_status(p, ec))) return;
     if (own) fs::remove(p, ec);
     else kept.push_back(p.string());
-  };
-  const auto isTemp = [](const std::string& n) { return n.find(".tailsim-tmp.") != std::string::npos; };
+  }
+  static bool isTemp(const std::string& n) { return n.find(".tailsim-tmp.") != std::string::npos; }
   // Folders: delete tailsim's files in them, then the folder if it is empty.
-  const auto clearDir = [&](const fs::path& dir, const std::function<bool(const std::string&)>& own) {
+  void clearDir(const fs::path& dir, const std::function<bool(const std::string&)>& own) {
     if (!fs::is_directory(fs::symlink_status(dir, ec))) {
       if (fs::exists(fs::symlink_status(dir, ec))) kept.push_back(dir.string());
       return;
@@ -201,38 +201,9 @@ void clearResultFolder(const fs::path& root) {
       removeIf(f.path(), f.is_regular_file(ec) && !f.is_symlink(ec) && (isTemp(n) || own(n)));
     }
     fs::remove(dir, ec);  // only if now empty
-  };
-  std::set<std::string> case_dirs;
-  const std::vector<std::string> models = modelNames();
-  if (fs::is_directory(fs::symlink_status(root / "cases", ec))) {
-    for (const auto& d : fs::directory_iterator(root / "cases", ec)) {
-      if (!d.is_directory(ec) || d.is_symlink(ec)) {
-        kept.push_back(d.path().string());
-        continue;
-      }
-      if (isRegularFile(d.path() / "result.json")) case_dirs.insert(d.path().filename().string());
-      clearDir(d.path(), [&](const std::string& n) {
-        if (n == "result.json") return true;
-        return std::any_of(models.begin(), models.end(), [&](const std::string& m) { return n == m + ".csv"; });
-      });
-    }
-    fs::remove(root / "cases", ec);
   }
-  if (const json s = readJsonFile(root / "summary.json"); s.is_object() && s.contains("cases") && s["cases"].is_array())
-    for (const json& c : s["cases"])
-      if (c.is_object() && c.contains("dir") && c["dir"].is_string()) case_dirs.insert(c["dir"].get<std::string>());
-  clearDir(root / "renders", [&](const std::string& n) {
-    const size_t dot = n.rfind('.');
-    return dot != std::string::npos && (n.substr(dot) == ".mp4" || n.substr(dot) == ".png") &&
-           case_dirs.count(n.substr(0, dot));
-  });
-  clearDir(root / "mjcf", [](const std::string& n) {
-    return n.size() == 20 && n.compare(16, 4, ".xml") == 0 &&
-           std::all_of(n.begin(), n.begin() + 16, [](char ch) { return std::isxdigit(static_cast<unsigned char>(ch)); });
-  });
-  clearDir(root / kH5Parts, [](const std::string& n) { return n.size() > 3 && n.compare(n.size() - 3, 3, ".h5") == 0; });
   // Folders of `tailsim plot` (figures, the result page): the files their manifest names unchanged.
-  const auto clearManifested = [&](const fs::path& dir) {
+  void clearManifested(const fs::path& dir) {
     if (!fs::is_directory(fs::symlink_status(dir, ec))) return;
     std::set<std::string> own = {".tailsim-manifest"};
     for (const auto& f : fs::directory_iterator(dir, ec)) {
@@ -244,13 +215,59 @@ void clearResultFolder(const fs::path& root) {
       }
     }
     clearDir(dir, [&](const std::string& n) { return own.count(n) > 0; });
-  };
-  clearManifested(root / "page" / "cases");
-  clearManifested(root / "page");
-  clearManifested(root / "plots");
+  }
+};
+
+// Stage 1: the case folders DIR/cases/<dir> (their result.json and <model>.csv), then DIR/cases;
+// returns the case folders that held a result.json.
+std::set<std::string> clearCaseFolders(FolderClearing& cl, const fs::path& root) {
+  std::error_code& ec = cl.ec;
+  std::set<std::string> case_dirs;
+  const std::vector<std::string> models = modelNames();
+  if (fs::is_directory(fs::symlink_status(root / "cases", ec))) {
+    for (const auto& d : fs::directory_iterator(root / "cases", ec)) {
+      if (!d.is_directory(ec) || d.is_symlink(ec)) {
+        cl.kept.push_back(d.path().string());
+        continue;
+      }
+      if (isRegularFile(d.path() / "result.json")) case_dirs.insert(d.path().filename().string());
+      cl.clearDir(d.path(), [&](const std::string& n) {
+        if (n == "result.json") return true;
+        return std::any_of(models.begin(), models.end(), [&](const std::string& m) { return n == m + ".csv"; });
+      });
+    }
+    fs::remove(root / "cases", ec);
+  }
+  return case_dirs;
+}
+
+// Stage 2: the folders of files named per case or per model: renders/<case dir>.{mp4,png} (of the
+// case folders found and those summary.json lists), mjcf/<hash>.xml, time_series.h5.d/*.h5.
+void clearSharedFolders(FolderClearing& cl, const fs::path& root, std::set<std::string>& case_dirs) {
+  if (const json s = readJsonFile(root / "summary.json"); s.is_object() && s.contains("cases") && s["cases"].is_array())
+    for (const json& c : s["cases"])
+      if (c.is_object() && c.contains("dir") && c["dir"].is_string()) case_dirs.insert(c["dir"].get<std::string>());
+  cl.clearDir(root / "renders", [&](const std::string& n) {
+    const size_t dot = n.rfind('.');
+    return dot != std::string::npos && (n.substr(dot) == ".mp4" || n.substr(dot) == ".png") &&
+           case_dirs.count(n.substr(0, dot));
+  });
+  cl.clearDir(root / "mjcf", [](const std::string& n) {
+    return n.size() == 20 && n.compare(16, 4, ".xml") == 0 &&
+           std::all_of(n.begin(), n.begin() + 16, [](char ch) { return std::isxdigit(static_cast<unsigned char>(ch)); });
+  });
+  cl.clearDir(root / kH5Parts, [](const std::string& n) { return n.size() > 3 && n.compare(n.size() - 3, 3, ".h5") == 0; });
+}
+
+// Stage 3: the files of `tailsim plot` and `report` (page/cases, page, plots, report.md,
+// figures.html, index.html) their manifest names unchanged, and time_series.h5 when it is whole.
+void clearPlotsAndSeries(FolderClearing& cl, const fs::path& root) {
+  cl.clearManifested(root / "page" / "cases");
+  cl.clearManifested(root / "page");
+  cl.clearManifested(root / "plots");
   {
     const fs::path h5 = root / "time_series.h5";
-    removeIf(h5, fs::is_regular_file(fs::symlink_status(h5, ec)) && TimeSeriesH5Reader(h5.string()).ok());
+    cl.removeIf(h5, fs::is_regular_file(fs::symlink_status(h5, cl.ec)) && TimeSeriesH5Reader(h5.string()).ok());
   }
   for (const char* name : {"report.md", "figures.html", "index.html"}) {
     bool own = false;
@@ -259,10 +276,14 @@ void clearResultFolder(const fs::path& root) {
       own = t && manifestNames(root.string(), name, *t);
     } catch (const std::exception&) {  // not a regular file: not tailsim's
     }
-    removeIf(root / name, own);
+    cl.removeIf(root / name, own);
   }
+}
+
+// Stage 4: the top-level files the runner writes (ownFile), summary.json last.
+void clearTopFiles(FolderClearing& cl, const fs::path& root) {
   std::vector<std::string> top = {"cases.jsonl", "results.csv", "experiment.yaml", "robot.yaml", "robot.xml"};
-  for (const auto& f : fs::directory_iterator(root, ec))
+  for (const auto& f : fs::directory_iterator(root, cl.ec))
     if (isRobotCopy(f.path().filename().string())) top.push_back(f.path().filename().string());
   top.push_back("summary.json");  // last: ownFile of the others may read it
   for (const std::string& name : top) {
@@ -271,10 +292,26 @@ void clearResultFolder(const fs::path& root) {
       own = ownFile(root, name);
     } catch (const std::exception&) {  // not a regular file: not tailsim's
     }
-    removeIf(root / name, own);
+    cl.removeIf(root / name, own);
   }
+}
+
+}  // namespace
+
+// The entries tailsim writes into a result folder (docs/ARCHITECTURE.md) are deleted, and in them
+// only what tailsim writes: its top-level files when they are its own (ownFile), a case folder's
+// result.json and <model>.csv, mjcf/<hash>.xml, renders/<case dir>.{mp4,png}, time_series.h5(.d),
+// its temporary files, and the files of `tailsim plot` / `report` (plots/, page/, report.md,
+// figures.html, index.html) that their folder's manifest names unchanged. Anything else stays
+// (named on stderr).
+void clearResultFolder(const fs::path& root) {
+  FolderClearing cl;
+  std::set<std::string> case_dirs = clearCaseFolders(cl, root);
+  clearSharedFolders(cl, root, case_dirs);
+  clearPlotsAndSeries(cl, root);
+  clearTopFiles(cl, root);
   compactManifest(root.string());
-  for (const std::string& k : kept) std::fprintf(stderr, "note: --fresh kept %s (not written by tailsim)\n", k.c_str());
+  for (const std::string& k : cl.kept) std::fprintf(stderr, "note: --fresh kept %s (not written by tailsim)\n", k.c_str());
 }
 
 // The experiment file a folder's results come from: e's file, unless e is run from the copy in a

@@ -105,13 +105,12 @@ std::vector<RunResult> runCase(const ExperimentCase& c, RunContext* ctx) {
 
 namespace runner {
 
-// Runs one case and writes its folder; result.json last, as the "finished" marker.
-std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
+namespace {
+
+// Stage 1: a case's entry before its runs: who it is, where its results come from, its key and
+// build, its settings (case folders only) and its swept values.
+json caseEntryHeader(const Job& job, size_t i) {
   const ExperimentCase& c = job.e->cases[i];
-  const std::vector<RunResult> runs = runCase(c, &ctx);
-  const fs::path dir = job.root / "cases" / job.dirs[i];
-  const bool folder = c.output.caseFolder();
-  if (folder) makeResultDir(dir.string());
   json j;
   j["name"] = c.name;
   j["dir"] = job.dirs[i];
@@ -133,6 +132,16 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
   j["sweep"] = json::object();
   for (const auto& [key, v] : c.sweep_values) j["sweep"][key] = v;
   j["runs"] = json::object();
+  return j;
+}
+
+// Stage 2: each model's time series (its CSV in the case folder, or its groups in the case's HDF5
+// part, returned unpublished) and its summary in the entry; then the case's verdict.
+std::unique_ptr<TimeSeriesH5Writer> writeRuns(const Job& job, size_t i, const std::vector<RunResult>& runs, json& j,
+                                              int& failed_runs) {
+  const ExperimentCase& c = job.e->cases[i];
+  const fs::path dir = job.root / "cases" / job.dirs[i];
+  const bool folder = c.output.caseFolder();
   const bool thin = c.output.time_series == TimeSeriesOutput::kThin;
   const std::vector<double> marks = thin && c.kind == CaseKind::kSimulate ? c.trajectory().breakpoints() : std::vector<double>{};
   std::unique_ptr<TimeSeriesH5Writer> part;  // this case's DIR/time_series.h5.d/<dir>.h5
@@ -157,8 +166,12 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
     for (const RunResult& r : runs) sums.push_back(r.summary);
     if (std::string v = caseVerdict(sums); !v.empty()) j["verdict"] = std::move(v);
   }
-  // The MJCF a model's run simulated, once per distinct model (mjcf/<hash>.xml); none when the
-  // model could not be built (the run's error says why).
+  return part;
+}
+
+// Stage 3: the MJCF a model's run simulated, once per distinct model (mjcf/<hash>.xml); none when
+// the model could not be built (the run's error says why).
+void writeCaseMjcf(const Job& job, const ExperimentCase& c, json& j) {
   const bool simulates_mjcf = std::any_of(c.models.begin(), c.models.end(), [](const std::string& m) {
     const ModelEntry* e = findModel(m);
     return e && e->simulates_mjcf;
@@ -176,14 +189,33 @@ std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& 
       j["mjcf"] = name;
     }
   }
-  if (job.render) renderCase(c, runs, (job.root / "renders").string());
-  if (part) {  // on disk, and named with its content before it takes its name, before the journal line
-    part->publish([&](const std::string& temp) {
-      const std::optional<std::string> hash = sha256OfFile(temp);
-      if (!hash) throw std::runtime_error("cannot read back " + temp);
-      recordHashInManifest((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *hash);
-    });
-  }
+}
+
+// Stage 5: the case's HDF5 part on disk, named with its content in its folder's manifest before
+// it takes its name (before the journal line).
+void publishPart(const Job& job, size_t i, TimeSeriesH5Writer& part) {
+  part.publish([&](const std::string& temp) {
+    const std::optional<std::string> hash = sha256OfFile(temp);
+    if (!hash) throw std::runtime_error("cannot read back " + temp);
+    recordHashInManifest((job.root / kH5Parts).string(), job.dirs[i] + ".h5", *hash);
+  });
+}
+
+}  // namespace
+
+// Runs one case and writes its folder; result.json last, as the "finished" marker.
+std::string runAndWrite(const Job& job, size_t i, int& failed_runs, RunContext& ctx) {
+  const ExperimentCase& c = job.e->cases[i];
+  const std::vector<RunResult> runs = runCase(c, &ctx);
+  const fs::path dir = job.root / "cases" / job.dirs[i];
+  const bool folder = c.output.caseFolder();
+  if (folder) makeResultDir(dir.string());
+  json j = caseEntryHeader(job, i);
+  const std::unique_ptr<TimeSeriesH5Writer> part = writeRuns(job, i, runs, j, failed_runs);
+  writeCaseMjcf(job, c, j);
+  if (job.render) renderCase(c, runs, (job.root / "renders").string());  // Stage 4: the video or still
+  if (part) publishPart(job, i, *part);
+  // Stage 6: the entry, the case's "finished" marker: its result.json, or one line, one write().
   std::string line = j.dump();
   if (folder) writeFileAtomic((dir / "result.json").string(), j.dump(1));
   else job.journal->append(line + "\n");  // one line, one write(): the case is finished

@@ -114,13 +114,16 @@ bool entryComplete(const json& j, const ExperimentCase& c) {
 
 }  // namespace
 
-// in_shard: per case, whether it belongs to this process's shard (--shard K/N; empty = all).
-Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, const std::vector<char>& in_shard) {
+namespace {
+
+// Stage 1: the job's cases: those run by this process (--case, --shard), the render switch, each
+// case's key and folder name (two cases sharing a folder: refused).
+Job planJob(const Experiment& e, const RunOptions& opt, const fs::path& root, const std::vector<char>& in_shard,
+            std::vector<size_t>& todo_all) {
   Job job;
   job.e = &e;
   job.root = root;
   job.source = recordedSource(e);
-  std::vector<size_t> todo_all;
   for (size_t i = 0; i < e.cases.size(); ++i)
     if ((opt.only_case.empty() || e.cases[i].name == opt.only_case) && (in_shard.empty() || in_shard[i]))
       todo_all.push_back(i);
@@ -136,6 +139,14 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
       throw std::runtime_error("experiment " + e.name + ": cases '" + e.cases[it->second].name + "' and '" +
                                e.cases[i].name + "' would share the folder cases/" + job.dirs.back());
   }
+  return job;
+}
+
+// Stage 2: the folder claimed (--fresh: cleared), a killed run's temporary files removed, its
+// subfolders checked, its inputs written and the render prerequisites checked.
+void readyFolder(const Job& job, const RunOptions& opt, const std::vector<size_t>& todo_all) {
+  const Experiment& e = *job.e;
+  const fs::path& root = job.root;
   claimFolder(e, root, !opt.resume);
   if (!opt.resume && opt.only_case.empty()) clearResultFolder(root);  // --fresh: no stale case folders
   removeStaleTemps(root);
@@ -157,50 +168,52 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
   compactManifest(root.string());
   for (const auto& [name, text] : folderInputs(e)) writeOwnFile(root, name, text);
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
-  job.entries.resize(e.cases.size());
-  // Cases without a folder are finished when DIR/cases.jsonl has them; with their time series in
-  // HDF5, only when their group is whole with the same key in their own file
-  // (DIR/time_series.h5.d/<dir>.h5, written before the journal line) or in the published
-  // DIR/time_series.h5 (else they run again).
-  const bool any_journal =
-      std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return !e.cases[i].output.caseFolder(); });
-  job.any_h5 = std::any_of(e.cases.begin(), e.cases.end(), [](const ExperimentCase& c) { return inH5(c); });
-  std::map<std::string, std::string> journal = readJournal(root / "cases.jsonl", true);
-  const bool had_journal = !journal.empty() || isRegularFile(root / "cases.jsonl");
-  job.h5_from.assign(e.cases.size(), kH5None);
-  // HDF5 files are opened only when they are as tailsim wrote them (their SHA-256 named in their
-  // folder's manifest): libhdf5 crashes on some damaged files, and copies others silently. A
-  // damaged time_series.h5 or part is not read: its cases run again (and the file is replaced).
-  if (job.any_h5) {
-    const fs::path h5 = root / "time_series.h5";
-    bool intact = false;
-    if (isRegularFile(h5)) {
-      const std::optional<std::string> hash = sha256OfFile(h5.string());
-      intact = hash && manifestNamesHash(root.string(), "time_series.h5", *hash);
-      if (!intact)
-        std::fprintf(stderr, "note: %s is not as tailsim wrote it (damaged or changed): not read, its cases run again\n",
-                     h5.c_str());
-    }
-    job.published = std::make_unique<TimeSeriesH5Reader>(intact ? h5.string() : std::string());
+}
+
+// Stage 3 (cases in HDF5): DIR/time_series.h5 opened only when it is as tailsim wrote it (its
+// SHA-256 named in the folder's manifest): libhdf5 crashes on some damaged files, and copies others
+// silently. A damaged time_series.h5 is not read: its cases run again (and the file is replaced).
+void openPublishedH5(Job& job) {
+  const fs::path h5 = job.root / "time_series.h5";
+  bool intact = false;
+  if (isRegularFile(h5)) {
+    const std::optional<std::string> hash = sha256OfFile(h5.string());
+    intact = hash && manifestNamesHash(job.root.string(), "time_series.h5", *hash);
+    if (!intact)
+      std::fprintf(stderr, "note: %s is not as tailsim wrote it (damaged or changed): not read, its cases run again\n",
+                   h5.c_str());
   }
-  // Where case i's whole group is: its own file (when intact), else the published file, else nowhere.
-  const auto findH5 = [&](size_t i, const std::vector<std::string>& models, const std::string& key) -> char {
-    const fs::path part = h5PartPath(job, i);
-    if (h5PartIntact(job, i) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
-      return kH5Part;
-    return job.published->hasCase(job.dirs[i], key, models) ? kH5Published : kH5None;
-  };
-  {  // the lines of cases not run now (--case, another shard's) are kept when the journal is rewritten
-    std::vector<char> now(e.cases.size(), 0);
-    for (size_t i : todo_all) now[i] = 1;
-    job.other_lines.resize(e.cases.size());
-    for (size_t i = 0; i < e.cases.size(); ++i)
-      if (!now[i])
-        if (auto it = journal.find(e.cases[i].name); it != journal.end()) {
-          job.other_lines[i] = it->second;
-          if (inH5(e.cases[i])) job.h5_from[i] = findH5(i, {}, job.keys[i]);  // its group stays too
-        }
-  }
+  job.published = std::make_unique<TimeSeriesH5Reader>(intact ? h5.string() : std::string());
+}
+
+// Where case i's whole group is: its own file (when intact), else the published file, else nowhere.
+char findH5(const Job& job, size_t i, const std::vector<std::string>& models, const std::string& key) {
+  const fs::path part = h5PartPath(job, i);
+  if (h5PartIntact(job, i) && TimeSeriesH5Reader(part.string()).hasCase(job.dirs[i], key, models))
+    return kH5Part;
+  return job.published->hasCase(job.dirs[i], key, models) ? kH5Published : kH5None;
+}
+
+// Stage 4: the journal lines of cases not run now (--case, another shard's), kept when the journal
+// is rewritten, and their HDF5 groups.
+void keepOtherLines(Job& job, const std::vector<size_t>& todo_all, const std::map<std::string, std::string>& journal) {
+  const Experiment& e = *job.e;
+  std::vector<char> now(e.cases.size(), 0);
+  for (size_t i : todo_all) now[i] = 1;
+  job.other_lines.resize(e.cases.size());
+  for (size_t i = 0; i < e.cases.size(); ++i)
+    if (!now[i])
+      if (auto it = journal.find(e.cases[i].name); it != journal.end()) {
+        job.other_lines[i] = it->second;
+        if (inH5(e.cases[i])) job.h5_from[i] = findH5(job, i, {}, job.keys[i]);  // its group stays too
+      }
+}
+
+// Stage 5: each case run now is finished (its entry kept, resumed) or to run (Job::todo).
+void sortFinished(Job& job, const RunOptions& opt, const std::vector<size_t>& todo_all,
+                  std::map<std::string, std::string>& journal) {
+  const Experiment& e = *job.e;
+  const fs::path& root = job.root;
   for (size_t i : todo_all) {  // finished cases of an earlier, interrupted run
     const ExperimentCase& c = e.cases[i];
     json j;
@@ -231,7 +244,7 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     if (reuse && inH5(c)) {
       std::vector<std::string> models;
       for (const auto& run : j["runs"].items()) models.push_back(run.key());
-      job.h5_from[i] = findH5(i, models, j.value("key", std::string()));
+      job.h5_from[i] = findH5(job, i, models, j.value("key", std::string()));
       reuse = job.h5_from[i] != kH5None;
     }
     if (reuse) {
@@ -243,43 +256,75 @@ Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, co
     if (inH5(c)) refuseUserPart(job, i);
     job.todo.push_back(i);
   }
-  if (!job.other_builds.empty()) {
-    std::string list;
-    int n = 0;
-    for (const auto& [build, count] : job.other_builds) {
-      list += (list.empty() ? "" : ", ") + std::to_string(count) + " by " + build;
-      n += count;
-    }
-    // Where those cases are: DIR, or for a merge the shard folders they come from.
-    std::string where = root.string();
-    if (opt.case_origin) {
-      std::set<std::string> shards;
-      for (const auto& [build, o] : job.other_build_origins) shards.insert(o.begin(), o.end());
-      where.clear();
-      for (const std::string& s : shards) where += (where.empty() ? "" : ", ") + s;
-      where = "merge: " + where;
-    }
-    const std::string self = "tailsim " + std::string(kVersion) + " (commit " + (*kGitCommit ? kGitCommit : "unknown") + ")";
-    if (!opt.allow_other_build)
-      throw std::runtime_error(where + " hold" + (opt.case_origin ? "" : "s") +
-                               " finished cases computed by another tailsim build (" + list +
-                               "; this is " + self + "): " +
-                               (opt.merge_only ? "merge shards of one build, or add --allow-other-build to keep them"
-                                               : "add --fresh to recompute them, or --allow-other-build to keep them") +
-                               " (recorded in summary.json)");
-    std::fprintf(stderr, "warning: %s: %d finished case%s of another tailsim build kept (%s; this is %s)\n",
-                 where.c_str(), n, n == 1 ? "" : "s", list.c_str(), self.c_str());
+}
+
+// Stage 6: finished cases of another tailsim build: refused, or with --allow-other-build kept
+// with a warning.
+void reportOtherBuilds(const Job& job, const RunOptions& opt) {
+  if (job.other_builds.empty()) return;
+  std::string list;
+  int n = 0;
+  for (const auto& [build, count] : job.other_builds) {
+    list += (list.empty() ? "" : ", ") + std::to_string(count) + " by " + build;
+    n += count;
   }
+  // Where those cases are: DIR, or for a merge the shard folders they come from.
+  std::string where = job.root.string();
+  if (opt.case_origin) {
+    std::set<std::string> shards;
+    for (const auto& [build, o] : job.other_build_origins) shards.insert(o.begin(), o.end());
+    where.clear();
+    for (const std::string& s : shards) where += (where.empty() ? "" : ", ") + s;
+    where = "merge: " + where;
+  }
+  const std::string self = "tailsim " + std::string(kVersion) + " (commit " + (*kGitCommit ? kGitCommit : "unknown") + ")";
+  if (!opt.allow_other_build)
+    throw std::runtime_error(where + " hold" + (opt.case_origin ? "" : "s") +
+                             " finished cases computed by another tailsim build (" + list +
+                             "; this is " + self + "): " +
+                             (opt.merge_only ? "merge shards of one build, or add --allow-other-build to keep them"
+                                             : "add --fresh to recompute them, or --allow-other-build to keep them") +
+                             " (recorded in summary.json)");
+  std::fprintf(stderr, "warning: %s: %d finished case%s of another tailsim build kept (%s; this is %s)\n",
+               where.c_str(), n, n == 1 ? "" : "s", list.c_str(), self.c_str());
+}
+
+// Stage 7: DIR/cases.jsonl compacted: one line per finished case, whatever earlier runs appended.
+void compactJournal(const Job& job) {
+  const Experiment& e = *job.e;
+  std::string lines;
+  for (size_t i = 0; i < e.cases.size(); ++i)
+    if (!job.entries[i].empty() && !e.cases[i].output.caseFolder()) lines += job.entries[i] + "\n";
+    else if (!job.other_lines[i].empty()) lines += job.other_lines[i] + "\n";
+  writeFileAtomic((job.root / "cases.jsonl").string(), lines);
+}
+
+}  // namespace
+
+// in_shard: per case, whether it belongs to this process's shard (--shard K/N; empty = all).
+Job prepare(const Experiment& e, const RunOptions& opt, const fs::path& root, const std::vector<char>& in_shard) {
+  std::vector<size_t> todo_all;
+  Job job = planJob(e, opt, root, in_shard, todo_all);
+  readyFolder(job, opt, todo_all);
+  job.entries.resize(e.cases.size());
+  // Cases without a folder are finished when DIR/cases.jsonl has them; with their time series in
+  // HDF5, only when their group is whole with the same key in their own file
+  // (DIR/time_series.h5.d/<dir>.h5, written before the journal line) or in the published
+  // DIR/time_series.h5 (else they run again).
+  const bool any_journal =
+      std::any_of(todo_all.begin(), todo_all.end(), [&](size_t i) { return !e.cases[i].output.caseFolder(); });
+  job.any_h5 = std::any_of(e.cases.begin(), e.cases.end(), [](const ExperimentCase& c) { return inH5(c); });
+  std::map<std::string, std::string> journal = readJournal(root / "cases.jsonl", true);
+  const bool had_journal = !journal.empty() || isRegularFile(root / "cases.jsonl");
+  job.h5_from.assign(e.cases.size(), kH5None);
+  if (job.any_h5) openPublishedH5(job);
+  keepOtherLines(job, todo_all, journal);
+  sortFinished(job, opt, todo_all, journal);
+  reportOtherBuilds(job, opt);
   if (opt.merge_only && !job.todo.empty())
     throw std::runtime_error("merge: case '" + e.cases[job.todo.front()].name + "' of experiment " + e.name +
                              " is finished in none of the shard folders (run its shard, or the shard again)");
-  if (had_journal) {  // compacted: one line per finished case, whatever earlier runs appended
-    std::string lines;
-    for (size_t i = 0; i < e.cases.size(); ++i)
-      if (!job.entries[i].empty() && !e.cases[i].output.caseFolder()) lines += job.entries[i] + "\n";
-      else if (!job.other_lines[i].empty()) lines += job.other_lines[i] + "\n";
-    writeFileAtomic((root / "cases.jsonl").string(), lines);
-  }
+  if (had_journal) compactJournal(job);
   if (any_journal || had_journal) job.journal = std::make_unique<CaseJournal>(root / "cases.jsonl");
   return job;
 }
