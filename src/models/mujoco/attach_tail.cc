@@ -58,25 +58,16 @@ double tiltFromDeg(const mjData* d, int body, const std::array<double, 3>& z0) {
 
 }  // namespace
 
-std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
-                       const MujocoSettings& s) {
-  tinyxml2::XMLDocument doc;
-  if (doc.Parse(r.model.xml.c_str()) != tinyxml2::XML_SUCCESS) throw RobotImportError("attachTail: the model does not parse");
-  XMLElement* root = doc.RootElement();
-  while (XMLElement* k = root->FirstChildElement("keyframe")) root->DeleteChild(k);
-  const std::string bodyName = mount.body.empty() ? r.root_body : mount.body;
-  XMLElement* parent = findBody(root->FirstChildElement("worldbody"), bodyName);
-  if (!parent) throw RobotImportError(r.model.source + ": tail mount: no body named '" + bodyName + "'");
-  // Tail frame: the mount body's frame turned about z so that x points backward (yaw + 180 deg).
+namespace {
+
+// Stage: the tail's bodies under `parent`: tail_link1..n with their inertials, hinges about z and
+// visual capsules; the first at the mount, turned so that x points backward (yaw + 180 deg).
+void addTailLinks(tinyxml2::XMLDocument& doc, XMLElement* parent, const TailMount& mount, const std::vector<TailLink>& tail) {
   const double a = 0.5 * (mount.yaw_rad + kPi);
-  XMLElement* link = nullptr;
   XMLElement* at = parent;
-  RobotParams p;
-  p.tail = tail;
-  const ServoGains gains = tailServoGains(p, s);
   for (std::size_t i = 0; i < tail.size(); ++i) {
     const TailLink& l = tail[i];
-    link = doc.NewElement("body");
+    XMLElement* link = doc.NewElement("body");
     at->InsertEndChild(link);
     link->SetAttribute("name", mjcf::tailBodyName(static_cast<int>(i + 1)).c_str());
     if (i == 0) {
@@ -113,27 +104,32 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
     g->SetAttribute("rgba", "0.85 0.45 0.1 1");
     at = link;
   }
-  if (r.legs_locked) {
-    // Each leg joint held at its stood angle (solref 0.002 s, critically damped; MuJoCo raises the
-    // time constant to 2 timesteps where it is shorter).
-    XMLElement* eq = doc.NewElement("equality");
-    root->InsertEndChild(eq);
-    for (const auto& [name, target] : r.hold_target_rad) {
-      (void)target;
-      XMLElement* e = doc.NewElement("joint");
-      eq->InsertEndChild(e);
-      e->SetAttribute("name", ("tailsim_lock_" + name).c_str());
-      e->SetAttribute("joint1", name.c_str());
-      e->SetAttribute("polycoef", nums({r.settled_qpos.at(name).at(0), 0.0, 0.0, 0.0, 0.0}).c_str());
-      e->SetAttribute("solref", "0.002 1");
-    }
+}
+
+// Stage: each leg joint held at its stood angle by a joint equality (solref 0.002 s, critically
+// damped; MuJoCo raises the time constant to 2 timesteps where it is shorter).
+void lockLegs(tinyxml2::XMLDocument& doc, XMLElement* root, const DerivedRobot& r) {
+  XMLElement* eq = doc.NewElement("equality");
+  root->InsertEndChild(eq);
+  for (const auto& [name, target] : r.hold_target_rad) {
+    (void)target;
+    XMLElement* e = doc.NewElement("joint");
+    eq->InsertEndChild(e);
+    e->SetAttribute("name", ("tailsim_lock_" + name).c_str());
+    e->SetAttribute("joint1", name.c_str());
+    e->SetAttribute("polycoef", nums({r.settled_qpos.at(name).at(0), 0.0, 0.0, 0.0, 0.0}).c_str());
+    e->SetAttribute("solref", "0.002 1");
   }
+}
+
+// Stage: one PD servo per tail joint (tail_motor<i>: a <general> actuator, affine bias) with gains.
+void addTailServos(tinyxml2::XMLDocument& doc, XMLElement* root, std::size_t links, const ServoGains& gains) {
   XMLElement* act = root->FirstChildElement("actuator");
   if (!act) {
     act = doc.NewElement("actuator");
     root->InsertEndChild(act);
   }
-  for (std::size_t i = 0; i < tail.size(); ++i) {
+  for (std::size_t i = 0; i < links; ++i) {
     XMLElement* g = doc.NewElement("general");
     act->InsertEndChild(g);
     g->SetAttribute("name", mjcf::tailActuatorName(static_cast<int>(i + 1)).c_str());
@@ -145,6 +141,26 @@ std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std:
     g->SetAttribute("biastype", "affine");
     g->SetAttribute("gaintype", "fixed");
   }
+}
+
+}  // namespace
+
+// Stages: parse the robot's model, drop its keyframes, the tail's links under the mount body, the
+// legs' locks (legs: locked), the tail's servos.
+std::string attachTail(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
+                       const MujocoSettings& s) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(r.model.xml.c_str()) != tinyxml2::XML_SUCCESS) throw RobotImportError("attachTail: the model does not parse");
+  XMLElement* root = doc.RootElement();
+  while (XMLElement* k = root->FirstChildElement("keyframe")) root->DeleteChild(k);
+  const std::string bodyName = mount.body.empty() ? r.root_body : mount.body;
+  XMLElement* parent = findBody(root->FirstChildElement("worldbody"), bodyName);
+  if (!parent) throw RobotImportError(r.model.source + ": tail mount: no body named '" + bodyName + "'");
+  addTailLinks(doc, parent, mount, tail);
+  if (r.legs_locked) lockLegs(doc, root, r);
+  RobotParams p;
+  p.tail = tail;
+  addTailServos(doc, root, tail.size(), tailServoGains(p, s));
   tinyxml2::XMLPrinter printer;
   doc.Print(&printer);
   return printer.CStr();

@@ -680,7 +680,23 @@ class MujocoRun {
   }
 
   // The summary of the run that ended, and the warnings of a result that is computed but doubtful.
+  // Stages: the final figures, then the warnings in the order they are printed.
   RunResult judge() {
+    const TrackingStats st = ctrl_.stats();
+    finalFigures(st);
+    if (standing_.enforced() && sum_.ok) warnContactFidelity();
+    if (standing_.enforced() && sum_.ok && settings_.max_tilt_deg > 0.0 &&
+        sum_.extra["max_tilt_deg"] > limits::kNearFallTiltShare * settings_.max_tilt_deg)
+      warnNearFall();
+    judgeAtRest();
+    warnTracking(st);
+    if (!sum_.ok) sum_.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+    return result_;
+  }
+
+  // Stage: phi_net, the final position, t_stop (the last row where |phi_dot| reaches the stop
+  // threshold), the tail's tracking, the standing and contact figures.
+  void finalFigures(const TrackingStats& st) {
     mj_kinematics(m_, d_);  // xmat of the final state
     phi_ += wrapPi(yawOf(d_, L_.quad_body) - yaw_prev_);
     sum_.phi_net_deg = (phi_ - phi0_) * kRad2Deg;
@@ -696,7 +712,6 @@ class MujocoRun {
         break;
       }
     }
-    const TrackingStats st = ctrl_.stats();
     for (int i = 0; i < n_; ++i) {
       sum_.extra["tracking_max_deg_j" + std::to_string(i + 1)] = st.max_abs_rad[i] * kRad2Deg;
       sum_.extra["tracking_rms_deg_j" + std::to_string(i + 1)] = st.rms_rad[i] * kRad2Deg;
@@ -705,54 +720,59 @@ class MujocoRun {
     sum_.extra["kp_j1"] = gains_.kp[0];
     standing_.report(sum_.extra);
     reportContact();
-    // Contact fidelity (docs/mujoco-model.md "Contact fidelity"): feet that leave the ground while the
-    // body slides, and impulsive normal forces, mean MuJoCo's soft contact, not Coulomb friction,
-    // shaped the result.
-    if (standing_.enforced() && sum_.ok) {
-      const double airborne = sum_.extra["airborne_fraction"], peak = sum_.extra["peak_normal_force_over_mg"];
-      std::ostringstream os;
-      os.precision(3);
-      if (airborne > limits::kMaxAirborneFraction)
-        os << "all four feet carry no load in " << 100.0 * airborne << " % of the steps (limit "
-           << 100.0 * limits::kMaxAirborneFraction << " %): MuJoCo's soft contact chatters while the body slides";
-      if (peak > limits::kMaxPeakNormalForceOverMg)
-        os << (os.str().empty() ? "" : "; ") << "the summed foot normal force peaks at " << peak
-           << " m g (limit " << limits::kMaxPeakNormalForceOverMg << " m g): impulsive contact";
-      if (!os.str().empty()) {
-        os << "; phi_net depends on the contact softness (mujoco.solref), see docs/mujoco-model.md \"Contact fidelity\"";
-        sum_.warnings.push_back(os.str());
-      }
-    }
-    // Near fall: the body rocked onto two feet and came back; a converged run may see it fall.
-    if (standing_.enforced() && sum_.ok && settings_.max_tilt_deg > 0.0 &&
-        sum_.extra["max_tilt_deg"] > limits::kNearFallTiltShare * settings_.max_tilt_deg) {
-      std::ostringstream os;
-      os.precision(3);
-      os << kUncertainWarning << ": the robot nearly fell (body tilt up to " << sum_.extra["max_tilt_deg"]
-         << " deg, more than " << 100.0 * limits::kNearFallTiltShare << " % of max_tilt_deg = " << settings_.max_tilt_deg
-         << " deg): it rocked on two feet, and whether it falls depends on the contact and the step "
-         << "(docs/mujoco-model.md \"Tipping over\")";
+  }
+
+  // Stage: contact fidelity (docs/mujoco-model.md "Contact fidelity"): feet that leave the ground
+  // while the body slides, and impulsive normal forces, mean MuJoCo's soft contact, not Coulomb
+  // friction, shaped the result.
+  void warnContactFidelity() {
+    const double airborne = sum_.extra["airborne_fraction"], peak = sum_.extra["peak_normal_force_over_mg"];
+    std::ostringstream os;
+    os.precision(3);
+    if (airborne > limits::kMaxAirborneFraction)
+      os << "all four feet carry no load in " << 100.0 * airborne << " % of the steps (limit "
+         << 100.0 * limits::kMaxAirborneFraction << " %): MuJoCo's soft contact chatters while the body slides";
+    if (peak > limits::kMaxPeakNormalForceOverMg)
+      os << (os.str().empty() ? "" : "; ") << "the summed foot normal force peaks at " << peak
+         << " m g (limit " << limits::kMaxPeakNormalForceOverMg << " m g): impulsive contact";
+    if (!os.str().empty()) {
+      os << "; phi_net depends on the contact softness (mujoco.solref), see docs/mujoco-model.md \"Contact fidelity\"";
       sum_.warnings.push_back(os.str());
     }
-    // At rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
-    {
-      mjtNum v6[6];
-      mj_objectVelocity(m_, d_, mjOBJ_BODY, L_.quad_body, v6, 0);  // (angular, linear), world axes
-      const double phidot_dps = std::abs(v6[2]) * kRad2Deg, speed = std::hypot(v6[3], v6[4]);
-      sum_.extra["final_phidot_dps"] = v6[2] * kRad2Deg;
-      sum_.extra["final_speed_mps"] = speed;
-      sum_.at_rest = phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps;
-      if (!sum_.at_rest && sum_.ok) {
-        std::ostringstream os;
-        os.precision(4);
-        os << "the body is still moving when the run ends at t = " << plan_.duration << " s (|phi_dot| " << phidot_dps
-           << " deg/s, speed " << speed << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
-           << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
-        sum_.warnings.push_back(os.str());
-      }
+  }
+
+  // Stage: near fall: the body rocked onto two feet and came back; a converged run may see it fall.
+  void warnNearFall() {
+    std::ostringstream os;
+    os.precision(3);
+    os << kUncertainWarning << ": the robot nearly fell (body tilt up to " << sum_.extra["max_tilt_deg"]
+       << " deg, more than " << 100.0 * limits::kNearFallTiltShare << " % of max_tilt_deg = " << settings_.max_tilt_deg
+       << " deg): it rocked on two feet, and whether it falls depends on the contact and the step "
+       << "(docs/mujoco-model.md \"Tipping over\")";
+    sum_.warnings.push_back(os.str());
+  }
+
+  // Stage: at rest at the end: yaw rate and the body's horizontal speed below the documented thresholds.
+  void judgeAtRest() {
+    mjtNum v6[6];
+    mj_objectVelocity(m_, d_, mjOBJ_BODY, L_.quad_body, v6, 0);  // (angular, linear), world axes
+    const double phidot_dps = std::abs(v6[2]) * kRad2Deg, speed = std::hypot(v6[3], v6[4]);
+    sum_.extra["final_phidot_dps"] = v6[2] * kRad2Deg;
+    sum_.extra["final_speed_mps"] = speed;
+    sum_.at_rest = phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps;
+    if (!sum_.at_rest && sum_.ok) {
+      std::ostringstream os;
+      os.precision(4);
+      os << "the body is still moving when the run ends at t = " << plan_.duration << " s (|phi_dot| " << phidot_dps
+         << " deg/s, speed " << speed << " m/s; at rest means below " << limits::kAtRestPhidotDps << " deg/s and "
+         << limits::kAtRestSpeedMps << " m/s): phi_net is not final, raise output.settle_s or duration_s";
+      sum_.warnings.push_back(os.str());
     }
-    // The servo follows the reference only as well as the step allows (a coarse timestep_s lowers
-    // the gains: kp ~ (servo_wn_dt / timestep_s)^2): a large tracking error means a different motion.
+  }
+
+  // Stage: the servo follows the reference only as well as the step allows (a coarse timestep_s
+  // lowers the gains: kp ~ (servo_wn_dt / timestep_s)^2): a large tracking error means a different motion.
+  void warnTracking(const TrackingStats& st) {
     double worst = 0.0;
     int worst_j = 0;
     for (int i = 0; i < n_; ++i)
@@ -765,8 +785,6 @@ class MujocoRun {
          << "lower mujoco.timestep_s (" << settings_.timestep_s << " s)";
       sum_.warnings.push_back(os.str());
     }
-    if (!sum_.ok) sum_.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
-    return result_;
   }
 
   // The result of a run that failed while settling.
