@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <tuple>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -411,4 +412,46 @@ TEST(RobotImport, TiltWithTheTailIsMeasuredFromTheStance) {
   for (const std::string& w : a.warnings) EXPECT_EQ(w.find("tilted"), std::string::npos) << w;
   std::printf("stance %.3f, after standing %.3f abs / %.3f from the stance, stroke max %.3f / %.3f deg\n",
               a.stance_tilt_deg, a.stand_end_tilt_deg, a.stand_end_rel_tilt_deg, a.max_tilt_deg, a.max_rel_tilt_deg);
+}
+
+// A URDF robot has no actuators: tailsim's PD holds its joints. Its damper is the joints' own
+// damping, which MuJoCo's Euler step treats implicitly; applied explicitly, kv = 5 N m s/rad on a
+// 0.3 kg shank at the default 2 ms diverged during the stroke ("Nan, Inf or huge value in QACC").
+TEST(RobotImport, UrdfLegsOnTailsimsPdStayStableThroughTheStroke) {
+  Scratch t("robot_import");
+  std::string legs;
+  for (const auto& [name, x, y] : {std::tuple<const char*, double, double>{"FL", 0.2, 0.12}, {"FR", 0.2, -0.12},
+                                   {"RR", -0.2, -0.12}, {"RL", -0.2, 0.12}}) {
+    char b[1600];
+    std::snprintf(b, sizeof b,
+                  "<link name=\"%s_th\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/><inertia ixx=\"0.002\" "
+                  "iyy=\"0.002\" izz=\"0.0003\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision><origin xyz=\"0 0 -0.1\"/>"
+                  "<geometry><cylinder radius=\"0.015\" length=\"0.2\"/></geometry></collision></link>\n"
+                  "<joint name=\"%s_hip\" type=\"revolute\"><parent link=\"base\"/><child link=\"%s_th\"/><origin "
+                  "xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/><limit lower=\"-2\" upper=\"2\" effort=\"50\" velocity=\"10\"/></joint>\n"
+                  "<link name=\"%s_sh\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.3\"/><inertia ixx=\"0.001\" "
+                  "iyy=\"0.001\" izz=\"0.0002\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision><origin xyz=\"0 0 -0.2\"/>"
+                  "<geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
+                  "<joint name=\"%s_knee\" type=\"revolute\"><parent link=\"%s_th\"/><child link=\"%s_sh\"/><origin "
+                  "xyz=\"0 0 -0.2\"/><axis xyz=\"0 1 0\"/><limit lower=\"-2.5\" upper=\"2.5\" effort=\"50\" velocity=\"10\"/></joint>\n",
+                  name, name, name, x, y, name, name, name, name);
+    legs += b;
+  }
+  RobotModelSpec s;
+  s.file = t.write("bot.urdf", "<robot name=\"bot\"><link name=\"base\"><inertial><mass value=\"10\"/><inertia ixx=\"0.1\" "
+                               "iyy=\"0.2\" izz=\"0.25\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial><collision><geometry>"
+                               "<box size=\"0.5 0.3 0.1\"/></geometry></collision></link>\n" + legs + "</robot>\n");
+  for (const char* leg : {"FL", "FR", "RR", "RL"}) {
+    s.joint_angles_rad[std::string(leg) + "_hip"] = 20.0 * M_PI / 180.0;
+    s.joint_angles_rad[std::string(leg) + "_knee"] = -40.0 * M_PI / 180.0;
+  }
+  s.mount.pos_m = {-0.3, 0.0, 0.0};
+  RobotTailChoice tail;  // 10 %, l_F, 1 link, 600 deg/s, 2 s standing
+  const RobotComparison c = compareRobotModels(s, tail);
+  EXPECT_EQ(c.robot.pd_joints.size(), 8u);
+  ASSERT_FALSE(c.rows.empty());
+  EXPECT_TRUE(c.rows.front().ok) << (c.rows.front().warnings.empty() ? "" : c.rows.front().warnings.front());
+  EXPECT_LT(c.articulated.stand_max_rel_tilt_deg, 1.0);
+  EXPECT_LT(c.articulated.max_tilt_deg, 5.0);
+  EXPECT_EQ(c.articulated.feet_in_contact, 4);
 }

@@ -217,14 +217,17 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
     a.vadr.push_back(m->jnt_dofadr[j]);
     a.act.push_back(actuatorId(m, mjcf::tailActuatorName(i)));
   }
+  std::vector<int> pdJoints;
   for (const std::string& name : r.pd_joints) {
     const int j = jointId(m, name);
+    pdJoints.push_back(j);
     a.pdq.push_back(m->jnt_qposadr[j]);
     a.pdv.push_back(m->jnt_dofadr[j]);
     a.pdTarget.push_back(r.hold_target_rad.at(name));
     a.pdStance.push_back(r.settled_qpos.at(name).at(0));
     a.pdHold.push_back(a.pdTarget.back());
   }
+  addStancePdDamping(m, pdJoints);
   std::vector<JointState> ref0;
   trajectory.evaluate(0.0, ref0);
   for (int i = 0; i < a.n; ++i) d->qpos[a.qadr[i]] = ref0[i].theta;
@@ -237,11 +240,11 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
   }
 }
 
-// One step: the legs' PD (for joints no actuator holds), the tail's controller at t_ref.
+// One step: the legs' PD spring (for joints no actuator holds), the tail's controller at t_ref.
 void stepArticulated(ArticulatedSim& a, TailController& ctrl, double t_ref, long& steps) {
   mj_step1(a.m, a.d);
   for (std::size_t k = 0; k < a.pdq.size(); ++k)
-    a.d->qfrc_applied[a.pdv[k]] = kStancePdKp * (a.pdTarget[k] - a.d->qpos[a.pdq[k]]) - kStancePdKv * a.d->qvel[a.pdv[k]];
+    a.d->qfrc_applied[a.pdv[k]] = kStancePdKp * (a.pdTarget[k] - a.d->qpos[a.pdq[k]]);  // its damper: dof_damping
   ctrl.apply(a.m, a.d, t_ref, false);
   mj_step2(a.m, a.d);
   ++steps;

@@ -509,11 +509,18 @@ LegHold holdLegs(const mjModel* m, const Stance& stance) {
   return h;
 }
 
+}  // namespace
+
+void addStancePdDamping(mjModel* m, const std::vector<int>& joints) {
+  for (int j : joints) m->dof_damping[m->jnt_dofadr[j]] += kStancePdKv;
+}
+
+namespace {
+
 // Stage: the stance lifted (or lowered) until the lowest colliding geom is 1 mm above the floor, then
 // settled for spec.settle_s with the legs held; r.tilt_deg is the root body's tilt afterwards.
-void stand(const mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stance, const LegHold& hold, int root,
+void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stance, const LegHold& hold, int root,
            int floor, const std::string& file, DerivedRobot& r) {
-  constexpr double kPdKp = kStancePdKp, kPdKv = kStancePdKv;
   mju_copy(d->qpos, stance.qpos.data(), m->nq);
   mj_kinematics(m, d);
   const double floorZ = floor >= 0 ? d->geom_xpos[3 * floor + 2] : 0.0;
@@ -526,11 +533,12 @@ void stand(const mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance
   r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
                     g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(spec.settle_s) + " s");
   mju_copy(d->ctrl, hold.ctrl.data(), m->nu);
+  addStancePdDamping(m, hold.pd);
   const int steps = static_cast<int>(std::ceil(spec.settle_s / m->opt.timestep));
   for (int i = 0; i < steps; ++i) {
     for (int j : hold.pd) {
       const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
-      d->qfrc_applied[va] = kPdKp * (stance.qpos[qa] - d->qpos[qa]) - kPdKv * d->qvel[va];
+      d->qfrc_applied[va] = kStancePdKp * (stance.qpos[qa] - d->qpos[qa]);
     }
     mj_step(m, d);
   }
