@@ -817,8 +817,8 @@ std::string threeFeetNote(const DerivedRobot& r) {
   for (const std::string& f : r.feet) names += (names.empty() ? "" : ", ") + f;
   return "the robot stands on 3 feet (" + names +
          "): only the articulated MuJoCo model runs on it; the planar models (analytic, perfoot) and MuJoCo's rigid "
-         "box take a body on 4 feet at a rectangle's corners, so l_F_m and w_F_m above are the support triangle's "
-         "extents, not their input";
+         "box take a body on 4 feet at a rectangle's corners (its derived l_F_m and w_F_m are the support "
+         "triangle's extents, not their input)";
 }
 
 std::string describeDerivedRobot(const DerivedRobot& r) {
