@@ -194,6 +194,96 @@ std::map<std::string, std::string> designFolderInputs(const std::string& design_
   return out;
 }
 
+namespace {
+
+std::string fmt4(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return std::string(b);
+}
+
+// The limits as the infeasible message names them: one torque and speed, or each joint's.
+std::string limitsText(const StrokeLimits& L) {
+  std::string limits;
+  if (L.joints.empty())
+    limits = "torque " + (L.torque_max_Nm > 0 ? fmt4(L.torque_max_Nm) + " N m" : std::string("unlimited")) + ", speed " +
+             fmt4(L.thetadot_max_radps * kDegPerRad) + " deg/s";
+  else
+    for (std::size_t i = 0; i < L.joints.size(); ++i)
+      limits += (i ? "; joint " : "joint ") + std::to_string(i + 1) + ": torque " +
+                (L.joints[i].torque_max_Nm > 0 ? fmt4(L.joints[i].torque_max_Nm) + " N m" : std::string("unlimited")) +
+                ", speed " + fmt4(L.joints[i].thetadot_max_radps * kDegPerRad) + " deg/s";
+  return limits;
+}
+
+// The infeasible message's first sentence: the limits, the turn asked and found, the binding
+// joint (B: its limits) and the stiction reach.
+std::string infeasibleHead(const Infeasibility& r, const JointLimits& B, const StrokeLimits& L,
+                           const StrokeEvaluation& best, double min_turn_rad) {
+  const std::string binding =
+      r.binding_joint < 0 ? std::string()
+                          : "; the binding joint is joint " + std::to_string(r.binding_joint + 1) + " (" +
+                                fmt4(r.binding_torque_Nm) + " N m" +
+                                (B.torque_max_Nm > 0 ? " of its " + fmt4(B.torque_max_Nm) + " N m" : std::string()) + ")";
+  return "no stroke within the limits (" + limitsText(L) + ") turns the body by min_turn_deg " +
+         fmt4(min_turn_rad * kDegPerRad) + " or more: the best found turns it " + fmt4(best.phi_net_rad * kDegPerRad) +
+         " deg" + binding +
+         (r.reach.applies ? "; its yaw moment on the held body peaks at " + fmt4(100.0 * r.reach.ratio) +
+                                " % of the static friction limit (" + fmt4(r.reach.peak_moment_Nm) +
+                                " N m of max(mu_s, mu_d) m g L_F = " + fmt4(r.reach.limit_Nm) + " N m)"
+                          : std::string());
+}
+
+// The problem without torque and speed limits.
+StrokeProblem unlimitedProblem(const StrokeProblem& p) {
+  StrokeProblem unlimited = p;
+  unlimited.space.limits.torque_max_Nm = 0.0;
+  unlimited.space.limits.thetadot_max_radps = std::numeric_limits<double>::infinity();
+  for (JointLimits& j : unlimited.space.limits.joints) {
+    j.torque_max_Nm = 0.0;
+    j.thetadot_max_radps = std::numeric_limits<double>::infinity();
+  }
+  return unlimited;
+}
+
+// The least speed-up k (to 1e-6 of k) at which the same stroke shape, run k times faster, turns
+// the body by min_turn_rad, bracketed from the stiction reach's estimate; none if not even 30
+// times faster does.
+std::optional<double> neededSpeedUp(const StrokeProblem& unlimited, const TailTrajectory& traj, const StictionReach& reach,
+                     double min_turn_rad) {
+  auto turns = [&](double k) {
+    const StrokeEvaluation e = evaluateStroke(unlimited, timeScaled(traj, k));
+    return e.ok && std::abs(e.phi_net_rad) >= min_turn_rad;
+  };
+  double lo = 1.0, hi = reach.applies && reach.ratio > 0.0 && reach.ratio < 1.0 ? std::sqrt(1.0 / reach.ratio) : 1.2;
+  while (!turns(hi) && hi < 30.0) {
+    lo = hi;
+    hi *= 1.25;
+  }
+  if (!turns(hi)) return std::nullopt;
+  for (int it = 0; it < 40 && hi - lo > 1e-6 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (turns(mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+
+// The needed figures at speed-up k: exactly k^2 and k times the stroke's (the check's are sampled
+// every 0.5 ms, coarse for a stroke this fast), in all and per joint.
+void neededFigures(const StrokeEvaluation& best, double k, Infeasibility& r) {
+  r.torque_needed_Nm = r.peak_torque_Nm * k * k;
+  r.speed_needed_dps = r.peak_speed_dps * k;
+  for (const JointFigures& g : best.figures.joints) {
+    r.torque_needed_per_joint_Nm.push_back(g.peak_torque_Nm * k * k);
+    r.speed_needed_per_joint_dps.push_back(g.peak_speed_radps * kDegPerRad * k);
+  }
+}
+
+}  // namespace
+
+// Stages: the binding joint, the message's head, the least speed-up that turns the body (the loads
+// are inertial: the same shape run k times faster needs joint torques x k^2, speeds x k), a check
+// run at it, and the figures needed.
 Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& best, const TailTrajectory& traj,
                                 double min_turn_rad) {
   Infeasibility r;
@@ -203,11 +293,6 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
   r.peak_torque_Nm = best.figures.peak_torque_Nm;
   r.peak_speed_dps = best.figures.peak_speed_radps * kDegPerRad;
   const StrokeLimits& L = p.space.limits;
-  auto fmt = [](double v) {
-    char b[40];
-    std::snprintf(b, sizeof b, "%.4g", v);
-    return std::string(b);
-  };
   // The joint that binds: the one whose torque uses the largest share of its limit.
   r.binding_joint = mostLoadedJoint(best.figures, L);
   const JointLimits B = L.joint(static_cast<std::size_t>(std::max(0, r.binding_joint)));
@@ -215,76 +300,30 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
     r.binding_torque_Nm = best.figures.joints[static_cast<std::size_t>(r.binding_joint)].peak_torque_Nm;
     r.binding_limit_Nm = B.torque_max_Nm;
   }
-  std::string limits;
-  if (L.joints.empty())
-    limits = "torque " + (L.torque_max_Nm > 0 ? fmt(L.torque_max_Nm) + " N m" : std::string("unlimited")) + ", speed " +
-             fmt(L.thetadot_max_radps * kDegPerRad) + " deg/s";
-  else
-    for (std::size_t i = 0; i < L.joints.size(); ++i)
-      limits += (i ? "; joint " : "joint ") + std::to_string(i + 1) + ": torque " +
-                (L.joints[i].torque_max_Nm > 0 ? fmt(L.joints[i].torque_max_Nm) + " N m" : std::string("unlimited")) +
-                ", speed " + fmt(L.joints[i].thetadot_max_radps * kDegPerRad) + " deg/s";
-  const std::string binding =
-      r.binding_joint < 0 ? std::string()
-                          : "; the binding joint is joint " + std::to_string(r.binding_joint + 1) + " (" +
-                                fmt(r.binding_torque_Nm) + " N m" +
-                                (B.torque_max_Nm > 0 ? " of its " + fmt(B.torque_max_Nm) + " N m" : std::string()) + ")";
-  const std::string head = "no stroke within the limits (" + limits + ") turns the body by min_turn_deg " +
-                           fmt(min_turn_rad * kDegPerRad) + " or more: the best found turns it " +
-                           fmt(best.phi_net_rad * kDegPerRad) + " deg" + binding +
-                           (r.reach.applies ? "; its yaw moment on the held body peaks at " + fmt(100.0 * r.reach.ratio) +
-                                                  " % of the static friction limit (" +
-                                                  fmt(r.reach.peak_moment_Nm) + " N m of max(mu_s, mu_d) m g L_F = " +
-                                                  fmt(r.reach.limit_Nm) + " N m)"
-                                            : std::string());
-  // The same shape run k times faster: joint torques x k^2, speeds x k (the loads are inertial).
-  StrokeProblem unlimited = p;
-  unlimited.space.limits.torque_max_Nm = 0.0;
-  unlimited.space.limits.thetadot_max_radps = std::numeric_limits<double>::infinity();
-  for (JointLimits& j : unlimited.space.limits.joints) {
-    j.torque_max_Nm = 0.0;
-    j.thetadot_max_radps = std::numeric_limits<double>::infinity();
-  }
-  auto turns = [&](double k) {
-    const StrokeEvaluation e = evaluateStroke(unlimited, timeScaled(traj, k));
-    return e.ok && std::abs(e.phi_net_rad) >= min_turn_rad;
-  };
-  double lo = 1.0, hi = r.reach.applies && r.reach.ratio > 0.0 && r.reach.ratio < 1.0 ? std::sqrt(1.0 / r.reach.ratio) : 1.2;
-  while (!turns(hi) && hi < 30.0) {
-    lo = hi;
-    hi *= 1.25;
-  }
-  if (!turns(hi)) {
+  const std::string head = infeasibleHead(r, B, L, best, min_turn_rad);
+  const StrokeProblem unlimited = unlimitedProblem(p);
+  const std::optional<double> speed_up = neededSpeedUp(unlimited, traj, r.reach, min_turn_rad);
+  if (!speed_up) {
     r.torque_needed_Nm = r.speed_needed_dps = std::numeric_limits<double>::infinity();
     r.message = head + "; even 30 times faster the same stroke shape does not: widen the angle range or change the robot";
     return r;
   }
-  for (int it = 0; it < 40 && hi - lo > 1e-6 * hi; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    (turns(mid) ? hi : lo) = mid;
-  }
-  const StrokeEvaluation c = evaluateStroke(unlimited, timeScaled(traj, hi));
+  const double k = *speed_up;
+  const StrokeEvaluation c = evaluateStroke(unlimited, timeScaled(traj, k));
   r.check_ok = c.ok;
   r.check_torque_Nm = c.figures.peak_torque_Nm;
   r.check_speed_dps = c.figures.peak_speed_radps * kDegPerRad;
   r.check_phi_net_deg = c.phi_net_rad * kDegPerRad;
-  // Exactly k^2 and k times the stroke's figures (the check's are sampled every 0.5 ms, coarse for
-  // a stroke this fast).
-  r.torque_needed_Nm = r.peak_torque_Nm * hi * hi;
-  r.speed_needed_dps = r.peak_speed_dps * hi;
-  for (const JointFigures& g : best.figures.joints) {
-    r.torque_needed_per_joint_Nm.push_back(g.peak_torque_Nm * hi * hi);
-    r.speed_needed_per_joint_dps.push_back(g.peak_speed_radps * kDegPerRad * hi);
-  }
+  neededFigures(best, k, r);
   std::string per_joint;
   if (!L.joints.empty())
     for (std::size_t i = 0; i < r.torque_needed_per_joint_Nm.size(); ++i)
       per_joint += (i ? ", joint " : "; per joint: joint ") + std::to_string(i + 1) + " " +
-                   fmt(r.torque_needed_per_joint_Nm[i]) + " N m, " + fmt(r.speed_needed_per_joint_dps[i]) + " deg/s";
-  r.message = head + ". The same stroke shape, run " + fmt(hi) + " times faster, turns it " + fmt(r.check_phi_net_deg) +
-              " deg (" + objectiveModelName(p.search_model) + " model) at a peak joint torque of " + fmt(r.torque_needed_Nm) +
-              " N m and a peak joint speed of " + fmt(r.speed_needed_dps) + " deg/s (now " + fmt(r.peak_torque_Nm) +
-              " N m, " + fmt(r.peak_speed_dps) + " deg/s" + per_joint + "): raise the limits to at least these" +
+                   fmt4(r.torque_needed_per_joint_Nm[i]) + " N m, " + fmt4(r.speed_needed_per_joint_dps[i]) + " deg/s";
+  r.message = head + ". The same stroke shape, run " + fmt4(k) + " times faster, turns it " + fmt4(r.check_phi_net_deg) +
+              " deg (" + objectiveModelName(p.search_model) + " model) at a peak joint torque of " + fmt4(r.torque_needed_Nm) +
+              " N m and a peak joint speed of " + fmt4(r.speed_needed_dps) + " deg/s (now " + fmt4(r.peak_torque_Nm) +
+              " N m, " + fmt4(r.peak_speed_dps) + " deg/s" + per_joint + "): raise the limits to at least these" +
               (r.binding_joint >= 0 ? " (first joint " + std::to_string(r.binding_joint + 1) + "'s torque)" : std::string()) +
               ", or change the robot";
   return r;

@@ -376,77 +376,71 @@ OptimizeResult searchSpace(const StrokeProblem& prob, const OptimizerSettings& s
   return search.finish();
 }
 
-}  // namespace
-
-OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s, const ProgressFn& progress) {
-  if (!s.enumerate_directions) return searchSpace(prob, s, progress);
-  if (prob.space.family != StrokeFamily::kSplitCycle)
-    throw std::invalid_argument("enumerating stroke directions needs the split-cycle family");
-  // The n = 3 problem's basins differ in which joints stroke up and which down (the best found has
-  // joint 1 against joints 2 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
-  // with its own sub-seeds, finds every pattern's basin instead of the one a single search
-  // happens to fall into. All 2^n patterns, mirror images included (no symmetry of the robot or
-  // the limits is assumed). Successive halving (directions_kept = K > 0): the first global restart
-  // runs in every pattern; the other restarts, the local restarts and the polish only in the K
-  // patterns whose first restart found the most (ties: the lower pattern index); the others keep
-  // their first restart's best. A pattern's search is the same either way (same sub-seeds).
-  const int n = prob.space.n_links;
-  if (n < 0 || n > limits::kMaxEnumeratedLinks)
-    throw std::invalid_argument("enumerating stroke directions: " + std::to_string(n) + " links, at most " +
-                                std::to_string(limits::kMaxEnumeratedLinks) + " (2^n patterns)");
-  const int patterns = 1 << n;
-  std::vector<StrokeProblem> problems(static_cast<std::size_t>(patterns), prob);
-  std::vector<std::unique_ptr<SpaceSearch>> searches;
-  // Progress over all patterns: runs summed, the best of the patterns' bests.
-  std::vector<SearchProgress> per_pattern(static_cast<std::size_t>(patterns));
-  auto patternProgress = [&](int mask) -> ProgressFn {
-    if (!progress) return {};
-    return [&, mask](const SearchProgress& p) {
-      per_pattern[static_cast<std::size_t>(mask)] = p;
+// Progress over all direction patterns: runs summed, the best of the patterns' bests.
+class PatternsProgress {
+ public:
+  PatternsProgress(const ProgressFn& progress, int patterns)
+      : progress_(progress), per_pattern_(static_cast<std::size_t>(patterns)) {}
+  // Pattern `mask`'s progress function (none without a progress function); it refers to this object.
+  ProgressFn forPattern(int mask) {
+    if (!progress_) return {};
+    return [this, mask](const SearchProgress& p) {
+      per_pattern_[static_cast<std::size_t>(mask)] = p;
       SearchProgress all{p.stage, 0, 0.0, 0.0};
-      for (const SearchProgress& q : per_pattern) {
+      for (const SearchProgress& q : per_pattern_) {
         all.evaluations += q.evaluations;
         if (q.best_objective > all.best_objective) {
           all.best_objective = q.best_objective;
           all.best_phi_net_rad = q.best_phi_net_rad;
         }
       }
-      progress(all);
+      progress_(all);
     };
-  };
+  }
+
+ private:
+  const ProgressFn& progress_;
+  std::vector<SearchProgress> per_pattern_;
+};
+
+// The problem of each direction pattern: joint j strokes down (-1) where bit j of the mask is set.
+std::vector<StrokeProblem> directionProblems(const StrokeProblem& prob, int n) {
+  const int patterns = 1 << n;
+  std::vector<StrokeProblem> problems(static_cast<std::size_t>(patterns), prob);
   for (int mask = 0; mask < patterns; ++mask) {
     StrokeProblem& p = problems[static_cast<std::size_t>(mask)];
     p.space.directions.assign(static_cast<std::size_t>(n), 1);
     for (int j = 0; j < n; ++j)
       if ((mask >> j) & 1) p.space.directions[static_cast<std::size_t>(j)] = -1;
-    OptimizerSettings ps = s;
-    ps.seed = s.seed * 4099u + static_cast<std::uint64_t>(mask);
-    searches.push_back(std::make_unique<SpaceSearch>(p, ps, patternProgress(mask)));
-    // Without successive halving each pattern's search runs through (as before the option).
-    if (s.directions_kept == 0 || s.directions_kept >= patterns) {
-      searches.back()->globalStage(0, s.restarts);
-      searches.back()->localStageAndPolish();
-    }
   }
-  if (s.directions_kept > 0 && s.directions_kept < patterns) {
-    for (auto& search : searches) search->globalStage(0, 1);
-    std::vector<int> order(static_cast<std::size_t>(patterns));
-    for (int m = 0; m < patterns; ++m) order[static_cast<std::size_t>(m)] = m;
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-      return searches[static_cast<std::size_t>(a)]->bestObjective() > searches[static_cast<std::size_t>(b)]->bestObjective();
-    });
-    for (int k = 0; k < s.directions_kept; ++k) {
-      SpaceSearch& kept = *searches[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
-      kept.globalStage(1, s.restarts);
-      kept.localStageAndPolish();
-    }
-  }
+  return problems;
+}
 
+// Successive halving: the first global restart in every pattern, then the other restarts, the
+// local restarts and the polish in the `kept` patterns whose first restart found the most (ties:
+// the lower pattern index).
+void halveDirections(std::vector<std::unique_ptr<SpaceSearch>>& searches, int kept, int restarts) {
+  for (auto& search : searches) search->globalStage(0, 1);
+  std::vector<int> order(searches.size());
+  for (std::size_t m = 0; m < order.size(); ++m) order[m] = static_cast<int>(m);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return searches[static_cast<std::size_t>(a)]->bestObjective() > searches[static_cast<std::size_t>(b)]->bestObjective();
+  });
+  for (int k = 0; k < kept; ++k) {
+    SpaceSearch& search = *searches[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+    search.globalStage(1, restarts);
+    search.localStageAndPolish();
+  }
+}
+
+// The patterns' results as one: the best feasible (the first pattern's if none is), every
+// pattern's best, the candidates, and one history curve over all patterns (rows after each
+// pattern's first continue the counts).
+OptimizeResult mergePatterns(std::vector<std::unique_ptr<SpaceSearch>>& searches) {
   OptimizeResult all;
   double best_so_far = 0.0, best_phi = 0.0;
-  for (int mask = 0; mask < patterns; ++mask) {
-    OptimizeResult r = searches[static_cast<std::size_t>(mask)]->finish();
-    // History: one curve over all patterns (rows after each pattern's first continue the counts).
+  for (std::size_t mask = 0; mask < searches.size(); ++mask) {
+    OptimizeResult r = searches[mask]->finish();
     const int gen0 = all.history.empty() ? 0 : all.history.back().generation;
     for (std::size_t k = mask == 0 ? 0 : 1; k < r.history.size(); ++k) {
       HistoryRow row = r.history[k];
@@ -474,6 +468,47 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
       all.trajectory = r.trajectory;
     }
   }
+  return all;
+}
+
+}  // namespace
+
+// Stages: one search per direction pattern (run through, or halved), their results merged, the
+// candidates kept, and the base stroke if no pattern is feasible.
+OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings& s, const ProgressFn& progress) {
+  if (!s.enumerate_directions) return searchSpace(prob, s, progress);
+  if (prob.space.family != StrokeFamily::kSplitCycle)
+    throw std::invalid_argument("enumerating stroke directions needs the split-cycle family");
+  // The n = 3 problem's basins differ in which joints stroke up and which down (the best found has
+  // joint 1 against joints 2 and 3; docs/design-a-tail-stroke.md): one search per pattern, each
+  // with its own sub-seeds, finds every pattern's basin instead of the one a single search
+  // happens to fall into. All 2^n patterns, mirror images included (no symmetry of the robot or
+  // the limits is assumed). Successive halving (directions_kept = K > 0, halveDirections): the
+  // others keep their first restart's best. A pattern's search is the same either way (same
+  // sub-seeds).
+  const int n = prob.space.n_links;
+  if (n < 0 || n > limits::kMaxEnumeratedLinks)
+    throw std::invalid_argument("enumerating stroke directions: " + std::to_string(n) + " links, at most " +
+                                std::to_string(limits::kMaxEnumeratedLinks) + " (2^n patterns)");
+  const int patterns = 1 << n;
+  const bool halving = s.directions_kept > 0 && s.directions_kept < patterns;
+  const std::vector<StrokeProblem> problems = directionProblems(prob, n);
+  PatternsProgress all_progress(progress, patterns);
+  std::vector<std::unique_ptr<SpaceSearch>> searches;
+  for (int mask = 0; mask < patterns; ++mask) {
+    OptimizerSettings ps = s;
+    ps.seed = s.seed * 4099u + static_cast<std::uint64_t>(mask);
+    searches.push_back(std::make_unique<SpaceSearch>(problems[static_cast<std::size_t>(mask)], ps,
+                                                     all_progress.forPattern(mask)));
+    // Without successive halving each pattern's search runs through (as before the option).
+    if (!halving) {
+      searches.back()->globalStage(0, s.restarts);
+      searches.back()->localStageAndPolish();
+    }
+  }
+  if (halving) halveDirections(searches, s.directions_kept, s.restarts);
+
+  OptimizeResult all = mergePatterns(searches);
   std::stable_sort(all.candidates.begin(), all.candidates.end(),
                    [](const Candidate& a, const Candidate& b) { return a.eval.objective > b.eval.objective; });
   if (all.candidates.size() > static_cast<std::size_t>(std::max(0, prob.keep_candidates)))

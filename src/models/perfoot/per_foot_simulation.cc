@@ -102,110 +102,24 @@ class Model {
   // stuck: the body is held (twist zero); the friction is the wrench that holds it and
   // load_factor says whether the discs can supply it (warm: warm-started, heldLoadFactor; else
   // from loadFactor's start scan). Otherwise per-foot sliding friction.
+  // Stages: the tail's loads and the coupling, then held (pinned or free) or sliding.
   Eval evaluate(double t, const State& y, bool stuck, bool decompose = false, bool warm = false) const {
     Eval ev;
-    std::vector<JointState>& js = js_;
-    traj_.evaluate(t, js);
-    systemLoads(robot_, js, decompose, ev.loads, scratch_);
-    if (!std::isfinite(ev.loads.MzT) || !std::isfinite(ev.loads.Izz_kgm2))
-      throw std::runtime_error("the tail loads became non-finite at t=" + std::to_string(t) + " s");
-    const double phi = y[kPhi], w = stuck ? 0.0 : y[kW];
-    const SinCos R = sinCos(phi);  // one rotation by phi, used below
-    ev.FT_W = rotate(R.c, R.s, ev.loads.F_T_Q);
     Eigen::Matrix3d A;
     Eigen::Vector3d r0;
-    exactCoupling(js, phi, w, ev, A, r0);
-    for (int i = 0; i < 4; ++i) ev.discs.r[i] = rotate(R.c, R.s, foot_Q_[i]) - ev.c_W;
-    if (hasFriction()) ev.L_F = footLoads(robot_.quadruped, ev.loads.p_QC).L_F;
-
+    const double phi = y[kPhi], w = stuck ? 0.0 : y[kW];
+    const SinCos R = sinCos(phi);  // one rotation by phi, used below
+    bodyAndTail(t, phi, w, R, decompose, ev, A, r0);
     if (stuck) {
-      // z = 0 in A z = r0 + E f: f = -E^-1 r0 (E: identity, plus c x F in the moment row).
-      Wrench2 req;
-      req.F = -Vec2(r0[0], r0[1]);
-      req.M = -r0[2] - cross2(ev.c_W, req.F);
-      if (!translation()) {
-        // x, y locked: a pin at the quadruped COM takes any force; the feet must supply the moment
-        // about it, -r0_z, at most sum c_i |rho_i| (every foot tangential).
-        normalLoads(ev, t, phi, Vec2::Zero());
-        double D = 0.0;
-        for (int i = 0; i < 4; ++i) {
-          ev.discs.c[i] = mu_break_ * ev.N[i];
-          D += ev.discs.c[i] * (ev.discs.r[i] + ev.c_W).norm();
-        }
-        const double MQ = -r0[2];
-        ev.load_factor = D > 0 ? std::abs(MQ) / D : (MQ == 0 ? 0.0 : std::numeric_limits<double>::infinity());
-        for (int i = 0; i < 4; ++i) {
-          const Vec2 rho = ev.discs.r[i] + ev.c_W;
-          if (D > 0 && rho.norm() > 0) ev.Ff[i] = MQ / D * ev.discs.c[i] * perp(rho) / rho.norm();
-          ev.friction.M += cross2(ev.discs.r[i], ev.Ff[i]);
-        }
-        return ev;
-      }
-      // Load transfer: a held body's friction is at most mu W (s >= |F| / (mu W) > 1 beyond, the
-      // loads cannot hold it anyway); the centre of pressure takes the force capped there, so a
-      // probe of a fast slide's holding wrench neither tips nor jumps.
-      const double F_cap = mu_break_ * weight_;
-      const double Fn = req.F.norm();
-      normalLoads(ev, t, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
-      for (int i = 0; i < 4; ++i) ev.discs.c[i] = mu_break_ * ev.N[i];
-      ev.load_factor = heldLoadFactor(ev.discs, req, warm);
-      ev.Ff = heldFootForces(ev.discs, req);
-      ev.friction = req;
+      if (!translation())
+        holdPinned(ev, t, phi, r0);
+      else
+        holdFree(ev, t, phi, r0, warm);
       return ev;
     }
-
-    // Sliding: foot i's friction -mu_i N_i v_i / |v_i| (regularized below v_stop for stiction).
-    const Vec2 vQ = translation() ? Vec2(y[kVx], y[kVy]) : Vec2::Zero();
-    std::array<Vec2, 4> dir = zeros4();  // F_i = N_i dir_i
-    const FrictionParams& fp = robot_.friction;
-    if (hasFriction()) {
-      for (int i = 0; i < 4; ++i) {
-        const Vec2 vi = vQ + w * perp(rotate(R.c, R.s, foot_Q_[i]));
-        const double sp = vi.norm();
-        if (e_.friction == FrictionLaw::kStiction) {
-          dir[i] = -fp.mu_d * vi / std::max(sp, s_.v_stop_mps);
-        } else if (sp > 0.0) {
-          dir[i] = -adamsFrictionCoefficient(sp, fp.v_s_mps, fp.v_d_mps, fp.mu_s, fp.mu_d) * vi / sp;
-        }
-      }
-    }
-    // Load transfer: N depends on the summed friction, which depends on N: fixed point (a
-    // contraction of factor ~ mu h / l_F).
-    Vec2 F = Vec2::Zero();
-    normalLoads(ev, t, phi, F);
-    if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction() && !prescribed_) {
-      bool converged = false;
-      for (int it = 0; it <= 201 && !converged; ++it) {  // (the 202 iterations it always had)
-        F.setZero();
-        for (int i = 0; i < 4; ++i) F += ev.N[i] * dir[i];
-        const std::array<double, 4> N_old = ev.N;
-        normalLoads(ev, t, phi, F);
-        double change = 0.0;
-        for (int i = 0; i < 4; ++i) change = std::max(change, std::abs(ev.N[i] - N_old[i]));
-        converged = change <= 1e-13 * weight_;
-      }
-      if (!converged) loadTransferNewton(ev, t, phi, dir, F);
-    }
-    for (int i = 0; i < 4; ++i) {
-      ev.discs.c[i] = (e_.friction == FrictionLaw::kStiction ? fp.mu_d : 0.0) * ev.N[i];
-      ev.Ff[i] = ev.N[i] * dir[i];
-      ev.friction.F += ev.Ff[i];
-      ev.friction.M += cross2(ev.discs.r[i], ev.Ff[i]);
-    }
-    if (!translation()) {
-      // x, y locked: the lock takes the force; solve rotation alone (A(2,2) w_dot = r0_2 + M_Q).
-      const double MQ = ev.friction.M + cross2(ev.c_W, ev.friction.F);
-      ev.phi_ddot = (r0[2] + MQ) / A(2, 2);
-      ev.friction.F.setZero();
-      return ev;
-    }
-    Eigen::Vector3d rhs = r0;
-    rhs[0] += ev.friction.F.x();
-    rhs[1] += ev.friction.F.y();
-    rhs[2] += ev.friction.M + cross2(ev.c_W, ev.friction.F);
-    const Eigen::Vector3d z = A.ldlt().solve(rhs);
-    ev.a_Q = Vec2(z[0], z[1]);
-    ev.phi_ddot = z[2];
+    const std::array<Vec2, 4> dir = slidingDirections(y, w, R);
+    slidingNormalLoads(ev, t, phi, dir);
+    slidingAccelerations(ev, dir, A, r0);
     return ev;
   }
 
@@ -230,6 +144,123 @@ class Model {
   }
 
  private:
+  // The tail's loads at t, the coupling A z = r0 + E f at (phi, w), the feet relative to the
+  // system COM and the paper's arm L_F.
+  void bodyAndTail(double t, double phi, double w, const SinCos& R, bool decompose, Eval& ev, Eigen::Matrix3d& A,
+                   Eigen::Vector3d& r0) const {
+    std::vector<JointState>& js = js_;
+    traj_.evaluate(t, js);
+    systemLoads(robot_, js, decompose, ev.loads, scratch_);
+    if (!std::isfinite(ev.loads.MzT) || !std::isfinite(ev.loads.Izz_kgm2))
+      throw std::runtime_error("the tail loads became non-finite at t=" + std::to_string(t) + " s");
+    ev.FT_W = rotate(R.c, R.s, ev.loads.F_T_Q);
+    exactCoupling(js, phi, w, ev, A, r0);
+    for (int i = 0; i < 4; ++i) ev.discs.r[i] = rotate(R.c, R.s, foot_Q_[i]) - ev.c_W;
+    if (hasFriction()) ev.L_F = footLoads(robot_.quadruped, ev.loads.p_QC).L_F;
+  }
+
+  // Held with x, y locked: a pin at the quadruped COM takes any force; the feet must supply the
+  // moment about it, -r0_z, at most sum c_i |rho_i| (every foot tangential).
+  void holdPinned(Eval& ev, double t, double phi, const Eigen::Vector3d& r0) const {
+    normalLoads(ev, t, phi, Vec2::Zero());
+    double D = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      ev.discs.c[i] = mu_break_ * ev.N[i];
+      D += ev.discs.c[i] * (ev.discs.r[i] + ev.c_W).norm();
+    }
+    const double MQ = -r0[2];
+    ev.load_factor = D > 0 ? std::abs(MQ) / D : (MQ == 0 ? 0.0 : std::numeric_limits<double>::infinity());
+    for (int i = 0; i < 4; ++i) {
+      const Vec2 rho = ev.discs.r[i] + ev.c_W;
+      if (D > 0 && rho.norm() > 0) ev.Ff[i] = MQ / D * ev.discs.c[i] * perp(rho) / rho.norm();
+      ev.friction.M += cross2(ev.discs.r[i], ev.Ff[i]);
+    }
+  }
+
+  // Held and free to translate: z = 0 in A z = r0 + E f, f = -E^-1 r0 (E: identity, plus c x F in
+  // the moment row), the wrench the feet must supply. Load transfer: a held body's friction is at
+  // most mu W (s >= |F| / (mu W) > 1 beyond, the loads cannot hold it anyway); the centre of
+  // pressure takes the force capped there, so a probe of a fast slide's holding wrench neither
+  // tips nor jumps.
+  void holdFree(Eval& ev, double t, double phi, const Eigen::Vector3d& r0, bool warm) const {
+    Wrench2 req;
+    req.F = -Vec2(r0[0], r0[1]);
+    req.M = -r0[2] - cross2(ev.c_W, req.F);
+    const double F_cap = mu_break_ * weight_;
+    const double Fn = req.F.norm();
+    normalLoads(ev, t, phi, Fn > F_cap ? Vec2(req.F * (F_cap / Fn)) : req.F);
+    for (int i = 0; i < 4; ++i) ev.discs.c[i] = mu_break_ * ev.N[i];
+    ev.load_factor = heldLoadFactor(ev.discs, req, warm);
+    ev.Ff = heldFootForces(ev.discs, req);
+    ev.friction = req;
+  }
+
+  // Sliding: foot i's friction per unit normal load, F_i = N_i dir_i, dir_i = -mu_i v_i / |v_i|
+  // (regularized below v_stop for stiction).
+  std::array<Vec2, 4> slidingDirections(const State& y, double w, const SinCos& R) const {
+    const Vec2 vQ = translation() ? Vec2(y[kVx], y[kVy]) : Vec2::Zero();
+    std::array<Vec2, 4> dir = zeros4();
+    const FrictionParams& fp = robot_.friction;
+    if (hasFriction()) {
+      for (int i = 0; i < 4; ++i) {
+        const Vec2 vi = vQ + w * perp(rotate(R.c, R.s, foot_Q_[i]));
+        const double sp = vi.norm();
+        if (e_.friction == FrictionLaw::kStiction) {
+          dir[i] = -fp.mu_d * vi / std::max(sp, s_.v_stop_mps);
+        } else if (sp > 0.0) {
+          dir[i] = -adamsFrictionCoefficient(sp, fp.v_s_mps, fp.v_d_mps, fp.mu_s, fp.mu_d) * vi / sp;
+        }
+      }
+    }
+    return dir;
+  }
+
+  // The sliding body's normal loads. Load transfer: N depends on the summed friction, which
+  // depends on N: fixed point (a contraction of factor ~ mu h / l_F), else loadTransferNewton.
+  void slidingNormalLoads(Eval& ev, double t, double phi, const std::array<Vec2, 4>& dir) const {
+    Vec2 F = Vec2::Zero();
+    normalLoads(ev, t, phi, F);
+    if (s_.normal_loads == NormalLoadModel::kLoadTransfer && hasFriction() && !prescribed_) {
+      bool converged = false;
+      for (int it = 0; it <= 201 && !converged; ++it) {  // (the 202 iterations it always had)
+        F.setZero();
+        for (int i = 0; i < 4; ++i) F += ev.N[i] * dir[i];
+        const std::array<double, 4> N_old = ev.N;
+        normalLoads(ev, t, phi, F);
+        double change = 0.0;
+        for (int i = 0; i < 4; ++i) change = std::max(change, std::abs(ev.N[i] - N_old[i]));
+        converged = change <= 1e-13 * weight_;
+      }
+      if (!converged) loadTransferNewton(ev, t, phi, dir, F);
+    }
+  }
+
+  // The sliding feet's friction and its wrench about the system COM, and the accelerations from
+  // A z = r0 + E f (x, y locked: the lock takes the force, rotation alone, A(2,2) w_dot = r0_2 + M_Q).
+  void slidingAccelerations(Eval& ev, const std::array<Vec2, 4>& dir, const Eigen::Matrix3d& A,
+                            const Eigen::Vector3d& r0) const {
+    const double mu_d = robot_.friction.mu_d;
+    for (int i = 0; i < 4; ++i) {
+      ev.discs.c[i] = (e_.friction == FrictionLaw::kStiction ? mu_d : 0.0) * ev.N[i];
+      ev.Ff[i] = ev.N[i] * dir[i];
+      ev.friction.F += ev.Ff[i];
+      ev.friction.M += cross2(ev.discs.r[i], ev.Ff[i]);
+    }
+    if (!translation()) {
+      const double MQ = ev.friction.M + cross2(ev.c_W, ev.friction.F);
+      ev.phi_ddot = (r0[2] + MQ) / A(2, 2);
+      ev.friction.F.setZero();
+      return;
+    }
+    Eigen::Vector3d rhs = r0;
+    rhs[0] += ev.friction.F.x();
+    rhs[1] += ev.friction.F.y();
+    rhs[2] += ev.friction.M + cross2(ev.c_W, ev.friction.F);
+    const Eigen::Vector3d z = A.ldlt().solve(rhs);
+    ev.a_Q = Vec2(z[0], z[1]);
+    ev.phi_ddot = z[2];
+  }
+
   // Normal loads from the Appendix distribution at the system COM, or (load transfer) at the
   // centre of pressure shifted by -h F / W. Quasi-static: throws TippingError outside the support
   // rectangle (never after requireSupport). Load transfer: ev.support is the centre of pressure's
@@ -586,8 +617,11 @@ std::array<double, 4> PrescribedNormalLoads::at(double t) const {
 }
 
 namespace {
-RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
-                              const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads* loads) {
+
+// The run's settings checked (std::invalid_argument) and its plan: the end, the rows, and the
+// scan and step lengths from the tail's shortest phase.
+RunPlan perFootRunPlan(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                       const OutputSettings& output) {
   requireOneJointPerLink(trajectory.joints.size(), robot.tail.size());
   if (!(settings.rel_tol > 0) || !(settings.abs_tol > 0)) throw std::invalid_argument("perfoot tolerances must be > 0");
   if (!(settings.event_tol_s > 0)) throw std::invalid_argument("perfoot event_tol_s must be > 0");
@@ -600,11 +634,6 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   if (output.sample_dt_s > t_end) throw std::invalid_argument("output.sample_dt_s is longer than the run");
   const double rows = output.rows(t_end);
   if (!(rows <= limits::kMaxRowsPerRun)) throw std::invalid_argument("the run would write too many rows");
-
-  const auto wall0 = std::chrono::steady_clock::now();
-  RunResult result;
-  RunSummary& sum = result.summary;
-  sum.model = "perfoot";
   RunPlan plan;
   plan.t_end = t_end;
   plan.rows = static_cast<long>(rows);
@@ -613,7 +642,44 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
   if (!std::isfinite(shortest)) shortest = t_end;
   plan.h_scan = shortest / 32.0;
   plan.h_max = settings.max_step_s > 0 ? settings.max_step_s : shortest / 8.0;
+  return plan;
+}
 
+// The finished run's series and summary: the final state, the counts, and whether it came to rest.
+void recordPerFootRun(PlanarRun<PerFootStickSlip>& run, const PerFootStickSlip& ss, const Model& model, double t_end,
+                      RunResult& result) {
+  RunSummary& sum = result.summary;
+  const State& y = run.y;
+  result.series = run.rec.take();
+  result.series_thinned = run.rec.thinned();
+  const bool stuck = run.modes.stuck[kRot];
+  sum.phi_net_deg = units::degrees(y[kPhi]);
+  sum.t_stop_s = stuck ? ss.t_stop : t_end;
+  sum.stick_slip_events = ss.switches;
+  sum.solver_steps = run.steps;
+  const double phidot_dps = units::degrees(std::abs(y[kW])), speed = std::hypot(y[kVx], y[kVy]);
+  sum.extra["final_x_m"] = y[kX];
+  sum.extra["final_y_m"] = y[kY];
+  sum.extra["final_phidot_dps"] = units::degrees(y[kW]);
+  sum.extra["final_speed_mps"] = speed;
+  sum.extra["breakaways"] = ss.breakaways;
+  sum.extra["rhs_evaluations"] = static_cast<double>(run.rhs);
+  sum.extra["rejected_steps"] = static_cast<double>(run.rejected);
+  if (model.stiction()) sum.extra["max_load_factor_stuck"] = ss.max_load_factor;
+  sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
+  if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
+}
+
+// Stages: the plan, the support checked along the trajectory, the stick/slip run from the initial
+// velocity, its record; a failure ends it with the summary's error, the counts kept.
+RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& trajectory, const PerFootSettings& settings,
+                              const Effects& effects, const OutputSettings& output, const PrescribedNormalLoads* loads) {
+  const RunPlan plan = perFootRunPlan(robot, trajectory, settings, output);
+  const double t_end = plan.t_end;
+  const auto wall0 = std::chrono::steady_clock::now();
+  RunResult result;
+  RunSummary& sum = result.summary;
+  sum.model = "perfoot";
   long newton_solves = 0, load_factors = 0, start_scans = 0;
   try {
     // Every evaluation with friction takes the paper's arm L_F at the system COM, which fails outside
@@ -636,25 +702,7 @@ RunResult simulatePerFootImpl(const RobotParams& robot, const TailTrajectory& tr
     run.modes = PerFootStickSlip::modesOf(model.stiction() && model.maxFootSpeed(y) == 0.0);
     planar_driver::switchAt(run, -1);
     integrate(run);
-
-    result.series = run.rec.take();
-    result.series_thinned = run.rec.thinned();
-    const bool stuck = run.modes.stuck[kRot];
-    sum.phi_net_deg = units::degrees(y[kPhi]);
-    sum.t_stop_s = stuck ? ss.t_stop : t_end;
-    sum.stick_slip_events = ss.switches;
-    sum.solver_steps = run.steps;
-    const double phidot_dps = units::degrees(std::abs(y[kW])), speed = std::hypot(y[kVx], y[kVy]);
-    sum.extra["final_x_m"] = y[kX];
-    sum.extra["final_y_m"] = y[kY];
-    sum.extra["final_phidot_dps"] = units::degrees(y[kW]);
-    sum.extra["final_speed_mps"] = speed;
-    sum.extra["breakaways"] = ss.breakaways;
-    sum.extra["rhs_evaluations"] = static_cast<double>(run.rhs);
-    sum.extra["rejected_steps"] = static_cast<double>(run.rejected);
-    if (model.stiction()) sum.extra["max_load_factor_stuck"] = ss.max_load_factor;
-    sum.at_rest = stuck || (phidot_dps < limits::kAtRestPhidotDps && speed < limits::kAtRestSpeedMps);
-    if (!sum.at_rest) sum.warnings.push_back(notAtRestWarning(t_end, phidot_dps, speed));
+    recordPerFootRun(run, ss, model, t_end, result);
   } catch (const TippingError& e) {
     sum.ok = false;
     sum.error = e.what();
