@@ -139,6 +139,39 @@ class PythonModule(unittest.TestCase):
         # The contact model turns the body the same way, within the documented ~10 % gap.
         self.assertAlmostEqual(r.summary["phi_net_deg"], self.cli_phi, delta=0.2 * abs(self.cli_phi))
 
+    def test_robot_from_its_model_file_equals_cli(self):
+        # robot={'mjcf': PATH, ...} as in an experiment: stood and derived, then the articulated run,
+        # to the last digit what `tailsim run` gives for the same experiment.
+        box = os.path.join(self.tmp.name, "box.xml")
+        with open(box, "w") as f:
+            f.write("""<mujoco model="box"><worldbody><body name="trunk" pos="0 0 0.3"><freejoint/>
+<inertial pos="0 0 0" mass="10" diaginertia="0.1 0.2 0.25"/><geom type="box" size="0.25 0.15 0.05"/>
+<geom name="f1" type="sphere" size="0.02" pos="0.2 0.12 -0.28"/><geom name="f2" type="sphere" size="0.02" pos="0.2 -0.12 -0.28"/>
+<geom name="f3" type="sphere" size="0.02" pos="-0.2 -0.12 -0.28"/><geom name="f4" type="sphere" size="0.02" pos="-0.2 0.12 -0.28"/>
+</body></worldbody><keyframe><key name="home" qpos="0 0 0.3 1 0 0 0"/></keyframe></mujoco>""")
+        exp = os.path.join(self.tmp.name, "box_tail.yaml")
+        with open(exp, "w") as f:
+            f.write("name: box_tail\nrobot: {mjcf: box.xml, mu: 0.3}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, links: 1}\n"
+                    "trajectory: {rule: eq25, thetadot_max_dps: 600}\nmodels: [mujoco, perfoot]\noutput: {settle_s: 1.0}\n")
+        out = os.path.join(self.tmp.name, "box_cli")
+        subprocess.run([os.path.join(BUILD, "tailsim"), "run", exp, "--out", out, "--quiet"], check=True,
+                       stdout=subprocess.DEVNULL)
+        with open(os.path.join(out, "summary.json")) as f:
+            cli = json.load(f)["cases"][0]["runs"]
+        for model in ("mujoco", "perfoot"):
+            r = tailsim.simulate(robot={"mjcf": box, "mu": 0.3}, tail={"mount": {"pos_m": [-0.25, 0, 0]}, "links": 1},
+                                 trajectory={"rule": "eq25", "thetadot_max_dps": 600}, model=model,
+                                 output={"settle_s": 1.0})
+            self.assertTrue(r.summary["ok"], r.summary.get("error"))
+            self.assertEqual(repr(r.summary["phi_net_deg"]), repr(cli[model]["phi_net_deg"]), model)
+        self.assertIn("stand_max_tilt_from_stance_deg", cli["mujoco"]["extra"])
+        with self.assertRaises(TypeError):
+            tailsim.simulate(robot=3)
+        with self.assertRaisesRegex(tailsim.ConfigError, "robot.mjcf: model file not found"):
+            tailsim.simulate(robot={"mjcf": os.path.join(self.tmp.name, "nothere.xml")},
+                             tail={"mount": {"pos_m": [-0.25, 0, 0]}, "links": 1},
+                             trajectory={"rule": "eq25", "thetadot_max_dps": 600})
+
     def test_thread_pool_equals_serial(self):
         dthetas = [-30 - 2 * k for k in range(30)]
 

@@ -2,7 +2,7 @@
 
 namespace tailsim {
 
-std::string simulateExperimentText(const std::string& robot, const nlohmann::ordered_json& trajectory,
+std::string simulateExperimentText(const nlohmann::ordered_json& robot, const nlohmann::ordered_json& trajectory,
                                    const std::string& model, const nlohmann::ordered_json& sections) {
   if (!sections.is_object()) throw KeywordError("tailsim.simulate: the keyword arguments must be a mapping");
   for (const char* k : {"name", "robot", "models"})

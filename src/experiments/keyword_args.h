@@ -18,7 +18,7 @@ struct KeywordError : std::invalid_argument {
 // {name: simulate, robot, <sections in the caller's order>, trajectory (unless null), models: [model]}
 // written as JSON (which is YAML), one key a line, non-ASCII escaped, so a loader error's line:col
 // points into this text. A non-finite number becomes null (the loader refuses it at its key).
-std::string simulateExperimentText(const std::string& robot, const nlohmann::ordered_json& trajectory,
+std::string simulateExperimentText(const nlohmann::ordered_json& robot, const nlohmann::ordered_json& trajectory,
                                    const std::string& model, const nlohmann::ordered_json& sections);
 
 }  // namespace tailsim

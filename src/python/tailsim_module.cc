@@ -181,14 +181,16 @@ void requireNoNul(const std::string& s, const char* arg) {
   if (s.find('\0') != std::string::npos) throw py::value_error(std::string(arg) + ": embedded null character");
 }
 
-Simulation simulate(const std::string& robot, py::object trajectory, const std::string& model, py::kwargs sections) {
-  requireNoNul(robot, "robot");
+Simulation simulate(py::object robot, py::object trajectory, const std::string& model, py::kwargs sections) {
+  if (py::isinstance<py::str>(robot)) requireNoNul(robot.cast<std::string>(), "robot");
+  else if (!py::isinstance<py::dict>(robot))
+    throw py::type_error("robot: a built-in name or a robot file's path (str), or {'mjcf': PATH, ...} (dict)");
   requireNoNul(model, "model");
   std::string text;
   try {
     JsonFromPython tj;
     const nlohmann::ordered_json traj = tj(trajectory, "trajectory");
-    text = simulateExperimentText(robot, traj, model, tj(sections, ""));
+    text = simulateExperimentText(tj(robot, "robot"), traj, model, tj(sections, ""));
   } catch (const KeywordError& e) {
     throw py::type_error(e.what());
   }
@@ -198,6 +200,7 @@ Simulation simulate(const std::string& robot, py::object trajectory, const std::
   {
     py::gil_scoped_release free;
     Experiment e = loadExperimentText(text, kSimulateLabel);
+    resolveRobotModels(e);  // a robot from its model file: stood and derived before the run
     if (e.cases.size() != 1)
       throw ConfigError(std::string(kSimulateLabel) + ": the arguments sweep " + std::to_string(e.cases.size()) +
                         " cases (" + e.swept_keys.front() + ", ...); simulate() runs one case: give single values, "
@@ -336,6 +339,8 @@ PYBIND11_MODULE(tailsim, m) {
   m.def("simulate", &simulate, py::arg("robot") = "paper", py::arg("trajectory") = py::none(),
         py::arg("model") = "analytic",
         "simulate(robot='paper', trajectory={...}, model='analytic'|'mujoco'|'perfoot', **sections) -> Simulation\n\n"
+        "robot: a built-in name, a robot file's path, or a robot from its MuJoCo model file as in an experiment,\n"
+        "{'mjcf': PATH, 'stance': {...}, ...} with tail={'mount': {...}, 'links': n} (docs/your-robot.md).\n"
         "One case, no files written. The keywords are the top-level keys of an experiment file (tail, quadruped,\n"
         "friction, gravity_mps2, kind, pose, analytic, perfoot, mujoco, effects, output) with dicts shaped as in\n"
         "YAML, e.g. trajectory={'theta0_deg': 0, 'dtheta_deg': -90, 'dT_s': 0.25, 'w_ss': 0.25}.\n"
