@@ -35,9 +35,18 @@
 namespace tailsim {
 namespace loader {
 
-// Pass 2: one case, with the sweeps resolved by `r`.
-ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
-  const Item root = r.root(doc);
+namespace {
+
+// The robot a case starts from, with where each value was set: a robot file (rf, its origins), or
+// a robot from its model file (model_robot; rf then has no values).
+struct CaseRobot {
+  const RobotFile* rf = nullptr;
+  bool model_robot = false;
+  Origins origin;
+};
+
+// Stage 1: the top-level map, the name and description.
+MapView readHeader(const Reader& r, const Item& root, const std::string& source, ExperimentCase& c) {
   static const std::vector<std::string> kTopKeys = [] {
     std::vector<std::string> k = {"name",         "description", "robot", "kind",  "tail",  "quadruped",
                                   "friction",     "gravity_mps2", "trajectory", "pose", "models"};
@@ -45,15 +54,17 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     return k;
   }();
   const MapView top = r.map(root, kTopKeys);
-  ExperimentCase c;
   c.source_file = source;
   const Item& name = r.need(top, "name");
   c.experiment = r.string(name);
   // The name becomes a folder (a suite's OUT/<name>/, render's OUT/<name>/): one safe path component.
   if (const std::string why = experimentNameProblem(c.experiment); !why.empty()) r.fail(name, why);
   if (const Item* d = top.get("description")) r.string(*d);
+  return top;
+}
 
-  // Robot file, then the experiment's overrides; or a robot from its MuJoCo model file.
+// Stage 2: the robot file (its base values and origins), or a robot from its MuJoCo model file.
+CaseRobot readRobotSource(Loader& L, const Reader& r, const MapView& top, const std::string& source, ExperimentCase& c) {
   const Item& robotItem = r.need(top, "robot");
   const bool modelRobot = !r.pick(robotItem) && robotItem.node.IsMap();
   static const RobotFile kNoRobotFile{};
@@ -72,23 +83,30 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   }
   const RobotFile& rf = *rfp;
   c.robot = rf.base;
-  Origins origin = rf.origin;
+  return CaseRobot{rfp, modelRobot, rf.origin};
+}
 
-  if (const Item* k = top.get("kind")) c.kind = r.choice(*k, kindNames());
+// Stage 3a: tail.mount, the tail's place on a robot from its model file.
+void readTailMount(const Reader& r, const Item& mount, bool modelRobot, ExperimentCase& c) {
+  if (!modelRobot) r.fail(mount, "only used with a robot from its model file (robot: {mjcf: PATH})");
+  static const std::vector<std::string> kMountKeys = declaredKeys<TailMount>();
+  const MapView mm = readDeclared(r, mount, c.robot_model->mount);
+  for (const std::string& k : kMountKeys)
+    if (const Item* x = mm.get(k)) c.robot_model_at["tail.mount." + k] = locText(r.loc(*x));
+  if (const Item* b = mm.get("body"))
+    if (c.robot_model->mount.body.empty()) r.fail(*b, "must not be empty (absent: the root body)");
+}
 
+// Stage 3: the tail: links: n of the robot file (or derived with a model robot), or custom links.
+void readTail(const Reader& r, const MapView& top, const Item& root, CaseRobot& robot, ExperimentCase& c) {
+  const bool modelRobot = robot.model_robot;
+  const RobotFile& rf = *robot.rf;
+  Origins& origin = robot.origin;
   if (const Item* t = top.get("tail")) {
     const MapView tm = r.map(*t, {"links", "custom", "mount"});
     const Item* links = tm.get("links");
     const Item* custom = tm.get("custom");
-    if (const Item* mount = tm.get("mount")) {
-      if (!modelRobot) r.fail(*mount, "only used with a robot from its model file (robot: {mjcf: PATH})");
-      static const std::vector<std::string> kMountKeys = declaredKeys<TailMount>();
-      const MapView mm = readDeclared(r, *mount, c.robot_model->mount);
-      for (const std::string& k : kMountKeys)
-        if (const Item* x = mm.get(k)) c.robot_model_at["tail.mount." + k] = locText(r.loc(*x));
-      if (const Item* b = mm.get("body"))
-        if (c.robot_model->mount.body.empty()) r.fail(*b, "must not be empty (absent: the root body)");
-    }
+    if (const Item* mount = tm.get("mount")) readTailMount(r, *mount, modelRobot, c);
     if (!links && !custom) r.fail(*t, "give links: n (1..6) or custom: [{mass_kg, izz_kgm2, length_m}, ...]");
     if (links && custom) r.fail(*custom, "give links: n or custom: [...], not both");
     if (links && modelRobot) {
@@ -120,13 +138,18 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     c.robot.tail = f->second;
     origin.insert(rf.tail_origin.at(1).begin(), rf.tail_origin.at(1).end());
   }
+}
+
+// Stage 4: the experiment's quadruped, friction and gravity over the robot file's; the robot validated.
+void readRobotOverrides(const Reader& r, const MapView& top, const Item& root, CaseRobot& robot, ExperimentCase& c) {
+  Origins& origin = robot.origin;
   if (const Item* q = top.get("quadruped")) readQuadruped(r, *q, false, c.robot.quadruped, origin);
   if (const Item* f = top.get("friction")) readFriction(r, *f, false, c.robot.friction, origin);
   if (const Item* g = top.get("gravity_mps2")) {
     c.robot.gravity_mps2 = r.number(*g);
     origin["gravity_mps2"] = r.loc(*g);
   }
-  if (modelRobot) {
+  if (robot.model_robot) {
     // The robot's own values come with its derivation (resolveRobotModels); a custom tail is checked now.
     if (c.robot_model_links == 0) {
       RobotParams check;
@@ -138,8 +161,10 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     validateRobot(c.robot, origin, r.loc(root));
     checkMasses(c.robot, origin, r.loc(root));
   }
-  const int n = c.robot.numLinks();
+}
 
+// Stage 5: the trajectory (kind: simulate: split-cycle or spline) or the pose (kind: pose) of n joints.
+void readMotion(const Reader& r, const MapView& top, const Item& root, int n, ExperimentCase& c) {
   const Item* traj = top.get("trajectory");
   const Item* pose = top.get("pose");
   if (c.kind == CaseKind::kSimulate) {
@@ -163,7 +188,10 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
     if (traj) r.fail(*traj, "only used with kind: simulate");
     c.pose = pose ? readPose(r, *pose, n) : readPose(r, Item{YAML::Node(YAML::NodeType::Map), "pose", root.mark}, n);
   }
+}
 
+// Stage 6: models: the models each case runs (default: the registry's first).
+void readModels(const Reader& r, const MapView& top, ExperimentCase& c) {
   if (const Item* m = top.get("models")) {
     const std::vector<Item> v = r.list(*m);
     const std::vector<std::string> names = modelNames();
@@ -180,8 +208,11 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   } else {
     c.models = {modelRegistry().front().name};
   }
-  // The settings sections (experiment_config.h forEachSection): declared fields, read by
-  // readDeclared; the few with checks across keys or defaults from elsewhere have their own reader.
+}
+
+// Stage 7: the settings sections (experiment_config.h forEachSection): declared fields, read by
+// readDeclared; the few with checks across keys or defaults from elsewhere have their own reader.
+void readSettingsSections(const Reader& r, const MapView& top, ExperimentCase& c) {
   forEachSection(c, [&](const SectionInfo& sec, auto& v) {
     using T = std::decay_t<decltype(v)>;
     const Item* x = top.get(sec.key);
@@ -198,6 +229,11 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
       readDeclared(r, *x, v);
     }
   });
+}
+
+// Stage 8: the rules across the whole case: a model robot's limits, the continuous law's
+// thresholds, the work limits.
+void checkCase(const Reader& r, const MapView& top, const Origins& origin, const ExperimentCase& c) {
   if (c.robot_model) {
     if (const Item* x = top.get("render"))
       r.fail(*x, "videos of a robot from its model file are not drawn yet: leave render: out");
@@ -205,6 +241,24 @@ ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const
   }
   requireContinuousThresholds(r, top, c, origin);
   checkCaseWork(r, top, c);
+}
+
+}  // namespace
+
+// Pass 2: one case, with the sweeps resolved by `r`, read in the stages above (each error at its
+// key, in the order the stages run).
+ExperimentCase readCase(Loader& L, const Reader& r, const YAML::Node& doc, const std::string& source) {
+  const Item root = r.root(doc);
+  ExperimentCase c;
+  const MapView top = readHeader(r, root, source, c);
+  CaseRobot robot = readRobotSource(L, r, top, source, c);
+  if (const Item* k = top.get("kind")) c.kind = r.choice(*k, kindNames());
+  readTail(r, top, root, robot, c);
+  readRobotOverrides(r, top, root, robot, c);
+  readMotion(r, top, root, c.robot.numLinks(), c);
+  readModels(r, top, c);
+  readSettingsSections(r, top, c);
+  checkCase(r, top, robot.origin, c);
   return c;
 }
 

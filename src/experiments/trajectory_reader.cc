@@ -101,13 +101,10 @@ std::vector<SplineParams> readSplineTrajectory(const Reader& r, const Item& item
   return joints;
 }
 
-std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, int n) {
-  const MapView t = r.map(item, kSplitCycleKeys);
-  if (const Item* f = t.get("family")) r.choice(*f, {"split_cycle"});  // spline: readSplineTrajectory
-  std::vector<SplitCycleParams> joints(static_cast<std::size_t>(n));
-  std::vector<JointLocs> locs(static_cast<std::size_t>(n), JointLocs{r.loc(item), r.loc(item)});
+namespace {
 
-  // w_ss, t0_s: both forms. Defaults 0.25 and 0.
+// Stage 1: w_ss and t0_s, one value or one per joint. Defaults 0.25 and 0.
+void readTiming(const Reader& r, const MapView& t, int n, std::vector<SplitCycleParams>& joints, std::vector<JointLocs>& locs) {
   if (const Item* w = t.get("w_ss")) {
     const std::vector<Item> v = r.perJoint(*w, n);
     for (int i = 0; i < n; ++i) {
@@ -126,64 +123,82 @@ std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, 
     const std::vector<Item> v = r.perJoint(*t0, n);
     for (int i = 0; i < n; ++i) joints[i].t0_s = r.nonNegative(v[i]);
   }
+}
 
-  if (const Item* rule = t.get("rule")) {
-    r.choice(*rule, {"eq25"});
-    for (const char* k : {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps"})
-      if (const Item* x = t.get(k)) r.fail(*x, "not allowed with rule: eq25 (Eq. 25 sets it)");
-    const Item* dps = t.get("thetadot_max_dps");
-    const Item* radps = t.get("thetadot_max_radps");
-    if (!dps && !radps) loader::fail(r.locAt(t.self, "thetadot_max_dps"), "rule: eq25 needs thetadot_max_dps or thetadot_max_radps");
-    if (dps && radps) r.fail(*radps, "give thetadot_max_dps or thetadot_max_radps, not both");
-    const Item& w = dps ? *dps : *radps;
-    const double wmax = r.positive(w) * (dps ? units::kRadPerDeg : 1.0);
+// Stage 2 (rule: eq25): every joint's stroke from the peak speed thetadot_max (Eq. 25).
+void readEqualPeakSpeed(const Reader& r, const MapView& t, const Item& rule, int n, std::vector<SplitCycleParams>& joints,
+                        std::vector<JointLocs>& locs) {
+  r.choice(rule, {"eq25"});
+  for (const char* k : {"theta0_deg", "dtheta_deg", "dT_s", "peak_speed_dps"})
+    if (const Item* x = t.get(k)) r.fail(*x, "not allowed with rule: eq25 (Eq. 25 sets it)");
+  const Item* dps = t.get("thetadot_max_dps");
+  const Item* radps = t.get("thetadot_max_radps");
+  if (!dps && !radps) loader::fail(r.locAt(t.self, "thetadot_max_dps"), "rule: eq25 needs thetadot_max_dps or thetadot_max_radps");
+  if (dps && radps) r.fail(*radps, "give thetadot_max_dps or thetadot_max_radps, not both");
+  const Item& w = dps ? *dps : *radps;
+  const double wmax = r.positive(w) * (dps ? units::kRadPerDeg : 1.0);
+  for (int i = 0; i < n; ++i) {
+    try {
+      joints[i] = equalPeakSpeedParams(n, wmax, joints[i].w_ss, joints[i].t0_s);  // Eq. (25)
+    } catch (const std::invalid_argument& e) {
+      r.fail(w, e.what());
+    }
+    locs[i].dT = r.loc(w);
+    if (!(joints[i].dT_s >= limits::kMinDT_s))
+      r.fail(w, "gives dT_s = " + formatG(joints[i].dT_s) + " s (Eq. 25), shorter than " + formatG(limits::kMinDT_s) +
+                    " s (docs/experiment-format.md \"Limits\")");
+  }
+}
+
+// Stage 2 (no rule): theta0_deg, dtheta_deg, and dT_s or peak_speed_dps, per joint.
+void readStroke(const Reader& r, const MapView& t, int n, std::vector<SplitCycleParams>& joints, std::vector<JointLocs>& locs) {
+  for (const char* k : {"thetadot_max_dps", "thetadot_max_radps"})
+    if (const Item* x = t.get(k)) r.fail(*x, "only used with rule: eq25");
+  if (const Item* th0 = t.get("theta0_deg")) {
+    const std::vector<Item> v = r.perJoint(*th0, n);
+    for (int i = 0; i < n; ++i) joints[i].theta0_rad = boundedDeg(r, v[i], limits::kMaxAbsTheta0Deg) * units::kRadPerDeg;
+  }
+  const std::vector<Item> dth = r.perJoint(r.need(t, "dtheta_deg"), n);
+  for (int i = 0; i < n; ++i) joints[i].dtheta_rad = boundedDeg(r, dth[i], limits::kMaxAbsDthetaDeg) * units::kRadPerDeg;
+  const Item* dT = t.get("dT_s");
+  const Item* peak = t.get("peak_speed_dps");
+  if (!dT && !peak) loader::fail(r.locAt(t.self, "dT_s"), "give dT_s or peak_speed_dps");
+  if (dT && peak) r.fail(*peak, "give dT_s or peak_speed_dps, not both");
+  if (dT) {
+    const std::vector<Item> v = r.perJoint(*dT, n);
     for (int i = 0; i < n; ++i) {
-      try {
-        joints[i] = equalPeakSpeedParams(n, wmax, joints[i].w_ss, joints[i].t0_s);  // Eq. (25)
-      } catch (const std::invalid_argument& e) {
-        r.fail(w, e.what());
-      }
-      locs[i].dT = r.loc(w);
-      if (!(joints[i].dT_s >= limits::kMinDT_s))
-        r.fail(w, "gives dT_s = " + formatG(joints[i].dT_s) + " s (Eq. 25), shorter than " + formatG(limits::kMinDT_s) +
-                      " s (docs/experiment-format.md \"Limits\")");
+      joints[i].dT_s = r.number(v[i]);
+      locs[i].dT = r.loc(v[i]);
+      if (joints[i].dT_s > 0.0 && joints[i].dT_s < limits::kMinDT_s)
+        r.fail(v[i], "must be >= " + formatG(limits::kMinDT_s) + " s, got " + formatG(joints[i].dT_s) +
+                         " (docs/experiment-format.md \"Limits\")");
     }
   } else {
-    for (const char* k : {"thetadot_max_dps", "thetadot_max_radps"})
-      if (const Item* x = t.get(k)) r.fail(*x, "only used with rule: eq25");
-    if (const Item* th0 = t.get("theta0_deg")) {
-      const std::vector<Item> v = r.perJoint(*th0, n);
-      for (int i = 0; i < n; ++i) joints[i].theta0_rad = boundedDeg(r, v[i], limits::kMaxAbsTheta0Deg) * units::kRadPerDeg;
-    }
-    const std::vector<Item> dth = r.perJoint(r.need(t, "dtheta_deg"), n);
-    for (int i = 0; i < n; ++i) joints[i].dtheta_rad = boundedDeg(r, dth[i], limits::kMaxAbsDthetaDeg) * units::kRadPerDeg;
-    const Item* dT = t.get("dT_s");
-    const Item* peak = t.get("peak_speed_dps");
-    if (!dT && !peak) loader::fail(r.locAt(t.self, "dT_s"), "give dT_s or peak_speed_dps");
-    if (dT && peak) r.fail(*peak, "give dT_s or peak_speed_dps, not both");
-    if (dT) {
-      const std::vector<Item> v = r.perJoint(*dT, n);
-      for (int i = 0; i < n; ++i) {
-        joints[i].dT_s = r.number(v[i]);
-        locs[i].dT = r.loc(v[i]);
-        if (joints[i].dT_s > 0.0 && joints[i].dT_s < limits::kMinDT_s)
-          r.fail(v[i], "must be >= " + formatG(limits::kMinDT_s) + " s, got " + formatG(joints[i].dT_s) +
-                           " (docs/experiment-format.md \"Limits\")");
-      }
-    } else {
-      const std::vector<Item> v = r.perJoint(*peak, n);
-      for (int i = 0; i < n; ++i) {
-        const double pk = r.positive(v[i]) * units::kRadPerDeg;
-        joints[i].dT_s = 2.0 * std::abs(joints[i].dtheta_rad) / pk;  // peak speed 2 |dtheta| / dT (Eq. 23)
-        if (!(joints[i].dT_s > 0.0)) r.fail(v[i], "dtheta_deg = 0 gives dT_s = 0; give dT_s instead");
-        if (joints[i].dT_s < limits::kMinDT_s)
-          r.fail(v[i], "gives dT_s = 2 |dtheta| / peak speed = " + formatG(joints[i].dT_s) + " s, shorter than " +
-                           formatG(limits::kMinDT_s) + " s (docs/experiment-format.md \"Limits\")");
-        locs[i].dT = r.loc(v[i]);
-      }
+    const std::vector<Item> v = r.perJoint(*peak, n);
+    for (int i = 0; i < n; ++i) {
+      const double pk = r.positive(v[i]) * units::kRadPerDeg;
+      joints[i].dT_s = 2.0 * std::abs(joints[i].dtheta_rad) / pk;  // peak speed 2 |dtheta| / dT (Eq. 23)
+      if (!(joints[i].dT_s > 0.0)) r.fail(v[i], "dtheta_deg = 0 gives dT_s = 0; give dT_s instead");
+      if (joints[i].dT_s < limits::kMinDT_s)
+        r.fail(v[i], "gives dT_s = 2 |dtheta| / peak speed = " + formatG(joints[i].dT_s) + " s, shorter than " +
+                         formatG(limits::kMinDT_s) + " s (docs/experiment-format.md \"Limits\")");
+      locs[i].dT = r.loc(v[i]);
     }
   }
-  // SplitCycleProfile's own checks (dT > 0, w_ss in (0, 1), finite), at the right value.
+}
+
+}  // namespace
+
+// family: split_cycle: timing, then the stroke (rule: eq25 or given per joint), then
+// SplitCycleProfile's own checks (dT > 0, w_ss in (0, 1), finite), each at the right value.
+std::vector<SplitCycleParams> readTrajectory(const Reader& r, const Item& item, int n) {
+  const MapView t = r.map(item, kSplitCycleKeys);
+  if (const Item* f = t.get("family")) r.choice(*f, {"split_cycle"});  // spline: readSplineTrajectory
+  std::vector<SplitCycleParams> joints(static_cast<std::size_t>(n));
+  std::vector<JointLocs> locs(static_cast<std::size_t>(n), JointLocs{r.loc(item), r.loc(item)});
+  readTiming(r, t, n, joints, locs);
+  if (const Item* rule = t.get("rule")) readEqualPeakSpeed(r, t, *rule, n, joints, locs);
+  else readStroke(r, t, n, joints, locs);
   for (int i = 0; i < n; ++i) {
     try {
       SplitCycleProfile check(joints[i]);
