@@ -315,6 +315,7 @@ class YamlFields {
       for (int k : only.one_of) list += (list.empty() ? "" : ", ") + std::to_string(k);
       r_.fail(*it, "must be one of " + list + ", got " + std::to_string(x));
     }
+    if (only.except != 0 && x == only.except) r_.fail(*it, "must not be " + std::to_string(x));
     if (x % only.multiple_of)
       r_.fail(*it, (only.multiple_of == 2 ? std::string("must be even") : "must be a multiple of " + std::to_string(only.multiple_of)) +
                        (*only.why ? std::string(" (") + only.why + ")" : "") + ", got " + std::to_string(x));

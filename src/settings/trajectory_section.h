@@ -2,7 +2,7 @@
 // split-cycle form (the default family, Eqs. 20-23, or Eq. 25's rule) and the spline form
 // (family: spline). The JSON Schema, the key tables of docs/experiment-format.md
 // (experiments/settings_schema.cc) and the loader's lists of allowed keys
-// (experiments/experiment_loader.cc) derive from these declarations. The loader reads the values
+// (experiments/trajectory_reader.cc, case_reader.cc) derive from these declarations. The loader reads the values
 // itself: a per-joint value is a number for every joint or a list of one per joint, and some keys
 // exclude others (dT_s or peak_speed_dps; rule: eq25 sets the angles and durations).
 //
@@ -103,6 +103,21 @@ struct KeyLister {
   void choice(const Field& f, T&, R&&...) { add(f); }
   template <class T, class... R>
   void text(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void integer(const Field& f, T&, R&&...) { add(f); }
+  template <class T>
+  void boolean(const Field& f, T&) { add(f); }
+  // The design sections' kinds (settings/optimize_section.h).
+  template <class... R>
+  void interval(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void jointLimit(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void integerList(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void section(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void nameOrSection(const Field& f, R&&...) { add(f); }
 };
 
 template <class S>
