@@ -263,31 +263,7 @@ class Reader {
 using Origins = std::map<std::string, Loc>;  // tailsim::validate() field name -> where it was set
 
 // The keys a struct declares (settings/fields.h), YAML keys only (not internal ones).
-struct KeyLister {
-  std::vector<std::string> keys;
-  void add(const settings::Field& f) { keys.push_back(f.key); }
-  template <class... T>
-  void number(const settings::Field& f, T&&...) { add(f); }
-  template <class... T>
-  void integer(const settings::Field& f, T&&...) { add(f); }
-  template <class... T>
-  void boolean(const settings::Field& f, T&&...) { add(f); }
-  template <class... T>
-  void choice(const settings::Field& f, T&&...) { add(f); }
-  template <class... T>
-  void text(const settings::Field& f, T&&...) { add(f); }
-  template <class... T>
-  void numbers(const settings::Field& f, T&&...) { add(f); }
-  template <class... T>
-  void internal(const settings::Field&, T&&...) {}
-};
-template <class S>
-std::vector<std::string> declaredKeys() {
-  KeyLister k;
-  const S s{};
-  declareFields(k, s);
-  return k.keys;
-}
+using settings::declaredKeys;
 
 // Reads the declared fields of one struct from a YAML map: each present key (every key when
 // `all`) is read, type- and range-checked at its file:line:col, and stored (times its scale).

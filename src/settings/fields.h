@@ -194,6 +194,51 @@ class FieldValidator {
   std::string prefix_;
 };
 
+// The keys a declaration names, in its order (the loader's lists of allowed keys, and the order
+// its "allowed here" messages list them in).
+struct KeyLister {
+  std::vector<std::string> keys;
+  void add(const Field& f) { keys.push_back(f.key); }
+  template <class T, class... R>
+  void number(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void perJoint(const Field& f, T&, R&&...) { add(f); }
+  template <class... R>
+  void knotLists(const Field& f, R&&...) { add(f); }
+  template <class T, class... R>
+  void choice(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void text(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void integer(const Field& f, T&, R&&...) { add(f); }
+  template <class T>
+  void boolean(const Field& f, T&) { add(f); }
+  template <class T>
+  void numbers(const Field& f, T&) { add(f); }
+  template <class T>
+  void internal(const Field&, T&) {}  // not a YAML key
+  // trajectory_section.h's kinds: perJoint, knotLists above. The design sections' kinds
+  // (optimize_section.h):
+  template <class... R>
+  void interval(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void jointLimit(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void integerList(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void section(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void nameOrSection(const Field& f, R&&...) { add(f); }
+};
+
+template <class S>
+std::vector<std::string> declaredKeys() {
+  KeyLister v;
+  S s{};
+  declareFields(v, s);
+  return v.keys;
+}
+
 // prefix: what precedes each key in the message, e.g. "quadruped." or "tail link 2 ".
 template <class S>
 void validateFields(const S& s, const std::string& prefix) {

@@ -86,47 +86,4 @@ settings::For<S, SplineSection> declareFields(V& v, S& s) {
            trajectoryFamilyNames());
 }
 
-namespace settings {
-
-// The keys a declaration names, in its order (the loader's lists of allowed keys, and the order
-// its "allowed here" messages list them in).
-struct KeyLister {
-  std::vector<std::string> keys;
-  void add(const Field& f) { keys.push_back(f.key); }
-  template <class T, class... R>
-  void number(const Field& f, T&, R&&...) { add(f); }
-  template <class T, class... R>
-  void perJoint(const Field& f, T&, R&&...) { add(f); }
-  template <class... R>
-  void knotLists(const Field& f, R&&...) { add(f); }
-  template <class T, class... R>
-  void choice(const Field& f, T&, R&&...) { add(f); }
-  template <class T, class... R>
-  void text(const Field& f, T&, R&&...) { add(f); }
-  template <class T, class... R>
-  void integer(const Field& f, T&, R&&...) { add(f); }
-  template <class T>
-  void boolean(const Field& f, T&) { add(f); }
-  // The design sections' kinds (settings/optimize_section.h).
-  template <class... R>
-  void interval(const Field& f, R&&...) { add(f); }
-  template <class... R>
-  void jointLimit(const Field& f, R&&...) { add(f); }
-  template <class... R>
-  void integerList(const Field& f, R&&...) { add(f); }
-  template <class... R>
-  void section(const Field& f, R&&...) { add(f); }
-  template <class... R>
-  void nameOrSection(const Field& f, R&&...) { add(f); }
-};
-
-template <class S>
-std::vector<std::string> declaredKeys() {
-  KeyLister v;
-  S s{};
-  declareFields(v, s);
-  return v.keys;
-}
-
-}  // namespace settings
 }  // namespace tailsim
