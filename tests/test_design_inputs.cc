@@ -26,6 +26,8 @@
 #include "plotting/gnuplot.h"
 #include "plotting/plots.h"
 #include "plotting/result_folder.h"
+#include "settings/optimize_section.h"
+#include "settings/trajectory_section.h"
 
 namespace tailsim {
 namespace {
@@ -500,6 +502,70 @@ TEST_F(Smaller, BasePathTooLongForTheFileSystemIsAConfigError) {
   const std::string eo = errorOf([&] { loadOptimizeSpec(o); }), em = errorOf([&] { loadManeuverSpec(m); });
   EXPECT_EQ(eo.rfind(o + ":3:7: base: no such experiment file: ", 0), 0u) << eo;
   EXPECT_EQ(em.rfind(m + ":3:7: base: no such experiment file: ", 0), 0u) << em;
+}
+
+// The optimize section's declaration (settings/optimize_section.h) is what `tailsim schema` and
+// docs/experiment-format.md show as defaults: they must be the ones the optimiser applies.
+TEST(OptimizeSectionDeclaration, DefaultsAreTheOptimizersDefaults) {
+  const OptimizeSection d;
+  const OptimizerSettings os;
+  const OptimizeSpec spec;
+  const StrokeSpace sp;
+  EXPECT_EQ(d.algorithm, os.algorithm);
+  EXPECT_EQ(d.islands, os.islands);
+  EXPECT_EQ(d.population, os.population);
+  EXPECT_EQ(d.generations, os.generations);
+  EXPECT_EQ(d.restarts, os.restarts);
+  EXPECT_EQ(d.restart_growth, os.restart_growth);
+  EXPECT_EQ(d.refine_generations, os.refine_generations);
+  EXPECT_EQ(d.local_restarts, os.local_restarts);
+  EXPECT_EQ(d.local_step, os.local_step);
+  EXPECT_EQ(d.directions == "enumerate", os.enumerate_directions);
+  EXPECT_EQ(d.directions_kept, os.directions_kept);
+  EXPECT_EQ(d.polish, os.polish);
+  EXPECT_EQ(d.polish_evaluations, os.polish_evaluations);
+  EXPECT_EQ(d.max_runs, os.max_runs);
+  EXPECT_EQ(d.pareto_points, spec.pareto_points);
+  EXPECT_EQ(d.mujoco_check, spec.mujoco_check);
+  EXPECT_EQ(d.min_turn_deg, spec.min_turn_deg);
+  EXPECT_EQ(d.knots, sp.knots);
+  EXPECT_EQ(d.objective, "phi_net");
+  EXPECT_EQ(spec.problem.objective, StrokeObjective::kPhiNet);
+  EXPECT_EQ(d.limits.end == "start", sp.limits.end == StrokeEnd::kAtStart);
+  EXPECT_EQ(d.limits.dT_s[0], sp.limits.dT_min_s);
+  EXPECT_EQ(d.limits.dT_s[1], sp.limits.dT_max_s);
+  EXPECT_EQ(d.limits.w_ss[0], sp.limits.w_ss_min);
+  EXPECT_EQ(d.limits.w_ss[1], sp.limits.w_ss_max);
+  EXPECT_EQ(d.limits.start_delay_s, sp.limits.t0_max_s);
+}
+
+// An unknown key of the optimize section and of its limits lists the declared keys, in their order.
+TEST(OptimizeSectionDeclaration, UnknownKeysListTheDeclaredKeys) {
+  const fs::path dir = fs::temp_directory_path() / ("tailsim_optsec_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "base.yaml") << "name: b\nrobot: paper\ntail: {links: 1}\ntrajectory: {dtheta_deg: -90, dT_s: 0.25}\n";
+  auto message = [&](const std::string& section) {
+    std::ofstream(dir / "opt.yaml") << "name: o\nkind: optimize\nbase: base.yaml\noptimize:\n" << section;
+    try {
+      loadOptimizeSpec((dir / "opt.yaml").string());
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  auto allowed = [](const std::vector<std::string>& keys) {
+    std::string s;
+    for (const std::string& k : keys) s += (s.empty() ? "" : ", ") + k;
+    return "(allowed here: " + s + ")";
+  };
+  EXPECT_NE(message("  family: spline\n  limits: {}\n  isalnds: 2\n").find(allowed(settings::declaredKeys<OptimizeSection>())),
+            std::string::npos);
+  EXPECT_NE(message("  family: spline\n  limits: {dt_s: [0.1, 0.2]}\n").find(allowed(settings::declaredKeys<OptimizeLimitsSection>())),
+            std::string::npos);
+  EXPECT_NE(message("  family: spline\n  objective: {qty: phi_net}\n  limits: {}\n")
+                .find(allowed(settings::declaredKeys<OptimizeObjectiveSection>())),
+            std::string::npos);
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -9,6 +9,9 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "app/commands.h"
 #include "experiments/experiment_loader.h"
@@ -53,95 +56,134 @@ std::string poseQuantity(const ExperimentResults* r, const std::string& case_nam
   return {};
 }
 
+// One experiment's summary.json read back: its cases by name (entries of `summary`).
+struct CaseSummaries {
+  nlohmann::json summary;
+  std::map<std::string, const nlohmann::json*> by_name;
+};
+void readCaseSummaries(const fs::path& dir, CaseSummaries& out) {
+  std::ifstream in(dir / "summary.json");
+  out.summary = nlohmann::json::parse(in, nullptr, false);
+  const nlohmann::json& s = out.summary;
+  if (!s.is_discarded() && s.contains("cases") && s["cases"].is_array())
+    for (const nlohmann::json& c : s["cases"])
+      if (c.is_object() && c.contains("name") && c["name"].is_string()) out.by_name[c["name"].get<std::string>()] = &c;
+}
+
+// run --quiet: one line per failed model run, "experiment/case: model: FAILED (why)".
+void printFailures(const Experiment& e, const std::map<std::string, const nlohmann::json*>& by_name) {
+  for (const ExperimentCase& c : e.cases) {
+    const auto it = by_name.find(c.name);
+    if (it == by_name.end() || !it->second->contains("runs") || !(*it->second)["runs"].is_object()) continue;
+    for (const auto& [model, r] : (*it->second)["runs"].items())
+      if (r.is_object() && !r.value("ok", false))
+        std::printf("%s/%s: %s: FAILED (%s)\n", e.name.c_str(), c.name.c_str(), model.c_str(),
+                    r.value("error", std::string()).c_str());
+  }
+}
+
+// The experiment's warnings, one per model and shape (the text with its numbers blanked), with the
+// number of runs that gave it, in order of first appearance.
+struct SharedWarnings {
+  struct Shared {
+    std::string model, text, first_case;
+    int runs = 0;
+  };
+  std::vector<Shared> warnings;
+  std::map<std::pair<std::string, std::string>, size_t> by_shape;
+  int runsOf(const std::string& model, const std::string& text) const {
+    return warnings[by_shape.at({model, warningShape(text)})].runs;
+  }
+};
+SharedWarnings collectWarnings(const Experiment& e, const std::map<std::string, const nlohmann::json*>& by_name) {
+  SharedWarnings sw;
+  std::vector<SharedWarnings::Shared>& warnings = sw.warnings;
+  std::map<std::pair<std::string, std::string>, size_t>& by_shape = sw.by_shape;
+  for (const ExperimentCase& c : e.cases) {
+    const auto it = by_name.find(c.name);
+    if (it == by_name.end() || !it->second->contains("runs") || !(*it->second)["runs"].is_object()) continue;
+    for (const auto& [model, r] : (*it->second)["runs"].items())
+      if (r.contains("warnings") && r["warnings"].is_array())
+        for (const auto& w : r["warnings"]) {
+          if (!w.is_string()) continue;
+          const auto key = std::make_pair(model, warningShape(w.get<std::string>()));
+          const auto [slot, added] = by_shape.emplace(key, warnings.size());
+          if (added) warnings.push_back({model, w.get<std::string>(), c.name});
+          ++warnings[slot->second].runs;
+        }
+  }
+  return sw;
+}
+
+// Instead of the table (too many cases): the case count and the runs with warnings.
+void printCaseCount(const Experiment& e, const fs::path& dir, const std::map<std::string, const nlohmann::json*>& by_name) {
+  int warned = 0;  // runs whose result carries warnings (e.g. still moving at the end)
+  for (const auto& [name, j] : by_name)
+    if (j->contains("runs") && (*j)["runs"].is_object())
+      for (const auto& [model, r] : (*j)["runs"].items())
+        if (r.contains("warnings") && r["warnings"].is_array() && !r["warnings"].empty()) ++warned;
+  std::printf("  %zu cases (see %s/summary.json)", e.cases.size(), dir.c_str());
+  if (warned > 0) std::printf(", %d model runs with warnings", warned);
+  std::printf("\n");
+}
+
+// One table row per case: each model's phi_net (a simulation) or the pose's quantity, its verdict,
+// and the warnings only this run gave.
+void printCaseRows(const Experiment& e, const std::map<std::string, const nlohmann::json*>& by_name, bool pose,
+                   const std::optional<ExperimentResults>& pose_results, const SharedWarnings& sw) {
+  for (const ExperimentCase& c : e.cases) {
+    std::printf("  %-40s", c.name.c_str());
+    const auto it = by_name.find(c.name);
+    if (it == by_name.end()) { std::printf(" (not run)\n"); continue; }
+    const nlohmann::json& j = *it->second;
+    if (!j.contains("runs") || !j["runs"].is_object()) { std::printf(" (unreadable)\n"); continue; }
+    for (const auto& [model, r] : j["runs"].items()) {
+      if (!r.value("ok", false)) std::printf(" %s: FAILED (%s)", model.c_str(), r.value("error", std::string()).c_str());
+      else if (pose) {
+        const std::string q = poseQuantity(pose_results ? &*pose_results : nullptr, c.name, model);
+        std::printf(" %s: %s", model.c_str(), q.empty() ? "ok" : q.c_str());
+      } else if (r["phi_net_deg"].is_number())
+        std::printf(" %s: phi_net %s deg (%.2f ms)", model.c_str(), readRunRecord(r).phiText().c_str(),
+                    1e3 * r.value("wall_time_s", 0.0));
+      else std::printf(" %s: ok", model.c_str());
+    }
+    std::printf("\n");
+    if (j.contains("verdict") && j["verdict"].is_string())
+      std::printf("    verdict: %s\n", j["verdict"].get<std::string>().c_str());
+    for (const auto& [model, r] : j["runs"].items())
+      if (r.contains("warnings") && r["warnings"].is_array())
+        for (const auto& w : r["warnings"])
+          if (w.is_string() && sw.runsOf(model, w.get<std::string>()) == 1)
+            std::printf("    warning (%s): %s\n", model.c_str(), w.get<std::string>().c_str());
+  }
+}
+
+// A short table per case and model, read back from the result folder's summary.json (its entries
+// name each case's folder: "dir"): phi_net of a simulation, the pose's own quantity of a pose
+// study. A warning that differs between runs only in its numbers is printed once, with the number
+// of runs (each run keeps its own in results.csv and summary.json). failures_only (run --quiet):
+// the failed model runs only.
 void printCases(const std::vector<Experiment>& suite, const std::string& out, bool is_suite, bool failures_only) {
-  // A short table per case and model, read back from the result folder's summary.json (its
-  // entries name each case's folder: "dir"): phi_net of a simulation, the pose's own quantity of
-  // a pose study. A warning that differs between runs only in its numbers is printed once, with
-  // the number of runs (each run keeps its own in results.csv and summary.json).
-  // failures_only (run --quiet): one line per failed model run, "experiment/case: model: FAILED (why)".
   for (const Experiment& e : suite) {
     const fs::path dir = is_suite ? fs::path(out) / e.name : fs::path(out);
-    std::ifstream in(dir / "summary.json");
-    const nlohmann::json s = nlohmann::json::parse(in, nullptr, false);
-    std::map<std::string, const nlohmann::json*> by_name;
-    if (!s.is_discarded() && s.contains("cases") && s["cases"].is_array())
-      for (const nlohmann::json& c : s["cases"])
-        if (c.is_object() && c.contains("name") && c["name"].is_string()) by_name[c["name"].get<std::string>()] = &c;
+    CaseSummaries cs;
+    readCaseSummaries(dir, cs);
     if (failures_only) {
-      for (const ExperimentCase& c : e.cases) {
-        const auto it = by_name.find(c.name);
-        if (it == by_name.end() || !it->second->contains("runs") || !(*it->second)["runs"].is_object()) continue;
-        for (const auto& [model, r] : (*it->second)["runs"].items())
-          if (r.is_object() && !r.value("ok", false))
-            std::printf("%s/%s: %s: FAILED (%s)\n", e.name.c_str(), c.name.c_str(), model.c_str(),
-                        r.value("error", std::string()).c_str());
-      }
+      printFailures(e, cs.by_name);
       continue;
     }
     std::printf("%s -> %s\n", e.name.c_str(), dir.c_str());
-    const bool pose = !s.is_discarded() && s.value("kind", std::string()) == "pose";
+    const bool pose = !cs.summary.is_discarded() && cs.summary.value("kind", std::string()) == "pose";
     std::optional<ExperimentResults> pose_results;
     if (pose) try {
         pose_results = loadResults(dir.string());
       } catch (const std::exception&) {
       }
-    struct Shared {
-      std::string model, text, first_case;
-      int runs = 0;
-    };
-    std::vector<Shared> warnings;  // in order of first appearance
-    std::map<std::pair<std::string, std::string>, size_t> by_shape;
-    for (const ExperimentCase& c : e.cases) {
-      const auto it = by_name.find(c.name);
-      if (it == by_name.end() || !it->second->contains("runs") || !(*it->second)["runs"].is_object()) continue;
-      for (const auto& [model, r] : (*it->second)["runs"].items())
-        if (r.contains("warnings") && r["warnings"].is_array())
-          for (const auto& w : r["warnings"]) {
-            if (!w.is_string()) continue;
-            const auto key = std::make_pair(model, warningShape(w.get<std::string>()));
-            const auto [slot, added] = by_shape.emplace(key, warnings.size());
-            if (added) warnings.push_back({model, w.get<std::string>(), c.name});
-            ++warnings[slot->second].runs;
-          }
-    }
+    const SharedWarnings sw = collectWarnings(e, cs.by_name);
     const bool table = e.cases.size() <= 60;  // a longer table scrolls away; summary.json has them all
-    if (!table) {
-      int warned = 0;  // runs whose result carries warnings (e.g. still moving at the end)
-      for (const auto& [name, j] : by_name)
-        if (j->contains("runs") && (*j)["runs"].is_object())
-          for (const auto& [model, r] : (*j)["runs"].items())
-            if (r.contains("warnings") && r["warnings"].is_array() && !r["warnings"].empty()) ++warned;
-      std::printf("  %zu cases (see %s/summary.json)", e.cases.size(), dir.c_str());
-      if (warned > 0) std::printf(", %d model runs with warnings", warned);
-      std::printf("\n");
-    }
-    for (const ExperimentCase& c : e.cases) {
-      if (!table) break;
-      std::printf("  %-40s", c.name.c_str());
-      const auto it = by_name.find(c.name);
-      if (it == by_name.end()) { std::printf(" (not run)\n"); continue; }
-      const nlohmann::json& j = *it->second;
-      if (!j.contains("runs") || !j["runs"].is_object()) { std::printf(" (unreadable)\n"); continue; }
-      for (const auto& [model, r] : j["runs"].items()) {
-        if (!r.value("ok", false)) std::printf(" %s: FAILED (%s)", model.c_str(), r.value("error", std::string()).c_str());
-        else if (pose) {
-          const std::string q = poseQuantity(pose_results ? &*pose_results : nullptr, c.name, model);
-          std::printf(" %s: %s", model.c_str(), q.empty() ? "ok" : q.c_str());
-        } else if (r["phi_net_deg"].is_number())
-          std::printf(" %s: phi_net %s deg (%.2f ms)", model.c_str(), readRunRecord(r).phiText().c_str(),
-                      1e3 * r.value("wall_time_s", 0.0));
-        else std::printf(" %s: ok", model.c_str());
-      }
-      std::printf("\n");
-      if (j.contains("verdict") && j["verdict"].is_string())
-        std::printf("    verdict: %s\n", j["verdict"].get<std::string>().c_str());
-      for (const auto& [model, r] : j["runs"].items())
-        if (r.contains("warnings") && r["warnings"].is_array())
-          for (const auto& w : r["warnings"])
-            if (w.is_string() && warnings[by_shape.at({model, warningShape(w.get<std::string>())})].runs == 1)
-              std::printf("    warning (%s): %s\n", model.c_str(), w.get<std::string>().c_str());
-    }
-    for (const Shared& w : warnings)
+    if (table) printCaseRows(e, cs.by_name, pose, pose_results, sw);
+    else printCaseCount(e, dir, cs.by_name);
+    for (const SharedWarnings::Shared& w : sw.warnings)
       if (w.runs > 1 || !table)
         std::printf("  warning (%s), %d run%s (first: %s; each run's numbers in results.csv): %s\n", w.model.c_str(),
                     w.runs, w.runs == 1 ? "" : "s", w.first_case.c_str(), w.text.c_str());

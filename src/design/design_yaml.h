@@ -47,14 +47,16 @@ class Reader {
 
   // The map's entries; a key not in `allowed` (or twice) is an error at the key.
   std::vector<std::pair<std::string, Val>> map(const Val& v, std::initializer_list<const char*> allowed) const {
+    return map(v, std::vector<std::string>(allowed.begin(), allowed.end()));
+  }
+  std::vector<std::pair<std::string, Val>> map(const Val& v, const std::vector<std::string>& names) const {
     if (!v.node.IsMap()) fail(v, "expected a map of key: value");
     std::vector<std::pair<std::string, Val>> out;
-    const std::vector<std::string> names(allowed.begin(), allowed.end());
     for (const auto& kv : v.node) {
       const std::string key = v.key.empty() ? kv.first.Scalar() : v.key + "." + kv.first.Scalar();
       if (!kv.first.IsScalar()) fail(kv.first.Mark(), v.key, "keys must be plain names");
       const std::string k = kv.first.Scalar();
-      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }))
+      if (std::find(names.begin(), names.end(), k) == names.end())
         fail(kv.first.Mark(), key, unknownKeyMessage(k, names));
       for (const auto& e : out)
         if (e.first == k) fail(kv.first.Mark(), key, "duplicate key");

@@ -18,17 +18,6 @@ namespace {
 
 using namespace design_yaml;
 
-// The keys a struct declares (settings/fields.h).
-struct KeyList {
-  std::vector<std::string> keys;
-  template <class... T>
-  void number(const settings::Field& f, T&&...) { keys.push_back(f.key); }
-  template <class... T>
-  void integer(const settings::Field& f, T&&...) { keys.push_back(f.key); }
-  template <class... T>
-  void boolean(const settings::Field& f, T&&...) { keys.push_back(f.key); }
-};
-
 // Reads the declared fields from a YAML map through design_yaml::Reader (file:line:col errors).
 struct YamlFieldReader {
   const Reader& r;
@@ -129,18 +118,17 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   s.base_file = std::move(file.head.base_file);
   const Val& base = file.base(r);  // the base experiment's own checks below point here
   const Val& mv = file.section(r);
-  KeyList kl;
-  declareFields(kl, static_cast<const ManeuverSettings&>(s.settings));
+  std::vector<std::string> allowed = settings::declaredKeys<ManeuverSettings>();
   if (!mv.node.IsMap()) r.fail(mv, "expected a map of key: value");
   std::vector<std::pair<std::string, Val>> m;
   {
     // Reader::map takes the allowed keys as an initializer list: check them here from the declaration.
-    kl.keys.push_back("stroke_from");  // not a declared number: a trajectory's source (below)
+    allowed.push_back("stroke_from");  // not a declared number: a trajectory's source (below)
     for (const auto& kv : mv.node) {
       const std::string key = "maneuver." + kv.first.Scalar();
       if (!kv.first.IsScalar()) r.fail(kv.first.Mark(), "maneuver", "keys must be plain names");
-      if (std::find(kl.keys.begin(), kl.keys.end(), kv.first.Scalar()) == kl.keys.end())
-        r.fail(kv.first.Mark(), key, unknownKeyMessage(kv.first.Scalar(), kl.keys));
+      if (std::find(allowed.begin(), allowed.end(), kv.first.Scalar()) == allowed.end())
+        r.fail(kv.first.Mark(), key, unknownKeyMessage(kv.first.Scalar(), allowed));
       for (const auto& e : m)
         if (e.first == kv.first.Scalar()) r.fail(kv.first.Mark(), key, "duplicate key");
       const bool empty = kv.second.IsNull() || kv.second.Mark().is_null();

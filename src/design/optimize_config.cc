@@ -13,6 +13,8 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
 #include "results/work_limits.h"
+#include "settings/optimize_section.h"
+#include "settings/trajectory_section.h"
 #include "settings/units.h"
 
 namespace tailsim {
@@ -110,7 +112,8 @@ void readObjective(const Reader& r, const Map& o, OptimizeSpec& s) {
   if (!v) return;
   const Val* q = v;
   if (v->node.IsMap()) {
-    const auto om = r.map(*v, {"quantity", "model", "search", "candidates"});
+    static const std::vector<std::string> kObjectiveKeys = settings::declaredKeys<OptimizeObjectiveSection>();
+    const auto om = r.map(*v, kObjectiveKeys);
     q = Reader::get(om, "quantity");
     if (const Val* m = Reader::get(om, "model")) {
       const std::string mn = r.choice(*m, {"analytic", "perfoot", "mujoco"});
@@ -406,8 +409,10 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   s.base_file = std::move(file.head.base_file);
   const Val& base = file.base(r);  // the base experiment's own checks below point here
   const Val& opt = file.section(r);
-  const auto o = r.map(opt, {"family", "knots", "objective", "limits", "algorithm", "islands", "population",
-                             "generations", "restarts", "restart_growth", "refine_generations", "local_restarts", "local_step", "directions", "directions_kept", "polish", "polish_evaluations", "max_runs", "seeds", "pareto_points", "mujoco_check", "min_turn_deg"});
+  // The allowed keys (and their order in "allowed here") from the declaration (settings/optimize_section.h).
+  static const std::vector<std::string> kOptimizeKeys = settings::declaredKeys<OptimizeSection>();
+  static const std::vector<std::string> kLimitsKeys = settings::declaredKeys<OptimizeLimitsSection>();
+  const auto o = r.map(opt, kOptimizeKeys);
   StrokeSpace& sp = s.problem.space;
   sp.family = r.choice(design_yaml::need(r, o, opt, "family"), {"split_cycle", "spline"}) == "spline"
                   ? StrokeFamily::kSpline
@@ -418,7 +423,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   }
   readObjective(r, o, s);
   const Val& lv = design_yaml::need(r, o, opt, "limits");
-  const auto l = r.map(lv, {"theta_deg", "thetadot_max_dps", "torque_max_Nm", "end", "dT_s", "w_ss", "start_delay_s"});
+  const auto l = r.map(lv, kLimitsKeys);
   const LimitKeys lk = readLimits(r, l, sp);
   const Val* kept = readOptimizer(r, o, sp, s.optimizer);
   readRunSettings(r, o, s);

@@ -13,6 +13,7 @@
 #include "experiments/model_registry.h"
 #include "results/work_limits.h"
 #include "results/number_text.h"
+#include "settings/optimize_section.h"
 #include "settings/trajectory_section.h"
 
 namespace tailsim {
@@ -40,8 +41,9 @@ json perJointSchema(json value, const std::string& doc) {
 struct Describer {
   json props = json::object();
   std::string rows;
+  bool sweeps = true;  // false: a design file's section (no sweeps)
   void add(const settings::Field& f, json value, const std::string& allowed, const std::string& dflt) {
-    json p = orSweep(std::move(value));
+    json p = sweeps ? orSweep(std::move(value)) : std::move(value);
     p["description"] = f.doc;
     props[f.key] = std::move(p);
     std::string doc = f.doc;
@@ -86,6 +88,10 @@ struct Describer {
       allowed = "one of";
       for (int k : only.one_of) allowed += " " + std::to_string(k);
     }
+    if (only.except != 0) {
+      v = {{"allOf", json::array({v, {{"not", {{"const", only.except}}}}})}};
+      allowed += ", not " + std::to_string(only.except);
+    }
     if (only.multiple_of != 1) {
       v["multipleOf"] = only.multiple_of;
       allowed += only.multiple_of == 2 ? ", even" : ", multiple of " + std::to_string(only.multiple_of);
@@ -128,11 +134,68 @@ struct Describer {
   }
   template <class T>
   void internal(const settings::Field&, const T&) {}
+
+  // The design sections' kinds (settings/optimize_section.h): no sweeps.
+  static json intervalSchema(const settings::Limits& l) {
+    json item = {{"type", "number"}};
+    limitsInto(item, l);
+    return {{"type", "array"}, {"minItems", 2}, {"maxItems", 2}, {"items", item}};
+  }
+  static std::string limitsWords(const settings::Limits& l, bool integer = false) {
+    const std::string t = l.text(integer);
+    return t.substr(t.find(' ') + 1);
+  }
+  void plainRow(const settings::Field& f, json value, const std::string& allowed, const std::string& dflt) {
+    value["description"] = f.doc;
+    props[f.key] = std::move(value);
+    rows += "| `" + std::string(f.key) + "` | " + allowed + " | " + (dflt.empty() ? std::string("(none)") : dflt) + " | " +
+            f.doc + " |\n";
+  }
+  void interval(const settings::Field& f, const std::array<double, 2>& x, const settings::Limits& l) {
+    plainRow(f, intervalSchema(l), "[low, high], each " + limitsWords(l),
+             "[" + formatG(x[0]) + ", " + formatG(x[1]) + "]");
+  }
+  void jointLimit(const settings::Field& f, const settings::Limits& l, bool range, const settings::TextRule& words) {
+    json one = {{"type", "number"}};
+    limitsInto(one, l);
+    if (range) one = intervalSchema(l);
+    json any = json::array({one, {{"type", "array"}, {"minItems", 1}, {"items", one}}});
+    std::string allowed = (range ? "[low, high], each " : "number, ") + limitsWords(l) + "; or one per joint";
+    if (!words.one_of.empty()) {
+      any = json::array({{{"anyOf", any}}, {{"enum", words.one_of}}});
+      for (const std::string& w : words.one_of) allowed += "; or `" + w + "`";
+    }
+    plainRow(f, {{"anyOf", any}}, allowed, "");
+  }
+  void integerList(const settings::Field& f, const settings::Limits& l, int max) {
+    json item = {{"type", "integer"}};
+    limitsInto(item, l);
+    plainRow(f, {{"type", "array"}, {"minItems", 1}, {"maxItems", max}, {"uniqueItems", true}, {"items", item}},
+             "1.." + std::to_string(max) + " distinct integers, each " + limitsWords(l, true), "");
+  }
+  template <class S>
+  void section(const settings::Field& f, const S& sub) {
+    Describer d;
+    d.sweeps = false;
+    declareFields(d, sub);
+    plainRow(f, {{"type", "object"}, {"additionalProperties", false}, {"properties", d.props}}, "map", "");
+  }
+  template <class S>
+  void nameOrSection(const settings::Field& f, const std::string& x, const settings::TextRule& names, const S& sub) {
+    Describer d;
+    d.sweeps = false;
+    declareFields(d, sub);
+    const json name = {{"type", "string"}, {"enum", names.one_of}};
+    const json map = {{"type", "object"}, {"additionalProperties", false}, {"properties", d.props}};
+    plainRow(f, {{"anyOf", json::array({name, map})}}, "`" + names.one_of.front() + "` .. `" + names.one_of.back() + "`, or map",
+             "`" + x + "`");
+  }
 };
 
 template <class S>
-Describer describe(const S& s = S{}) {
+Describer describe(const S& s = S{}, bool sweeps = true) {
   Describer d;
+  d.sweeps = sweeps;
   declareFields(d, s);
   return d;
 }
@@ -192,18 +255,6 @@ json nameSchema() {
   return {{"type", "string"}, {"minLength", 1}, {"maxLength", 100}, {"pattern", "^[^/\\\\-][^/\\\\]*$"}};
 }
 
-json integerIn(int lo, int hi) { return {{"type", "integer"}, {"minimum", lo}, {"maximum", hi}}; }
-json numberIn(double lo, double hi) { return {{"type", "number"}, {"minimum", lo}, {"maximum", hi}}; }
-json oneOfNames(std::initializer_list<const char*> names) {
-  json e = json::array();
-  for (const char* n : names) e.push_back(n);
-  return {{"type", "string"}, {"enum", e}};
-}
-// [low, high], both in [lo, hi].
-json interval(double lo, double hi) {
-  return {{"type", "array"}, {"minItems", 2}, {"maxItems", 2}, {"items", numberIn(lo, hi)}};
-}
-
 // A design file (`tailsim optimize`, `tailsim maneuver`): name, description, kind, the base
 // experiment file and the section named like the kind. No sweeps.
 json designFile(const std::string& kind, json section_schema) {
@@ -215,50 +266,8 @@ json designFile(const std::string& kind, json section_schema) {
                  {"name", "kind", "base", kind});
 }
 
-// The optimize section as src/design/optimize_config.cc reads it (docs/design-a-tail-stroke.md).
-json optimizeSection() {
-  // A joint limit: one value for every joint, or a list of one per joint.
-  auto perJoint = [](json one) {
-    return json{{"anyOf", json::array({one, {{"type", "array"}, {"minItems", 1}, {"items", one}}})}};
-  };
-  json lim = section({{"theta_deg", perJoint(interval(-360, 360))},
-                      {"thetadot_max_dps", perJoint(numberIn(1, 36000))},
-                      {"torque_max_Nm", {{"anyOf", json::array({perJoint({{"type", "number"}, {"exclusiveMinimum", 0}}),
-                                                                {{"enum", json::array({"base", "none"})}}})}}},
-                      {"end", oneOfNames({"rest", "start"})},
-                      {"dT_s", interval(0.01, 10)},
-                      {"w_ss", interval(0.01, 0.99)},
-                      {"start_delay_s", numberIn(0, 10)}});  // the limits may come from the robot file's tail entries
-  using namespace limits;
-  return section({{"family", oneOfNames({"split_cycle", "spline"})},
-                  {"knots", integerIn(0, kMaxOptimizeKnots)},
-                  {"objective", {{"anyOf", json::array({oneOfNames({"phi_net", "phi_net_per_torque", "phi_net_per_energy"}),
-                                                          section({{"quantity", oneOfNames({"phi_net", "phi_net_per_torque", "phi_net_per_energy"})},
-                                                                   {"model", oneOfNames({"analytic", "perfoot", "mujoco"})},
-                                                                   {"search", oneOfNames({"analytic", "perfoot"})},
-                                                                   {"candidates", integerIn(1, 50)}})})}}},
-                  {"limits", lim},
-                  {"algorithm", oneOfNames({"cmaes", "de"})},
-                  {"islands", integerIn(1, kMaxOptimizeIslands)},
-                  {"population", integerIn(5, kMaxOptimizePopulation)},
-                  {"generations", integerIn(1, kMaxOptimizeGenerations)},
-                  {"restarts", integerIn(1, kMaxOptimizeRestarts)},
-                  {"restart_growth", integerIn(1, 4)},
-                  {"refine_generations", integerIn(0, kMaxOptimizeGenerations)},
-                  {"local_restarts", integerIn(0, kMaxOptimizeLocalRestarts)},
-                  {"local_step", {{"type", "number"}, {"exclusiveMinimum", 0}, {"maximum", 1}}},
-                  {"directions", oneOfNames({"free", "enumerate"})},
-                  {"directions_kept", integerIn(0, 1 << kMaxKeptDirectionsLog2)},
-                  {"polish", oneOfNames({"cobyla", "bobyqa", "none"})},
-                  {"polish_evaluations", integerIn(0, kMaxPolishEvaluations)},
-                  {"max_runs", integerIn(0, static_cast<int>(kMaxOptimizeRuns))},
-                  {"seeds", {{"type", "array"}, {"minItems", 1}, {"maxItems", kMaxOptimizeSeeds}, {"uniqueItems", true},
-                             {"items", integerIn(0, 1000000000)}}},
-                  {"pareto_points", {{"allOf", json::array({integerIn(0, kMaxParetoPoints), {{"not", {{"const", 1}}}}})}}},
-                  {"mujoco_check", {{"type", "boolean"}}},
-                  {"min_turn_deg", numberIn(0, 90)}},
-                 {"family", "limits"});
-}
+// The optimize section (settings/optimize_section.h; docs/design-a-tail-stroke.md).
+json optimizeSection() { return section(describe<OptimizeSection>(OptimizeSection{}, false).props, {"family", "limits"}); }
 
 // The maneuver section: its declared settings and stroke_from (a trajectory's source, not a number).
 json maneuverSection() {
@@ -410,6 +419,16 @@ std::string settingsMarkdown() {
   table("maneuver", "The `maneuver:` section of a `kind: maneuver` file (`tailsim maneuver`, "
                     "[design-a-tail-stroke.md](design-a-tail-stroke.md) \"Maneuvers\"), not of `tailsim run` experiments.",
         describe<ManeuverSettings>().rows);
+  table("optimize", "The `optimize:` section of a `kind: optimize` file (`tailsim optimize`, "
+                    "[design-a-tail-stroke.md](design-a-tail-stroke.md)); `family` and `limits` required. The reader "
+                    "also refuses keys that do not fit together (`knots` without `family: spline`, `directions_kept` "
+                    "without `directions: enumerate`, a last restart's population over the limit, ...).",
+        describe<OptimizeSection>(OptimizeSection{}, false).rows);
+  table("optimize.limits", "A joint limit not given here is the robot file's tail entry's (`theta_min_deg`, "
+                           "`theta_max_deg`, `thetadot_max_dps`, `torque_max_Nm`).",
+        describe<OptimizeLimitsSection>(OptimizeLimitsSection{}, false).rows);
+  table("optimize.objective", "The map form of `objective:`; `search` and `candidates` with `model: mujoco` only.",
+        describe<OptimizeObjectiveSection>(OptimizeObjectiveSection{}, false).rows);
   table("trajectory (split-cycle, Eqs. 20-23)",
         "The default family. Each per-joint key is a number (the same for every joint) or a list with one value per "
         "joint (exactly n values). Give `dtheta_deg` and one of `dT_s`, `peak_speed_dps`; or `rule: eq25` with "

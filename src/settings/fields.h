@@ -5,7 +5,7 @@
 // naming each field's key (with its unit, as written in YAML and JSON), its doc string, its allowed
 // range or enum values and, for an angle given in degrees but kept in radians, the conversion. The
 // default is the struct's own member initializer (a visitor reads it from `S{}`). The visitors are:
-// the YAML loader (experiments/experiment_loader.cc), validation (validateFields below), the JSON
+// the YAML loader (YamlFields in experiments/yaml_reader.h), validation (validateFields below), the JSON
 // writer/reader of the resolved case (experiments/settings_json.cc), the JSON Schema and the key
 // tables of docs/experiment-format.md (experiments/settings_schema.cc). A new setting is one line in
 // its struct's declareFields (plus the member); nothing else lists keys.
@@ -85,17 +85,24 @@ struct Limits {
   }
 };
 
-// Integers allowed within Limits: only these (empty: all), only multiples of multiple_of.
+// Integers allowed within Limits: only these (empty: all), only multiples of multiple_of, never
+// `except` (0: no exception; e.g. a front of 0 or at least 2 points).
 struct IntSet {
   std::vector<int> one_of;
   int multiple_of = 1;
   const char* why = "";  // why multiple_of, for messages
+  int except = 0;
   IntSet() = default;
   IntSet(std::initializer_list<int> v) : one_of(v) {}
   static IntSet multiple(int k, const char* why) {
     IntSet s;
     s.multiple_of = k;
     s.why = why;
+    return s;
+  }
+  static IntSet not_(int k) {
+    IntSet s;
+    s.except = k;
     return s;
   }
 };
@@ -157,6 +164,7 @@ class FieldValidator {
       if (!in) bad(f, "is not one of the allowed values, got " + std::to_string(x));
     }
     if (x % only.multiple_of) bad(f, "must be a multiple of " + std::to_string(only.multiple_of) + ", got " + std::to_string(x));
+    if (only.except != 0 && x == only.except) bad(f, "must not be " + std::to_string(x));
   }
   void boolean(const Field&, bool) const {}
   template <class E>
@@ -185,6 +193,51 @@ class FieldValidator {
   }
   std::string prefix_;
 };
+
+// The keys a declaration names, in its order (the loader's lists of allowed keys, and the order
+// its "allowed here" messages list them in).
+struct KeyLister {
+  std::vector<std::string> keys;
+  void add(const Field& f) { keys.push_back(f.key); }
+  template <class T, class... R>
+  void number(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void perJoint(const Field& f, T&, R&&...) { add(f); }
+  template <class... R>
+  void knotLists(const Field& f, R&&...) { add(f); }
+  template <class T, class... R>
+  void choice(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void text(const Field& f, T&, R&&...) { add(f); }
+  template <class T, class... R>
+  void integer(const Field& f, T&, R&&...) { add(f); }
+  template <class T>
+  void boolean(const Field& f, T&) { add(f); }
+  template <class T>
+  void numbers(const Field& f, T&) { add(f); }
+  template <class T>
+  void internal(const Field&, T&) {}  // not a YAML key
+  // trajectory_section.h's kinds: perJoint, knotLists above. The design sections' kinds
+  // (optimize_section.h):
+  template <class... R>
+  void interval(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void jointLimit(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void integerList(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void section(const Field& f, R&&...) { add(f); }
+  template <class... R>
+  void nameOrSection(const Field& f, R&&...) { add(f); }
+};
+
+template <class S>
+std::vector<std::string> declaredKeys() {
+  KeyLister v;
+  S s{};
+  declareFields(v, s);
+  return v.keys;
+}
 
 // prefix: what precedes each key in the message, e.g. "quadruped." or "tail link 2 ".
 template <class S>

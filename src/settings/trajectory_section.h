@@ -2,7 +2,7 @@
 // split-cycle form (the default family, Eqs. 20-23, or Eq. 25's rule) and the spline form
 // (family: spline). The JSON Schema, the key tables of docs/experiment-format.md
 // (experiments/settings_schema.cc) and the loader's lists of allowed keys
-// (experiments/experiment_loader.cc) derive from these declarations. The loader reads the values
+// (experiments/trajectory_reader.cc, case_reader.cc) derive from these declarations. The loader reads the values
 // itself: a per-joint value is a number for every joint or a list of one per joint, and some keys
 // exclude others (dT_s or peak_speed_dps; rule: eq25 sets the angles and durations).
 //
@@ -86,32 +86,4 @@ settings::For<S, SplineSection> declareFields(V& v, S& s) {
            trajectoryFamilyNames());
 }
 
-namespace settings {
-
-// The keys a declaration names, in its order (the loader's lists of allowed keys, and the order
-// its "allowed here" messages list them in).
-struct KeyLister {
-  std::vector<std::string> keys;
-  void add(const Field& f) { keys.push_back(f.key); }
-  template <class T, class... R>
-  void number(const Field& f, T&, R&&...) { add(f); }
-  template <class T, class... R>
-  void perJoint(const Field& f, T&, R&&...) { add(f); }
-  template <class... R>
-  void knotLists(const Field& f, R&&...) { add(f); }
-  template <class T, class... R>
-  void choice(const Field& f, T&, R&&...) { add(f); }
-  template <class T, class... R>
-  void text(const Field& f, T&, R&&...) { add(f); }
-};
-
-template <class S>
-std::vector<std::string> declaredKeys() {
-  KeyLister v;
-  S s{};
-  declareFields(v, s);
-  return v.keys;
-}
-
-}  // namespace settings
 }  // namespace tailsim
