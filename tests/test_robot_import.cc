@@ -210,6 +210,23 @@ TEST(RobotImport, MissingMeshDroppedWhenItCannotCollideElseAnError) {
   }
 }
 
+// A scene that includes the robot and then has its own <worldbody> with the floor (Menagerie's
+// A1 and Go2 scene.xml): MuJoCo merges the worldbodies, so the scene's floor is the floor; no
+// second plane is added under the feet.
+TEST(RobotImport, SceneFloorInALaterWorldbodyIsTheFloor) {
+  Scratch t("robot_import");
+  t.write("robot.xml", boxRobot(""));
+  const std::string scene = R"(<mujoco model="scene">
+  <include file="robot.xml"/>
+  <worldbody><geom name="floor" type="plane" size="0 0 0.05"/></worldbody>
+</mujoco>
+)";
+  const PreparedModel p = prepareRobotModel(t.write("scene.xml", scene));
+  EXPECT_EQ(p.floor_geom, "floor");
+  for (const std::string& n : p.notes) EXPECT_EQ(n.find("added a floor"), std::string::npos) << n;
+  EXPECT_EQ(p.xml.find("tailsim_floor"), std::string::npos);
+}
+
 TEST(RobotImport, FeetAndPlanarNumbersOfARigidBox) {
   Scratch t("robot_import");
   std::string xml = boxRobot("");

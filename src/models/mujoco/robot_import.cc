@@ -356,6 +356,15 @@ bool findFloor(const std::vector<XMLElement*>& geoms, const Defaults& defaults, 
   return hasPlane;
 }
 
+// Stage 3b: every later <worldbody> (a scene file's, after an included robot's) moved into the
+// first, in order, as MuJoCo merges them: the floor, the geoms and the bodies are all in one place.
+void mergeWorldbodies(XMLElement* world) {
+  for (XMLElement* w = world->NextSiblingElement("worldbody"); w; w = world->NextSiblingElement("worldbody")) {
+    while (tinyxml2::XMLNode* c = w->FirstChild()) world->InsertEndChild(c);
+    w->Parent()->DeleteChild(w);
+  }
+}
+
 // Stage 6: a floor when the model has none (a robot file without its scene), or a name for its
 // unnamed plane; out.floor_geom names it.
 void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLElement*>& geoms, const Defaults& defaults,
@@ -395,6 +404,7 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
   const Defaults defaults(root);
   XMLElement* world = root->FirstChildElement("worldbody");
   if (!world) fail(file, "no <worldbody>");
+  mergeWorldbodies(world);
   std::vector<XMLElement*> geoms;
   forEachElement(world, [&](XMLElement* e) {
     if (std::string(e->Name()) == "geom") geoms.push_back(e);
