@@ -227,6 +227,41 @@ TEST(RobotImport, SceneFloorInALaterWorldbodyIsTheFloor) {
   EXPECT_EQ(p.xml.find("tailsim_floor"), std::string::npos);
 }
 
+// A Menagerie file written for MuJoCo 3.x (Spot's joint actuatorfrcrange, position inheritrange):
+// MuJoCo 2.2's schema refuses it; the error names the user's file (an included one too), the line
+// and the attribute, and says it is from a newer MuJoCo.
+TEST(RobotImport, AttributeFromANewerMujocoNamedAtItsLineInTheUsersFile) {
+  Scratch t("robot_import");
+  std::string robot = boxRobot("");
+  robot.replace(robot.find("<default>"), 9, "<default>\n  <joint actuatorfrcrange=\"-10 10\"/>");
+  RobotModelSpec s;
+  s.file = t.write("robot.xml", robot);
+  s.keyframe = "";
+  s.joint_angles_rad = {};
+  const std::string scene = R"(<mujoco model="scene">
+  <include file="robot.xml"/>
+  <worldbody><geom name="floor" type="plane" size="0 0 0.05"/></worldbody>
+</mujoco>
+)";
+  const std::string robotFile = (t.dir / "robot.xml").lexically_normal().string();
+  for (const std::string& f : {s.file, t.write("scene.xml", scene)}) {
+    s.file = f;
+    try {
+      deriveRobot(s);
+      ADD_FAILURE() << "no error for an attribute MuJoCo 2.2 does not know";
+    } catch (const RobotImportError& e) {
+      const std::string msg = e.what();
+      std::printf("error text: %s\n", msg.c_str());
+      EXPECT_EQ(msg.rfind(robotFile + ":3: attribute 'actuatorfrcrange' of <joint> is not known to MuJoCo 2.2", 0),
+                0u)
+          << msg;
+      EXPECT_NE(msg.find("newer MuJoCo, 3.x"), std::string::npos) << msg;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not a RobotImportError: " << e.what();
+    }
+  }
+}
+
 TEST(RobotImport, FeetAndPlanarNumbersOfARigidBox) {
   Scratch t("robot_import");
   std::string xml = boxRobot("");

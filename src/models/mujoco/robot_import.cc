@@ -767,6 +767,61 @@ void settledJoints(const mjModel* m, const mjData* d, const Stance& stance, cons
   }
 }
 
+// "file:line" of the first <element> carrying attribute `attr` (any attribute when empty) in `file`
+// or the files it includes; "" when none.
+std::string findInUserFiles(const std::string& file, const std::string& element, const std::string& attr, int depth) {
+  XMLDocument doc;
+  if (depth > 8 || doc.LoadFile(file.c_str()) != tinyxml2::XML_SUCCESS || !doc.RootElement()) return "";
+  std::string found;
+  forEachElement(doc.RootElement(), [&](XMLElement* e) {
+    if (!found.empty()) return;
+    const std::string name = e->Name();
+    if (name == element && (attr.empty() || e->Attribute(attr.c_str())))
+      found = file + ":" + std::to_string(e->GetLineNum());
+    else if (name == "include" && e->Attribute("file")) {
+      const fs::path f = e->Attribute("file");
+      found = findInUserFiles((f.is_absolute() ? f : fs::path(file).parent_path() / f).string(), element, attr,
+                              depth + 1);
+    }
+  });
+  return found;
+}
+
+// The text between `open` and the next `close` after it in `text`, or "".
+std::string between(const std::string& text, const std::string& open, const std::string& close) {
+  const std::size_t a = text.find(open);
+  if (a == std::string::npos) return "";
+  const std::size_t b = text.find(close, a + open.size());
+  return b == std::string::npos ? "" : text.substr(a + open.size(), b - a - open.size());
+}
+
+// The prepared model compiled by MuJoCo. An attribute or element MuJoCo 2.2's schema does not know
+// (MJCF written for MuJoCo 3.x) is an error at its line in the user's file; any other refusal keeps
+// MuJoCo's text and names the user's file.
+ModelPtr compileUserModel(const PreparedModel& pm) {
+  try {
+    return loadModelFromXml(pm.xml);
+  } catch (const MujocoError& e) {
+    const std::string msg = e.what();
+    const std::string element = between(msg, "Element '", "'");
+    const std::string attr = between(msg, "unrecognized attribute: '", "'");
+    const bool unknownElement = msg.find("unrecognized element") != std::string::npos;
+    if (!element.empty() && (!attr.empty() || unknownElement)) {
+      std::string where = findInUserFiles(pm.source, element, attr, 0);
+      if (where.empty()) where = pm.source;
+      const std::string what = attr.empty() ? "element <" + element + ">"
+                                            : "attribute '" + attr + "' of <" + element + ">";
+      throw RobotImportError(where + ": " + what +
+                             " is not known to MuJoCo 2.2, the MuJoCo tailsim is built with (the file is "
+                             "written for a newer MuJoCo, 3.x): remove it, or use a version of the model "
+                             "made for MuJoCo 2.2");
+    }
+    const std::string prefix = "MuJoCo could not compile the generated MJCF: ";
+    fail(pm.source, "MuJoCo 2.2 refuses the model (line numbers are of tailsim's copy, includes inlined): " +
+                        (msg.rfind(prefix, 0) == 0 ? msg.substr(prefix.size()) : msg));
+  }
+}
+
 }  // namespace
 
 // The stages in order: prepare and compile the model, the stance and how the legs are held, stand,
@@ -776,7 +831,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   r.model = prepareRobotModel(spec.file);
   const std::string& file = r.model.source;
   MujocoMessages messages;
-  ModelPtr mp = loadModelFromXml(r.model.xml);
+  ModelPtr mp = compileUserModel(r.model);
   mjModel* m = mp.get();
   DataPtr dp = makeData(m);
   mjData* d = dp.get();

@@ -87,7 +87,8 @@ inline constexpr double kStancePdKp = 200.0;  // [N m/rad]
 inline constexpr double kStancePdKv = 5.0;    // [N m s/rad]
 
 // Loads, stands (settle_s with the legs held) and measures the robot. Throws RobotImportError with
-// a message for the user (no stance, not on 3-4 feet, ...), MujocoError when MuJoCo refuses the file.
+// a message for the user (no stance, not on 3-4 feet, an attribute MuJoCo 2.2 does not know at its
+// file and line, MuJoCo's refusal of the file, ...); MujocoError when MuJoCo fails while standing.
 DerivedRobot deriveRobot(const RobotModelSpec& spec);
 
 // Why a robot on 3 feet runs only as the articulated MuJoCo model (a note of deriveRobot, and the
