@@ -392,6 +392,11 @@ void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLEleme
 
 // The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
 // joint names, floor, print.
+bool isPositionServo(const mjModel* m, int a) {
+  return m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_biastype[a] == mjBIAS_AFFINE &&
+         m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
+}
+
 PreparedModel prepareRobotModel(const std::string& file_in) {
   PreparedModel out;
   out.source = fs::absolute(file_in).lexically_normal().string();
@@ -497,6 +502,7 @@ struct LegHold {
   std::vector<double> ctrl;      // the actuators' ctrl: the stance angle for position actuators
   std::vector<int> pd;           // hinge and slide joints held by tailsim's PD
   int position_servos = 0;
+  int other_actuators = 0;       // joint actuators that are not position servos (motors): ctrl 0
 };
 
 // Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
@@ -508,8 +514,10 @@ LegHold holdLegs(const mjModel* m, const Stance& stance) {
   for (int a = 0; a < m->nu; ++a) {
     if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
     const int j = m->actuator_trnid[2 * a];
-    const bool position = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
-    if (!position) continue;
+    if (!isPositionServo(m, a)) {
+      ++h.other_actuators;
+      continue;
+    }
     h.ctrl[a] = stance.qpos[m->jnt_qposadr[j]];
     h.by_actuator[j] = 1;
     ++h.position_servos;
@@ -848,7 +856,12 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   const LegHold hold = holdLegs(m, stance);
   r.stance += ", legs held by " + std::to_string(hold.position_servos) + " position actuator" +
               (hold.position_servos == 1 ? "" : "s") + " of the model" +
-              (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints");
+              (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints") +
+              (hold.other_actuators == 0
+                   ? ""
+                   : " (the model's " + std::to_string(hold.other_actuators) + " other joint actuator" +
+                         (hold.other_actuators == 1 ? " is not a position servo" : "s are not position servos") +
+                         ", e.g. torque motors: their ctrl stays 0)");
 
   const int floor = mj_name2id(m, mjOBJ_GEOM, r.model.floor_geom.c_str());
   stand(m, d, spec, stance, hold, root, floor, file, r);

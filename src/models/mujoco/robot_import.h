@@ -31,6 +31,11 @@ struct PreparedModel {
 // missing file when a colliding geom's mesh is missing, or a body whose mass came from a dropped geom.
 PreparedModel prepareRobotModel(const std::string& file);
 
+// A position servo of the model: a joint actuator whose bias is affine with -kp q (MJCF <position>,
+// or <general biastype="affine"> with biasprm[1] < 0); its ctrl is a joint angle. Others (a
+// <motor>, ctrl a torque) are not.
+bool isPositionServo(const mjModel* m, int a);
+
 class RobotImportError : public std::runtime_error {
  public:
   // key: the experiment key the error is about (robot.mjcf, robot.stance, robot.feet,
