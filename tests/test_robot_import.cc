@@ -191,6 +191,18 @@ TEST(RobotImport, MissingMeshDroppedWhenItCannotCollideElseAnError) {
   s.keyframe = "";
   // No keyframe and no joints: a rigid robot still needs a stance named; give none -> error.
   EXPECT_THROW(deriveRobot(s), RobotImportError);
+  // A standing keyframe under another name (Menagerie's Barkour v0: 'standing'): the error lists it.
+  std::string keyed = boxRobot("");
+  keyed.replace(keyed.find("</worldbody>"), 12,
+                "</worldbody>\n<keyframe><key name=\"standing\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
+  s.file = t.write("keyed.xml", keyed);
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "no error without a home keyframe or joint angles";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("no `home` keyframe (keyframes: standing)"), std::string::npos) << e.what();
+  }
+  s.file = t.write("ok.xml", boxRobot(""));
   const PreparedModel p = prepareRobotModel(s.file);
   EXPECT_EQ(p.dropped_geoms, 1);
   EXPECT_EQ(p.xml.find("shell.stl"), std::string::npos);

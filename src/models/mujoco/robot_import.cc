@@ -461,18 +461,16 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
   s.qpos.assign(m->qpos0, m->qpos0 + m->nq);
   std::string key = spec.keyframe;
   if (key.empty() && mj_name2id(m, mjOBJ_KEY, "home") >= 0) key = "home";
+  std::string names;  // the model's keyframes, for the errors
+  for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
   if (!key.empty()) {
     const int k = mj_name2id(m, mjOBJ_KEY, key.c_str());
-    if (k < 0) {
-      std::string names;
-      for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
-      fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
-    }
+    if (k < 0) fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
     s.qpos.assign(m->key_qpos + k * m->nq, m->key_qpos + (k + 1) * m->nq);
     s.words = "keyframe '" + key + "'";
   } else if (spec.joint_angles_rad.empty()) {
-    fail(file, "no stance: the model has no `home` keyframe; name a keyframe or give the joint angles of its "
-               "standing pose (docs/your-robot.md)",
+    fail(file, "no stance: the model has no `home` keyframe (keyframes: " + (names.empty() ? "none" : names) +
+                   "); name a keyframe or give the joint angles of its standing pose (docs/your-robot.md)",
          "robot.stance");
   } else {
     s.words = "the model's reference pose (qpos0)";
