@@ -192,6 +192,18 @@ TEST(RobotImport, MissingMeshDroppedWhenItCannotCollideElseAnError) {
   s.keyframe = "";
   // No keyframe and no joints: a rigid robot still needs a stance named; give none -> error.
   EXPECT_THROW(deriveRobot(s), RobotImportError);
+  // A standing keyframe under another name (Menagerie's Barkour v0: 'standing'): the error lists it.
+  std::string keyed = boxRobot("");
+  keyed.replace(keyed.find("</worldbody>"), 12,
+                "</worldbody>\n<keyframe><key name=\"standing\" qpos=\"0 0 0.3 1 0 0 0\"/></keyframe>");
+  s.file = t.write("keyed.xml", keyed);
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "no error without a home keyframe or joint angles";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("no `home` keyframe (keyframes: standing)"), std::string::npos) << e.what();
+  }
+  s.file = t.write("ok.xml", boxRobot(""));
   const PreparedModel p = prepareRobotModel(s.file);
   EXPECT_EQ(p.dropped_geoms, 1);
   EXPECT_EQ(p.xml.find("shell.stl"), std::string::npos);
@@ -208,6 +220,58 @@ TEST(RobotImport, MissingMeshDroppedWhenItCannotCollideElseAnError) {
                        " is missing"),
               std::string::npos)
         << msg;
+  }
+}
+
+// A scene that includes the robot and then has its own <worldbody> with the floor (Menagerie's
+// A1 and Go2 scene.xml): MuJoCo merges the worldbodies, so the scene's floor is the floor; no
+// second plane is added under the feet.
+TEST(RobotImport, SceneFloorInALaterWorldbodyIsTheFloor) {
+  Scratch t("robot_import");
+  t.write("robot.xml", boxRobot(""));
+  const std::string scene = R"(<mujoco model="scene">
+  <include file="robot.xml"/>
+  <worldbody><geom name="floor" type="plane" size="0 0 0.05"/></worldbody>
+</mujoco>
+)";
+  const PreparedModel p = prepareRobotModel(t.write("scene.xml", scene));
+  EXPECT_EQ(p.floor_geom, "floor");
+  for (const std::string& n : p.notes) EXPECT_EQ(n.find("added a floor"), std::string::npos) << n;
+  EXPECT_EQ(p.xml.find("tailsim_floor"), std::string::npos);
+}
+
+// A Menagerie file written for MuJoCo 3.x (Spot's joint actuatorfrcrange, position inheritrange):
+// MuJoCo 2.2's schema refuses it; the error names the user's file (an included one too), the line
+// and the attribute, and says it is from a newer MuJoCo.
+TEST(RobotImport, AttributeFromANewerMujocoNamedAtItsLineInTheUsersFile) {
+  Scratch t("robot_import");
+  std::string robot = boxRobot("");
+  robot.replace(robot.find("<default>"), 9, "<default>\n  <joint actuatorfrcrange=\"-10 10\"/>");
+  RobotModelSpec s;
+  s.file = t.write("robot.xml", robot);
+  s.keyframe = "";
+  s.joint_angles_rad = {};
+  const std::string scene = R"(<mujoco model="scene">
+  <include file="robot.xml"/>
+  <worldbody><geom name="floor" type="plane" size="0 0 0.05"/></worldbody>
+</mujoco>
+)";
+  const std::string robotFile = (t.dir / "robot.xml").lexically_normal().string();
+  for (const std::string& f : {s.file, t.write("scene.xml", scene)}) {
+    s.file = f;
+    try {
+      deriveRobot(s);
+      ADD_FAILURE() << "no error for an attribute MuJoCo 2.2 does not know";
+    } catch (const RobotImportError& e) {
+      const std::string msg = e.what();
+      std::printf("error text: %s\n", msg.c_str());
+      EXPECT_EQ(msg.rfind(robotFile + ":3: attribute 'actuatorfrcrange' of <joint> is not known to MuJoCo 2.2", 0),
+                0u)
+          << msg;
+      EXPECT_NE(msg.find("newer MuJoCo, 3.x"), std::string::npos) << msg;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not a RobotImportError: " << e.what();
+    }
   }
 }
 
@@ -385,6 +449,56 @@ TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
 // Standing with the tail: the tilt that counts is the one from the robot's own settled stance. A
 // rigid box robot whose front feet are 40 mm shorter stands pitched by atan(0.04 / 0.4) = 5.7 deg
 // with or without a tail; holding the tail must not tilt it further, and no tilt warning is given.
+// Legs driven by torque motors (Menagerie's Go2: <motor> actuators, a home keyframe whose ctrl
+// are joint angles): tailsim's PD holds the joints and the motors' ctrl stays 0 while the robot
+// stands with the tail. A motor given the stance angle as its ctrl would push each leg with
+// gear x angle (here 50 x 0.3 = 15 N m) away from the stance.
+TEST(RobotImport, MotorLegsAreHeldByThePdAndTheirCtrlStaysZero) {
+  Scratch t("robot_import");
+  std::string legs, motors;
+  const double xy[4][2] = {{0.2, 0.12}, {0.2, -0.12}, {-0.2, -0.12}, {-0.2, 0.12}};
+  for (int i = 0; i < 4; ++i) {
+    char b[600];
+    std::snprintf(b, sizeof b,
+                  "<body name=\"leg%d\" pos=\"%g %g -0.05\"><joint name=\"j%d\" axis=\"0 1 0\"/>"
+                  "<inertial pos=\"0 0 -0.1\" mass=\"0.5\" diaginertia=\"0.002 0.002 0.0003\"/>"
+                  "<geom type=\"capsule\" fromto=\"0 0 0 0 0 -0.2\" size=\"0.015\" contype=\"0\" conaffinity=\"0\"/>"
+                  "<geom name=\"f%d\" type=\"sphere\" size=\"0.02\" pos=\"0 0 -0.22\"/></body>\n",
+                  i + 1, xy[i][0], xy[i][1], i + 1, i + 1);
+    legs += b;
+    motors += "<motor joint=\"j" + std::to_string(i + 1) + "\" gear=\"50\"/>";
+  }
+  const std::string xml = R"(<mujoco model="motorbot">
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <body name="trunk" pos="0 0 0.3">
+      <freejoint/>
+      <inertial pos="0 0 0" mass="10" diaginertia="0.1 0.2 0.25"/>
+      <geom name="body_box" type="box" size="0.25 0.15 0.05"/>
+)" + legs + R"(    </body>
+  </worldbody>
+  <actuator>)" + motors + R"(</actuator>
+  <keyframe><key name="home" qpos="0 0 0.3 1 0 0 0 0.3 0.3 0.3 0.3" ctrl="0.3 0.3 0.3 0.3"/></keyframe>
+</mujoco>
+)";
+  RobotModelSpec s;
+  s.file = t.write("motorbot.xml", xml);
+  s.mount.pos_m = {-0.25, 0.0, 0.0};
+  s.settle_s = 0.3;
+  RobotTailChoice tail;
+  tail.stand_s = 0.5;
+  const RobotComparison c = compareRobotModels(s, tail);
+  EXPECT_EQ(c.robot.pd_joints.size(), 4u);
+  EXPECT_NE(c.robot.stance.find("the model's 4 other joint actuators are not position servos"), std::string::npos)
+      << c.robot.stance;
+  const ArticulatedRun& a = c.articulated;
+  ASSERT_TRUE(a.ok) << a.error;
+  std::printf("stance: %s\ntrim: %d rounds, largest joint error %.3f deg; tilt from the stance %.3f deg\n",
+              c.robot.stance.c_str(), a.trim.rounds, a.trim.residual_deg, a.stand_end_rel_tilt_deg);
+  EXPECT_LT(a.trim.residual_deg, 1.0);
+  EXPECT_LT(a.stand_max_rel_tilt_deg, 1.0);
+}
+
 TEST(RobotImport, TiltWithTheTailIsMeasuredFromTheStance) {
   Scratch t("robot_import");
   std::string xml = boxRobot("");

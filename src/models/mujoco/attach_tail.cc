@@ -201,7 +201,7 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
     for (std::size_t k = 0; k < q.size(); ++k) d->qpos[m->jnt_qposadr[j] + k] = q[k];
   }
   for (int u = 0; u < m->nu; ++u) {
-    if (m->actuator_trntype[u] != mjTRN_JOINT) continue;
+    if (!isPositionServo(m, u)) continue;  // a motor's ctrl is a torque, not a set-point: it stays 0
     const char* jn = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * u]);
     const auto t = jn ? r.hold_target_rad.find(jn) : r.hold_target_rad.end();
     if (t == r.hold_target_rad.end()) continue;

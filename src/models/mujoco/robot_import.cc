@@ -356,6 +356,15 @@ bool findFloor(const std::vector<XMLElement*>& geoms, const Defaults& defaults, 
   return hasPlane;
 }
 
+// Stage 3b: every later <worldbody> (a scene file's, after an included robot's) moved into the
+// first, in order, as MuJoCo merges them: the floor, the geoms and the bodies are all in one place.
+void mergeWorldbodies(XMLElement* world) {
+  for (XMLElement* w = world->NextSiblingElement("worldbody"); w; w = world->NextSiblingElement("worldbody")) {
+    while (tinyxml2::XMLNode* c = w->FirstChild()) world->InsertEndChild(c);
+    w->Parent()->DeleteChild(w);
+  }
+}
+
 // Stage 6: a floor when the model has none (a robot file without its scene), or a name for its
 // unnamed plane; out.floor_geom names it.
 void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLElement*>& geoms, const Defaults& defaults,
@@ -383,6 +392,11 @@ void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLEleme
 
 // The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
 // joint names, floor, print.
+bool isPositionServo(const mjModel* m, int a) {
+  return m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_biastype[a] == mjBIAS_AFFINE &&
+         m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
+}
+
 PreparedModel prepareRobotModel(const std::string& file_in) {
   PreparedModel out;
   out.source = fs::absolute(file_in).lexically_normal().string();
@@ -395,6 +409,7 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
   const Defaults defaults(root);
   XMLElement* world = root->FirstChildElement("worldbody");
   if (!world) fail(file, "no <worldbody>");
+  mergeWorldbodies(world);
   std::vector<XMLElement*> geoms;
   forEachElement(world, [&](XMLElement* e) {
     if (std::string(e->Name()) == "geom") geoms.push_back(e);
@@ -446,18 +461,16 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
   s.qpos.assign(m->qpos0, m->qpos0 + m->nq);
   std::string key = spec.keyframe;
   if (key.empty() && mj_name2id(m, mjOBJ_KEY, "home") >= 0) key = "home";
+  std::string names;  // the model's keyframes, for the errors
+  for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
   if (!key.empty()) {
     const int k = mj_name2id(m, mjOBJ_KEY, key.c_str());
-    if (k < 0) {
-      std::string names;
-      for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
-      fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
-    }
+    if (k < 0) fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
     s.qpos.assign(m->key_qpos + k * m->nq, m->key_qpos + (k + 1) * m->nq);
     s.words = "keyframe '" + key + "'";
   } else if (spec.joint_angles_rad.empty()) {
-    fail(file, "no stance: the model has no `home` keyframe; name a keyframe or give the joint angles of its "
-               "standing pose (docs/your-robot.md)",
+    fail(file, "no stance: the model has no `home` keyframe (keyframes: " + (names.empty() ? "none" : names) +
+                   "); name a keyframe or give the joint angles of its standing pose (docs/your-robot.md)",
          "robot.stance");
   } else {
     s.words = "the model's reference pose (qpos0)";
@@ -487,6 +500,7 @@ struct LegHold {
   std::vector<double> ctrl;      // the actuators' ctrl: the stance angle for position actuators
   std::vector<int> pd;           // hinge and slide joints held by tailsim's PD
   int position_servos = 0;
+  int other_actuators = 0;       // joint actuators that are not position servos (motors): ctrl 0
 };
 
 // Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
@@ -498,8 +512,10 @@ LegHold holdLegs(const mjModel* m, const Stance& stance) {
   for (int a = 0; a < m->nu; ++a) {
     if (m->actuator_trntype[a] != mjTRN_JOINT) continue;
     const int j = m->actuator_trnid[2 * a];
-    const bool position = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
-    if (!position) continue;
+    if (!isPositionServo(m, a)) {
+      ++h.other_actuators;
+      continue;
+    }
     h.ctrl[a] = stance.qpos[m->jnt_qposadr[j]];
     h.by_actuator[j] = 1;
     ++h.position_servos;
@@ -765,6 +781,61 @@ void settledJoints(const mjModel* m, const mjData* d, const Stance& stance, cons
   }
 }
 
+// "file:line" of the first <element> carrying attribute `attr` (any attribute when empty) in `file`
+// or the files it includes; "" when none.
+std::string findInUserFiles(const std::string& file, const std::string& element, const std::string& attr, int depth) {
+  XMLDocument doc;
+  if (depth > 8 || doc.LoadFile(file.c_str()) != tinyxml2::XML_SUCCESS || !doc.RootElement()) return "";
+  std::string found;
+  forEachElement(doc.RootElement(), [&](XMLElement* e) {
+    if (!found.empty()) return;
+    const std::string name = e->Name();
+    if (name == element && (attr.empty() || e->Attribute(attr.c_str())))
+      found = file + ":" + std::to_string(e->GetLineNum());
+    else if (name == "include" && e->Attribute("file")) {
+      const fs::path f = e->Attribute("file");
+      found = findInUserFiles((f.is_absolute() ? f : fs::path(file).parent_path() / f).string(), element, attr,
+                              depth + 1);
+    }
+  });
+  return found;
+}
+
+// The text between `open` and the next `close` after it in `text`, or "".
+std::string between(const std::string& text, const std::string& open, const std::string& close) {
+  const std::size_t a = text.find(open);
+  if (a == std::string::npos) return "";
+  const std::size_t b = text.find(close, a + open.size());
+  return b == std::string::npos ? "" : text.substr(a + open.size(), b - a - open.size());
+}
+
+// The prepared model compiled by MuJoCo. An attribute or element MuJoCo 2.2's schema does not know
+// (MJCF written for MuJoCo 3.x) is an error at its line in the user's file; any other refusal keeps
+// MuJoCo's text and names the user's file.
+ModelPtr compileUserModel(const PreparedModel& pm) {
+  try {
+    return loadModelFromXml(pm.xml);
+  } catch (const MujocoError& e) {
+    const std::string msg = e.what();
+    const std::string element = between(msg, "Element '", "'");
+    const std::string attr = between(msg, "unrecognized attribute: '", "'");
+    const bool unknownElement = msg.find("unrecognized element") != std::string::npos;
+    if (!element.empty() && (!attr.empty() || unknownElement)) {
+      std::string where = findInUserFiles(pm.source, element, attr, 0);
+      if (where.empty()) where = pm.source;
+      const std::string what = attr.empty() ? "element <" + element + ">"
+                                            : "attribute '" + attr + "' of <" + element + ">";
+      throw RobotImportError(where + ": " + what +
+                             " is not known to MuJoCo 2.2, the MuJoCo tailsim is built with (the file is "
+                             "written for a newer MuJoCo, 3.x): remove it, or use a version of the model "
+                             "made for MuJoCo 2.2");
+    }
+    const std::string prefix = "MuJoCo could not compile the generated MJCF: ";
+    fail(pm.source, "MuJoCo 2.2 refuses the model (line numbers are of tailsim's copy, includes inlined): " +
+                        (msg.rfind(prefix, 0) == 0 ? msg.substr(prefix.size()) : msg));
+  }
+}
+
 }  // namespace
 
 // The stages in order: prepare and compile the model, the stance and how the legs are held, stand,
@@ -774,7 +845,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   r.model = prepareRobotModel(spec.file);
   const std::string& file = r.model.source;
   MujocoMessages messages;
-  ModelPtr mp = loadModelFromXml(r.model.xml);
+  ModelPtr mp = compileUserModel(r.model);
   mjModel* m = mp.get();
   DataPtr dp = makeData(m);
   mjData* d = dp.get();
@@ -791,7 +862,12 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   const LegHold hold = holdLegs(m, stance);
   r.stance += ", legs held by " + std::to_string(hold.position_servos) + " position actuator" +
               (hold.position_servos == 1 ? "" : "s") + " of the model" +
-              (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints");
+              (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints") +
+              (hold.other_actuators == 0
+                   ? ""
+                   : " (the model's " + std::to_string(hold.other_actuators) + " other joint actuator" +
+                         (hold.other_actuators == 1 ? " is not a position servo" : "s are not position servos") +
+                         ", e.g. torque motors: their ctrl stays 0)");
 
   const int floor = mj_name2id(m, mjOBJ_GEOM, r.model.floor_geom.c_str());
   stand(m, d, spec, stance, hold, root, floor, file, r);

@@ -31,6 +31,11 @@ struct PreparedModel {
 // missing file when a colliding geom's mesh is missing, or a body whose mass came from a dropped geom.
 PreparedModel prepareRobotModel(const std::string& file);
 
+// A position servo of the model: a joint actuator whose bias is affine with -kp q (MJCF <position>,
+// or <general biastype="affine"> with biasprm[1] < 0); its ctrl is a joint angle. Others (a
+// <motor>, ctrl a torque) are not.
+bool isPositionServo(const mjModel* m, int a);
+
 class RobotImportError : public std::runtime_error {
  public:
   // key: the experiment key the error is about (robot.mjcf, robot.stance, robot.feet,
@@ -91,7 +96,8 @@ inline constexpr double kStancePdKv = 5.0;    // [N m s/rad]
 void addStancePdDamping(mjModel* m, const std::vector<int>& joints);
 
 // Loads, stands (settle_s with the legs held) and measures the robot. Throws RobotImportError with
-// a message for the user (no stance, not on 3-4 feet, ...), MujocoError when MuJoCo refuses the file.
+// a message for the user (no stance, not on 3-4 feet, an attribute MuJoCo 2.2 does not know at its
+// file and line, MuJoCo's refusal of the file, ...); MujocoError when MuJoCo fails while standing.
 DerivedRobot deriveRobot(const RobotModelSpec& spec);
 
 // Why a robot on 3 feet runs only as the articulated MuJoCo model (a note of deriveRobot, and the
