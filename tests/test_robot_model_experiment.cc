@@ -174,9 +174,12 @@ TEST(RobotModelExperiment, ErrorsNameFileLineAndKey) {
   EXPECT_NE(m.find("no body named 'tailbone'"), std::string::npos) << m;
   // 3 feet (named, or standing): only the articulated MuJoCo model runs on them, so asking the planar
   // models is an error naming the feet; an unknown foot geom.
-  m = run("{mjcf: box.xml, feet: [f1, f2, f3]}");
-  expectAt(m, f, 2, "robot.mjcf");
-  EXPECT_NE(m.find("models: analytic cannot run this robot: the robot stands on 3 feet (f1, f2, f3)"), std::string::npos) << m;
+  m = run("{mjcf: box.xml, feet: [f1, f2, f3]}");  // f4 stands too: named feet are the ones standing
+  expectAt(m, f, 2, "robot.feet");
+  EXPECT_NE(m.find("feet: 'f4' also touches the floor after standing but is not named"), std::string::npos) << m;
+  m = run("{mjcf: box.xml, feet: [f1, f2, f3, body_box]}");
+  expectAt(m, f, 2, "robot.feet");
+  EXPECT_NE(m.find("feet: 'body_box' does not touch the floor after standing"), std::string::npos) << m;
   m = run("{mjcf: three.xml}");
   expectAt(m, f, 2, "robot.mjcf");
   EXPECT_NE(m.find("models: analytic cannot run this robot: the robot stands on 3 feet"), std::string::npos) << m;
@@ -377,4 +380,42 @@ TEST(RobotModelExperiment, ThreeFeetRunArticulatedAndFeetAreOnePerBody) {
   const std::string shown = describeDerivedRobot(*c.robot_derived);
   EXPECT_NE(shown.find("feet (front to back): "), std::string::npos) << shown;
   EXPECT_NE(shown.find("only the articulated MuJoCo model runs on it"), std::string::npos) << shown;
+}
+
+// A robot that falls is a failed run, never a turn: a 10 kg box with a 15 kg, 1 m tail held out to
+// its side (the Eq. 25 stroke starts at theta = +90 deg) rolls over while standing. Before, the
+// articulated run reported ok and a phi_net with only a tilt warning.
+TEST(RobotModelExperiment, ARobotThatFallsIsAFailedRun) {
+  Scratch t("robot_model_exp");
+  t.write("box.xml", boxRobot(kHome));
+  const std::string f =
+      t.write("e.yaml", "name: topple\nrobot: {mjcf: box.xml}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, custom: "
+                        "[{mass_kg: 15, izz_kgm2: 1.25, length_m: 1.0}]}\ntrajectory: {rule: eq25, thetadot_max_dps: 600}\n"
+                        "models: [mujoco]\noutput: {settle_s: 0.5, time_series: none}\n");
+  std::vector<Experiment> s = loadExperimentSuite(f);
+  resolveRobotModels(s);
+  const RunSummary r = runCase(s.front().cases.front(), nullptr).front().summary;
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.error.find("the robot fell over"), std::string::npos) << r.error;
+  EXPECT_TRUE(std::isnan(r.phi_net_deg));
+}
+
+// In a scene with two free bodies the robot is the tree of the tail mount's body; with no mount body
+// to choose by, an error names both.
+TEST(RobotModelExperiment, TwoFreeBodiesTheMountBodyChoosesTheRobot) {
+  Scratch t("robot_model_exp");
+  std::string xml = boxRobot(kHome);
+  xml.replace(xml.find("  </worldbody>"), 0,
+              "    <body name=\"crate\" pos=\"1 1 0.1\"><freejoint/><geom type=\"box\" size=\"0.1 0.1 0.1\" mass=\"2\"/></body>\n");
+  xml.replace(xml.find("qpos=\"0 0 0.3 1 0 0 0\""), 22, "qpos=\"0 0 0.3 1 0 0 0 1 1 0.1 1 0 0 0\"");
+  t.write("two.xml", xml);
+  const std::string f = (t.dir / "e.yaml").string();
+  t.write("e.yaml", experiment("{mjcf: two.xml}"));
+  const std::string m = errorOf(f);
+  expectAt(m, f, 2, "robot");  // no tail.mount.body in the file: the robot key
+  EXPECT_NE(m.find("2 bodies have a free joint ('trunk', 'crate')"), std::string::npos) << m;
+  t.write("e.yaml", experiment("{mjcf: two.xml}", "{mount: {body: trunk, pos_m: [-0.25, 0, 0]}, links: 1}"));
+  std::vector<Experiment> s = loadExperimentSuite(f);
+  resolveRobotModels(s);
+  EXPECT_NEAR(s.front().cases.front().robot.quadruped.mass_kg, 10.0, 1e-12);  // the trunk's tree, not the crate
 }

@@ -6,6 +6,7 @@
 
 #include "app/commands.h"
 #include "experiments/experiment_loader.h"
+#include "experiments/robot_model_cases.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/render_case.h"
 
@@ -23,6 +24,7 @@ void addRenderCommand(CLI::App& app, int& exit_code) {
   render->add_option("--out", a->out, "output folder (default: renders/)")->check(nonEmptyPath());
   render->callback([a, &exit_code] {
     const std::vector<Experiment> suite = loadExperimentSuite(a->exp_path);
+    refuseRobotModels(suite, "render");  // the articulated robot's videos are not drawn yet
     requireCase(suite, a->exp_path, a->case_name);
     for (const Experiment& e : suite) {
       const fs::path dir = fs::path(a->out) / e.name;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 
 #include "controllers/tail_controller.h"
@@ -240,6 +241,15 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
   }
 }
 
+// A fall: the body tilted more than kFallTiltFromStanceDeg from its stance. Sets the run's error
+// (phase: while what) and returns true.
+bool fell(double tilt_deg, const char* phase, std::string& error) {
+  if (tilt_deg <= kFallTiltFromStanceDeg) return false;
+  error = "the robot fell over: its body tilted " + std::to_string(tilt_deg) + " deg from its stance (limit " +
+          std::to_string(kFallTiltFromStanceDeg) + " deg) " + phase;
+  return true;
+}
+
 // One step: the legs' PD spring (for joints no actuator holds), the tail's controller at t_ref.
 void stepArticulated(ArticulatedSim& a, TailController& ctrl, double t_ref, long& steps) {
   mj_step1(a.m, a.d);
@@ -278,6 +288,7 @@ StanceTrim trimStance(ArticulatedSim& a, TailController& ctrl, bool legs_locked,
     for (long k = 0; k < roundSteps; ++k) {
       stepArticulated(a, ctrl, 0.0, steps);
       t.max_rel_tilt_deg = std::max(t.max_rel_tilt_deg, tiltFromDeg(a.d, a.body, a.stanceZ));
+      if (fell(t.max_rel_tilt_deg, "while its legs were trimmed for the tail's weight", error)) return t;
       if (warningCount(a.d)) {
         error = "MuJoCo warnings while trimming the legs' set-points for the tail: " + describeWarnings(a.d);
         return t;
@@ -323,6 +334,7 @@ void standWithTail(ArticulatedSim& a, TailController& ctrl, const DerivedRobot& 
     out.stand_max_tilt_deg = std::max(out.stand_max_tilt_deg, tiltDeg(d, a.body));
     out.stand_max_rel_tilt_deg = std::max(out.stand_max_rel_tilt_deg, tiltFromDeg(d, a.body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings while standing: " + describeWarnings(d);
+    if (out.ok && fell(out.stand_max_rel_tilt_deg, "while standing with the tail", out.error)) out.ok = false;
   }
   out.stand_s = stand_s;
   out.stand_end_tilt_deg = tiltDeg(d, a.body);
@@ -411,6 +423,7 @@ void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& tr
     out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
     out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
+    if (out.ok && fell(out.max_rel_tilt_deg, "during the stroke", out.error)) out.ok = false;
   }
   out.run_s = t_end;
   out.phi_net_deg = units::degrees(phi);
@@ -418,8 +431,20 @@ void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& tr
   out.at_rest = units::degrees(std::abs(v[2])) < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
 }
 
-// Stage: the run's warnings: a tilt from the stance while standing with the tail.
+// Stage: the run's verdict: not standing on 3 feet at the stroke's start is a failed run (phi_net
+// NaN, as a fall); warnings: a tilt from the stance while standing with the tail, a near fall.
 void judgeArticulated(ArticulatedRun& out) {
+  if (out.ok && out.feet_in_contact < 3) {
+    out.ok = false;
+    out.error = "the robot does not stand: " + std::to_string(out.feet_in_contact) +
+                " of its feet touch the floor after standing with the tail";
+  }
+  if (!out.ok) out.phi_net_deg = std::numeric_limits<double>::quiet_NaN();
+  if (out.ok && out.max_rel_tilt_deg > kNearFallTiltFromStanceDeg)
+    out.warnings.push_back(std::string(kUncertainWarning) + ": the robot nearly fell (body tilt up to " +
+                           std::to_string(out.max_rel_tilt_deg) + " deg from its stance during the stroke, more than " +
+                           std::to_string(kNearFallTiltFromStanceDeg) + " deg): whether it falls depends on the "
+                           "contact and the step");
   if (out.stand_max_rel_tilt_deg >= kStandingTiltLimitDeg)
     out.warnings.push_back("the body tilted up to " + std::to_string(out.stand_max_rel_tilt_deg) + " deg from its stance (" +
                            std::to_string(out.stand_max_tilt_deg) + " deg absolute) while standing with the tail");

@@ -66,6 +66,12 @@ struct ArticulatedRun {
 
 // Standing with the tail: a larger tilt from the stance is warned about.
 inline constexpr double kStandingTiltLimitDeg = 1.0;
+// A fall: the root body tilted more than this from its stance (trimming, standing or the stroke):
+// the run fails ("the robot fell over"), phi_net NaN. Over kNearFallTiltFromStanceDeg during the
+// stroke: the "nearly fell" uncertain warning. (The rigid box's limit is mujoco.max_tilt_deg, 5
+// deg: a robot on compliant legs rocks further and stands, ANYmal C up to 9 deg at 600 deg/s.)
+inline constexpr double kFallTiltFromStanceDeg = 45.0;      // [deg]
+inline constexpr double kNearFallTiltFromStanceDeg = 20.0;  // [deg]
 
 // Stands stand_s with the tail held at theta(0), then runs the stroke and settle_after_s more, at
 // the model's own timestep; one run, without an uncertainty estimate (simulateArticulated).

@@ -28,6 +28,24 @@ std::string g6(double v) {
   return b;
 }
 
+// A name from the user's file or experiment as a message shows it: control characters as \xHH, at
+// most 60 characters (then "...").
+std::string clipped(const std::string& v) {
+  std::string out;
+  for (const char ch : v) {
+    if (out.size() >= 60) return out + "...";
+    const unsigned char u = static_cast<unsigned char>(ch);
+    if (u < 0x20 || u == 0x7f) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02x", u);
+      out += b;
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
 [[noreturn]] void fail(const std::string& file, const std::string& what, const std::string& key = "robot.mjcf") {
   throw RobotImportError(file + ": " + what, key);
 }
@@ -465,7 +483,7 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
   for (int i = 0; i < m->nkey; ++i) names += (names.empty() ? "" : ", ") + std::string(mj_id2name(m, mjOBJ_KEY, i) ? mj_id2name(m, mjOBJ_KEY, i) : "?");
   if (!key.empty()) {
     const int k = mj_name2id(m, mjOBJ_KEY, key.c_str());
-    if (k < 0) fail(file, "no keyframe named '" + key + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
+    if (k < 0) fail(file, "no keyframe named '" + clipped(key) + "' (keyframes: " + (names.empty() ? "none" : names) + ")", "robot.stance");
     s.qpos.assign(m->key_qpos + k * m->nq, m->key_qpos + (k + 1) * m->nq);
     s.words = "keyframe '" + key + "'";
   } else if (spec.joint_angles_rad.empty()) {
@@ -477,7 +495,7 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
   }
   for (const auto& [name, angle] : spec.joint_angles_rad) {
     const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
-    if (j < 0) fail(file, "stance: no joint named '" + name + "'", "robot.stance");
+    if (j < 0) fail(file, "stance: no joint named '" + clipped(name) + "'", "robot.stance");
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
       fail(file, "stance: joint '" + name + "' is not a hinge or slide", "robot.stance");
     s.qpos[m->jnt_qposadr[j]] = angle;
@@ -488,10 +506,26 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
   return s;
 }
 
-int rootBody(const mjModel* m, const std::string& file) {
+// The robot: the body with a free joint, or, in a scene with several, the one whose tree holds the
+// tail mount's body (tail.mount.body); several and no mount body to choose by is an error.
+int rootBody(const mjModel* m, const RobotModelSpec& spec, const std::string& file) {
+  std::vector<int> free;
   for (int j = 0; j < m->njnt; ++j)
-    if (m->jnt_type[j] == mjJNT_FREE) return m->jnt_bodyid[j];
-  fail(file, "no free joint: a standing robot needs a floating base (<freejoint/>)");
+    if (m->jnt_type[j] == mjJNT_FREE) free.push_back(m->jnt_bodyid[j]);
+  if (free.empty()) fail(file, "no free joint: a standing robot needs a floating base (<freejoint/>)");
+  if (free.size() == 1) return free.front();
+  std::string names;
+  for (int b : free) names += (names.empty() ? "'" : ", '") + clipped(mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "?") + "'";
+  if (!spec.mount.body.empty()) {
+    const int mb = mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
+    if (mb < 0) fail(file, "tail mount: no body named '" + clipped(spec.mount.body) + "'", "tail.mount.body");
+    for (int b : free)
+      if (m->body_rootid[mb] == m->body_rootid[b]) return b;
+  }
+  fail(file, std::to_string(free.size()) + " bodies have a free joint (" + names +
+                 "): name the robot's body the tail goes on with tail.mount.body (--mount-body), and the robot is that "
+                 "body's tree",
+       "tail.mount.body");
 }
 
 // How the legs are held in the stance.
@@ -574,28 +608,61 @@ std::string geomName(const mjModel* m, int g) {
 // Stage: the feet: the named geoms, or the robot's geoms touching the floor (a foot body's geoms within
 // kFootMergeM of each other count once, its lowest); 3 or 4 of them.
 constexpr double kFootMergeM = 0.05;  // [m] horizontal, between geom centres
-std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int floor, const std::string& file,
-                          const DerivedRobot& r) {
+// The robot's (root's tree's) geoms touching the floor after standing, a foot body's geoms within
+// kFootMergeM of each other as one (its lowest).
+std::vector<int> touchingFeet(const mjModel* m, const mjData* d, int floor, int root) {
   std::vector<int> feet;
+  for (int i = 0; i < d->ncon; ++i) {
+    const mjContact& c = d->contact[i];
+    const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
+    if (other < 0 || c.dist > 1e-3 || m->body_rootid[m->geom_bodyid[other]] != root) continue;
+    const auto same = std::find_if(feet.begin(), feet.end(), [&](int g) {
+      const double* a = d->geom_xpos + 3 * g;
+      const double* b = d->geom_xpos + 3 * other;
+      return g == other || (m->geom_bodyid[g] == m->geom_bodyid[other] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
+    });
+    if (same == feet.end()) feet.push_back(other);
+    else if (lowestZ(m, d, other) < lowestZ(m, d, *same)) *same = other;
+  }
+  return feet;
+}
+
+// Named feet must be the ones standing: each touches the floor, and no other geom does (one
+// within kFootMergeM of a named foot on its body counts as that foot).
+void checkNamedFeet(const mjModel* m, const mjData* d, const std::vector<int>& named, const std::vector<int>& touching,
+                    const std::string& file) {
+  auto sameFoot = [&](int g, int h) {
+    const double* a = d->geom_xpos + 3 * g;
+    const double* b = d->geom_xpos + 3 * h;
+    return g == h || (m->geom_bodyid[g] == m->geom_bodyid[h] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
+  };
+  for (int g : named)
+    if (std::none_of(touching.begin(), touching.end(), [&](int t) { return sameFoot(g, t); }))
+      fail(file, "feet: '" + clipped(geomName(m, g)) + "' does not touch the floor after standing: name the geoms the robot "
+                 "stands on (or leave feet: out to take the touching ones)",
+           "robot.feet");
+  for (int t : touching)
+    if (std::none_of(named.begin(), named.end(), [&](int g) { return sameFoot(g, t); }))
+      fail(file, "feet: '" + clipped(geomName(m, t)) + "' also touches the floor after standing but is not named: name "
+                 "every foot the robot stands on",
+           "robot.feet");
+}
+
+std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int floor, int root,
+                          const std::string& file, const DerivedRobot& r) {
+  std::vector<int> feet = touchingFeet(m, d, floor, root);
   if (!spec.feet.empty()) {
+    std::vector<int> named;
     for (const std::string& n : spec.feet) {
       const int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
-      if (g < 0) fail(file, "feet: no geom named '" + n + "'", "robot.feet");
-      feet.push_back(g);
+      if (g < 0) fail(file, "feet: no geom named '" + clipped(n) + "'", "robot.feet");
+      named.push_back(g);
     }
-  } else {  // the touching geoms; two of one body within kFootMergeM of each other are one foot (its lowest)
-    for (int i = 0; i < d->ncon; ++i) {
-      const mjContact& c = d->contact[i];
-      const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
-      if (other < 0 || c.dist > 1e-3) continue;
-      const auto same = std::find_if(feet.begin(), feet.end(), [&](int g) {
-        const double* a = d->geom_xpos + 3 * g;
-        const double* b = d->geom_xpos + 3 * other;
-        return g == other || (m->geom_bodyid[g] == m->geom_bodyid[other] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
-      });
-      if (same == feet.end()) feet.push_back(other);
-      else if (lowestZ(m, d, other) < lowestZ(m, d, *same)) *same = other;
-    }
+    if (named.size() < 3 || named.size() > 4)
+      fail(file, "feet: names " + std::to_string(named.size()) + " geoms; name the 3 or 4 feet the robot stands on",
+           "robot.feet");
+    checkNamedFeet(m, d, named, feet, file);
+    feet = named;
   }
   if (feet.size() < 3 || feet.size() > 4) {
     std::string names;
@@ -651,7 +718,7 @@ double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& s
                       const MassCentre& mc, const std::string& file, DerivedRobot& r) {
   const double* c = mc.c;
   const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
-  if (mount < 0) fail(file, "tail mount: no body named '" + spec.mount.body + "'", "tail.mount.body");
+  if (mount < 0) fail(file, "tail mount: no body named '" + clipped(spec.mount.body) + "'", "tail.mount.body");
   r.mount_body = mj_id2name(m, mjOBJ_BODY, mount) ? mj_id2name(m, mjOBJ_BODY, mount) : "";
   const double* Rm = d->xmat + 9 * mount;
   const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
@@ -852,7 +919,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   r.gravity_mps2 = -m->opt.gravity[2];
   if (!(r.gravity_mps2 > 0.0)) fail(file, "gravity must point down (-z) to stand the robot");
 
-  const int root = rootBody(m, file);
+  const int root = rootBody(m, spec, file);
   r.root_body = mj_id2name(m, mjOBJ_BODY, root) ? mj_id2name(m, mjOBJ_BODY, root) : "";
   const Stance stance = stanceOf(m, spec, file);
   r.stance = stance.words;
@@ -871,7 +938,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
 
   const int floor = mj_name2id(m, mjOBJ_GEOM, r.model.floor_geom.c_str());
   stand(m, d, spec, stance, hold, root, floor, file, r);
-  const std::vector<int> feet = findFeet(m, d, spec, floor, file, r);
+  const std::vector<int> feet = findFeet(m, d, spec, floor, root, file, r);
   const MassCentre mc = massProperties(m, d, root, r);
   const double asym = planarGeometry(m, d, spec, root, feet, mc, file, r);
   listValues(spec, footFriction(m, d, spec, feet, r), r);
