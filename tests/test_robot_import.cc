@@ -569,3 +569,27 @@ TEST(RobotImport, UrdfLegsOnTailsimsPdStayStableThroughTheStroke) {
   EXPECT_LT(c.articulated.max_tilt_deg, 5.0);
   EXPECT_EQ(c.articulated.feet_in_contact, 4);
 }
+
+// A stance angle outside the joint's range is an error naming the joint and its range (before, the
+// actuator's ctrlrange clamped it silently); a tail on a leg body is noted.
+TEST(RobotImport, StanceOutsideAJointsRangeIsAnErrorAndALegMountIsNoted) {
+  REQUIRE_MENAGERIE(dir);
+  RobotModelSpec s;
+  s.file = (dir / "go1" / "go1.xml").string();
+  s.joint_angles_rad = {{"FR_hip_joint", 300.0 * M_PI / 180.0}};
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a stance at 300 deg was taken";
+  } catch (const RobotImportError& e) {
+    EXPECT_EQ(e.key(), "robot.stance");
+    EXPECT_NE(std::string(e.what()).find("joint 'FR_hip_joint' at 300 deg is outside its range [-49.4463, 49.4463] deg"),
+              std::string::npos)
+        << e.what();
+  }
+  s.joint_angles_rad.clear();
+  s.mount.body = "FR_calf";
+  const DerivedRobot r = deriveRobot(s);
+  bool noted = false;
+  for (const std::string& n : r.notes) noted = noted || n.find("the tail is mounted on 'FR_calf'") != std::string::npos;
+  EXPECT_TRUE(noted);
+}

@@ -1,6 +1,7 @@
 // tailsim robot FILE [--keyframe K] [--joint NAME=DEG ...] [--feet A,B,C,D] [--mount-body B]
 //                    [--mount-pos X,Y,Z] [--mount-yaw-deg Y] [--mu MU]
 //                    [--compare [--tail-mass-frac F] [--tail-length-m L] [--links N] [--stroke-dps W]]
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -48,7 +49,11 @@ void addRobotOptions(CLI::App* cmd, RobotOptions& o) {
                   "--compare: the articulated robot's legs: servos (the model's actuators) or locked (joint equalities)")
       ->check(CLI::IsMember({"servos", "locked"}))
       ->capture_default_str();
-  cmd->add_option("--settle-s", o.settle_s, "standing time before measuring [s]")->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--settle-s", o.settle_s, "standing time before measuring [s]")
+      ->check(CLI::Validator([](std::string& v) {  // CLI::Range lets nan through
+        const double x = std::strtod(v.c_str(), nullptr);
+        return x >= 0.1 && x <= 10.0 ? std::string() : std::string("from 0.1 to 10 s");
+      }, "[0.1, 10]"));
   cmd->add_flag("--compare", o.compare,
                 "also run the four models with a tail: MuJoCo articulated, MuJoCo rigid box, perfoot, analytic");
   cmd->add_option("--write-robot", o.write_robot,

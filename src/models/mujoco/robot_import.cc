@@ -497,7 +497,15 @@ Stance stanceOf(const mjModel* m, const RobotModelSpec& spec, const std::string&
     const int j = mj_name2id(m, mjOBJ_JOINT, name.c_str());
     if (j < 0) fail(file, "stance: no joint named '" + clipped(name) + "'", "robot.stance");
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
-      fail(file, "stance: joint '" + name + "' is not a hinge or slide", "robot.stance");
+      fail(file, "stance: joint '" + clipped(name) + "' is not a hinge or slide", "robot.stance");
+    if (m->jnt_limited[j] && (angle < m->jnt_range[2 * j] || angle > m->jnt_range[2 * j + 1])) {
+      const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
+      auto shown = [&](double v) { return g6(hinge ? units::degrees(v) : v); };
+      fail(file, "stance: joint '" + clipped(name) + "' at " + shown(angle) + (hinge ? " deg" : " m") +
+                     " is outside its range [" + shown(m->jnt_range[2 * j]) + ", " + shown(m->jnt_range[2 * j + 1]) +
+                     "]" + (hinge ? " deg" : " m"),
+           "robot.stance");
+    }
     s.qpos[m->jnt_qposadr[j]] = angle;
   }
   if (!spec.joint_angles_rad.empty())
@@ -719,7 +727,19 @@ double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& s
   const double* c = mc.c;
   const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
   if (mount < 0) fail(file, "tail mount: no body named '" + clipped(spec.mount.body) + "'", "tail.mount.body");
+  if (m->body_rootid[mount] != root)
+    fail(file, "tail mount: body '" + clipped(spec.mount.body) + "' is not part of the robot (the tree of '" +
+                   clipped(mj_id2name(m, mjOBJ_BODY, root) ? mj_id2name(m, mjOBJ_BODY, root) : "?") + "')",
+         "tail.mount.body");
   r.mount_body = mj_id2name(m, mjOBJ_BODY, mount) ? mj_id2name(m, mjOBJ_BODY, mount) : "";
+  for (int b = mount; b != root; b = m->body_parentid[b])
+    if (m->body_jntnum[b] > 0) {
+      r.notes.push_back("the tail is mounted on '" + clipped(r.mount_body) + "', which a joint of body '" +
+                        clipped(mj_id2name(m, mjOBJ_BODY, b) ? mj_id2name(m, mjOBJ_BODY, b) : "?") +
+                        "' moves relative to the robot's root body: the planar frame and d_Q2B_m are taken in the "
+                        "stance, and the tail's base moves with that leg");
+      break;
+    }
   const double* Rm = d->xmat + 9 * mount;
   const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
   const double ex[2] = {std::cos(psi), std::sin(psi)}, ey[2] = {-std::sin(psi), std::cos(psi)};
