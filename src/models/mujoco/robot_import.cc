@@ -719,12 +719,9 @@ MassCentre massProperties(const mjModel* m, const mjData* d, int root, DerivedRo
   return mc;
 }
 
-// Stage: the planar frame (the mount body's x axis turned by the mount yaw, projected on the floor,
-// origin at the COM), the feet ordered FL, FR, RR, RL in it (3 feet: front to back), and the
-// quadruped's lengths. Returns the difference of the left and right foot spacings.
-double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int root, const std::vector<int>& feet,
-                      const MassCentre& mc, const std::string& file, DerivedRobot& r) {
-  const double* c = mc.c;
+// The tail mount's body: tail.mount.body, else the root; part of the robot's tree. A body that a
+// joint moves relative to the root is noted.
+int mountBody(const mjModel* m, const RobotModelSpec& spec, int root, const std::string& file, DerivedRobot& r) {
   const int mount = spec.mount.body.empty() ? root : mj_name2id(m, mjOBJ_BODY, spec.mount.body.c_str());
   if (mount < 0) fail(file, "tail mount: no body named '" + clipped(spec.mount.body) + "'", "tail.mount.body");
   if (m->body_rootid[mount] != root)
@@ -740,6 +737,37 @@ double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& s
                         "stance, and the tail's base moves with that leg");
       break;
     }
+  return mount;
+}
+
+// The feet's order in the planar frame (fp: their positions, (mx, my) their centroid): FL, FR, RR,
+// RL (front = x above the centroid, left = y above it), or 3 feet front to back.
+std::vector<int> footOrder(const std::vector<std::array<double, 2>>& fp, double mx, double my, const std::string& file) {
+  const int nf = static_cast<int>(fp.size());
+  std::vector<int> order(nf, -1);
+  if (nf == 4) {
+    for (int i = 0; i < 4; ++i) {
+      const bool front = fp[i][0] > mx, left = fp[i][1] > my;
+      const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
+      if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
+                                           std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
+                              "robot.feet");
+      order[slot] = i;
+    }
+  } else {
+    for (int i = 0; i < nf; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return fp[a][0] > fp[b][0]; });
+  }
+  return order;
+}
+
+// Stage: the planar frame (the mount body's x axis turned by the mount yaw, projected on the floor,
+// origin at the COM), the feet ordered FL, FR, RR, RL in it (3 feet: front to back), and the
+// quadruped's lengths. Returns the difference of the left and right foot spacings.
+double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& spec, int root, const std::vector<int>& feet,
+                      const MassCentre& mc, const std::string& file, DerivedRobot& r) {
+  const double* c = mc.c;
+  const int mount = mountBody(m, spec, root, file, r);
   const double* Rm = d->xmat + 9 * mount;
   const double psi = std::atan2(Rm[3], Rm[0]) + spec.mount.yaw_rad;
   const double ex[2] = {std::cos(psi), std::sin(psi)}, ey[2] = {-std::sin(psi), std::cos(psi)};
@@ -753,21 +781,7 @@ double planarGeometry(const mjModel* m, const mjData* d, const RobotModelSpec& s
   double mx = 0.0, my = 0.0;
   for (const auto& p : fp) mx += p[0] / nf, my += p[1] / nf;
   r.foot_count = nf;
-  std::vector<int> order(nf);
-  if (nf == 4) {  // FL, FR, RR, RL: front = x above the centroid, left = y above it.
-    std::fill(order.begin(), order.end(), -1);
-    for (int i = 0; i < 4; ++i) {
-      const bool front = fp[i][0] > mx, left = fp[i][1] > my;
-      const int slot = front ? (left ? 0 : 1) : (left ? 3 : 2);
-      if (order[slot] >= 0) fail(file, "the feet do not stand at the corners of a quadrilateral (two feet are " +
-                                           std::string(front ? "front " : "rear ") + (left ? "left" : "right") + ")",
-                              "robot.feet");
-      order[slot] = i;
-    }
-  } else {  // 3 feet: front to back
-    for (int i = 0; i < nf; ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return fp[a][0] > fp[b][0]; });
-  }
+  const std::vector<int> order = footOrder(fp, mx, my, file);
   for (int s = 0; s < nf; ++s) {
     const int g = feet[order[s]], b = m->geom_bodyid[g];
     r.feet.push_back(geomName(m, g));
