@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 

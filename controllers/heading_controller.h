@@ -16,7 +16,7 @@
 
 #include "settings/fields.h"
 #include "trajectory/split_cycle_profile.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 

@@ -36,7 +36,8 @@
 #include "models/perfoot/per_foot_model.h"
 #include "experiments/experiment_loader.h"
 #include "models/mujoco/mujoco_simulation.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
+#include "results/csv.h"
 #include "results/columns.h"
 
 using namespace tailsim;

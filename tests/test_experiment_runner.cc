@@ -19,7 +19,8 @@
 
 #include "experiments/accuracy_study.h"
 #include "experiments/experiment_runner.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
+#include "results/csv.h"
 #include "tailsim_version.h"
 
 using namespace tailsim;

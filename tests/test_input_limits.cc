@@ -15,7 +15,7 @@
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
 #include "experiments/yaml_file.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 namespace {

@@ -20,8 +20,8 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/sharding.h"
 #include "experiments/time_series_h5.h"
-#include "results/atomic_file.h"
-#include "results/sha256.h"
+#include "common/atomic_file.h"
+#include "common/sha256.h"
 #include "tailsim_version.h"
 
 using namespace tailsim;

@@ -313,7 +313,7 @@ TEST(MujocoSimulation, ImpulseAveragedContactLoadsIntegrateToTheMomentumChange) 
 
 // Contact fidelity figures (docs/mujoco-model.md "Contact fidelity"): airborne_fraction and
 // peak_normal_force_over_mg, checked against what the impulse-averaged foot columns imply, and the
-// warning above the limits of results/work_limits.h.
+// warning above the limits of common/work_limits.h.
 TEST(MujocoSimulation, ContactFidelityFiguresAndTheirWarning) {
   const RobotParams p = paperRobot(1);
   SplitCycleParams sp = fig6(-90.0);

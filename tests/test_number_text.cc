@@ -1,4 +1,4 @@
-// The CSV number text (src/results/number_text.h): formatG12 must write exactly what
+// The CSV number text (src/common/number_text.h): formatG12 must write exactly what
 // std::to_chars(..., general, 12) writes, for every double. Checked on random bit patterns over
 // the whole range, on the values a run writes, and on the places a fast path gets wrong: ties
 // and near-ties at the 12th digit, powers of ten and their neighbours, the fixed/scientific
@@ -13,7 +13,7 @@
 #include <random>
 #include <string>
 
-#include "results/number_text.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 namespace {

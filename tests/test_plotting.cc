@@ -23,7 +23,8 @@
 #include "plotting/report.h"
 #include "plotting/style.h"
 #include "plotting/sweep_summary.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
+#include "results/csv.h"
 #include "trajectory/split_cycle_profile.h"
 
 namespace fs = std::filesystem;

@@ -13,7 +13,7 @@
 #include "analytic_test_util.h"
 #include "random_cases.h"
 #include "models/mujoco/mujoco_simulation.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 namespace {

@@ -2,7 +2,7 @@
 // rely on it being the standard hash, stable across builds).
 #include <gtest/gtest.h>
 
-#include "results/sha256.h"
+#include "common/sha256.h"
 
 using namespace tailsim;
 

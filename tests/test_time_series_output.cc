@@ -20,7 +20,7 @@
 #include "experiments/model_registry.h"
 #include "experiments/time_series_h5.h"
 #include "plotting/result_folder.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 #include "results/columns.h"
 #include "results/thin_series.h"
 

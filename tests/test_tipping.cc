@@ -18,7 +18,7 @@
 #include "plotting/plots.h"
 #include "plotting/report.h"
 #include "plotting/result_folder.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -19,7 +19,7 @@
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/result_folder.h"
 #include "plotting/trust_report.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace fs = std::filesystem;
 using namespace tailsim;

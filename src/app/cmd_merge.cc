@@ -5,7 +5,7 @@
 
 #include "app/commands.h"
 #include "experiments/sharding.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 

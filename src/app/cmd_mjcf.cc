@@ -10,10 +10,10 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/robot_model_cases.h"
 #include "models/mujoco/mjcf_generator.h"
-#include "results/atomic_file.h"
-#include "results/number_text.h"
-#include "results/sha256.h"
-#include "results/work_limits.h"
+#include "common/atomic_file.h"
+#include "common/number_text.h"
+#include "common/sha256.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 

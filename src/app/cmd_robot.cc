@@ -11,9 +11,9 @@
 
 #include "app/commands.h"
 #include "experiments/robot_compare.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 #include "models/mujoco/robot_import.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -22,7 +22,7 @@
 #include "plotting/report.h"
 #include "plotting/result_folder.h"
 #include "plotting/result_page.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;

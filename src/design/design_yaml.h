@@ -17,7 +17,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/yaml_file.h"
-#include "results/number_text.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 namespace design_yaml {

@@ -15,9 +15,9 @@
 #include "experiments/render_case.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
-#include "results/atomic_file.h"
-#include "results/work_limits.h"
-#include "settings/units.h"
+#include "common/atomic_file.h"
+#include "common/work_limits.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -11,7 +11,7 @@
 #include "design/maneuver.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 namespace {

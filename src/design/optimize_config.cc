@@ -12,10 +12,10 @@
 #include "design/design_yaml.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "settings/optimize_section.h"
 #include "settings/trajectory_section.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

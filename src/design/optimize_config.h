@@ -12,7 +12,7 @@
 #include "design/stroke_family.h"
 #include "design/stroke_optimizer.h"
 #include "experiments/experiment_config.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 
@@ -36,7 +36,7 @@ struct OptimizeSpec {
   ObjectiveModel objective_model = ObjectiveModel::kAnalytic;
 };
 
-// Limits of the optimize section (documented in docs/design-a-tail-stroke.md; results/work_limits.h).
+// Limits of the optimize section (documented in docs/design-a-tail-stroke.md; common/work_limits.h).
 constexpr int kMaxKnots = limits::kMaxOptimizeKnots;
 constexpr int kMaxIslands = limits::kMaxOptimizeIslands;
 constexpr int kMaxPopulation = limits::kMaxOptimizePopulation;

@@ -20,8 +20,9 @@
 #include "experiments/folder_inputs.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "plotting/gnuplot.h"
-#include "results/atomic_file.h"
-#include "settings/units.h"
+#include "common/atomic_file.h"
+#include "results/csv.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "models/planar/tail_dynamics.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

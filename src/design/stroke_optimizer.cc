@@ -21,8 +21,8 @@
 #include "models/analytic/analytic_simulation.h"
 #include "models/perfoot/per_foot_model.h"
 #include "design/stiction_reach.h"
-#include "results/work_limits.h"
-#include "settings/units.h"
+#include "common/work_limits.h"
+#include "common/units.h"
 
 namespace tailsim {
 

@@ -9,8 +9,8 @@
 #include "models/analytic/analytic_simulation.h"
 #include "results/columns.h"
 #include "models/mujoco/mujoco_simulation.h"
-#include "results/atomic_file.h"
-#include "results/number_text.h"
+#include "common/atomic_file.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 namespace {

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;

@@ -10,7 +10,7 @@
 #include "experiments/folder_inputs.h"
 #include "experiments/run_job.h"
 #include "experiments/sharding.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;

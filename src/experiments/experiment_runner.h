@@ -44,7 +44,7 @@ struct RunOptions {
   std::function<bool()> should_stop;
 };
 
-// Throws std::invalid_argument unless 0 <= threads <= limits::kMaxThreads (results/work_limits.h).
+// Throws std::invalid_argument unless 0 <= threads <= limits::kMaxThreads (common/work_limits.h).
 void checkThreads(int threads);
 
 struct RunStats {

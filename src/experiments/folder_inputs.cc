@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "models/mujoco/robot_import.h"
-#include "results/sha256.h"
+#include "common/sha256.h"
 
 namespace tailsim {
 

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "experiments/experiment_runner.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;

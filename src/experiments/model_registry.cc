@@ -10,7 +10,7 @@
 #include "models/mujoco/mujoco_simulation.h"
 #include "experiments/work_estimate.h"
 #include "results/columns.h"
-#include "results/palette.h"
+#include "common/palette.h"
 
 namespace tailsim {
 

@@ -32,7 +32,7 @@ struct RunContext {
   MujocoSettleCache mujoco_settle;  // the MuJoCo pre-roll, once per distinct model and start pose
 };
 
-// A model's solver work in one case, and the limit on it (results/work_limits.h).
+// A model's solver work in one case, and the limit on it (common/work_limits.h).
 struct StepLimit {
   double steps = 0;  // estimated solver steps of one run (a lower bound)
   double limit = 0;  // at most this many (0: unbounded)

@@ -5,7 +5,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
 #include "models/mujoco/mjcf_generator.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 

@@ -27,7 +27,7 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/model_registry.h"
 #include "experiments/time_series_h5.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;

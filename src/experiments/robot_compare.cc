@@ -9,7 +9,7 @@
 #include "experiments/model_registry.h"
 #include "experiments/robot_model_cases.h"
 #include "experiments/yaml_file.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 #include <yaml-cpp/yaml.h>
 

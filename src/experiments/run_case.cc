@@ -29,9 +29,10 @@
 #include "models/analytic/analytic_simulation.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_simulation.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
+#include "results/csv.h"
 #include "results/columns.h"
-#include "results/sha256.h"
+#include "common/sha256.h"
 #include "results/thin_series.h"
 #include "tailsim_version.h"
 

@@ -33,8 +33,8 @@
 #include <nlohmann/json.hpp>
 
 #include "experiments/work_estimate.h"
-#include "results/atomic_file.h"
-#include "results/work_limits.h"
+#include "common/atomic_file.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 namespace fs = std::filesystem;

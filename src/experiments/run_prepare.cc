@@ -25,8 +25,8 @@
 #include "experiments/folder_inputs.h"
 #include "experiments/render_case.h"
 #include "experiments/settings_json.h"
-#include "results/atomic_file.h"
-#include "results/sha256.h"
+#include "common/atomic_file.h"
+#include "common/sha256.h"
 #include "tailsim_version.h"
 
 namespace tailsim {

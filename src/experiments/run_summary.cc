@@ -20,8 +20,8 @@
 #include <vector>
 #include <nlohmann/json.hpp>
 
-#include "results/atomic_file.h"
-#include "results/sha256.h"
+#include "common/atomic_file.h"
+#include "common/sha256.h"
 #include "tailsim_version.h"
 
 namespace tailsim {

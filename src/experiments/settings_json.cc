@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "models/mujoco/robot_import.h"
-#include "results/sha256.h"
+#include "common/sha256.h"
 #include "tailsim_version.h"
 
 namespace tailsim {

@@ -11,8 +11,8 @@
 #include "experiments/experiment_config.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/model_registry.h"
-#include "results/work_limits.h"
-#include "results/number_text.h"
+#include "common/work_limits.h"
+#include "common/number_text.h"
 #include "settings/optimize_section.h"
 #include "settings/trajectory_section.h"
 

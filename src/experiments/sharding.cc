@@ -17,8 +17,8 @@
 
 #include "experiments/experiment_runner.h"
 #include "experiments/robot_model_cases.h"
-#include "results/atomic_file.h"
-#include "results/sha256.h"
+#include "common/atomic_file.h"
+#include "common/sha256.h"
 
 #include <map>
 #include <nlohmann/json.hpp>

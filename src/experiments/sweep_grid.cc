@@ -11,9 +11,9 @@
 
 #include "experiments/model_registry.h"
 #include "experiments/work_estimate.h"
-#include "results/work_limits.h"
-#include "results/number_text.h"
-#include "settings/units.h"
+#include "common/work_limits.h"
+#include "common/number_text.h"
+#include "common/units.h"
 #include "settings/trajectory_section.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "results/number_text.h"
+#include "common/number_text.h"
 #include "experiments/trust_study.h"
 
 #include <algorithm>

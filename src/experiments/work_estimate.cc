@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <limits>
 
-#include "results/work_limits.h"
-#include "results/number_text.h"
-#include "settings/units.h"
+#include "common/work_limits.h"
+#include "common/number_text.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -1,6 +1,6 @@
 // The work a case asks for, estimated before it runs (docs/experiment-format.md "Limits"): the
 // one place that turns a case's settings into rows, CSV bytes, solver steps and video frames.
-// The loader refuses a case over a limit of results/work_limits.h with file:line:col.
+// The loader refuses a case over a limit of common/work_limits.h with file:line:col.
 #pragma once
 
 #include <string>

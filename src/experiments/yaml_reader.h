@@ -10,7 +10,7 @@
 
 #include "experiments/experiment_loader.h"
 #include "experiments/yaml_file.h"
-#include "results/number_text.h"
+#include "common/number_text.h"
 #include "settings/fields.h"
 
 #include <algorithm>

@@ -6,7 +6,7 @@
 
 #include "plotting/style.h"
 #include "plotting/sweep_summary.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 

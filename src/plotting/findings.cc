@@ -13,8 +13,8 @@
 #include "models/planar/system_loads.h"
 #include "results/columns.h"
 #include "experiments/model_registry.h"
-#include "results/number_text.h"
-#include "settings/units.h"
+#include "common/number_text.h"
+#include "common/units.h"
 
 namespace tailsim {
 

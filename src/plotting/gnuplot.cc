@@ -17,7 +17,7 @@
 #include <cstring>
 #include <stdexcept>
 
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 extern char** environ;
 

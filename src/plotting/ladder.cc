@@ -12,8 +12,8 @@
 #include "plotting/gnuplot.h"
 #include "plotting/result_folder.h"
 #include "plotting/style.h"
-#include "results/atomic_file.h"
-#include "results/number_text.h"
+#include "common/atomic_file.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 

@@ -10,12 +10,12 @@
 #include <stdexcept>
 
 #include "plotting/figure_sheet.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 #include "results/columns.h"
 #include "plotting/gnuplot.h"
 #include "plotting/style.h"
 #include "experiments/model_registry.h"
-#include "results/number_text.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 

@@ -10,8 +10,8 @@
 #include "plotting/figure_sheet.h"
 #include "plotting/style.h"
 #include "plotting/sweep_summary.h"
-#include "results/atomic_file.h"
-#include "results/number_text.h"
+#include "common/atomic_file.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 

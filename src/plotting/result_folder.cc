@@ -17,7 +17,8 @@
 #include "experiments/model_registry.h"
 #include "experiments/time_series_h5.h"
 #include "experiments/robot_model_cases.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
+#include "results/csv.h"
 
 namespace tailsim {
 

@@ -18,9 +18,9 @@
 #include "plotting/result_folder.h"
 #include "plotting/result_page_assets.h"
 #include "rendering/replay.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 #include "results/columns.h"
-#include "results/number_text.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 

@@ -11,7 +11,7 @@
 #include "experiments/model_registry.h"
 #include "plotting/gnuplot.h"
 #include "plotting/result_folder.h"
-#include "results/number_text.h"
+#include "common/number_text.h"
 
 namespace tailsim {
 

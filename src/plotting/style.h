@@ -10,11 +10,11 @@
 #include <vector>
 
 #include "plotting/result_folder.h"
-#include "results/palette.h"
+#include "common/palette.h"
 
 namespace tailsim {
 
-// ---- colours: the Okabe-Ito palette, results/palette.h (shared with the videos) -------------
+// ---- colours: the Okabe-Ito palette, common/palette.h (shared with the videos) -------------
 
 // Fixed colour per model in every plot: analytic blue, MuJoCo vermillion, others bluish green.
 std::string modelColor(const std::string& model);

@@ -1,4 +1,4 @@
-#include "results/number_text.h"
+#include "common/number_text.h"
 #include "plotting/trust_report.h"
 
 #include <algorithm>
@@ -12,7 +12,7 @@
 #include "experiments/verdict.h"
 #include "plotting/gnuplot.h"
 #include "plotting/style.h"
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 

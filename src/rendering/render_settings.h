@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "settings/fields.h"
 
 namespace tailsim {

@@ -2,7 +2,7 @@
 
 #include "models/mujoco/mjcf_generator.h"
 #include "results/columns.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 #include <mujoco/mujoco.h>
 

@@ -25,10 +25,10 @@
 #include "rendering/ffmpeg_writer.h"
 #include "rendering/gl_context.h"
 #include "rendering/replay.h"
-#include "results/palette.h"
-#include "results/work_limits.h"
-#include "results/number_text.h"
-#include "settings/units.h"
+#include "common/palette.h"
+#include "common/work_limits.h"
+#include "common/number_text.h"
+#include "common/units.h"
 
 namespace tailsim {
 
@@ -131,7 +131,7 @@ GhostShape ghostShape(const mjModel* m, mjData* d, const MujocoReplayLayout& L, 
   return g;
 }
 
-// Colours of the models, the same as in every plot (results/palette.h): MuJoCo vermillion (its
+// Colours of the models, the same as in every plot (common/palette.h): MuJoCo vermillion (its
 // own geoms, solid), analytic blue (an outline ghost).
 constexpr Rgb kMujocoRgb = rgbOf(kMujocoColor);
 constexpr Rgb kAnalyticRgb = rgbOf(kAnalyticColor);

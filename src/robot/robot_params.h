@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "settings/fields.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 

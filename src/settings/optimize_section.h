@@ -20,7 +20,7 @@
 #include <array>
 #include <string>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "settings/fields.h"
 
 namespace tailsim {

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "settings/fields.h"
 
 namespace tailsim {

@@ -12,7 +12,7 @@
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/experiment_runner.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace {
 void copyMessage(const char* what, char* err, size_t err_len) {

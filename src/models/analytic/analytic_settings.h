@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "settings/fields.h"
 
 namespace tailsim {
@@ -55,7 +55,7 @@ settings::For<S, AnalyticSettings> declareFields(V& v, S& s) {
            Limits::positive());
   v.choice(Field{"coupling", "paper: Eqs. (5)-(13) as printed; exact: planar multibody with the base moving"},
            s.coupling, kCouplings);
-  v.internal(Field{"max_steps", "step budget (results/work_limits.h); not a YAML key"}, s.max_steps);
+  v.internal(Field{"max_steps", "step budget (common/work_limits.h); not a YAML key"}, s.max_steps);
 }
 
 }  // namespace tailsim

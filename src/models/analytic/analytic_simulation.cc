@@ -18,8 +18,8 @@
 #include "models/planar/foot_loads.h"
 #include "models/planar/stick_slip_driver.h"
 #include "models/planar/support_check.h"
-#include "results/work_limits.h"
-#include "settings/units.h"
+#include "common/work_limits.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -14,7 +14,7 @@
 #include "results/columns.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/run_uncertainty.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "results/atomic_file.h"
+#include "common/atomic_file.h"
 
 namespace tailsim {
 

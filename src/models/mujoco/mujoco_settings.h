@@ -4,7 +4,7 @@
 #include <array>
 #include <string>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "settings/fields.h"
 
 namespace tailsim {
@@ -150,7 +150,7 @@ settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
   v.number(Field{"uncertainty_warn_share",
                  "warn when phi_net_uncertainty_deg exceeds this share of max(abs(phi_net), 0.5 deg)"},
            s.uncertainty_warn_share, Limits::positive());
-  v.internal(Field{"max_steps", "step budget (results/work_limits.h); not a YAML key"}, s.max_steps);
+  v.internal(Field{"max_steps", "step budget (common/work_limits.h); not a YAML key"}, s.max_steps);
 }
 
 }  // namespace tailsim

@@ -21,10 +21,10 @@
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_handles.h"
 #include "models/mujoco/run_uncertainty.h"
-#include "results/sha256.h"
-#include "results/work_limits.h"
+#include "common/sha256.h"
+#include "common/work_limits.h"
 #include "robot/friction_law.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 

@@ -13,7 +13,7 @@
 #include <set>
 #include <sstream>
 
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

@@ -11,7 +11,7 @@
 #include "models/planar/foot_loads.h"
 #include "results/output_settings.h"
 #include "results/time_series.h"
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 #include "robot/scene_effects.h"
 #include "settings/fields.h"
 
@@ -60,7 +60,7 @@ settings::For<S, PerFootSettings> declareFields(V& v, S& s) {
            s.normal_loads, kLoads);
   v.internal(Field{"initial_velocity", "body (vx, vy, phidot) at t = 0 [m/s, rad/s]; not a YAML key"},
              s.initial_velocity);
-  v.internal(Field{"max_steps", "step budget (results/work_limits.h); not a YAML key"}, s.max_steps);
+  v.internal(Field{"max_steps", "step budget (common/work_limits.h); not a YAML key"}, s.max_steps);
 }
 
 // Integrates from t = 0 (tail at rest at theta_0, body at rest) to the output duration, as

@@ -17,7 +17,7 @@
 #include "models/planar/support_check.h"
 #include "results/columns.h"
 #include "robot/friction_law.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 namespace {

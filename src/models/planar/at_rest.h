@@ -4,7 +4,7 @@
 #include <sstream>
 #include <string>
 
-#include "results/work_limits.h"
+#include "common/work_limits.h"
 
 namespace tailsim {
 

@@ -15,7 +15,7 @@
 #include "models/planar/stick_slip.h"
 #include "results/thin_series.h"
 #include "results/time_series.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 

@@ -14,7 +14,7 @@
 #include "models/planar/system_loads.h"
 #include "results/columns.h"
 #include "trajectory/split_cycle_profile.h"
-#include "settings/units.h"
+#include "common/units.h"
 
 namespace tailsim {
 

@@ -1,6 +1,6 @@
 // SHA-256 as specified in FIPS 180-4 (sections 4.1.2, 4.2.2, 5.1.1, 6.2); checked against the
 // standard's test vectors in tests/test_sha256.cc.
-#include "results/sha256.h"
+#include "common/sha256.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>

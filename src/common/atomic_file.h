@@ -6,7 +6,6 @@
 #include <optional>
 #include <string>
 
-#include "results/time_series.h"
 
 namespace tailsim {
 
@@ -87,12 +86,5 @@ void writeOwnedFile(const std::string& dir, const std::string& name, const std::
                     const EarlierOwnFile& earlier = {});
 // Records DIR/name's current content in the manifest (a file a program tailsim ran wrote).
 void recordWrittenFile(const std::string& dir, const std::string& name);
-
-// CSV with a header row of column names; numbers with 12 significant digits.
-std::string toCsv(const TimeSeries& ts);
-void writeCsvAtomic(const std::string& path, const TimeSeries& ts);
-
-// Reads a CSV written by toCsv back (for `tailsim plot`, reports and tests).
-TimeSeries readCsv(const std::string& path);
 
 }  // namespace tailsim
