@@ -125,6 +125,33 @@ TEST(Verdict, AGapIsAssignedToTheLadderStepBetweenTheModels) {
   EXPECT_NE(v.find("agree:"), std::string::npos) << v;
 }
 
+// A MuJoCo run of the user's robot from its model file (the articulated run: its summary has the
+// standing tilt figures) differs from the planar models by its legs, feet and contact, and a fall of
+// it is a fall, with its tilt from the stance quoted.
+TEST(Verdict, TheArticulatedRobotsGapAndFallAreNamedAsSuch) {
+  RunSummary art = standing("mujoco", 7.0, 0.1);
+  art.extra["stand_max_tilt_from_stance_deg"] = 0.3;
+  std::string v = caseVerdict({standing("analytic", 6.0), standing("perfoot", 6.01), art});
+  EXPECT_NE(v.find("per-foot - MuJoCo = -0.990 deg (14.1 %): the articulated robot"), std::string::npos) << v;
+  EXPECT_EQ(v.find("contact model (the ladder's contact step"), std::string::npos) << v;
+  RunSummary fell = art;
+  fell.ok = false;
+  fell.phi_net_deg = NAN;
+  fell.error = "the robot fell over: its body tilted 60 deg from its stance (limit 45 deg) during the stroke";
+  fell.extra["stroke_max_tilt_from_stance_deg"] = 60.0;
+  v = caseVerdict({standing("perfoot", 6.0), fell});
+  EXPECT_EQ(v.rfind("falls: MuJoCo falls", 0), 0u) << v;
+  RunSummary standingArt = art;
+  standingArt.extra["stroke_max_tilt_from_stance_deg"] = 3.25;
+  RunSummary tipped;
+  tipped.model = "perfoot";
+  tipped.ok = false;
+  tipped.phi_net_deg = NAN;
+  tipped.error = std::string(kPlanarTipText) + " (test)";
+  v = caseVerdict({tipped, standingArt});
+  EXPECT_NE(v.find("MuJoCo's largest tilt 3.25 deg"), std::string::npos) << v;
+}
+
 // The verdict quotes "+- U" only for an uncertainty the run estimated itself: the planar models
 // (which estimate none) and a MuJoCo run without its check run are quoted bare, and the verdict
 // says what each model was compared with (its own estimate, or the 0.5 % floor).

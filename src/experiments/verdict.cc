@@ -68,7 +68,11 @@ std::string toleranceNote(const std::vector<Entry>& e) {
 }
 
 // Which ladder step a gap between two adjacent models belongs to.
-const char* ladderStep(const std::string& a, const std::string& b) {
+// articulated: MuJoCo ran the user's robot from its model file (legs and all), not the rigid box.
+const char* ladderStep(const std::string& a, const std::string& b, bool articulated) {
+  if (a == "perfoot" && b == "mujoco" && articulated)
+    return "the articulated robot (MuJoCo ran the model file's robot: its legs on their servos, its feet, MuJoCo's "
+           "soft contact and the body's tilt, against the planar models' rigid body on Coulomb feet)";
   if (a == "analytic" && b == "perfoot")
     return "coupling and per-foot friction (the ladder's first steps: one friction moment for the whole body and "
            "the analytic coupling against Coulomb friction at each foot)";
@@ -110,13 +114,15 @@ std::string caseVerdict(const std::vector<RunSummary>& runs) {
   const Entry* mj = nullptr;
   for (const Entry& x : e)
     if (x.run->model == "mujoco") mj = &x;
+  const bool articulated = mj && mj->run->extra.count("stand_max_tilt_from_stance_deg");
   if (standing.empty()) return "fall: every model sees the robot fall (" + join(fallen) + ")";
   if (!fallen.empty()) {
     std::string s = "falls: " + join(fallen) + (fallen.size() == 1 ? " falls, " : " fall, ") + join(standing) +
                     (standing.size() == 1 ? " stands" : " stand");
     double tilt = std::numeric_limits<double>::quiet_NaN();
     if (mj)
-      if (const auto it = mj->run->extra.find("max_tilt_deg"); it != mj->run->extra.end()) tilt = it->second;
+      for (const char* key : {"max_tilt_deg", "stroke_max_tilt_from_stance_deg"})  // the rigid box's, the articulated run's
+        if (const auto it = mj->run->extra.find(key); it != mj->run->extra.end() && !std::isfinite(tilt)) tilt = it->second;
     if (mj && mj->fell) {
       s += ": dynamic load transfer (the tail's inertial loads rock the robot onto two feet and over while the "
            "planar models' support check, the system COM or the centre of pressure of a rigid body that cannot "
@@ -143,7 +149,7 @@ std::string caseVerdict(const std::vector<RunSummary>& runs) {
     const double d = a.run->phi_net_deg - b.run->phi_net_deg;
     gaps += std::string(gaps.empty() ? "" : "; ") + a.title + " - " + b.title + " = " + fmt("%+.3f", d) + " deg (" +
             fmt("%.1f", 100.0 * std::abs(d) / std::max(std::abs(b.run->phi_net_deg), kUncertaintyFloorDeg)) +
-            " %): " + ladderStep(a.run->model, b.run->model);
+            " %): " + ladderStep(a.run->model, b.run->model, articulated);
   }
   if (gaps.empty() && !agree(e.front(), e.back()))
     gaps = std::string(e.front().title) + " - " + e.back().title + " = " +
