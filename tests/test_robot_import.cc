@@ -593,3 +593,15 @@ TEST(RobotImport, StanceOutsideAJointsRangeIsAnErrorAndALegMountIsNoted) {
   for (const std::string& n : r.notes) noted = noted || n.find("the tail is mounted on 'FR_calf'") != std::string::npos;
   EXPECT_TRUE(noted);
 }
+
+// A model path that is there but not a regular file is named as such, not "not found".
+TEST(RobotImport, ADeviceAsTheModelFileIsNotARegularFile) {
+  RobotModelSpec s;
+  s.file = "/dev/zero";
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "/dev/zero was taken as a model file";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/zero: the model file is not a regular file"), std::string::npos) << e.what();
+  }
+}

@@ -408,17 +408,19 @@ void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLEleme
 
 }  // namespace
 
-// The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
-// joint names, floor, print.
 bool isPositionServo(const mjModel* m, int a) {
   return m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_biastype[a] == mjBIAS_AFFINE &&
          m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
 }
 
+// The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
+// joint names, floor, print.
 PreparedModel prepareRobotModel(const std::string& file_in) {
   PreparedModel out;
   out.source = fs::absolute(file_in).lexically_normal().string();
   const std::string& file = out.source;
+  std::error_code ec;
+  if (fs::exists(file, ec) && !isFile(file)) fail(file, "the model file is not a regular file (a folder, a device or a FIFO)");
   if (!isFile(file)) fail(file, "model file not found");
   XMLDocument doc;
   XMLElement* root = loadModelXml(doc, file, out);
