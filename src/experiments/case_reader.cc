@@ -73,7 +73,9 @@ CaseRobot readRobotSource(Loader& L, const Reader& r, const MapView& top, const 
     readRobotModel(r, robotItem, source, c);
     for (const char* k : {"quadruped", "friction", "gravity_mps2"})
       if (const Item* x = top.get(k))
-        r.fail(*x, "not used with robot: {mjcf: ...}: derived from the model file (robot.mu sets the friction)");
+        r.fail(*x, std::string("not used with robot: {mjcf: ...}: derived from the model file") +
+                       (std::string(k) == "friction" ? " (robot.mu sets the friction)"
+                        : std::string(k) == "gravity_mps2" ? " (the model's <option gravity>)" : ""));
   } else {
     const std::string robotRel = r.string(robotItem);
     if (robotRel.empty()) r.fail(robotItem, "needs a built-in robot name (paper) or the path of a robot file");
