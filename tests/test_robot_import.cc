@@ -605,3 +605,24 @@ TEST(RobotImport, ADeviceAsTheModelFileIsNotARegularFile) {
     EXPECT_NE(std::string(e.what()).find("/dev/zero: the model file is not a regular file"), std::string::npos) << e.what();
   }
 }
+
+// A URDF whose collision mesh is missing: tailsim's error naming the link and the file (before,
+// MuJoCo's own "could not open STL file" from inside its URDF reader).
+TEST(RobotImport, UrdfCollisionMeshMissingNamesTheLinkAndFile) {
+  Scratch t("robot_import");
+  RobotModelSpec s;
+  s.file = t.write("bot.urdf", R"(<robot name="bot"><link name="base"><inertial><mass value="10"/>
+<inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
+<collision><geometry><mesh filename="package://bot/meshes/shell.stl"/></geometry></collision></link></robot>
+)");
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a URDF with a missing collision mesh was read";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("1 colliding geom has a missing mesh file: a collision of link 'base': its mesh "
+                                         "package://bot/meshes/shell.stl is missing (looked for " +
+                                         (t.dir / "shell.stl").string() + ")"),
+              std::string::npos)
+        << e.what();
+  }
+}

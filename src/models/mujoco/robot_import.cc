@@ -167,6 +167,31 @@ class TempFile {
 // gets the free joint a standing robot needs (unless the URDF gives it one, a floating joint from a
 // link with nothing else). Visual elements are discarded (the reader's default); mesh and texture
 // folders are made absolute, the text being read from /tmp.
+// A URDF's collision meshes are files MuJoCo's reader looks for in meshdir by their file name (it
+// strips the path, package:// included); one that is missing is the same error as an MJCF's
+// colliding geom without its mesh, naming the link and the file, before MuJoCo reads the URDF.
+void missingUrdfCollisionMeshes(const XMLElement* robot, const char* meshdir, const std::string& file) {
+  std::vector<std::string> missing;
+  for (const XMLElement* link = robot->FirstChildElement("link"); link; link = link->NextSiblingElement("link"))
+    for (const XMLElement* c = link->FirstChildElement("collision"); c; c = c->NextSiblingElement("collision")) {
+      const XMLElement* g = c->FirstChildElement("geometry");
+      const XMLElement* mesh = g ? g->FirstChildElement("mesh") : nullptr;
+      const char* f = mesh ? mesh->Attribute("filename") : nullptr;
+      if (!f) continue;
+      const fs::path p = fs::path(meshdir ? meshdir : "") / fs::path(f).filename();
+      if (!isFile(p))
+        missing.push_back("a collision of link '" + clipped(link->Attribute("name") ? link->Attribute("name") : "?") +
+                          "': its mesh " + clipped(f) + " is missing (looked for " + p.string() + ")");
+    }
+  if (missing.empty()) return;
+  std::string msg = std::to_string(missing.size()) + " colliding geom" + (missing.size() > 1 ? "s have" : " has") +
+                    " a missing mesh file: ";
+  for (std::size_t i = 0; i < missing.size() && i < 5; ++i) msg += (i ? "; " : "") + missing[i];
+  if (missing.size() > 5) msg += "; and " + std::to_string(missing.size() - 5) + " more";
+  fail(file, msg + ". Supply the mesh files (meshdir " + std::string(meshdir ? meshdir : "") +
+                 "), or remove those <collision> elements");
+}
+
 std::string urdfToMjcf(const std::string& file) {
   XMLDocument urdf;
   loadXmlFile(urdf, file);
@@ -190,6 +215,7 @@ std::string urdfToMjcf(const std::string& file) {
     if (a.empty() || a.back() != '/') a += "/";
     compiler->SetAttribute(attr, a.c_str());
   }
+  missingUrdfCollisionMeshes(robot, compiler->Attribute("meshdir"), file);
   TempFile in("urdf", ".urdf", file);
   if (urdf.SaveFile(in.path().c_str()) != tinyxml2::XML_SUCCESS) fail(file, "cannot write a temporary copy of the URDF");
 
