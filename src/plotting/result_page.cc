@@ -158,6 +158,12 @@ class GeometryCache {
  public:
   std::string of(const ExperimentResults& r, const ExperimentCase* c, std::vector<std::string>* notes) {
     if (!c) return "null";
+    if (c->robot_model) {
+      const std::string why = "the 3D replay of " + r.name + " draws the rigid box of the robot's derived parameters; "
+                              "its MuJoCo run was the model file's own robot (articulated: legs, feet, servos), "
+                              "which the replay does not draw";
+      if (std::find(notes->begin(), notes->end(), why) == notes->end()) notes->push_back(why);
+    }
     std::string xml;
     try {
       xml = generateMjcf(c->robot, c->mujoco, c->effects);

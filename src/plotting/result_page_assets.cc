@@ -216,6 +216,12 @@ const char* const kResultPageJs = R"JS('use strict';
       if (exp.axes.length > 2) $('mapnote').textContent = 'Other swept keys at their first value.';
     } else {
       const a = grid.x, xs = a.numbers;
+      lo = Infinity; hi = -Infinity;  // every model is drawn: the range of them all
+      exp.models.forEach((m) => exp.cases.runs[m.name].phi_net_deg.forEach((v) => {
+        if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+      }));
+      if (!(hi >= lo)) { lo = 0; hi = 1; }
+      if (hi === lo) hi = lo + 1;
       let xl = Math.min.apply(null, xs), xh = Math.max.apply(null, xs); if (xh === xl) xh = xl + 1;
       const X = (x) => MAP.x0 + (x - xl) / (xh - xl) * W, Y = (v) => MAP.y1 - (v - lo) / (hi - lo) * H;
       g.strokeStyle = '#888'; g.strokeRect(MAP.x0, MAP.y0, W, H);
@@ -278,6 +284,12 @@ const char* const kResultPageJs = R"JS('use strict';
       if (ix >= 0 && ix < grid.nx && iy >= 0 && iy < grid.ny) k = grid.cell[iy * grid.nx + ix];
     } else {
       const a = grid.x, xs = a.numbers;
+      lo = Infinity; hi = -Infinity;  // every model is drawn: the range of them all
+      exp.models.forEach((m) => exp.cases.runs[m.name].phi_net_deg.forEach((v) => {
+        if (v !== null) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+      }));
+      if (!(hi >= lo)) { lo = 0; hi = 1; }
+      if (hi === lo) hi = lo + 1;
       let xl = Math.min.apply(null, xs), xh = Math.max.apply(null, xs); if (xh === xl) xh = xl + 1;
       let best = 15;
       for (let c = 0; c < exp.cases.name.length; ++c) {
