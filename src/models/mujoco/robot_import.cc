@@ -644,6 +644,13 @@ std::string geomName(const mjModel* m, int g) {
 // Stage: the feet: the named geoms, or the robot's geoms touching the floor (a foot body's geoms within
 // kFootMergeM of each other count once, its lowest); 3 or 4 of them.
 constexpr double kFootMergeM = 0.05;  // [m] horizontal, between geom centres
+// Geoms g and h are one foot: the same geom, or two of one body within kFootMergeM of each other.
+bool sameFoot(const mjModel* m, const mjData* d, int g, int h) {
+  const double* a = d->geom_xpos + 3 * g;
+  const double* b = d->geom_xpos + 3 * h;
+  return g == h || (m->geom_bodyid[g] == m->geom_bodyid[h] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
+}
+
 // The robot's (root's tree's) geoms touching the floor after standing, a foot body's geoms within
 // kFootMergeM of each other as one (its lowest).
 std::vector<int> touchingFeet(const mjModel* m, const mjData* d, int floor, int root) {
@@ -652,11 +659,7 @@ std::vector<int> touchingFeet(const mjModel* m, const mjData* d, int floor, int 
     const mjContact& c = d->contact[i];
     const int other = c.geom1 == floor ? c.geom2 : c.geom2 == floor ? c.geom1 : -1;
     if (other < 0 || c.dist > 1e-3 || m->body_rootid[m->geom_bodyid[other]] != root) continue;
-    const auto same = std::find_if(feet.begin(), feet.end(), [&](int g) {
-      const double* a = d->geom_xpos + 3 * g;
-      const double* b = d->geom_xpos + 3 * other;
-      return g == other || (m->geom_bodyid[g] == m->geom_bodyid[other] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
-    });
+    const auto same = std::find_if(feet.begin(), feet.end(), [&](int g) { return sameFoot(m, d, g, other); });
     if (same == feet.end()) feet.push_back(other);
     else if (lowestZ(m, d, other) < lowestZ(m, d, *same)) *same = other;
   }
@@ -667,18 +670,13 @@ std::vector<int> touchingFeet(const mjModel* m, const mjData* d, int floor, int 
 // within kFootMergeM of a named foot on its body counts as that foot).
 void checkNamedFeet(const mjModel* m, const mjData* d, const std::vector<int>& named, const std::vector<int>& touching,
                     const std::string& file) {
-  auto sameFoot = [&](int g, int h) {
-    const double* a = d->geom_xpos + 3 * g;
-    const double* b = d->geom_xpos + 3 * h;
-    return g == h || (m->geom_bodyid[g] == m->geom_bodyid[h] && std::hypot(a[0] - b[0], a[1] - b[1]) < kFootMergeM);
-  };
   for (int g : named)
-    if (std::none_of(touching.begin(), touching.end(), [&](int t) { return sameFoot(g, t); }))
+    if (std::none_of(touching.begin(), touching.end(), [&](int t) { return sameFoot(m, d, g, t); }))
       fail(file, "feet: '" + clipped(geomName(m, g)) + "' does not touch the floor after standing: name the geoms the robot "
                  "stands on (or leave feet: out to take the touching ones)",
            "robot.feet");
   for (int t : touching)
-    if (std::none_of(named.begin(), named.end(), [&](int g) { return sameFoot(g, t); }))
+    if (std::none_of(named.begin(), named.end(), [&](int g) { return sameFoot(m, d, g, t); }))
       fail(file, "feet: '" + clipped(geomName(m, t)) + "' also touches the floor after standing but is not named: name "
                  "every foot the robot stands on",
            "robot.feet");
