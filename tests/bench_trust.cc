@@ -76,6 +76,7 @@ void today(const RobotParams&, const TailTrajectory&, MujocoSettings& s) {
   s.foot_radius_m = 0.01;
   s.settle_s = 0.1;
   s.uncertainty = false;
+  s.rest_step_factor = 1;
 }
 
 // Finer step with the servo's natural frequency kept.
@@ -99,6 +100,10 @@ std::map<std::string, Rule> rules() {
   std::map<std::string, Rule> m;
   m["today"] = today;
   m["default"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings&) {};  // MujocoSettings' defaults
+  for (int f : {1, 2, 10})  // the defaults with another step once the body rests
+    m["default_rest" + std::to_string(f)] = [f](const RobotParams&, const TailTrajectory&, MujocoSettings& s) {
+      s.rest_step_factor = f;
+    };
   m["imp100"] = [](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
     today(r, t, s);
     s.impratio = 100.0;
@@ -192,8 +197,9 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
     out.phi_deg = res.summary.phi_net_deg;
     out.wall_s = res.summary.wall_time_s;
     out.steps = res.summary.solver_steps + static_cast<long>(std::lround(s.settle_s / s.timestep_s));
+    // The check run starts where the run's pre-roll ended: its steps are all after t = 0.
     if (const auto u = res.summary.extra.find("uncertainty_solver_steps"); u != res.summary.extra.end())
-      out.steps += static_cast<long>(u->second) + static_cast<long>(std::lround(s.settle_s / (2 * s.timestep_s)));
+      out.steps += static_cast<long>(u->second);
     auto x = [&](const char* k) {
       const auto it = res.summary.extra.find(k);
       return it == res.summary.extra.end() ? NAN : it->second;

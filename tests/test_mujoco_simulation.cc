@@ -400,3 +400,62 @@ TEST(MujocoSimulation, RandomRobotsKeepAFootLoaded) {
     EXPECT_LT(r.summary.extra.at("peak_normal_force_over_mg"), 3.0) << k << ": " << tailsim::testing::describe(c);
   }
 }
+
+// The step schedule (docs/mujoco-model.md "Step schedule"): once the tail has stopped and the
+// body rests, the run steps at rest_step_factor * timestep_s. Nothing moves there, so every output
+// is what the fine step gives, on the same rows, for far fewer steps; where the coarse step does
+// not divide the output spacing, the schedule stays fine.
+TEST(MujocoSimulation, ARestingBodyStepsCoarserWithTheSameAnswer) {
+  const RobotParams p = paperRobot(1);
+  const TailTrajectory traj = sameForAllJoints(1, fig6(-90));
+  MujocoSettings fine;
+  fine.uncertainty = false;
+  fine.rest_step_factor = 1;
+  MujocoSettings coarse = fine;
+  coarse.rest_step_factor = 5;
+  const RunResult a = simulateMujoco(p, traj, fine, Effects{}, {});
+  const RunResult b = simulateMujoco(p, traj, coarse, Effects{}, {});
+  expectCleanRun(a);
+  expectCleanRun(b);
+  EXPECT_TRUE(b.summary.at_rest);
+  // The stroke ends at 0.25 s, the run at 0.75 s: most of the last 0.5 s rests at 5 x the step.
+  EXPECT_LT(b.summary.solver_steps, 0.7 * a.summary.solver_steps)
+      << a.summary.solver_steps << " -> " << b.summary.solver_steps;
+  EXPECT_NEAR(b.summary.phi_net_deg, a.summary.phi_net_deg, 1e-6);
+  ASSERT_EQ(a.series.names(), b.series.names());
+  for (const std::string& name : a.series.names()) {
+    const std::vector<double>& x = a.series.values(name);
+    const std::vector<double>& y = b.series.values(name);
+    ASSERT_EQ(x.size(), y.size()) << name;
+    double scale = 1e-9, diff = 0.0;
+    for (size_t k = 0; k < x.size(); ++k) {
+      scale = std::max(scale, std::abs(x[k]));
+      diff = std::max(diff, std::abs(x[k] - y[k]));
+    }
+    if (name == "t_s") EXPECT_EQ(diff, 0.0);
+    EXPECT_LE(diff, 1e-4 * scale) << name;
+  }
+  // A spacing of 0.3 ms is no multiple of the 0.5 ms rest step: every step stays at timestep_s.
+  OutputSettings odd;
+  odd.sample_dt_s = 3e-4;
+  const RunResult c = simulateMujoco(p, traj, fine, Effects{}, odd);
+  const RunResult d = simulateMujoco(p, traj, coarse, Effects{}, odd);
+  EXPECT_EQ(c.summary.solver_steps, d.summary.solver_steps);
+  EXPECT_EQ(c.summary.phi_net_deg, d.summary.phi_net_deg);
+}
+
+// The check run at twice the step begins where the run's pre-roll ended and stops once the body
+// rests after the stroke: it costs the stroke's steps at 2 h, not the whole run's again.
+TEST(MujocoSimulation, TheCheckRunStopsOnceTheBodyRests) {
+  MujocoSettings s;
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  const RunResult r = simulateMujoco(paperRobot(1), sameForAllJoints(1, fig6(-90)), s, Effects{}, o);
+  ASSERT_TRUE(r.summary.ok) << r.summary.error;
+  const double run_s = 0.25 + o.settle_s;  // the stroke's end + settle_s
+  const double check_steps = r.summary.extra.at("uncertainty_solver_steps");
+  EXPECT_LT(check_steps, 0.7 * run_s / (2.0 * s.timestep_s)) << check_steps;
+  EXPECT_GT(check_steps, 0.25 / (2.0 * s.timestep_s));  // at least the stroke
+  EXPECT_NEAR(r.summary.extra.at("phi_net_check_deg"), r.summary.phi_net_deg,
+              r.summary.extra.at("phi_net_uncertainty_deg"));
+}

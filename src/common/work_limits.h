@@ -63,6 +63,13 @@ constexpr double kMaxMassKg = 1e4;
 // Run-end checks (RunSummary::at_rest and warnings).
 constexpr double kAtRestPhidotDps = 0.1;        // |phi_dot| at the end below this: at rest  [deg/s]
 constexpr double kAtRestSpeedMps = 1e-3;        // body speed at the end below this: at rest  [m/s]
+// MuJoCo's step schedule (docs/mujoco-model.md "Step schedule"): after the tail's motion ends, the
+// body counts as resting once every speed below stays under these for kRestHoldS; the run then
+// steps at mujoco.rest_step_factor times timestep_s, and the check run stops there.
+constexpr double kRestAngularRadps = 1e-4;  // quadruped body |angular velocity|  [rad/s]
+constexpr double kRestSpeedMps = 1e-5;      // quadruped body |linear velocity|  [m/s]
+constexpr double kRestJointRadps = 1e-3;    // every tail joint |theta_dot|  [rad/s]
+constexpr double kRestHoldS = 0.02;         // [s]
 constexpr double kMaxPaperSpuriousTurnDeg = 10.0;  // paper coupling: turn its momentum error alone causes  [deg]
 constexpr double kMaxTrackingErrorDeg = 1.0;       // MuJoCo: max servo tracking error above this warns  [deg]
 // A tail joint's peak speed above this warns (every model): 100 turns a second, beyond any tail

@@ -82,6 +82,10 @@ struct MujocoSettings {
   MujocoFootShape foot_shape = MujocoFootShape::kSphere;  // contact geometry of the feet (see the enum)
   double foot_half_length_m = 0.01;     // capsule feet: half-length of the cylinder along body x  [m]
   double settle_s = 0.1;                // pre-roll with the tail held at theta(0) so the feet settle; then t = 0  [s]
+  // Once the tail's motion has ended and the body rests (common/work_limits.h kRest*), the run
+  // steps at rest_step_factor * timestep_s: nothing moves, so the finer step buys nothing there
+  // (docs/mujoco-model.md "Step schedule"). 1 = every step at timestep_s.
+  int rest_step_factor = 5;
   double stop_phidot_radps = 1e-3;      // t_stop: |phi_dot| below this from then on  [rad/s]
   // Tipping over (docs/mujoco-model.md "Tipping over"): with gravity and ground contact on, the run
   // fails when the quadruped body tilts beyond max_tilt_deg (angle between its z axis and the
@@ -92,7 +96,8 @@ struct MujocoSettings {
   double max_all_feet_off_s = 0.1;      // [s]
   // The run's own error estimate (docs/mujoco-model.md "Uncertainty of a run"): a second run at
   // twice the timestep (servo w_n kept) gives phi_net_uncertainty_deg = 2 |phi_h - phi_2h| + 0.5 %
-  // of max(|phi_net|, 0.5 deg); it costs half the run's steps again. A result whose uncertainty
+  // of max(|phi_net|, 0.5 deg); it starts where the run's pre-roll ended and stops once the body rests
+  // after the stroke (the stroke's steps at 2 h). A result whose uncertainty
   // exceeds uncertainty_warn_share of max(|phi_net|, 0.5 deg) carries a warning.
   bool uncertainty = true;
   double uncertainty_warn_share = 0.1;  // [1]
@@ -140,6 +145,9 @@ settings::For<S, MujocoSettings> declareFields(V& v, S& s) {
            s.foot_half_length_m, Limits::positive());
   v.number(Field{"settle_s", "pre-roll with the tail held at theta(0) so the feet settle [s]"}, s.settle_s,
            Limits::nonNegative());
+  v.integer(Field{"rest_step_factor",
+                  "after the tail stops, once the body rests, step at this multiple of timestep_s; 1 = never"},
+            s.rest_step_factor, Limits::closed(1, 16));
   v.number(Field{"stop_phidot_radps", "t_stop: |phi_dot| below this from then on [rad/s]"}, s.stop_phidot_radps,
            Limits::positive());
   v.number(Field{"max_tilt_deg", "tipping over: largest body tilt; 0 = off [deg]"}, s.max_tilt_deg,

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -224,13 +225,13 @@ class ImpulseAverager {
   ImpulseAverager(double sample_dt, double h, long rows, const Columns& c, TimeSeries& ts)
       : dt_(sample_dt), h_(h), rows_(rows), c_(c), ts_(ts) {}
   void addRow(long k, const std::vector<double>& row) { pending_.push_back({k, row}); }
-  // The loads of the step that starts at t_step.
-  void addStep(double t_step, const Loads& loads) {
+  // The loads of the step of length h_step that starts at t_step.
+  void addStep(double t_step, double h_step, const Loads& loads) {
     const long k = std::clamp(static_cast<long>(std::floor((t_step + 1e-6 * h_) / dt_ + 0.5)), 0L, rows_ - 1);
     if (k != bucket_) flushBucket();
     bucket_ = k;
-    for (int j = 0; j < kNumLoads; ++j) sum_[j] += loads[j] * h_;
-    time_ += h_;
+    for (int j = 0; j < kNumLoads; ++j) sum_[j] += loads[j] * h_step;
+    time_ += h_step;
   }
   // At the end of the run: the last interval, every row still waiting.
   void finish() {
@@ -290,8 +291,10 @@ class StandingMonitor {
         max_tilt_deg_(s.max_tilt_deg),
         max_off_s_(s.max_all_feet_off_s) {}
 
-  // Returns false (and why()) once the robot has fallen. t_s: time of the state, for the message.
-  bool update(const mjData* d, double t_s) {
+  // Returns false (and why()) once the robot has fallen. t_s: time of the state, for the message;
+  // h_step: the step taken from it (a whole multiple of timestep_s, counted as that many steps).
+  bool update(const mjData* d, double t_s, double h_step) {
+    const long units = std::max(1L, std::lround(h_step / h_));
     const double cz = d->xmat[9 * body_ + 8];  // cos(tilt) = body z axis . world z
     min_cos_ = std::min(min_cos_, cz);
     const double dz = d->xpos[3 * body_ + 2] - z_ref_;
@@ -304,11 +307,11 @@ class StandingMonitor {
       if (pyramid_rows_)  // pyramidal: the normal force is the sum of the (>= 0) edge forces
         for (int r = 1; r < 2 * (d->contact[i].dim - 1) && !loaded; ++r) loaded = d->efc_force[a + r] > 0.0;
     }
-    off_steps_ = loaded ? 0 : off_steps_ + 1;
+    off_steps_ = loaded ? 0 : off_steps_ + units;
     longest_off_steps_ = std::max(longest_off_steps_, off_steps_);
     if (t_s >= 0.0) {  // the run proper (the pre-roll has t < 0): airborne steps
-      ++run_steps_;
-      if (!loaded) ++airborne_steps_;
+      run_steps_ += units;
+      if (!loaded) airborne_steps_ += units;
     }
     if (!enforce_ || !why_.empty()) return why_.empty();
     std::ostringstream os;
@@ -334,7 +337,8 @@ class StandingMonitor {
     extra["longest_all_feet_off_s"] = longest_off_steps_ * h_;
     extra["airborne_fraction"] = airborneFraction();
   }
-  // Share of the run's steps (t >= 0, the pre-roll excluded) in which no foot carried load.
+  // Share of the run's steps (t >= 0, the pre-roll excluded; a step of k timestep_s counts k times)
+  // in which no foot carried load.
   double airborneFraction() const {
     return run_steps_ > 0 ? static_cast<double>(airborne_steps_) / static_cast<double>(run_steps_) : 0.0;
   }
@@ -528,19 +532,87 @@ MujocoPlan planMujocoRun(const RobotParams& robot, const TailTrajectory& traject
   return {duration, static_cast<long>(rows)};
 }
 
+// Whether every speed of the state is below the rest thresholds (common/work_limits.h kRest*):
+// the quadruped's free, ball and slide joints by their linear and angular parts, the tail's hinges.
+bool speedsAtRest(const mjModel* m, const mjData* d) {
+  for (int j = 0; j < m->njnt; ++j) {
+    const mjtNum* v = d->qvel + m->jnt_dofadr[j];
+    auto below = [](const mjtNum* x, int n, double lim) {
+      double s = 0.0;
+      for (int i = 0; i < n; ++i) s += x[i] * x[i];
+      return s < lim * lim;
+    };
+    switch (m->jnt_type[j]) {
+      case mjJNT_FREE:
+        if (!below(v, 3, limits::kRestSpeedMps) || !below(v + 3, 3, limits::kRestAngularRadps)) return false;
+        break;
+      case mjJNT_BALL:
+        if (!below(v, 3, limits::kRestAngularRadps)) return false;
+        break;
+      case mjJNT_SLIDE:
+        if (!below(v, 1, limits::kRestSpeedMps)) return false;
+        break;
+      default:
+        if (!below(v, 1, limits::kRestJointRadps)) return false;
+    }
+  }
+  return true;
+}
+
+// The step schedule (docs/mujoco-model.md "Step schedule"): timestep_s h until the tail's motion has
+// ended and every speed has stayed at rest for kRestHoldS, then H = rest_step_factor h, back to h
+// the step anything moves again. A coarse step starts only on a multiple of H and ends within the
+// run, and only where H divides the output spacing, so that every row stays on its grid.
+class StepSchedule {
+ public:
+  StepSchedule(double h, int factor, double tail_end_s, double duration_s, double sample_dt_s, bool allowed)
+      : h_(h), H_(h * factor), tail_end_(tail_end_s), end_(duration_s) {
+    const double per_row = sample_dt_s / H_;
+    allowed_ = allowed && factor > 1 && per_row >= 1.0 - 1e-9 &&
+               std::abs(per_row - std::round(per_row)) < 1e-9 * per_row;
+  }
+  // After the step that ended at t: whether the state rests, and the length of the next step.
+  double next(double t, bool speeds_at_rest) {
+    if (!(t >= tail_end_ - 1e-6 * h_) || !speeds_at_rest) {
+      rest_since_ = -1.0;
+      return h_;
+    }
+    if (rest_since_ < 0.0) rest_since_ = t;
+    if (!rested(t) || !allowed_) return h_;
+    const bool on_grid = std::abs(t / H_ - std::round(t / H_)) < 1e-6;
+    return on_grid && t + H_ <= end_ + 1e-6 * h_ ? H_ : h_;
+  }
+  // The body has rested for kRestHoldS after the tail's motion.
+  bool rested(double t) const { return rest_since_ >= 0.0 && t - rest_since_ >= limits::kRestHoldS - 1e-6 * h_; }
+
+ private:
+  double h_, H_, tail_end_, end_;
+  bool allowed_ = false;
+  double rest_since_ = -1.0;
+};
+
 // One MuJoCo run, in named stages in the manner of mj_forward: build (the constructor: MJCF,
 // model, data, columns, start pose), settle (the pre-roll or its cached end state), stepLoop (the
 // steps, with the output rows sampled on the grid as it passes, sampleRows), judge (the summary
 // and the warnings of a doubtful result). The stages share the run's state below.
 class MujocoRun {
  public:
+  // How a run starts and ends besides its settings: `start`, a settled state to begin from instead
+  // of a pre-roll (the check run begins where its run's pre-roll ended); `stop_at_rest`, end once the
+  // body rests after the tail's motion (only phi_net is wanted).
+  struct Options {
+    const SettledState* start = nullptr;
+    bool stop_at_rest = false;
+  };
+
   MujocoRun(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
-            const Effects& effects, const OutputSettings& output, const MujocoPlan& plan)
+            const Effects& effects, const OutputSettings& output, const MujocoPlan& plan, const Options& options)
       : robot_(robot),
         settings_(settings),
         effects_(effects),
         output_(output),
         plan_(plan),
+        options_(options),
         n_(robot.numLinks()),
         xml_(generateMjcf(robot, settings, effects)),  // validates robot + settings
         model_(loadModelFromXml(xml_)),
@@ -575,7 +647,9 @@ class MujocoRun {
     const std::string key =
         settle_cache ? settleKey(xml_, settings_, effects_, robot_.friction, ref0_) : std::string();
     const std::shared_ptr<const SettledState> cached = settle_cache ? settle_cache->impl().find(key) : nullptr;
-    if (cached) {
+    if (options_.start) {
+      restoreSettled(*options_.start, m_, d_, standing_);
+    } else if (cached) {
       restoreSettled(*cached, m_, d_, standing_);
     } else {
       long settle_steps = 0;
@@ -585,7 +659,7 @@ class MujocoRun {
         ++settle_steps;
         if (warningCount(d_) > 0)
           fail(instabilityMessage(d_, d_->time - settings_.settle_s, settings_, gains_) + " (settling)");
-        else if (!standing_.update(d_, t_state))
+        else if (!standing_.update(d_, t_state, settings_.timestep_s))
           fail(standing_.why() + " (while settling with the tail held at theta(0))");
       }
       if (settle_cache) settle_cache->impl().miss(settle_steps);
@@ -594,9 +668,13 @@ class MujocoRun {
       for (int v = 0; v < m_->nv; ++v) d_->qvel[v] = 0.0;
       if (settle_cache && messages_.text().empty()) settle_cache->impl().keep(key, saveSettled(m_, d_, standing_));
     }
+    settled_ = saveSettled(m_, d_, standing_);
     mj_forward(m_, d_);
     return true;
   }
+
+  // Where the pre-roll ended (valid after settle()).
+  const SettledState& settled() const { return *settled_; }
 
   // The run from t = 0 to its end. Row k is the state at the start of the first step with
   // t >= t_k (exact when the timestep divides sample_dt; otherwise up to one timestep late,
@@ -608,12 +686,15 @@ class MujocoRun {
     long k = 0;
     std::vector<mjtNum> qpos_t(m_->nq), qvel_t(m_->nv), qacc_t(m_->nv);
     ImpulseAverager averager(output_.sample_dt_s, h, plan_.rows, cols_, ts_);
+    StepSchedule schedule(h, settings_.rest_step_factor, ctrl_.trajectory().endTime(), duration,
+                          output_.sample_dt_s, !rk4_ && !hook);
     phi_ = yaw_prev_ = phi0_ = yawOf(d_, L_.quad_body);
     const auto wall0 = std::chrono::steady_clock::now();
     // Runs to the end of the simulated time even when the output grid ends earlier (a spacing that
     // does not divide the duration): the summary is the state at the end, not the last row.
     while (k < plan_.rows || d_->time < duration - eps) {
       const double t = d_->time;
+      const double h_step = m_->opt.timestep;
       const bool sample = k < plan_.rows && t >= k * output_.sample_dt_s - eps;
       const bool averaged = t < duration - eps;  // the step lies inside the run: its impulse counts
       if (sample) {
@@ -655,7 +736,7 @@ class MujocoRun {
         fail(instabilityMessage(d_, t, settings_, gains_));
         break;
       }
-      if (!standing_.update(d_, t)) {
+      if (!standing_.update(d_, t, h_step)) {
         fellOver(t);
         break;
       }
@@ -664,15 +745,17 @@ class MujocoRun {
         phi_ += wrapPi(yaw - yaw_prev_);
         yaw_prev_ = yaw;
         // The acceleration the integrator applied (implicit: (M - h D)^-1 f, not d->qacc's explicit one).
-        for (int v = 0; v < m_->nv; ++v) qacc_s_[v] = (d_->qvel[v] - qvel_s_[v]) / h;
+        for (int v = 0; v < m_->nv; ++v) qacc_s_[v] = (d_->qvel[v] - qvel_s_[v]) / h_step;
         loads_ = computeLoads(m_, d_, L_, qvel_s_, qacc_s_, scratch_);
       }
       if (sample && !rk4_) sampleRows(k, t, eps, qpos_t, qvel_s_, qacc_s_, averager);
       if (averaged) {
-        averager.addStep(t, loads_);
+        averager.addStep(t, h_step, loads_);
         peak_normal_N_ =
             std::max(peak_normal_N_, loads_[kFn1] + loads_[kFn1 + 1] + loads_[kFn1 + 2] + loads_[kFn1 + 3]);
       }
+      m_->opt.timestep = schedule.next(d_->time, speedsAtRest(m_, d_));
+      if (options_.stop_at_rest && schedule.rested(d_->time)) break;
     }
     averager.finish();
     sum_.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -860,6 +943,7 @@ class MujocoRun {
   const Effects& effects_;
   const OutputSettings& output_;
   const MujocoPlan plan_;
+  const Options options_;
   const int n_;
   const std::string xml_;
   const MujocoMessages messages_;  // MuJoCo's warnings go into this run's error text, not MUJOCO_LOG.TXT
@@ -884,29 +968,36 @@ class MujocoRun {
   double peak_normal_N_ = 0.0;
   double phi_ = 0.0, yaw_prev_ = 0.0, phi0_ = 0.0;  // the unwrapped yaw, the last yaw read, the yaw at t = 0
   long steps_ = 0;
+  std::optional<SettledState> settled_;
 };
 
 // One MuJoCo run at `settings`, without the uncertainty estimate: the stages of a MujocoRun.
+// `settled`, when given, receives the state its pre-roll ended in.
 RunResult runMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
                     const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
-                    MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
+                    MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook,
+                    const MujocoRun::Options& options, std::optional<SettledState>* settled) {
   const MujocoPlan plan = planMujocoRun(robot, trajectory, settings, output);
-  MujocoRun run(robot, trajectory, settings, effects, output, plan);
+  MujocoRun run(robot, trajectory, settings, effects, output, plan, options);
   if (!run.settle(settle_cache)) return run.failed();
+  if (settled) settled->emplace(run.settled());
   run.stepLoop(observer, hook);
   return run.judge();
 }
 
-// The run's error estimate from a second run at twice the step (run_uncertainty.h): its own
-// pre-roll, not the run's settle cache (whose hit and miss counts are the runs'), no time series;
-// its wall time is added to the run's.
+// The run's error estimate from a second run at twice the step (run_uncertainty.h). It starts
+// where the run's pre-roll ended (the pre-roll is the same robot standing still, whatever the
+// step) and stops once the body rests after the tail's motion (from there phi_net no longer
+// moves); no time series; its wall time is added to the run's.
 void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
-                    const Effects& effects, const OutputSettings& output, RunResult& fine) {
+                    const Effects& effects, const OutputSettings& output, const SettledState& start,
+                    RunResult& fine) {
   const MujocoSettings coarse = checkRunSettings(settings);
   OutputSettings quiet = output;
   quiet.time_series = TimeSeriesOutput::kNone;
   const auto wall0 = std::chrono::steady_clock::now();
-  const RunResult check = runMujoco(robot, trajectory, coarse, effects, quiet, nullptr, nullptr, nullptr);
+  const RunResult check = runMujoco(robot, trajectory, coarse, effects, quiet, nullptr, nullptr, nullptr,
+                                    MujocoRun::Options{&start, true}, nullptr);
   fine.summary.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   applyCheckRun(fine.summary, check.summary, coarse.timestep_s, settings.uncertainty_warn_share,
                 "lower mujoco.timestep_s or see `tailsim trust`");
@@ -917,10 +1008,12 @@ void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, 
 RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
                          const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
                          MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
-  RunResult r = runMujoco(robot, trajectory, settings, effects, output, observer, settle_cache, hook);
+  std::optional<SettledState> settled;
+  RunResult r = runMujoco(robot, trajectory, settings, effects, output, observer, settle_cache, hook,
+                          MujocoRun::Options{}, &settled);
   // A run steered by a hook decides its reference as it goes: a second run would steer differently.
   if (settings.uncertainty && r.summary.ok && !hook)
-    addUncertainty(robot, trajectory, settings, effects, output, r);
+    addUncertainty(robot, trajectory, settings, effects, output, *settled, r);
   return r;
 }
 
