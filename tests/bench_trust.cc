@@ -100,6 +100,8 @@ std::map<std::string, Rule> rules() {
   std::map<std::string, Rule> m;
   m["today"] = today;
   m["default"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings&) {};  // MujocoSettings' defaults
+  m["default_ns3"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings& s) { s.noslip_iterations = 3; };
+  m["default_h2"] = [](const RobotParams&, const TailTrajectory&, MujocoSettings& s) { refine(s, 2.0); };
   for (int f : {1, 2, 10})  // the defaults with another step once the body rests
     m["default_rest" + std::to_string(f)] = [f](const RobotParams&, const TailTrajectory&, MujocoSettings& s) {
       s.rest_step_factor = f;
