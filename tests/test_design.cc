@@ -463,6 +463,74 @@ TEST(StrokeDesign, DirectionsKeptFinishOnlyTheBestPatterns) {
   }
 }
 
+// restart_polish_evaluations: the polish's algorithm runs from each global restart's best point
+// before the next restart, so every restart's basin is converged, not only the best one's. The
+// first restart's global rows are the plain search's; one polish row follows every restart, each
+// within its budget, and the best never goes down.
+TEST(StrokeDesign, RestartPolishConvergesEveryRestart) {
+  const StrokeProblem p = torqueLimitedProblem(1, 8.0);
+  OptimizerSettings plain = globalOnly(5, 6);
+  plain.restarts = 3;
+  plain.polish = "cobyla";
+  plain.polish_evaluations = 0;  // no final polish: the rows below are the restarts' own
+  OptimizerSettings each = plain;
+  each.restart_polish_evaluations = 25;
+  const OptimizeResult a = optimizeStroke(p, plain), b = optimizeStroke(p, each);
+  ASSERT_EQ(a.history.size(), 1u + 3u * 6u);
+  ASSERT_EQ(b.history.size(), 1u + 3u * (6u + 1u));
+  for (std::size_t g = 0; g <= 6; ++g) {
+    EXPECT_EQ(b.history[g].stage, "global");
+    EXPECT_EQ(b.history[g].evaluations, a.history[g].evaluations) << g;
+    EXPECT_EQ(b.history[g].best_objective, a.history[g].best_objective) << g;
+  }
+  long polish_runs = 0;
+  for (std::size_t r = 0; r < 3; ++r) {
+    const std::size_t row = 1 + r * 7 + 6;  // after restart r's 6 generations
+    EXPECT_EQ(b.history[row].stage, "polish") << r;
+    const long runs = b.history[row].evaluations - b.history[row - 1].evaluations;
+    EXPECT_GE(runs, 1) << r;
+    EXPECT_LE(runs, 25) << r;
+    polish_runs += runs;
+  }
+  EXPECT_EQ(b.evaluations - a.evaluations, polish_runs);
+  for (std::size_t k = 1; k < b.history.size(); ++k) EXPECT_GE(b.history[k].best_objective, b.history[k - 1].best_objective);
+  EXPECT_GE(b.best.objective, a.best.objective);
+  EXPECT_TRUE(b.best.feasible());
+}
+
+// With directions: enumerate, max_runs is the seed's budget over all patterns: the first restarts
+// share it evenly, the kept patterns share what they leave (the earlier kept pattern's unused
+// runs go to the next), so the seed costs at most max_runs whatever n is.
+TEST(StrokeDesign, EnumeratedDirectionsShareOneRunBudget) {
+  StrokeProblem p;
+  p.base = baseCase(2);
+  p.space.n_links = 2;
+  OptimizerSettings s = globalOnly(3, 4);
+  s.enumerate_directions = true;
+  s.restarts = 10;
+  s.polish = "cobyla";
+  s.polish_evaluations = 20;
+  s.restart_polish_evaluations = 10;
+  s.directions_kept = 1;
+  const long first = 1 + 2L * 8 * (4 + 1) + 2 + 10;  // start, restart 0 (the start set in 2 islands), its polish
+  s.max_runs = 4 * first + 300;
+  const OptimizeResult r = optimizeStroke(p, s);
+  ASSERT_EQ(r.by_direction.size(), 4u);
+  EXPECT_LE(r.evaluations, s.max_runs);
+  EXPECT_GT(r.evaluations, s.max_runs - 2L * 8 * 5);  // the runs left went to the kept pattern
+  int kept = 0;
+  for (const DirectionResult& d : r.by_direction) {
+    EXPECT_LE(d.evaluations, d.evaluations > first ? s.max_runs : first);
+    if (d.evaluations > first) ++kept;
+  }
+  EXPECT_EQ(kept, 1);
+  // Without halving every pattern's whole search shares it too.
+  s.directions_kept = 0;
+  const OptimizeResult all = optimizeStroke(p, s);
+  EXPECT_LE(all.evaluations, s.max_runs);
+  for (const DirectionResult& d : all.by_direction) EXPECT_GT(d.evaluations, first);
+}
+
 class OptimizeFileTest : public ::testing::Test {
  protected:
   void SetUp() override {

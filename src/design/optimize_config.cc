@@ -237,6 +237,8 @@ const Val* readOptimizer(const Reader& r, const Map& o, const StrokeSpace& sp, O
   }
   if (const Val* v = Reader::get(o, "polish")) os.polish = r.choice(*v, {"cobyla", "bobyqa", "none"});
   if (const Val* v = Reader::get(o, "polish_evaluations")) os.polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
+  if (const Val* v = Reader::get(o, "restart_polish_evaluations"))
+    os.restart_polish_evaluations = r.integer(*v, 0, kMaxPolishEvaluations);
   if (const Val* v = Reader::get(o, "max_runs")) {
     os.max_runs = r.integer(*v, 0, static_cast<int>(limits::kMaxOptimizeRuns));
     const long least = 2 + static_cast<long>(os.islands) * os.population + (os.polish != "none" ? os.polish_evaluations : 0);
@@ -380,16 +382,17 @@ double optimizeRunEstimate(const OptimizeSpec& s) {
     return o.islands * pop * (o.generations + 1.0 + o.refine_generations);
   };
   double later = 0;  // the restarts after the first, the local restarts and the polish
-  for (int r = 1; r < o.restarts; ++r) later += restartRuns(r);
+  const double restart_polish = o.polish != "none" ? o.restart_polish_evaluations : 0.0;
+  for (int r = 1; r < o.restarts; ++r) later += restartRuns(r) + restart_polish;
   later += o.local_restarts * static_cast<double>(o.islands) * o.population * (o.generations + 1.0);
   if (o.polish != "none") later += o.polish_evaluations;
-  const double first = 2.0 + restartRuns(0);  // the start (base stroke and its box point) and restart 0
+  const double first = 2.0 + restartRuns(0) + restart_polish;  // the start (base stroke and its box point) and restart 0
   double per_search = first + later;
   if (o.enumerate_directions) {
     const double patterns = std::ldexp(1.0, std::min(s.problem.space.n_links, 1000));
     const double kept = o.directions_kept > 0 ? std::min<double>(o.directions_kept, patterns) : patterns;
     per_search = patterns * first + kept * later;
-    if (o.max_runs > 0) per_search = std::min(per_search, patterns * static_cast<double>(o.max_runs));
+    if (o.max_runs > 0) per_search = std::min(per_search, static_cast<double>(o.max_runs));
   } else if (o.max_runs > 0) {
     per_search = std::min(per_search, static_cast<double>(o.max_runs));
   }

@@ -620,6 +620,7 @@ void summarizeSettings(const OptimizeSpec& spec, nlohmann::json& j) {
   j["restarts"] = spec.optimizer.restarts;
   j["restart_growth"] = spec.optimizer.restart_growth;
   j["refine_generations"] = spec.optimizer.refine_generations;
+  j["restart_polish_evaluations"] = spec.optimizer.restart_polish_evaluations;
   j["local_restarts"] = spec.optimizer.local_restarts;
   j["local_step"] = spec.optimizer.local_step;
   j["directions"] = spec.optimizer.enumerate_directions ? "enumerate" : "free";

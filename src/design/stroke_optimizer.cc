@@ -162,16 +162,28 @@ class SpaceSearch {
         pp_(PagmoStroke{shared_, tracker_}) {
     tracker_->keep = static_cast<std::size_t>(std::max(0, prob.keep_candidates));
     if (s.islands < 1 || s.population < 5 || s.generations < 1 || s.polish_evaluations < 0 || s.restarts < 1 ||
-        s.restart_growth < 1 || s.refine_generations < 0 || s.local_restarts < 0 || !(s.local_step > 0.0) ||
+        s.restart_growth < 1 || s.refine_generations < 0 || s.restart_polish_evaluations < 0 || s.local_restarts < 0 || !(s.local_step > 0.0) ||
         s.directions_kept < 0)
       throw std::invalid_argument("optimizer settings out of range");
-    if (s.max_runs > 0) budget_ = s.max_runs - (s.polish != "none" ? s.polish_evaluations : 0);
+    if (s.max_runs > 0) setMaxRuns(s.max_runs, true);
     // The start: the base experiment's own trajectory (e.g. Eq. 25), in every island's population.
     x0_ = prob.space.pointOf(prob.base.joints);
     res_.start = evaluateStroke(prob, prob.base.trajectory());
     tracker_->record(x0_, evaluateStroke(prob, x0_));
     snapshot("global");
     endStage();
+  }
+
+  // At most max_runs runs in all, counted from this search's first (OptimizerSettings::max_runs);
+  // with_polish: the last polish_evaluations of them are kept for the polish.
+  void setMaxRuns(long max_runs, bool with_polish) {
+    max_runs_ = max_runs;
+    budget_ = max_runs - (with_polish && s_.polish != "none" ? s_.polish_evaluations : 0);
+  }
+
+  long evaluations() const {
+    std::lock_guard<std::mutex> lock(tracker_->mu);
+    return tracker_->evaluations;
   }
 
   double bestObjective() const {
@@ -207,6 +219,18 @@ class SpaceSearch {
               pagmo::algorithm(pagmo::cmaes(1u, -1, -1, -1, -1, 0.05, 1e-9, 1e-9, true, true, subSeed(i, r) + 2u)));
         evolve(archi, s_.refine_generations, "refine", s_.islands * pop_size);
       }
+      // This restart's basin converged by the polish's algorithm from the restart's best point
+      // (not the best over all restarts: that one is polished at the end).
+      if (s_.restart_polish_evaluations > 0 && s_.polish != "none") {
+        const std::size_t best = bestIsland(archi);
+        const pagmo::population pop = archi[best].get_population();
+        long evals = s_.restart_polish_evaluations;
+        {
+          std::lock_guard<std::mutex> lock(tracker_->mu);
+          evals = std::min(evals, budget_ - tracker_->evaluations);
+        }
+        polish(pop.champion_x(), evals);
+      }
     }
     endStage();
   }
@@ -237,7 +261,16 @@ class SpaceSearch {
       }
       evolve(archi, s_.generations, "local", static_cast<long>(s_.islands) * s_.population);
     }
-    if (s_.polish != "none" && s_.polish_evaluations > 0 && tracker_->have_best) polish();
+    if (s_.polish != "none" && s_.polish_evaluations > 0 && tracker_->have_best) {
+      std::vector<double> x;
+      long evals = s_.polish_evaluations;
+      {
+        std::lock_guard<std::mutex> lock(tracker_->mu);
+        x = tracker_->best_x;
+        evals = std::min(evals, max_runs_ - tracker_->evaluations);
+      }
+      polish(x, evals);
+    }
     endStage();
   }
 
@@ -269,6 +302,21 @@ class SpaceSearch {
     return tracker_->evaluations + runs <= budget_;
   }
 
+  // The island whose population holds the archipelago's best point so far (the lowest fitness;
+  // ties: the lower index).
+  static std::size_t bestIsland(const pagmo::archipelago& archi) {
+    std::size_t best = 0;
+    double f_best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < archi.size(); ++i) {
+      const double f = archi[i].get_population().champion_f()[0];
+      if (f < f_best) {
+        f_best = f;
+        best = i;
+      }
+    }
+    return best;
+  }
+
   // `generations` generations of every island, each of at most `runs_per_generation` runs; stops
   // before a generation the budget cannot hold.
   void evolve(pagmo::archipelago& archi, int generations, const char* stage, long runs_per_generation) {
@@ -296,16 +344,12 @@ class SpaceSearch {
     if (progress_) progress_(p);
   }
 
-  void polish() {
+  // NLopt (polish: cobyla | bobyqa) from x, at most evals runs.
+  void polish(std::vector<double> x, long evals) {
     const unsigned d = static_cast<unsigned>(prob_.space.dim());
     nlopt::opt opt(s_.polish == "cobyla" ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, d);
     opt.set_lower_bounds(std::vector<double>(d, 0.0));
     opt.set_upper_bounds(std::vector<double>(d, 1.0));
-    long evals = s_.polish_evaluations;
-    if (s_.max_runs > 0) {
-      std::lock_guard<std::mutex> lock(tracker_->mu);
-      evals = std::min(evals, s_.max_runs - tracker_->evaluations);
-    }
     if (evals <= 0) return;
     opt.set_maxeval(static_cast<int>(evals));
     opt.set_xtol_rel(1e-7);
@@ -340,11 +384,6 @@ class SpaceSearch {
             return e.ok ? e.violation : 1.0;
           },
           &ctx, 0.0);
-    std::vector<double> x;
-    {
-      std::lock_guard<std::mutex> lock(tracker_->mu);
-      x = tracker_->best_x;
-    }
     double f = 0.0;
     try {
       opt.optimize(x, f);
@@ -365,7 +404,8 @@ class SpaceSearch {
   OptimizeResult res_;
   int gen_count_ = 0;
   double wall_s_ = 0.0;
-  long budget_ = std::numeric_limits<long>::max();  // runs before the polish (max_runs less the polish's share)
+  long max_runs_ = std::numeric_limits<long>::max();  // runs in all, the polish included
+  long budget_ = std::numeric_limits<long>::max();    // runs before the polish (max_runs less the polish's share)
   Clock::time_point stage_start_ = Clock::now();  // wall time counts the stages only (not the waits between)
 };
 
@@ -419,8 +459,13 @@ std::vector<StrokeProblem> directionProblems(const StrokeProblem& prob, int n) {
 // Successive halving: the first global restart in every pattern, then the other restarts, the
 // local restarts and the polish in the `kept` patterns whose first restart found the most (ties:
 // the lower pattern index).
-void halveDirections(std::vector<std::unique_ptr<SpaceSearch>>& searches, int kept, int restarts) {
-  for (auto& search : searches) search->globalStage(0, 1);
+void halveDirections(std::vector<std::unique_ptr<SpaceSearch>>& searches, int kept, int restarts, long max_runs) {
+  const long patterns = static_cast<long>(searches.size());
+  // max_runs is the seed's: the first restarts share it evenly, the kept patterns what they leave.
+  for (auto& search : searches) {
+    if (max_runs > 0) search->setMaxRuns(max_runs / patterns, false);
+    search->globalStage(0, 1);
+  }
   std::vector<int> order(searches.size());
   for (std::size_t m = 0; m < order.size(); ++m) order[m] = static_cast<int>(m);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
@@ -428,6 +473,11 @@ void halveDirections(std::vector<std::unique_ptr<SpaceSearch>>& searches, int ke
   });
   for (int k = 0; k < kept; ++k) {
     SpaceSearch& search = *searches[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+    if (max_runs > 0) {  // an even share of the runs left, the earlier kept patterns' unused runs included
+      long used = 0;
+      for (const auto& other : searches) used += other->evaluations();
+      search.setMaxRuns(search.evaluations() + (max_runs - used) / (kept - k), true);
+    }
     search.globalStage(1, restarts);
     search.localStageAndPolish();
   }
@@ -498,15 +548,23 @@ OptimizeResult optimizeStroke(const StrokeProblem& prob, const OptimizerSettings
   for (int mask = 0; mask < patterns; ++mask) {
     OptimizerSettings ps = s;
     ps.seed = s.seed * 4099u + static_cast<std::uint64_t>(mask);
+    ps.max_runs = 0;  // the seed's budget is shared out below
     searches.push_back(std::make_unique<SpaceSearch>(problems[static_cast<std::size_t>(mask)], ps,
                                                      all_progress.forPattern(mask)));
     // Without successive halving each pattern's search runs through (as before the option).
     if (!halving) {
+      if (s.max_runs > 0) {  // an even share of the runs left, the earlier patterns' unused runs included
+        long used = 0;
+        for (const auto& other : searches) used += other->evaluations();
+        const long later_starts = patterns - 1 - mask;  // the later patterns' start runs
+        searches.back()->setMaxRuns(
+            searches.back()->evaluations() + (s.max_runs - used - later_starts) / (patterns - mask), true);
+      }
       searches.back()->globalStage(0, s.restarts);
       searches.back()->localStageAndPolish();
     }
   }
-  if (halving) halveDirections(searches, s.directions_kept, s.restarts);
+  if (halving) halveDirections(searches, s.directions_kept, s.restarts, s.max_runs);
 
   OptimizeResult all = mergePatterns(searches);
   std::stable_sort(all.candidates.begin(), all.candidates.end(),

@@ -22,6 +22,9 @@ struct OptimizerSettings {
   int restarts = 1;                 // independent global searches per seed (distinct sub-seeds); the best is polished
   int restart_growth = 1;           // population factor from one restart to the next (2: IPOP-CMA-ES)
   int refine_generations = 0;       // CMA-ES generations on each island's population after its global search
+  // NLopt (the polish's algorithm) from each global restart's best point, up to this many runs, before the
+  // next restart (0: none): each restart's basin converged, not only the best restart's.
+  int restart_polish_evaluations = 0;
   bool enumerate_directions = false;  // split-cycle: one search per joint-direction pattern (2^n), the best kept
   int local_restarts = 0;           // CMA-ES runs (population, generations) centred on the best point so far, after the global search
   double local_step = 0.1;          // their initial step, a share of the unit box
@@ -32,6 +35,8 @@ struct OptimizerSettings {
   // that would take the runs so far over max_runs - polish_evaluations is not started, and the
   // polish gets what is left (at most polish_evaluations). The stages keep their order, so a search
   // whose first restart uses the whole budget is exactly the single-start search of that size.
+  // With enumerate_directions it is the seed's budget over all patterns: the patterns' first
+  // restarts share it evenly, the kept patterns (directions_kept) what those leave.
   long max_runs = 0;
   std::uint64_t seed = 1;
 };

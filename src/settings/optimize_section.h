@@ -61,6 +61,7 @@ struct OptimizeSection {
   int directions_kept = 0;
   std::string polish = "cobyla";
   int polish_evaluations = 200;
+  int restart_polish_evaluations = 0;
   int max_runs = 0;
   int pareto_points = 0;
   bool mujoco_check = true;
@@ -131,7 +132,9 @@ settings::For<S, OptimizeSection> declareFields(V& v, S& s) {
          TextRule{false, {"cobyla", "bobyqa", "none"}});
   v.integer(Field{"polish_evaluations", "the polish's budget of model runs"}, s.polish_evaluations,
             Limits::closed(0, limits::kMaxPolishEvaluations));
-  v.integer(Field{"max_runs", "at most this many model runs per search, polish included (0: no cap)"}, s.max_runs,
+  v.integer(Field{"restart_polish_evaluations", "the polish's algorithm from each global restart's best, this many runs (0: none)"},
+            s.restart_polish_evaluations, Limits::closed(0, limits::kMaxPolishEvaluations));
+  v.integer(Field{"max_runs", "at most this many model runs per seed (every direction pattern's), polish included (0: no cap)"}, s.max_runs,
             Limits::closed(0, static_cast<int>(limits::kMaxOptimizeRuns)));
   v.integerList(Field{"seeds", "one optimisation per seed (distinct); the best is the result (default [1])"},
                 Limits::closed(0, 1000000000), limits::kMaxOptimizeSeeds);
