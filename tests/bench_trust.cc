@@ -45,6 +45,7 @@
 
 #include "experiments/verdict.h"
 #include "models/perfoot/per_foot_model.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_settings.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "random_robots.h"
@@ -344,9 +345,38 @@ RunSummary perFootSummary(const RobotParams& r, const TailTrajectory& t) {
   }
 }
 
-// `reference(k, free)`: case k's reference run; free: with the tilt check off (max_tilt_deg 0).
-void fallsReport(const std::vector<RandomRobotCase>& cases, const std::function<Run(int, bool)>& reference,
-                 std::ofstream& csv) {
+// A run with the tilt check off (max_tilt_deg 0, no check run): does it rock back or topple? Its
+// largest tilt and the tilt at its last output row [deg]; ok false when it failed all the same
+// (no foot loaded for max_all_feet_off_s).
+struct FreeRun {
+  bool ok = false;
+  double max_tilt_deg = NAN, final_tilt_deg = NAN;
+};
+
+FreeRun freeRun(const RandomRobotCase& c, MujocoSettings s) {
+  s.max_tilt_deg = 0.0;
+  s.uncertainty = false;
+  FreeRun out;
+  int body = -1;
+  double cz = NAN;
+  const MujocoSampleObserver last = [&](double, const mjModel* m, const mjData* d) {
+    if (body < 0) body = mj_name2id(m, mjOBJ_BODY, mjcf::kQuadrupedBody);
+    cz = d->xmat[9 * body + 8];
+  };
+  try {
+    const RunResult r = simulateMujoco(c.robot, c.trajectory, s, Effects{}, OutputSettings{}, last);
+    out.ok = r.summary.ok;
+    out.max_tilt_deg = r.summary.extra.at("max_tilt_deg");
+    out.final_tilt_deg = std::acos(std::clamp(cz, -1.0, 1.0)) * 180.0 / M_PI;
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "free run threw: %s\n", ex.what());
+  }
+  return out;
+}
+
+// `reference(k)`: case k's reference run; `ref_settings`: its settings.
+void fallsReport(const std::vector<RandomRobotCase>& cases, const std::function<Run(int)>& reference,
+                 const std::function<MujocoSettings(const RobotParams&)>& ref_settings, std::ofstream& csv) {
   const int N = static_cast<int>(cases.size());
   // [reference: falls, stands, fails][default: falls, warns, plain, fails]; [reference][per-foot: tips, stands, fails]
   int mj[3][4] = {}, pf[3][3] = {};
@@ -359,7 +389,7 @@ void fallsReport(const std::vector<RandomRobotCase>& cases, const std::function<
   const char* kMj[] = {"falls", "warns", "plain", "fails"};
   for (int k = 0; k < N; ++k) {
     const RandomRobotCase& c = cases[k];
-    const Run f = reference(k, false);
+    const Run f = reference(k);
     const Run d = runOnce(c.robot, c.trajectory, baseSettings(c.robot));
     RunSummary p = perFootSummary(c.robot, c.trajectory);
     RunSummary m = d.summary;
@@ -382,20 +412,16 @@ void fallsReport(const std::vector<RandomRobotCase>& cases, const std::function<
     if ((fi == 0 && de != End::kFalls) || (fi == 1 && de == End::kFalls)) {
       // How far each tilts with the tilt check off: a fall goes on past the tip-over angle (the
       // system COM over the side feet, atan(w_F / 2 / h)), a rock comes back.
-      MujocoSettings sf = baseSettings(c.robot);
-      sf.max_tilt_deg = 0.0;
-      sf.uncertainty = false;
-      const Run df = runOnce(c.robot, c.trajectory, sf);
-      const Run ff = reference(k, true);
+      const FreeRun df = freeRun(c, baseSettings(c.robot)), ff = freeRun(c, ref_settings(c.robot));
       const double tip_deg = std::atan(0.5 * c.robot.quadruped.w_F_m / c.robot.quadruped.com_height_m) * 180.0 / M_PI;
       char b[400];
       std::snprintf(b, sizeof b,
-                    "case %d: reference %s (tilt %.2f deg; free: %s, max %.1f deg), default %s (phi %.2f deg, tilt %.2f "
-                    "deg%s%s; free: %s, max %.1f deg), side tip-over angle %.1f deg, per-foot %s: ",
-                    k, fname, f.tilt_deg, ff.ok ? "ends standing" : "fails", ff.tilt_deg, kMj[static_cast<int>(de)],
-                    d.phi_deg, d.tilt_deg, de == End::kWarns ? ", " : "",
-                    de == End::kWarns ? warnReason(d.summary).c_str() : "", df.ok ? "ends standing" : "fails",
-                    df.tilt_deg, tip_deg, pname);
+                    "case %d: reference %s (tilt %.2f deg; free: max %.1f, end %.1f deg%s), default %s (phi %.2f deg, "
+                    "tilt %.2f deg%s%s; free: max %.1f, end %.1f deg%s), side tip-over angle %.1f deg, per-foot %s: ",
+                    k, fname, f.tilt_deg, ff.max_tilt_deg, ff.final_tilt_deg, ff.ok ? "" : ", fails",
+                    kMj[static_cast<int>(de)], d.phi_deg, d.tilt_deg, de == End::kWarns ? ", " : "",
+                    de == End::kWarns ? warnReason(d.summary).c_str() : "", df.max_tilt_deg, df.final_tilt_deg,
+                    df.ok ? "" : ", fails", tip_deg, pname);
       notes.push_back(b + describe(c));
     }
     if (csv.is_open())
@@ -508,16 +534,14 @@ int main(int argc, char** argv) {
 
   if (falls) {
     std::printf("corpus: %d cases (seed %u, %s)\n\n", N, seed, corpus == RandomCorpus::kTippy ? "tippy" : "mixed");
-    fallsReport(cases,
-                [&](int k, bool free) {
-                  if (!free) return refRun(all.at("default"), k, 8.0, 0.0);
-                  const RandomRobotCase& c = cases[k];
-                  MujocoSettings s = baseSettings(c.robot);
-                  toReference(s, 8.0);
-                  s.max_tilt_deg = 0.0;
-                  return cache.get(tag(k) + "reffree:" + key(s), [&] { return runOnce(c.robot, c.trajectory, s); });
-                },
-                csv);
+    fallsReport(
+        cases, [&](int k) { return refRun(all.at("default"), k, 8.0, 0.0); },
+        [](const RobotParams& r) {
+          MujocoSettings s = baseSettings(r);
+          toReference(s, 8.0);
+          return s;
+        },
+        csv);
     return 0;
   }
   std::printf("corpus: %d cases (seed %u); reference: the rule's settings at timestep / 8 (servo w_n kept), impratio "
