@@ -3,6 +3,7 @@
 // the rule and its evidence"). Plain main, one thread; prints one Markdown row per rule:
 //   nice build/tests/bench_trust [--cases N=120] [--seed S=31] [--rules "today;set:imp=100,ns=3;.."]
 //                                [--ref-cache FILE] [--check16 K=10] [--csv FILE] [--jitter-check]
+//                                [--corpus mixed|tippy] [--falls]
 // Reference of a rule: the rule's settings at timestep / 8 (servo w_n kept), impratio >= 100,
 // noslip >= 3 (for "today": the old defaults' reference); every K-th case also at timestep / 16, to
 // show the reference itself has converged. --ref-cache keeps the reference runs (keyed by seed,
@@ -22,6 +23,12 @@
 //  * U bounds err: runs whose phi_net_uncertainty_deg >= |phi_net - phi_net,ref|; U median: the
 //    uncertainty / max(|phi_net|, 0.5 deg); U flagged: runs warned as uncertain; err > 3 %
 //    flagged: of the runs more than 3 % off the reference, those warned.
+// --corpus tippy: the robots near tipping over (random_robots.h RandomCorpus::kTippy).
+// --falls: instead of the rule table, the fall signal (docs/mujoco-model.md "Tipping over"):
+// MuJoCo at the defaults (uncertainty on) and the per-foot model with load transfer against the
+// reference of the defaults, as confusion tables, the count of cases where the reference falls
+// and the default run prints a plain turn (no warning beginning kUncertainWarning), and the
+// verdict (src/experiments/verdict.h) of per-foot and MuJoCo where they disagree on falling.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -36,7 +43,9 @@
 #include <string>
 #include <vector>
 
+#include "experiments/verdict.h"
 #include "models/perfoot/per_foot_model.h"
+#include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_settings.h"
 #include "models/mujoco/mujoco_simulation.h"
 #include "random_robots.h"
@@ -50,6 +59,8 @@ struct Run {
   bool ok = false;
   double phi_deg = NAN, airborne = NAN, peak = NAN, wall_s = NAN, u_deg = NAN, tilt_deg = NAN, check_deg = NAN;
   long steps = 0;
+  bool fell = false;  // failed because the robot fell over (kMujocoFallText), not from instability
+  RunSummary summary;
 };
 
 // Settings every rule starts from: MujocoSettings' defaults with the body at the robot's COM
@@ -196,6 +207,8 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
   try {
     const RunResult res = simulateMujoco(r, t, s, e, o);
     out.ok = res.summary.ok;
+    out.fell = !res.summary.ok && res.summary.error.find(kMujocoFallText) != std::string::npos;
+    out.summary = res.summary;
     out.phi_deg = res.summary.phi_net_deg;
     out.wall_s = res.summary.wall_time_s;
     out.steps = res.summary.solver_steps + static_cast<long>(std::lround(s.settle_s / s.timestep_s));
@@ -242,15 +255,28 @@ std::string key(const MujocoSettings& s) {
   return os.str();
 }
 
-// Reference runs, optionally kept in a file: one line "key ok phi airborne peak steps wall".
+// Reference runs, optionally kept in a file: one line "key ok phi airborne peak steps wall
+// [max_tilt fell]" (the last two are absent in caches written before --falls).
 class RefCache {
  public:
   explicit RefCache(std::string path) : path_(std::move(path)) {
     if (path_.empty()) return;
     std::ifstream in(path_);
-    std::string k;
-    Run r;
-    while (in >> k >> r.ok >> r.phi_deg >> r.airborne >> r.peak >> r.steps >> r.wall_s) map_[k] = r;
+    // Numbers through strtod, which reads the "nan" a failed run writes (operator>> does not).
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream is(line);
+      std::string k;
+      std::vector<double> x;
+      is >> k;
+      for (std::string w; is >> w;) x.push_back(std::strtod(w.c_str(), nullptr));
+      if (x.size() < 6) continue;
+      Run r;
+      r.ok = x[0] != 0.0;
+      r.phi_deg = x[1], r.airborne = x[2], r.peak = x[3], r.steps = static_cast<long>(x[4]), r.wall_s = x[5];
+      if (x.size() >= 8) r.tilt_deg = x[6], r.fell = x[7] != 0.0;
+      else if (!r.ok) continue;  // an older line: whether the run fell is not known, run it again
+      map_[k] = r;
+    }
   }
   Run get(const std::string& k, const std::function<Run()>& make) {
     const auto it = map_.find(k);
@@ -261,7 +287,7 @@ class RefCache {
       std::ofstream out(path_, std::ios::app);
       out.precision(17);
       out << k << ' ' << r.ok << ' ' << r.phi_deg << ' ' << r.airborne << ' ' << r.peak << ' ' << r.steps << ' '
-          << r.wall_s << '\n';
+          << r.wall_s << ' ' << r.tilt_deg << ' ' << r.fell << '\n';
     }
     return r;
   }
@@ -281,11 +307,165 @@ double quantile(std::vector<double> v, double q) {
 
 double rel(double a, double ref) { return std::abs(a - ref) / std::max(std::abs(ref), 0.5); }
 
+// The fall signal (--falls): how each case ends in the per-foot model (load transfer), MuJoCo at the
+// defaults and the defaults' reference, as confusion tables and the list of the cases that matter.
+enum class End { kFalls, kWarns, kPlain, kFails };  // MuJoCo; the planar model: kFalls = tips, kPlain = stands
+
+bool uncertainWarned(const RunSummary& s) {
+  for (const std::string& w : s.warnings)
+    if (w.rfind(kUncertainWarning, 0) == 0) return true;
+  return false;
+}
+
+End mujocoEnd(const Run& r) {
+  if (!r.ok) return r.fell ? End::kFalls : End::kFails;
+  return uncertainWarned(r.summary) ? End::kWarns : End::kPlain;
+}
+
+// Why a default run was marked uncertain: the near-fall tilt, the check run, or the size of U.
+std::string warnReason(const RunSummary& s) {
+  std::string out;
+  for (const std::string& w : s.warnings) {
+    if (w.rfind(kUncertainWarning, 0) != 0) continue;
+    const char* why = w.find("nearly fell") != std::string::npos  ? "near fall"
+                      : w.find("check run") != std::string::npos ? (w.find(kMujocoFallText) != std::string::npos ? "check run fell" : "check run failed")
+                                                                 : "U > share";
+    out += std::string(out.empty() ? "" : "+") + why;
+  }
+  return out;
+}
+
+RunSummary perFootSummary(const RobotParams& r, const TailTrajectory& t) {
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  PerFootSettings p;
+  p.normal_loads = NormalLoadModel::kLoadTransfer;
+  try {
+    RunSummary s = simulatePerFoot(r, t, p, Effects{}, o).summary;
+    s.model = "perfoot";
+    return s;
+  } catch (const std::exception& e) {
+    RunSummary s;
+    s.model = "perfoot";
+    s.ok = false;
+    s.error = e.what();
+    return s;
+  }
+}
+
+// A run with the tilt check off (max_tilt_deg 0, no check run): does it rock back or topple? Its
+// largest tilt and the tilt at its last output row [deg]; ok false when it failed all the same
+// (no foot loaded for max_all_feet_off_s).
+struct FreeRun {
+  bool ok = false;
+  double max_tilt_deg = NAN, final_tilt_deg = NAN;
+};
+
+FreeRun freeRun(const RandomRobotCase& c, MujocoSettings s) {
+  s.max_tilt_deg = 0.0;
+  s.uncertainty = false;
+  FreeRun out;
+  int body = -1;
+  double cz = NAN;
+  const MujocoSampleObserver last = [&](double, const mjModel* m, const mjData* d) {
+    if (body < 0) body = mj_name2id(m, mjOBJ_BODY, mjcf::kQuadrupedBody);
+    cz = d->xmat[9 * body + 8];
+  };
+  try {
+    const RunResult r = simulateMujoco(c.robot, c.trajectory, s, Effects{}, OutputSettings{}, last);
+    out.ok = r.summary.ok;
+    out.max_tilt_deg = r.summary.extra.at("max_tilt_deg");
+    out.final_tilt_deg = std::acos(std::clamp(cz, -1.0, 1.0)) * 180.0 / M_PI;
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "free run threw: %s\n", ex.what());
+  }
+  return out;
+}
+
+// `reference(k)`: case k's reference run; `ref_settings`: its settings.
+void fallsReport(const std::vector<RandomRobotCase>& cases, const std::function<Run(int)>& reference,
+                 const std::function<MujocoSettings(const RobotParams&)>& ref_settings, std::ofstream& csv) {
+  const int N = static_cast<int>(cases.size());
+  // [reference: falls, stands, fails][default: falls, warns, plain, fails]; [reference][per-foot: tips, stands, fails]
+  int mj[3][4] = {}, pf[3][3] = {};
+  std::vector<std::string> notes;
+  std::vector<double> tilt_stand, tilt_fall;  // default runs that stand: max tilt, by the reference's end
+  std::map<std::string, int> reasons;  // verdict of per-foot vs MuJoCo default where they disagree on falling
+  if (csv.is_open())
+    csv << "case,ref_end,ref_phi_deg,ref_max_tilt_deg,default_end,default_phi_deg,default_max_tilt_deg,default_u_deg,"
+           "default_check_phi_deg,default_warning,default_error,perfoot_end,perfoot_phi_deg,perfoot_error,verdict,description\n";
+  const char* kMj[] = {"falls", "warns", "plain", "fails"};
+  for (int k = 0; k < N; ++k) {
+    const RandomRobotCase& c = cases[k];
+    const Run f = reference(k);
+    const Run d = runOnce(c.robot, c.trajectory, baseSettings(c.robot));
+    RunSummary p = perFootSummary(c.robot, c.trajectory);
+    RunSummary m = d.summary;
+    m.model = "mujoco";
+    const int fi = !f.ok ? (f.fell ? 0 : 2) : 1;
+    const End de = mujocoEnd(d);
+    const int pi = p.ok ? 1 : p.error.find(kPlanarTipText) != std::string::npos ? 0 : 2;
+    ++mj[fi][static_cast<int>(de)];
+    ++pf[fi][pi];
+    if (de != End::kFalls && de != End::kFails) (fi == 0 ? tilt_fall : tilt_stand).push_back(d.tilt_deg);
+    const std::string verdict = caseVerdict({p, m});
+    if ((pi == 0) != (de == End::kFalls) && pi != 2 && de != End::kFails) {
+      const bool lt = verdict.find("dynamic load transfer") != std::string::npos;
+      const bool sm = verdict.find("support margin") != std::string::npos;
+      ++reasons[std::string(pi == 0 ? "per-foot tips, MuJoCo stands" : "MuJoCo falls, per-foot stands") + ": " +
+                (lt ? "dynamic load transfer" : sm ? "support margin" : "no reason")];
+    }
+    const char* fname = fi == 0 ? "falls" : fi == 1 ? "stands" : "fails";
+    const char* pname = pi == 0 ? "tips" : pi == 1 ? "stands" : "fails";
+    if ((fi == 0 && de != End::kFalls) || (fi == 1 && de == End::kFalls)) {
+      // How far each tilts with the tilt check off: a fall goes on past the tip-over angle (the
+      // system COM over the side feet, atan(w_F / 2 / h)), a rock comes back.
+      const FreeRun df = freeRun(c, baseSettings(c.robot)), ff = freeRun(c, ref_settings(c.robot));
+      const double tip_deg = std::atan(0.5 * c.robot.quadruped.w_F_m / c.robot.quadruped.com_height_m) * 180.0 / M_PI;
+      char b[400];
+      std::snprintf(b, sizeof b,
+                    "case %d: reference %s (tilt %.2f deg; free: max %.1f, end %.1f deg%s), default %s (phi %.2f deg, "
+                    "tilt %.2f deg%s%s; free: max %.1f, end %.1f deg%s), side tip-over angle %.1f deg, per-foot %s: ",
+                    k, fname, f.tilt_deg, ff.max_tilt_deg, ff.final_tilt_deg, ff.ok ? "" : ", fails",
+                    kMj[static_cast<int>(de)], d.phi_deg, d.tilt_deg, de == End::kWarns ? ", " : "",
+                    de == End::kWarns ? warnReason(d.summary).c_str() : "", df.max_tilt_deg, df.final_tilt_deg,
+                    df.ok ? "" : ", fails", tip_deg, pname);
+      notes.push_back(b + describe(c));
+    }
+    if (csv.is_open())
+      csv << k << ',' << fname << ',' << f.phi_deg << ',' << f.tilt_deg << ',' << kMj[static_cast<int>(de)] << ','
+          << d.phi_deg << ',' << d.tilt_deg << ',' << d.u_deg << ',' << d.check_deg << ",\"" << warnReason(d.summary)
+          << "\",\"" << d.summary.error << "\"," << pname << ',' << p.phi_net_deg << ",\"" << p.error << "\",\"" << verdict << "\",\"" << describe(c) << "\"\n";
+    std::fprintf(stderr, "case %d/%d: reference %s, default %s, per-foot %s\n", k + 1, N, fname,
+                 kMj[static_cast<int>(de)], pname);
+  }
+  const char* kRef[] = {"reference falls", "reference stands", "reference fails (unstable)"};
+  std::printf("MuJoCo at the defaults (uncertainty on) against the reference (the defaults at timestep / 8, impratio "
+              "100, noslip 3); warns = a warning beginning \"%s\" (near fall, check run failed, or U beyond "
+              "uncertainty_warn_share)\n\n",
+              kUncertainWarning);
+  std::printf("| | default falls | default warns | default plain turn | default fails (unstable) |\n|---|---|---|---|---|\n");
+  for (int i = 0; i < 3; ++i)
+    std::printf("| %s | %d | %d | %d | %d |\n", kRef[i], mj[i][0], mj[i][1], mj[i][2], mj[i][3]);
+  std::printf("\n**Reference falls, default prints a plain turn: %d** (of %d cases)\n\n", mj[0][2], N);
+  std::printf("| | per-foot tips | per-foot stands | per-foot fails |\n|---|---|---|---|\n");
+  for (int i = 0; i < 3; ++i) std::printf("| %s | %d | %d | %d |\n", kRef[i], pf[i][0], pf[i][1], pf[i][2]);
+  std::printf("\nlargest tilt of the default runs that stand: where the reference stands median %.2f, p90 %.2f, max "
+              "%.2f deg (n %zu); where it falls min %.2f, median %.2f, max %.2f deg (n %zu)\n\n",
+              quantile(tilt_stand, 0.5), quantile(tilt_stand, 0.9), quantile(tilt_stand, 1.0), tilt_stand.size(),
+              quantile(tilt_fall, 0.0), quantile(tilt_fall, 0.5), quantile(tilt_fall, 1.0), tilt_fall.size());
+  std::printf("verdict (per-foot and MuJoCo at the defaults) where they disagree on falling:\n");
+  for (const auto& [r, n] : reasons) std::printf("  %s: %d\n", r.c_str(), n);
+  std::printf("\ncases where the reference and the default disagree on falling:\n");
+  for (const std::string& n : notes) std::printf("  %s\n", n.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int N = 120, check16 = 10;
-  bool jitter_check = false;  // --jitter-check: the jitter run has its own check run (check_jitter_phi_deg)
+  bool jitter_check = false, falls = false;
+  RandomCorpus corpus = RandomCorpus::kMixed;  // --jitter-check: the jitter run has its own check run (check_jitter_phi_deg)
   unsigned seed = 31;
   std::string rule_list = "today", cache_path, csv_path;
   for (int i = 1; i < argc; ++i) {
@@ -304,6 +484,15 @@ int main(int argc, char** argv) {
     else if (a == "--check16") check16 = std::atoi(next().c_str());
     else if (a == "--csv") csv_path = next();
     else if (a == "--jitter-check") jitter_check = true;
+    else if (a == "--falls") falls = true;
+    else if (a == "--corpus") {
+      const std::string v = next();
+      if (v != "mixed" && v != "tippy") {
+        std::fprintf(stderr, "--corpus is mixed or tippy, not %s\n", v.c_str());
+        return 2;
+      }
+      corpus = v == "tippy" ? RandomCorpus::kTippy : RandomCorpus::kMixed;
+    }
     else {
       std::fprintf(stderr, "unknown argument %s\n", a.c_str());
       return 2;
@@ -325,8 +514,8 @@ int main(int argc, char** argv) {
   }
   RefCache cache(cache_path);
   std::ofstream csv;
-  if (!csv_path.empty()) {
-    csv.open(csv_path);
+  if (!csv_path.empty()) csv.open(csv_path);
+  if (csv.is_open() && !falls) {
     csv << "rule,case,ok,phi_deg,phi_jitter_deg,ref_ok,ref_phi_deg,ref_jitter_deg,today_ref_phi_deg,ref16_phi_deg,perfoot_phi_deg,airborne,"
            "peak_over_mg,steps,wall_s,u_deg,max_tilt_deg,check_phi_deg,check_jitter_phi_deg,"
            "description\n";
@@ -335,10 +524,12 @@ int main(int argc, char** argv) {
   std::vector<RandomRobotCase> cases;
   std::vector<double> perfoot;
   for (int k = 0; k < N; ++k) {
-    cases.push_back(randomRobotCase(seed, k));
+    cases.push_back(randomRobotCase(seed, k, corpus));
     perfoot.push_back(perFootPhi(cases.back().robot, cases.back().trajectory));
   }
-  auto tag = [&](int k) { return std::to_string(seed) + ':' + std::to_string(k) + ':'; };
+  auto tag = [&](int k) {
+    return std::string(corpus == RandomCorpus::kTippy ? "tippy:" : "") + std::to_string(seed) + ':' + std::to_string(k) + ':';
+  };
   // A rule's reference runs (cached): its settings refined by `factor`, impratio >= 100, noslip >= 3.
   auto refRun = [&](const Rule& rule, int k, double factor, double jitter_s) {
     const RandomRobotCase& c = cases[k];
@@ -349,6 +540,18 @@ int main(int argc, char** argv) {
     return cache.get(kk, [&] { return runOnce(c.robot, jittered(c.trajectory, jitter_s), s); });
   };
 
+  if (falls) {
+    std::printf("corpus: %d cases (seed %u, %s)\n\n", N, seed, corpus == RandomCorpus::kTippy ? "tippy" : "mixed");
+    fallsReport(
+        cases, [&](int k) { return refRun(all.at("default"), k, 8.0, 0.0); },
+        [](const RobotParams& r) {
+          MujocoSettings s = baseSettings(r);
+          toReference(s, 8.0);
+          return s;
+        },
+        csv);
+    return 0;
+  }
   std::printf("corpus: %d cases (seed %u); reference: the rule's settings at timestep / 8 (servo w_n kept), impratio "
               ">= 100, noslip >= 3; 'today ref': today's rule's reference (the same for every rule)\n\n",
               N, seed);

@@ -194,6 +194,26 @@ TEST(Verdict, FallsAreFallsAndADisagreementNamesItsReason) {
             0u);
 }
 
+// A planar model tips and MuJoCo stands, but MuJoCo's run nearly fell: the "support margin" (MuJoCo
+// comes back) is then in doubt, and the verdict says so. On the tippy corpus (docs/mujoco-model.md
+// "Tipping over") six robots the converged reference sees fall stand uncertain at the defaults,
+// and the per-foot model tips in each.
+TEST(Verdict, AMujocoRunThatNearlyFellLeavesTheSupportMarginInDoubt) {
+  const RunSummary tipped = fallen("perfoot", std::string(kPlanarTipText) + " at t = 0.1 s (test)");
+  RunSummary rocked = standing("mujoco", -11.9, 0.32);
+  rocked.extra["max_tilt_deg"] = 1.66;
+  std::string v = caseVerdict({tipped, rocked});
+  EXPECT_EQ(v.rfind("falls:", 0), 0u) << v;
+  EXPECT_NE(v.find("support margin"), std::string::npos) << v;
+  EXPECT_EQ(v.find("may see it fall"), std::string::npos) << v;  // no warning: MuJoCo's stand is not in doubt
+  rocked.warnings.push_back(std::string(kUncertainWarning) + ": the robot nearly fell (body tilt up to 1.66 deg)");
+  v = caseVerdict({tipped, rocked});
+  EXPECT_EQ(v.rfind("falls:", 0), 0u) << v;
+  EXPECT_NE(v.find("MuJoCo's largest tilt 1.66 deg"), std::string::npos) << v;
+  EXPECT_NE(v.find("MuJoCo's own result is uncertain"), std::string::npos) << v;
+  EXPECT_NE(v.find("a converged MuJoCo run may see it fall too"), std::string::npos) << v;
+}
+
 TEST(Verdict, TheModelsFailureTextsAreTheOnesTheVerdictReads) {
   // A robot that falls in every model (tests/test_tipping.cc's static tip, 30 kg tail): the
   // planar support check and MuJoCo's standing monitor say so in the words caseVerdict looks for.

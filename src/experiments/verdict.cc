@@ -131,6 +131,9 @@ std::string caseVerdict(const std::vector<RunSummary>& runs) {
       s += " (MuJoCo's largest tilt " + (std::isfinite(tilt) ? fmt("%.2f", tilt) : std::string("n/a")) +
            " deg): support margin (the planar check fails the moment the system COM or the centre of pressure "
            "crosses the support edge; MuJoCo's body tilts and comes back before the max_tilt_deg limit)";
+      if (uncertainWarning(*mj->run))
+        s += "; but MuJoCo's own result is uncertain (its warning says why: a near fall, a failed check run, or "
+             "its uncertainty beyond mujoco.uncertainty_warn_share), so a converged MuJoCo run may see it fall too";
     } else {
       s += ": support margin (the analytic model checks the system COM, the per-foot model with load transfer the "
            "centre of pressure shifted by the friction forces)";
