@@ -212,9 +212,8 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
     out.phi_deg = res.summary.phi_net_deg;
     out.wall_s = res.summary.wall_time_s;
     out.steps = res.summary.solver_steps + static_cast<long>(std::lround(s.settle_s / s.timestep_s));
-    // The check run starts where the run's pre-roll ended: its steps are all after t = 0.
     if (const auto u = res.summary.extra.find("uncertainty_solver_steps"); u != res.summary.extra.end())
-      out.steps += static_cast<long>(u->second);
+      out.steps += static_cast<long>(u->second) + static_cast<long>(std::lround(s.settle_s / (2 * s.timestep_s)));
     auto x = [&](const char* k) {
       const auto it = res.summary.extra.find(k);
       return it == res.summary.extra.end() ? NAN : it->second;

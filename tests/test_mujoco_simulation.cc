@@ -432,7 +432,9 @@ TEST(MujocoSimulation, ARestingBodyStepsCoarserWithTheSameAnswer) {
       scale = std::max(scale, std::abs(x[k]));
       diff = std::max(diff, std::abs(x[k] - y[k]));
     }
-    if (name == "t_s") EXPECT_EQ(diff, 0.0);
+    if (name == "t_s") {
+      EXPECT_EQ(diff, 0.0);
+    }
     EXPECT_LE(diff, 1e-4 * scale) << name;
   }
   // A spacing of 0.3 ms is no multiple of the 0.5 ms rest step: every step stays at timestep_s.

@@ -183,6 +183,28 @@ TEST(Tipping, AFallInTheReferenceIsNotAPlainTurnAtTheDefaults) {
                          << d.summary.warnings.size() << " warnings";
 }
 
+// The check run at twice the step runs its own pre-roll: a robot at the edge of standing meets the
+// coarser step from the start. Tippy seed 33, case 38 falls in the converged reference but stands
+// at the defaults, tilted 0.42 deg only (no tilt threshold can tell it from a robot that stands);
+// its check run falls, and that failure is what marks the result uncertain. A check run started
+// from the run's own pre-roll stood and left a plain turn of +48 deg.
+TEST(Tipping, ACheckRunThatFallsMarksTheResultUncertain) {
+  const RandomRobotCase c = randomRobotCase(33, 38, RandomCorpus::kTippy);
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  MujocoSettings s;
+  s.body_height_m = c.robot.quadruped.com_height_m;
+  const RunResult d = simulateMujoco(c.robot, c.trajectory, s, Effects{}, o);
+  ASSERT_TRUE(d.summary.ok) << d.summary.error;
+  EXPECT_LT(d.summary.extra.at("max_tilt_deg"), 0.25 * s.max_tilt_deg) << describe(c);
+  EXPECT_TRUE(std::isnan(d.summary.extra.at("phi_net_uncertainty_deg")));
+  bool failed_check = false;
+  for (const std::string& w : d.summary.warnings)
+    failed_check |= w.rfind(kUncertainWarning, 0) == 0 && w.find("check run") != std::string::npos;
+  EXPECT_TRUE(failed_check) << "phi_net " << d.summary.phi_net_deg << " deg, " << d.summary.warnings.size()
+                            << " warnings";
+}
+
 fs::path writeFile(const fs::path& p, const std::string& text) {
   fs::create_directories(p.parent_path());
   std::ofstream(p) << text;

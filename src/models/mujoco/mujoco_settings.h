@@ -96,8 +96,8 @@ struct MujocoSettings {
   double max_all_feet_off_s = 0.1;      // [s]
   // The run's own error estimate (docs/mujoco-model.md "Uncertainty of a run"): a second run at
   // twice the timestep (servo w_n kept) gives phi_net_uncertainty_deg = 2 |phi_h - phi_2h| + 0.5 %
-  // of max(|phi_net|, 0.5 deg); it starts where the run's pre-roll ended and stops once the body rests
-  // after the stroke (the stroke's steps at 2 h). A result whose uncertainty
+  // of max(|phi_net|, 0.5 deg); it has its own pre-roll and stops once the body rests after the
+  // stroke (the pre-roll and the stroke's steps at 2 h). A result whose uncertainty
   // exceeds uncertainty_warn_share of max(|phi_net|, 0.5 deg) carries a warning.
   bool uncertainty = true;
   double uncertainty_warn_share = 0.1;  // [1]

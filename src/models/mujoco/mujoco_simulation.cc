@@ -11,7 +11,6 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -597,11 +596,9 @@ class StepSchedule {
 // and the warnings of a doubtful result). The stages share the run's state below.
 class MujocoRun {
  public:
-  // How a run starts and ends besides its settings: `start`, a settled state to begin from instead
-  // of a pre-roll (the check run begins where its run's pre-roll ended); `stop_at_rest`, end once the
-  // body rests after the tail's motion (only phi_net is wanted).
+  // How a run ends besides its settings: `stop_at_rest`, once the body rests after the tail's
+  // motion (the check run: only phi_net is wanted).
   struct Options {
-    const SettledState* start = nullptr;
     bool stop_at_rest = false;
   };
 
@@ -647,9 +644,7 @@ class MujocoRun {
     const std::string key =
         settle_cache ? settleKey(xml_, settings_, effects_, robot_.friction, ref0_) : std::string();
     const std::shared_ptr<const SettledState> cached = settle_cache ? settle_cache->impl().find(key) : nullptr;
-    if (options_.start) {
-      restoreSettled(*options_.start, m_, d_, standing_);
-    } else if (cached) {
+    if (cached) {
       restoreSettled(*cached, m_, d_, standing_);
     } else {
       long settle_steps = 0;
@@ -668,13 +663,9 @@ class MujocoRun {
       for (int v = 0; v < m_->nv; ++v) d_->qvel[v] = 0.0;
       if (settle_cache && messages_.text().empty()) settle_cache->impl().keep(key, saveSettled(m_, d_, standing_));
     }
-    settled_ = saveSettled(m_, d_, standing_);
     mj_forward(m_, d_);
     return true;
   }
-
-  // Where the pre-roll ended (valid after settle()).
-  const SettledState& settled() const { return *settled_; }
 
   // The run from t = 0 to its end. Row k is the state at the start of the first step with
   // t >= t_k (exact when the timestep divides sample_dt; otherwise up to one timestep late,
@@ -968,36 +959,33 @@ class MujocoRun {
   double peak_normal_N_ = 0.0;
   double phi_ = 0.0, yaw_prev_ = 0.0, phi0_ = 0.0;  // the unwrapped yaw, the last yaw read, the yaw at t = 0
   long steps_ = 0;
-  std::optional<SettledState> settled_;
 };
 
 // One MuJoCo run at `settings`, without the uncertainty estimate: the stages of a MujocoRun.
-// `settled`, when given, receives the state its pre-roll ended in.
 RunResult runMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
                     const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
                     MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook,
-                    const MujocoRun::Options& options, std::optional<SettledState>* settled) {
+                    const MujocoRun::Options& options) {
   const MujocoPlan plan = planMujocoRun(robot, trajectory, settings, output);
   MujocoRun run(robot, trajectory, settings, effects, output, plan, options);
   if (!run.settle(settle_cache)) return run.failed();
-  if (settled) settled->emplace(run.settled());
   run.stepLoop(observer, hook);
   return run.judge();
 }
 
-// The run's error estimate from a second run at twice the step (run_uncertainty.h). It starts
-// where the run's pre-roll ended (the pre-roll is the same robot standing still, whatever the
-// step) and stops once the body rests after the tail's motion (from there phi_net no longer
-// moves); no time series; its wall time is added to the run's.
+// The run's error estimate from a second run at twice the step (run_uncertainty.h): its own
+// pre-roll at 2 h (not the run's settle cache, whose hit and miss counts are the runs'), so that a
+// robot at the edge of standing meets the coarser step from the start; it stops once the body
+// rests after the tail's motion (from there phi_net no longer moves); no time series; its wall
+// time is added to the run's.
 void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
-                    const Effects& effects, const OutputSettings& output, const SettledState& start,
-                    RunResult& fine) {
+                    const Effects& effects, const OutputSettings& output, RunResult& fine) {
   const MujocoSettings coarse = checkRunSettings(settings);
   OutputSettings quiet = output;
   quiet.time_series = TimeSeriesOutput::kNone;
   const auto wall0 = std::chrono::steady_clock::now();
   const RunResult check = runMujoco(robot, trajectory, coarse, effects, quiet, nullptr, nullptr, nullptr,
-                                    MujocoRun::Options{&start, true}, nullptr);
+                                    MujocoRun::Options{true});
   fine.summary.wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   applyCheckRun(fine.summary, check.summary, coarse.timestep_s, settings.uncertainty_warn_share,
                 "lower mujoco.timestep_s or see `tailsim trust`");
@@ -1008,12 +996,11 @@ void addUncertainty(const RobotParams& robot, const TailTrajectory& trajectory, 
 RunResult simulateMujoco(const RobotParams& robot, const TailTrajectory& trajectory, const MujocoSettings& settings,
                          const Effects& effects, const OutputSettings& output, const MujocoSampleObserver& observer,
                          MujocoSettleCache* settle_cache, const MujocoTrajectoryHook& hook) {
-  std::optional<SettledState> settled;
   RunResult r = runMujoco(robot, trajectory, settings, effects, output, observer, settle_cache, hook,
-                          MujocoRun::Options{}, &settled);
+                          MujocoRun::Options{});
   // A run steered by a hook decides its reference as it goes: a second run would steer differently.
   if (settings.uncertainty && r.summary.ok && !hook)
-    addUncertainty(robot, trajectory, settings, effects, output, *settled, r);
+    addUncertainty(robot, trajectory, settings, effects, output, r);
   return r;
 }
 
