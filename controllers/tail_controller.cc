@@ -38,7 +38,7 @@ void TailController::setTrajectory(TailTrajectory trajectory) {
   traj_ = std::move(trajectory);
 }
 
-void TailController::apply(const mjModel* m, mjData* d, double t_ref, bool record) {
+void TailController::apply(const mjModel* m, mjData* d, double t_ref, bool record, double weight) {
   traj_.evaluate(t_ref, ref_);
   const size_t n = ref_.size();
   for (size_t i = 0; i < n; ++i) {
@@ -55,9 +55,10 @@ void TailController::apply(const mjModel* m, mjData* d, double t_ref, bool recor
   if (record) {
     for (size_t i = 0; i < n; ++i) {
       max_abs_[i] = std::max(max_abs_[i], std::abs(err_[i]));
-      sum_sq_[i] += err_[i] * err_[i];
+      sum_sq_[i] += weight * err_[i] * err_[i];
     }
     ++n_;
+    weight_sum_ += weight;
   }
 }
 
@@ -65,7 +66,7 @@ TrackingStats TailController::stats() const {
   TrackingStats s;
   s.samples = n_;
   s.max_abs_rad = max_abs_;
-  for (double q : sum_sq_) s.rms_rad.push_back(n_ > 0 ? std::sqrt(q / n_) : 0.0);
+  for (double q : sum_sq_) s.rms_rad.push_back(weight_sum_ > 0.0 ? std::sqrt(q / weight_sum_) : 0.0);
   return s;
 }
 
@@ -73,6 +74,7 @@ void TailController::resetStats() {
   max_abs_.assign(qposadr_.size(), 0.0);
   sum_sq_.assign(qposadr_.size(), 0.0);
   n_ = 0;
+  weight_sum_ = 0.0;
 }
 
 }  // namespace tailsim

@@ -32,7 +32,7 @@ struct TailControllerOptions {
 // Per-joint tracking error theta - theta_ref over the recorded steps.
 struct TrackingStats {
   std::vector<double> max_abs_rad;  // max |e|  [rad]
-  std::vector<double> rms_rad;      // sqrt(mean e^2)  [rad]
+  std::vector<double> rms_rad;      // sqrt(mean e^2), the mean over time  [rad]
   long samples = 0;
 };
 
@@ -45,8 +45,9 @@ class TailController {
 
   // Call between mj_step1 and mj_step2 (or after mj_forward): reference at time t_ref, writes
   // d->ctrl and d->qfrc_applied of the tail dofs; records the tracking error at the current
-  // state when `record` is set.
-  void apply(const mjModel* m, mjData* d, double t_ref, bool record);
+  // state when `record` is set, weighted by `weight` in the RMS (a step k times as long as the
+  // others counts k times, so that the RMS is over time).
+  void apply(const mjModel* m, mjData* d, double t_ref, bool record, double weight = 1.0);
 
   // Replaces the reference (same number of joints; throws std::invalid_argument otherwise). For a
   // trajectory decided stroke by stroke (MujocoTrajectoryHook): the new one should continue the old
@@ -70,6 +71,7 @@ class TailController {
   std::vector<double> err_, max_abs_, sum_sq_;
   std::vector<mjtNum> qacc_des_, tau_;
   long n_ = 0;
+  double weight_sum_ = 0.0;
 };
 
 }  // namespace tailsim

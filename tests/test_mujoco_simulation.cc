@@ -446,8 +446,8 @@ TEST(MujocoSimulation, ARestingBodyStepsCoarserWithTheSameAnswer) {
   EXPECT_EQ(c.summary.phi_net_deg, d.summary.phi_net_deg);
 }
 
-// The check run at twice the step begins where the run's pre-roll ended and stops once the body
-// rests after the stroke: it costs the stroke's steps at 2 h, not the whole run's again.
+// The check run at twice the step (its own pre-roll) stops once the body rests after the stroke:
+// it costs the stroke's steps at 2 h, not the whole run's again.
 TEST(MujocoSimulation, TheCheckRunStopsOnceTheBodyRests) {
   MujocoSettings s;
   OutputSettings o;

@@ -564,11 +564,18 @@ bool speedsAtRest(const mjModel* m, const mjData* d) {
 // run, and only where H divides the output spacing, so that every row stays on its grid.
 class StepSchedule {
  public:
-  StepSchedule(double h, int factor, double tail_end_s, double duration_s, double sample_dt_s, bool allowed)
+  // `allowed`: the run may coarsen (no controller steering it, not RK4). The coarse step must also
+  // leave the contact as it is (solref's time constant at least 2 H, else MuJoCo raises it: a
+  // softer floor at rest) and keep the servo's explicit spring well inside its stable range
+  // (w_n H <= 1; its damper is implicit), and an even number of it must make an output row, so
+  // that each row's averaging window [t_k - dt/2, t_k + dt/2) stays made of whole steps.
+  StepSchedule(double h, int factor, double tail_end_s, double duration_s, double sample_dt_s, double solref_s,
+               double servo_wn_radps, bool allowed)
       : h_(h), H_(h * factor), tail_end_(tail_end_s), end_(duration_s) {
-    const double per_row = sample_dt_s / H_;
-    allowed_ = allowed && factor > 1 && per_row >= 1.0 - 1e-9 &&
-               std::abs(per_row - std::round(per_row)) < 1e-9 * per_row;
+    const double per_two = sample_dt_s / (2.0 * H_);
+    allowed_ = allowed && factor > 1 && per_two >= 1.0 - 1e-9 &&
+               std::abs(per_two - std::round(per_two)) < 1e-9 * per_two && solref_s >= 2.0 * H_ * (1.0 - 1e-9) &&
+               servo_wn_radps * H_ <= 1.0 + 1e-9;
   }
   // After the step that ended at t: whether the state rests, and the length of the next step.
   double next(double t, bool speeds_at_rest) {
@@ -578,7 +585,7 @@ class StepSchedule {
     }
     if (rest_since_ < 0.0) rest_since_ = t;
     if (!rested(t) || !allowed_) return h_;
-    const bool on_grid = std::abs(t / H_ - std::round(t / H_)) < 1e-6;
+    const bool on_grid = std::abs(t - std::round(t / H_) * H_) < 1e-6 * h_;
     return on_grid && t + H_ <= end_ + 1e-6 * h_ ? H_ : h_;
   }
   // The body has rested for kRestHoldS after the tail's motion.
@@ -677,8 +684,12 @@ class MujocoRun {
     long k = 0;
     std::vector<mjtNum> qpos_t(m_->nq), qvel_t(m_->nv), qacc_t(m_->nv);
     ImpulseAverager averager(output_.sample_dt_s, h, plan_.rows, cols_, ts_);
+    // The servo's w_n is known where the gains come from it (kp = 0); its damper is implicit only
+    // with the implicit integrator; a direct solref (<= 0) has no time constant to keep.
+    const double servo_wn = settings_.kp == 0.0 ? settings_.servo_wn_dt / h : HUGE_VAL;
     StepSchedule schedule(h, settings_.rest_step_factor, ctrl_.trajectory().endTime(), duration,
-                          output_.sample_dt_s, !rk4_ && !hook);
+                          output_.sample_dt_s, settings_.solref[0] > 0.0 ? settings_.solref[0] : 0.0, servo_wn,
+                          settings_.integrator == MujocoIntegrator::kImplicit && !hook);
     phi_ = yaw_prev_ = phi0_ = yawOf(d_, L_.quad_body);
     const auto wall0 = std::chrono::steady_clock::now();
     // Runs to the end of the simulated time even when the output grid ends earlier (a spacing that
@@ -715,7 +726,7 @@ class MujocoRun {
         step(t, true, &loads_);
       } else {
         std::copy(d_->qvel, d_->qvel + m_->nv, qvel_s_.begin());
-        step(t, true, nullptr);
+        step(t, true, nullptr, h_step / h);
       }
       ++steps_;
       if (steps_ > settings_.max_steps) {
@@ -873,11 +884,12 @@ class MujocoRun {
  private:
   // One step. RK4 with `rk4_loads`: also the loads of the state the step starts from (RK4 overwrites
   // the intermediate fields, so they are taken before it; the step's impulse is then h times them).
-  void step(double t_ref, bool record, Loads* rk4_loads) {
+  // `weight`: this step's length in timestep_s (the step schedule), for the tracking RMS over time.
+  void step(double t_ref, bool record, Loads* rk4_loads, double weight = 1.0) {
     if (continuous_) updateFootFriction(m_, d_, L_, robot_.friction);
     if (rk4_) {
       mj_forward(m_, d_);  // M, bias at this state for the feed-forward; ctrl is held over the RK4 step
-      ctrl_.apply(m_, d_, t_ref, record);
+      ctrl_.apply(m_, d_, t_ref, record, weight);
       if (rk4_loads) {
         std::copy(d_->qvel, d_->qvel + m_->nv, qvel_s_.begin());
         std::copy(d_->qacc, d_->qacc + m_->nv, qacc_s_.begin());
@@ -886,7 +898,7 @@ class MujocoRun {
       mj_step(m_, d_);
     } else {
       mj_step1(m_, d_);
-      ctrl_.apply(m_, d_, t_ref, record);
+      ctrl_.apply(m_, d_, t_ref, record, weight);
       mj_step2(m_, d_);
     }
   }
@@ -905,6 +917,7 @@ class MujocoRun {
   // servo gains) also throws the body over, usually a few steps before MuJoCo's own warning. Look
   // 0.05 s further: if MuJoCo then warns, the cause is the step, not the robot's balance.
   void fellOver(double t) {
+    m_->opt.timestep = settings_.timestep_s;
     const long look = std::max(1L, std::lround(0.05 / settings_.timestep_s));
     bool unstable = false;
     double t_bad = t;
