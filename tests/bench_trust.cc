@@ -229,19 +229,6 @@ Run runOnce(const RobotParams& r, const TailTrajectory& t, const MujocoSettings&
   return out;
 }
 
-// The per-foot model with load transfer (rigid Coulomb friction at four point feet), for scale.
-double perFootPhi(const RobotParams& r, const TailTrajectory& t) {
-  OutputSettings o;
-  o.time_series = TimeSeriesOutput::kNone;
-  PerFootSettings p;
-  p.normal_loads = NormalLoadModel::kLoadTransfer;
-  try {
-    const RunResult res = simulatePerFoot(r, t, p, Effects{}, o);
-    return res.summary.ok ? res.summary.phi_net_deg : NAN;
-  } catch (const std::exception&) {
-    return NAN;
-  }
-}
 
 std::string key(const MujocoSettings& s) {
   std::ostringstream os;
@@ -350,6 +337,12 @@ RunSummary perFootSummary(const RobotParams& r, const TailTrajectory& t) {
     s.error = e.what();
     return s;
   }
+}
+
+// The per-foot model with load transfer (rigid Coulomb friction at four point feet), for scale.
+double perFootPhi(const RobotParams& r, const TailTrajectory& t) {
+  const RunSummary s = perFootSummary(r, t);
+  return s.ok ? s.phi_net_deg : NAN;
 }
 
 // A run with the tilt check off (max_tilt_deg 0, no check run): does it rock back or topple? Its

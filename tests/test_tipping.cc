@@ -151,6 +151,20 @@ TEST(Tipping, StaticTipIsCaughtWhileSettling) {
   EXPECT_TRUE(m.summary.extra.count("max_tilt_deg"));
 }
 
+// A random robot's MuJoCo settings at the defaults (its COM height as the body's), and an output
+// without time series.
+MujocoSettings defaultsFor(const RandomRobotCase& c) {
+  MujocoSettings s;
+  s.body_height_m = c.robot.quadruped.com_height_m;
+  return s;
+}
+
+OutputSettings noSeries() {
+  OutputSettings o;
+  o.time_series = TimeSeriesOutput::kNone;
+  return o;
+}
+
 // A robot the converged reference sees fall is never a plain turn at the defaults. Case 11 of the
 // tippy corpus, seed 31 (tests/bench_trust.cc --corpus tippy --falls; 44 kg, 0.27 m x 0.09 m,
 // COM 0.15 m high, a 13.8 kg 3-link tail flicked 49 deg in 0.13 s): the reference (timestep / 8,
@@ -158,10 +172,8 @@ TEST(Tipping, StaticTipIsCaughtWhileSettling) {
 // with it within 0.3 deg, so only the tilt can tell.
 TEST(Tipping, AFallInTheReferenceIsNotAPlainTurnAtTheDefaults) {
   const RandomRobotCase c = randomRobotCase(31, 11, RandomCorpus::kTippy);
-  OutputSettings o;
-  o.time_series = TimeSeriesOutput::kNone;
-  MujocoSettings s;
-  s.body_height_m = c.robot.quadruped.com_height_m;
+  const OutputSettings o = noSeries();
+  const MujocoSettings s = defaultsFor(c);
   MujocoSettings ref = s;
   ref.timestep_s /= 8.0;
   ref.servo_wn_dt /= 8.0;
@@ -190,11 +202,8 @@ TEST(Tipping, AFallInTheReferenceIsNotAPlainTurnAtTheDefaults) {
 // from the run's own pre-roll stood and left a plain turn of +48 deg.
 TEST(Tipping, ACheckRunThatFallsMarksTheResultUncertain) {
   const RandomRobotCase c = randomRobotCase(33, 38, RandomCorpus::kTippy);
-  OutputSettings o;
-  o.time_series = TimeSeriesOutput::kNone;
-  MujocoSettings s;
-  s.body_height_m = c.robot.quadruped.com_height_m;
-  const RunResult d = simulateMujoco(c.robot, c.trajectory, s, Effects{}, o);
+  const MujocoSettings s = defaultsFor(c);
+  const RunResult d = simulateMujoco(c.robot, c.trajectory, s, Effects{}, noSeries());
   ASSERT_TRUE(d.summary.ok) << d.summary.error;
   EXPECT_LT(d.summary.extra.at("max_tilt_deg"), 0.25 * s.max_tilt_deg) << describe(c);
   EXPECT_TRUE(std::isnan(d.summary.extra.at("phi_net_uncertainty_deg")));
