@@ -134,9 +134,12 @@ TEST(StrokeDesign, YawOnlySearchGivesTheFullModelsPhiNet) {
 }
 
 // A returned optimum keeps every limit on the trajectory the model actually ran (its CSV columns),
-// not as the optimiser claims: both families, with a torque limit that binds.
+// not as the optimiser claims: both families, with a torque limit that binds, over_torque penalize
+// and slow_down.
 TEST(StrokeDesign, LimitsNeverViolatedOnTheResimulatedOptimum) {
+  for (const bool slow : {false, true})
   for (StrokeFamily fam : {StrokeFamily::kSplitCycle, StrokeFamily::kSpline}) {
+    SCOPED_TRACE(slow ? "slow_down" : "penalize");
     StrokeProblem p;
     p.base = baseCase(2);
     p.space.family = fam;
@@ -147,6 +150,8 @@ TEST(StrokeDesign, LimitsNeverViolatedOnTheResimulatedOptimum) {
     p.space.limits.thetadot_max_radps = 500 * kDeg;
     p.space.limits.torque_max_Nm = 6.0;
     p.space.limits.t0_max_s = 0.05;
+    p.space.slow_down_over_torque = slow;
+    p.space.tail = p.base.robot.tail;
     const OptimizeResult r = optimizeStroke(p, smallBudget());
     ASSERT_TRUE(r.best.feasible()) << familyName(fam);
     const TailTrajectory traj = p.space.trajectory(r.x);
@@ -223,6 +228,98 @@ TEST(StrokeDesign, FindsTheBruteForceOptimum) {
   EXPECT_TRUE(r.best.feasible());
   EXPECT_GE(r.best.objective, grid_best * (1 - 1e-3)) << "grid " << grid_best << " optimiser " << r.best.objective;
   EXPECT_GE(r.best.objective, r.start.objective);  // never worse than where it started (Eq. 25)
+}
+
+// limits.over_torque: slow_down. Every stroke over a joint's torque limit is the same motion slowed
+// by one factor s: angles, w_ss and the joints' relative timing unchanged, each torque at s t the raw
+// one's at t over s^2 (the fixed-base Newton-Euler recursion, an independent closed form), and the
+// peak on the limit unless a duration or delay reached its range's end. Strokes within the limits
+// are untouched. Per-joint limits, both families.
+TEST(StrokeDesign, SlowDownMeetsTheTorqueLimitWithTheSameMotion) {
+  const ExperimentCase base = baseCase(3);
+  std::mt19937 rng(35);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  int untouched = 0, on_limit = 0, capped = 0;
+  double lowest = 1.0;
+  for (const StrokeFamily family : {StrokeFamily::kSplitCycle, StrokeFamily::kSpline}) {
+    StrokeSpace raw;
+    raw.family = family;
+    raw.n_links = 3;
+    raw.knots = 2;
+    raw.limits.t0_max_s = 0.1;
+    raw.limits.dT_min_s = 0.05;
+    raw.limits.dT_max_s = 1.0;
+    raw.limits.joints = {{-M_PI / 2, M_PI / 2, 600 * kDeg, 12.0}, {-M_PI / 2, M_PI / 2, 600 * kDeg, 6.0},
+                         {-M_PI / 2, M_PI / 2, 600 * kDeg, 0.0 /* none */}};
+    StrokeSpace slow = raw;
+    slow.slow_down_over_torque = true;
+    slow.tail = base.robot.tail;
+    for (int k = 0; k < 200; ++k) {
+      std::vector<double> x(static_cast<std::size_t>(raw.dim()));
+      for (double& v : x) v = u01(rng);
+      const TailTrajectory a = raw.trajectory(x), b = slow.trajectory(x);
+      const StrokeFigures fa = strokeFigures(base.robot.tail, a), fb = strokeFigures(base.robot.tail, b);
+      double over = 0.0, after = 0.0;  // the largest peak / limit before and after
+      for (std::size_t i = 0; i < 2; ++i) {
+        over = std::max(over, fa.joints[i].peak_torque_Nm / raw.limits.joints[i].torque_max_Nm);
+        after = std::max(after, fb.joints[i].peak_torque_Nm / raw.limits.joints[i].torque_max_Nm);
+      }
+      auto dT = [](const JointProfile& j) { return j.isSpline() ? j.spline().dT_s : j.params().dT_s; };
+      auto t0 = [](const JointProfile& j) { return j.isSpline() ? j.spline().t0_s : j.params().t0_s; };
+      const double s = dT(b.joints[0]) / dT(a.joints[0]);
+      if (over <= 1.0 + 1e-9) {
+        EXPECT_EQ(s, 1.0) << "a stroke within its limits is left as it is";
+        ++untouched;
+        continue;
+      }
+      bool at_range_end = false;
+      for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_NEAR(dT(b.joints[i]), s * dT(a.joints[i]), 1e-12 * s);
+        EXPECT_NEAR(t0(b.joints[i]), s * t0(a.joints[i]), 1e-12 * s);
+        if (family == StrokeFamily::kSplitCycle) {
+          EXPECT_EQ(b.joints[i].params().theta0_rad, a.joints[i].params().theta0_rad);
+          EXPECT_EQ(b.joints[i].params().dtheta_rad, a.joints[i].params().dtheta_rad);
+          EXPECT_EQ(b.joints[i].params().w_ss, a.joints[i].params().w_ss);
+        } else {
+          EXPECT_EQ(b.joints[i].spline().knots_rad, a.joints[i].spline().knots_rad);
+        }
+        at_range_end = at_range_end || dT(b.joints[i]) >= raw.limits.dT_max_s * (1 - 1e-12) ||
+                       (t0(b.joints[i]) > 0 && t0(b.joints[i]) >= raw.limits.t0_max_s * (1 - 1e-12));
+      }
+      if (!at_range_end) {
+        ASSERT_GT(s, 1.0);
+      }
+      for (const double t : {0.013, 0.071, 0.19, 0.33}) {  // tau_b(s t) = tau_a(t) / s^2
+        std::vector<JointState> ja, jb;
+        a.evaluate(t, ja);
+        b.evaluate(s * t, jb);
+        const std::vector<double> ta = jointTorques(base.robot.tail, ja), tb = jointTorques(base.robot.tail, jb);
+        for (std::size_t i = 0; i < 3; ++i) {
+          EXPECT_NEAR(jb[i].theta, ja[i].theta, 1e-9);
+          EXPECT_NEAR(tb[i], ta[i] / (s * s), 1e-9 * std::max(1.0, std::abs(ta[i])));
+        }
+      }
+      if (at_range_end) {  // slowed as far as the ranges allow: still over, by less (up to the sampling)
+        EXPECT_LE(after, over * (1 + 1e-2));
+        capped += s > 1.0;
+      } else {
+        EXPECT_LE(after, 1.0 + 1e-9);
+        // On the limit, up to the figures' 0.5 ms sampling grid (the slowed stroke's grid samples
+        // other phases of the motion than the raw one's).
+        EXPECT_GT(after, 0.99) << "the peak torque sits on the limit";
+        lowest = std::min(lowest, after);
+        if (family == StrokeFamily::kSplitCycle) {
+          EXPECT_EQ(limitViolation(fb, slow.limits), 0.0);
+        }
+        ++on_limit;
+      }
+    }
+  }
+  // Every branch is exercised.
+  std::printf("untouched %d on_limit %d (lowest peak / limit %.6f) capped %d\n", untouched, on_limit, lowest, capped);
+  EXPECT_GT(untouched, 5);
+  EXPECT_GT(on_limit, 20);
+  EXPECT_GT(capped, 5);
 }
 
 TEST(StrokeDesign, SameSeedSameResult) {
@@ -615,6 +712,13 @@ TEST_F(OptimizeFileTest, GoodFileLoads) {
   EXPECT_EQ(u.optimizer.local_step, 0.2);
   EXPECT_TRUE(u.optimizer.enumerate_directions);
   EXPECT_EQ(u.optimizer.directions_kept, 2);
+  // over_torque: penalize by default; slow_down gives the space the base's tail for its torques.
+  EXPECT_FALSE(u.problem.space.slow_down_over_torque);
+  const OptimizeSpec v = loadOptimizeSpec(write(
+      "  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 2, over_torque: slow_down}\n"));
+  EXPECT_TRUE(v.problem.space.slow_down_over_torque);
+  EXPECT_EQ(v.problem.space.tail.size(), 1u);
+  EXPECT_EQ(v.problem.space.tail.at(0).mass_kg, v.base.robot.tail.at(0).mass_kg);
 }
 
 TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
@@ -633,6 +737,8 @@ TEST_F(OptimizeFileTest, BadSettingsNameFileLineColumnAndKey) {
        "6:63: optimize.limits.w_ss: ", "only used with family: split_cycle"},
       {"  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, end: start}\n",
        "6:62: optimize.limits.end: ", "cannot end where it started"},
+      {"  family: split_cycle\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, over_torque: slower}\n",
+       "6:70: optimize.limits.over_torque: ", "not one of: penalize, slow_down"},
       {"  family: spline\n  limits: {theta_deg: [-90, 90], thetadot_max_dps: -5}\n", "6:52: optimize.limits.thetadot_max_dps: ",
        "must lie in"},
       {"  family: spline\n  limits: {theta_deg: [-90, 90]}\n", "6:11: optimize.limits.thetadot_max_dps: ", "required key is missing"},

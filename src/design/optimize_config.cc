@@ -201,6 +201,7 @@ LimitKeys readLimits(const Reader& r, const Map& l, StrokeSpace& sp) {
     L.w_ss_max = b;
   }
   if (const Val* t = Reader::get(l, "start_delay_s")) L.t0_max_s = r.inRange(*t, 0.0, 10.0);
+  if (const Val* v = Reader::get(l, "over_torque")) sp.slow_down_over_torque = r.choice(*v, {"penalize", "slow_down"}) == "slow_down";
   return k;
 }
 
@@ -439,6 +440,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
   }
   resolveJointLimits(r, lv, s.base, lk.theta, lk.speed, lk.torque, lk.torque_word, L);
   requireSearchableLimits(r, lv, s);
+  sp.tail = s.base.robot.tail;
   s.problem.base = s.base;
   return s;
 }

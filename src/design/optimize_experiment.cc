@@ -626,6 +626,7 @@ void summarizeSettings(const OptimizeSpec& spec, nlohmann::json& j) {
   j["directions"] = spec.optimizer.enumerate_directions ? "enumerate" : "free";
   j["directions_kept"] = spec.optimizer.directions_kept;
   j["polish"] = spec.optimizer.polish;
+  j["over_torque"] = prob.space.slow_down_over_torque ? "slow_down" : "penalize";
 }
 
 // summary.json's search results: start, seeds, directions, the best stroke and its joints.

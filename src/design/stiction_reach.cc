@@ -36,22 +36,4 @@ StictionReach stictionReach(const ExperimentCase& base, const TailTrajectory& tr
   return r;
 }
 
-TailTrajectory timeScaled(const TailTrajectory& traj, double k) {
-  TailTrajectory out;
-  for (const JointProfile& j : traj.joints) {
-    if (j.isSpline()) {
-      SplineParams s = j.spline();
-      s.dT_s /= k;
-      s.t0_s /= k;
-      out.joints.emplace_back(s);
-    } else {
-      SplitCycleParams p = j.params();
-      p.dT_s /= k;
-      p.t0_s /= k;
-      out.joints.emplace_back(p);
-    }
-  }
-  return out;
-}
-
 }  // namespace tailsim

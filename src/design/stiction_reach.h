@@ -21,8 +21,4 @@ struct StictionReach {
 // strokeFigures), body and translation held stuck, with searchEffects(base).
 StictionReach stictionReach(const ExperimentCase& base, const TailTrajectory& traj, double dt = 5e-4);
 
-// The same stroke run k times faster (every duration and start delay divided by k): joint speeds
-// scale by k, joint torques and the tail's loads on the body (all inertial) by k^2.
-TailTrajectory timeScaled(const TailTrajectory& traj, double k);
-
 }  // namespace tailsim

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 #include "models/planar/tail_dynamics.h"
@@ -55,7 +56,70 @@ TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const {
       t.joints.emplace_back(s);
     }
   }
-  return t;
+  return slow_down_over_torque ? slowedToTorqueLimit(tail, limits, t) : t;
+}
+
+TailTrajectory timeScaled(const TailTrajectory& traj, double k) {
+  TailTrajectory out;
+  for (const JointProfile& j : traj.joints) {
+    if (j.isSpline()) {
+      SplineParams s = j.spline();
+      s.dT_s /= k;
+      s.t0_s /= k;
+      out.joints.emplace_back(s);
+    } else {
+      SplitCycleParams p = j.params();
+      p.dT_s /= k;
+      p.t0_s /= k;
+      out.joints.emplace_back(p);
+    }
+  }
+  return out;
+}
+
+TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t) {
+  auto peakOverLimit = [&](const TailTrajectory& u) {  // the largest peak torque / its limit (0: no limit)
+    const StrokeFigures f = strokeFigures(links, u);
+    double ratio = 0.0;
+    for (std::size_t i = 0; i < f.joints.size(); ++i) {
+      const JointLimits J = L.joint(i);
+      if (J.torque_max_Nm > 0.0) ratio = std::max(ratio, f.joints[i].peak_torque_Nm / J.torque_max_Nm);
+    }
+    return ratio;
+  };
+  auto kept = [](double ratio) { return !exceedsLimit(ratio, 1.0); };
+  double ratio = peakOverLimit(t);
+  if (kept(ratio)) return t;
+  double s_max = std::numeric_limits<double>::infinity();  // where a duration or delay reaches its range's end
+  for (const JointProfile& j : t.joints) {
+    const double dT = j.isSpline() ? j.spline().dT_s : j.params().dT_s;
+    const double t0 = j.isSpline() ? j.spline().t0_s : j.params().t0_s;
+    if (dT > 0.0) s_max = std::min(s_max, L.dT_max_s / dT);
+    if (t0 > 0.0) s_max = std::min(s_max, L.t0_max_s / t0);
+  }
+  // Torques scale with 1/s^2 up to the figures' fixed 0.5 ms sampling grid, which samples the slowed
+  // motion at other phases: a few corrections s <- s sqrt(peak / limit), each from the slowed
+  // stroke's own figures, ending on the smallest factor seen that keeps the limit.
+  s_max = std::max(1.0, s_max);
+  double s = 1.0, s_kept = std::numeric_limits<double>::infinity();
+  TailTrajectory out = t, best;
+  for (int it = 0; it < 8; ++it) {
+    if (kept(ratio) && s < s_kept) {
+      s_kept = s;
+      best = out;
+      if (ratio > 1.0 - 1e-7) break;
+    }
+    // A margin over the limit's rounding, grown from the 4th correction on (the grid can keep a
+    // stroke a hair over the limit correction after correction).
+    const double margin = it < 3 ? 1e-9 : std::pow(10.0, it - 9);
+    const double next = std::min(s_max, std::max(1.0, s * std::sqrt(ratio) * (1.0 + margin)));
+    if (next == s) break;
+    s = next;
+    out = timeScaled(t, 1.0 / s);
+    ratio = peakOverLimit(out);
+  }
+  if (kept(ratio) && s < s_kept) return out;
+  return std::isfinite(s_kept) ? best : out;  // none kept: capped by the ranges, still over
 }
 
 std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& joints) const {

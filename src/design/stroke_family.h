@@ -56,6 +56,14 @@ struct StrokeSpace {
   // (free); empty = all free. With a direction, the point's second coordinate is the share of the
   // way from the start angle to the angle limit on that side.
   std::vector<int> directions;
+  // limits.over_torque: slow_down. A stroke whose peak joint torque (tail base held still: `tail`'s
+  // torques) exceeds a joint's limit is slowed in time, every joint's duration and start delay by
+  // one factor s >= 1, until it meets the limit (those torques scale with 1/s^2; speeds fall as
+  // 1/s), or as far as the dT and start-delay ranges allow (it then stays over the limit);
+  // slowedToTorqueLimit.
+  // false (penalize): the stroke is searched as it is and an excess counts as a violation.
+  bool slow_down_over_torque = false;
+  std::vector<TailLink> tail;
 
   int dimPerJoint() const;
   int dim() const { return n_links * dimPerJoint(); }
@@ -63,6 +71,16 @@ struct StrokeSpace {
   // The unit-box point of a split-cycle trajectory (the search's start); entries are clamped.
   std::vector<double> pointOf(const std::vector<SplitCycleParams>& joints) const;
 };
+
+// The same stroke run k times faster (every duration and start delay divided by k): joint speeds
+// scale by k, joint torques and the tail's loads on the body (all inertial) by k^2.
+TailTrajectory timeScaled(const TailTrajectory& traj, double k);
+
+// StrokeSpace::slow_down_over_torque: t itself when it keeps L's torque limits; else t slowed by the
+// smallest s >= 1 that brings every joint's peak torque (strokeFigures of links) within L, capped
+// where a joint's dT would pass L.dT_max_s or its start delay L.t0_max_s (the stroke then stays over
+// the limit).
+TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t);
 
 // Joint torques tau_i = M_J,i (the Newton-Euler recursion of Eqs. 5-7, tail base held still).
 std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints);

@@ -39,6 +39,7 @@ struct OptimizeLimitsSection {
   std::array<double, 2> dT_s{0.05, 1.0};
   std::array<double, 2> w_ss{0.05, 0.95};
   double start_delay_s = 0.0;
+  std::string over_torque = "penalize";
 };
 
 // The optimize: section. Required: family and limits.
@@ -97,6 +98,9 @@ settings::For<S, OptimizeLimitsSection> declareFields(V& v, S& s) {
   v.interval(Field{"dT_s", "stroke duration range [s]"}, s.dT_s, Limits::closed(0.01, 10));
   v.interval(Field{"w_ss", "split_cycle only: acceleration share range"}, s.w_ss, Limits::closed(0.01, 0.99));
   v.number(Field{"start_delay_s", "per-joint start delay range [0, this] [s]"}, s.start_delay_s, Limits::closed(0, 10));
+  v.text(Field{"over_torque", "a stroke over the torque limit: penalize (searched as it is, the excess a violation) "
+                              "or slow_down (slowed in time by one factor until its peak torque meets the limit)"},
+         s.over_torque, settings::TextRule{false, {"penalize", "slow_down"}});
 }
 
 template <class V, class S>
