@@ -322,6 +322,41 @@ TEST(StrokeDesign, SlowDownMeetsTheTorqueLimitWithTheSameMotion) {
   EXPECT_GT(capped, 5);
 }
 
+// Stuck strokes (the body does not turn) rank by how close they come to breaking away, in a band
+// CMA-ES can see: its tolerance stops a generation whose fitnesses differ by less than 1e-9. With a
+// band of 1e-12 the 3 kg robot's single-start search (2 x 12 x 450 generations, COBYLA 300, seed 17)
+// stopped after its first population, all stuck, and reported "no stroke within the limits turns the
+// body", while other seeds turn it 1.39 deg.
+TEST(StrokeDesign, StuckStrokesRankAboveCmaesToleranceAndBelowEveryTurn) {
+  StrokeEvaluation a, b, turn;
+  a.ok = b.ok = turn.ok = true;
+  a.stiction_ratio = 0.5;
+  b.stiction_ratio = 0.501;
+  turn.objective = 1e-12;  // the smallest turn still ranks above every stuck stroke
+  EXPECT_GT(a.fitness() - b.fitness(), 1e-9 * 100);
+  EXPECT_LT(turn.fitness(), b.fitness());
+  StrokeEvaluation stuck_near_one = a;
+  stuck_near_one.stiction_ratio = 0.999999;
+  EXPECT_LT(turn.fitness(), stuck_near_one.fitness());
+  StrokeEvaluation over = a;
+  over.violation = 1e-6;
+  EXPECT_GT(over.fitness(), a.fitness());  // every infeasible point below every feasible one
+
+  const fs::path dir = fs::temp_directory_path() / ("tailsim_stuck_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path f = dir / "o.yaml";
+  std::ofstream(f) << "name: o\nkind: optimize\nbase: " << kSourceDir << "/configs/design/base/small_n2.yaml\n"
+                   << "optimize:\n  family: split_cycle\n  limits: {dT_s: [0.05, 1.0], start_delay_s: 0.1}\n"
+                   << "  islands: 2\n  population: 12\n  generations: 450\n  polish_evaluations: 300\n  seeds: [17]\n";
+  const OptimizeSpec spec = loadOptimizeSpec(f.string());
+  fs::remove_all(dir);
+  OptimizerSettings os = spec.optimizer;
+  os.seed = 17;
+  const OptimizeResult r = optimizeStroke(spec.problem, os);
+  EXPECT_GT(r.evaluations, 5000);
+  EXPECT_GT(std::abs(r.best.phi_net_rad) / kDeg, 1.0);
+}
+
 TEST(StrokeDesign, SameSeedSameResult) {
   StrokeProblem p;
   p.base = baseCase(1);

@@ -29,7 +29,7 @@ namespace tailsim {
 double StrokeEvaluation::fitness() const {
   if (!ok) return 10.0;
   if (violation > 0.0) return violation;
-  return objective > 0.0 ? -objective : -1e-12 * stiction_ratio;
+  return -score();
 }
 
 Effects searchEffects(const ExperimentCase& base) {
@@ -374,7 +374,7 @@ class SpaceSearch {
           auto* c = static_cast<Ctx*>(data);
           const StrokeEvaluation& e = c->eval(x);
           if (!e.ok) return -10.0;
-          return c->bobyqa ? -e.fitness() : e.objective;
+          return c->bobyqa ? -e.fitness() : e.score();
         },
         &ctx);
     if (s_.polish == "cobyla")
