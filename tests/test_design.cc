@@ -338,6 +338,9 @@ TEST(StrokeDesign, StuckStrokesRankAboveCmaesToleranceAndBelowEveryTurn) {
   StrokeEvaluation stuck_near_one = a;
   stuck_near_one.stiction_ratio = 0.999999;
   EXPECT_LT(turn.fitness(), stuck_near_one.fitness());
+  StrokeEvaluation stuck_over_one = a;  // the analytic stiction ratio of a stroke another model found stuck
+  stuck_over_one.stiction_ratio = 3.0;
+  EXPECT_LT(turn.fitness(), stuck_over_one.fitness());
   StrokeEvaluation over = a;
   over.violation = 1e-6;
   EXPECT_GT(over.fitness(), a.fitness());  // every infeasible point below every feasible one

@@ -22,7 +22,9 @@ int StrokeSpace::dimPerJoint() const {
   return 1 + knots + (limits.end == StrokeEnd::kAtRest ? 1 : 0) + 2;
 }
 
-TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const {
+TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const { return trajectory(x, nullptr, nullptr); }
+
+TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x, StrokeFigures* figures, bool* have_figures) const {
   if (static_cast<int>(x.size()) != dim()) throw std::invalid_argument("stroke point has the wrong size");
   const StrokeLimits& L = limits;
   TailTrajectory t;
@@ -56,7 +58,8 @@ TailTrajectory StrokeSpace::trajectory(const std::vector<double>& x) const {
       t.joints.emplace_back(s);
     }
   }
-  return slow_down_over_torque ? slowedToTorqueLimit(tail, limits, t) : t;
+  if (have_figures) *have_figures = slow_down_over_torque && figures;
+  return slow_down_over_torque ? slowedToTorqueLimit(tail, limits, t, figures) : t;
 }
 
 TailTrajectory timeScaled(const TailTrajectory& traj, double k) {
@@ -77,9 +80,11 @@ TailTrajectory timeScaled(const TailTrajectory& traj, double k) {
   return out;
 }
 
-TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t) {
+TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t,
+                                   StrokeFigures* figures) {
+  StrokeFigures f, f_best;  // the last stroke's figures, the best kept one's
   auto peakOverLimit = [&](const TailTrajectory& u) {  // the largest peak torque / its limit (0: no limit)
-    const StrokeFigures f = strokeFigures(links, u);
+    f = strokeFigures(links, u);
     double ratio = 0.0;
     for (std::size_t i = 0; i < f.joints.size(); ++i) {
       const JointLimits J = L.joint(i);
@@ -89,7 +94,10 @@ TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const Str
   };
   auto kept = [](double ratio) { return !exceedsLimit(ratio, 1.0); };
   double ratio = peakOverLimit(t);
-  if (kept(ratio)) return t;
+  if (kept(ratio)) {
+    if (figures) *figures = f;
+    return t;
+  }
   double s_max = std::numeric_limits<double>::infinity();  // where a duration or delay reaches its range's end
   for (const JointProfile& j : t.joints) {
     const double dT = j.isSpline() ? j.spline().dT_s : j.params().dT_s;
@@ -107,6 +115,7 @@ TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const Str
     if (kept(ratio) && s < s_kept) {
       s_kept = s;
       best = out;
+      f_best = f;
       if (ratio > 1.0 - 1e-7) break;
     }
     // A margin over the limit's rounding, grown from the 4th correction on (the grid can keep a
@@ -118,8 +127,9 @@ TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const Str
     out = timeScaled(t, 1.0 / s);
     ratio = peakOverLimit(out);
   }
-  if (kept(ratio) && s < s_kept) return out;
-  return std::isfinite(s_kept) ? best : out;  // none kept: capped by the ranges, still over
+  const bool last = !std::isfinite(s_kept) || (kept(ratio) && s < s_kept);  // else the best kept one
+  if (figures) *figures = last ? f : f_best;
+  return last ? out : best;  // none kept: capped by the ranges, still over
 }
 
 std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& joints) const {

@@ -47,6 +47,8 @@ struct StrokeLimits {
 };
 
 // A family maps a point x of the unit box [0, 1]^dim to a trajectory of n joints.
+struct StrokeFigures;
+
 struct StrokeSpace {
   StrokeFamily family = StrokeFamily::kSplitCycle;
   int n_links = 1;
@@ -68,6 +70,9 @@ struct StrokeSpace {
   int dimPerJoint() const;
   int dim() const { return n_links * dimPerJoint(); }
   TailTrajectory trajectory(const std::vector<double>& x) const;  // x in [0, 1]^dim (clamped)
+  // The same; with slow_down_over_torque also the returned stroke's figures (of `tail`, computed
+  // on the way) into *figures, and true; false (figures untouched) otherwise.
+  TailTrajectory trajectory(const std::vector<double>& x, StrokeFigures* figures, bool* have_figures) const;
   // The unit-box point of a split-cycle trajectory (the search's start); entries are clamped.
   std::vector<double> pointOf(const std::vector<SplitCycleParams>& joints) const;
 };
@@ -80,7 +85,9 @@ TailTrajectory timeScaled(const TailTrajectory& traj, double k);
 // smallest s >= 1 that brings every joint's peak torque (strokeFigures of links) within L, capped
 // where a joint's dT would pass L.dT_max_s or its start delay L.t0_max_s (the stroke then stays over
 // the limit).
-TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t);
+// figures (optional): the returned stroke's figures, computed on the way.
+TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t,
+                                   StrokeFigures* figures = nullptr);
 
 // Joint torques tau_i = M_J,i (the Newton-Euler recursion of Eqs. 5-7, tail base held still).
 std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints);

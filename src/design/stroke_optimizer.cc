@@ -42,9 +42,9 @@ Effects searchEffects(const ExperimentCase& base) {
   return e;
 }
 
-StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj) {
+StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj, const StrokeFigures* figures) {
   StrokeEvaluation e;
-  e.figures = strokeFigures(p.base.robot.tail, traj);
+  e.figures = figures ? *figures : strokeFigures(p.base.robot.tail, traj);
   e.violation = limitViolation(e.figures, p.space.limits);
   OutputSettings out;
   out.settle_s = p.base.output.settle_s;
@@ -76,7 +76,10 @@ StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& tr
 }
 
 StrokeEvaluation evaluateStroke(const StrokeProblem& p, const std::vector<double>& x) {
-  return evaluateStroke(p, p.space.trajectory(x));
+  StrokeFigures f;
+  bool have = false;
+  const TailTrajectory t = p.space.trajectory(x, &f, &have);
+  return evaluateStroke(p, t, have ? &f : nullptr);
 }
 
 namespace {

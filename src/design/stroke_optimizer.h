@@ -4,6 +4,8 @@
 // judged by running the analytic model (simulateAnalytic) on its trajectory.
 #pragma once
 
+#include <algorithm>
+
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -69,7 +71,12 @@ struct StrokeEvaluation {
   // stopped the search at once, and the 3 kg robot, which turns 1.39 deg in other seeds, was
   // reported infeasible in seed 17); COBYLA maximises the same score (it saw 0 for every stuck one).
   static constexpr double kStuckBand = 1e-3;
-  double score() const { return objective > 0.0 ? kStuckBand + objective : kStuckBand * stiction_ratio; }
+  // The ratio is the analytic model's, sampled every 0.5 ms, while the search model decides "stuck"
+  // at its own steps (or is the per-foot model): a stuck stroke may measure over 1; capped there, it
+  // stays below every turning stroke.
+  double score() const {
+    return objective > 0.0 ? kStuckBand + objective : kStuckBand * std::min(stiction_ratio, 1.0);
+  }
   // Minimised by CMA-ES and DE: -score() when feasible; else the violation (> any feasible), 10 when failed.
   double fitness() const;
   // Better than o in the tracker's order: feasible first, then objective, then stiction_ratio.
@@ -85,7 +92,8 @@ Effects searchEffects(const ExperimentCase& base);
 
 // Runs the search model on traj (analytic: with searchEffects; per-foot: the base's effects
 // without the load decomposition) and judges it against the limits.
-StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj);
+// figures (optional): traj's strokeFigures when already known (a slowed stroke's, StrokeSpace).
+StrokeEvaluation evaluateStroke(const StrokeProblem& p, const TailTrajectory& traj, const StrokeFigures* figures = nullptr);
 StrokeEvaluation evaluateStroke(const StrokeProblem& p, const std::vector<double>& x);
 
 struct HistoryRow {
