@@ -344,6 +344,9 @@ TEST(StrokeDesign, StuckStrokesRankAboveCmaesToleranceAndBelowEveryTurn) {
   StrokeEvaluation over = a;
   over.violation = 1e-6;
   EXPECT_GT(over.fitness(), a.fitness());  // every infeasible point below every feasible one
+  StrokeEvaluation failed, far_over = over;
+  far_over.violation = 50.0;  // a torque 51 times its limit
+  EXPECT_GT(failed.fitness(), far_over.fitness());  // and a failed run below every infeasible one
 
   const fs::path dir = fs::temp_directory_path() / ("tailsim_stuck_" + std::to_string(::getpid()));
   fs::create_directories(dir);

@@ -344,6 +344,36 @@ TEST_F(DesignLimitsTest, TheOptimumAndTheInfeasibleAnswerNameTheBindingJoint) {
   double most = 0.0;  // the stroke's peak joint torque is its largest joint's, k^2 times faster as well
   for (const auto& v : t["infeasible"]["torque_needed_per_joint_Nm"]) most = std::max(most, v.get<double>());
   EXPECT_NEAR(most, t["infeasible"]["torque_needed_Nm"].get<double>(), 1e-9 * most);
+  // The message names exactly the limits the needed figures pass, joint by joint.
+  const double tl[] = {10, 9, 8};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::string jt = "joint " + std::to_string(i + 1) + "'s ";
+    const double tq = t["infeasible"]["torque_needed_per_joint_Nm"][i].get<double>();
+    const double sp = t["infeasible"]["speed_needed_per_joint_dps"][i].get<double>();
+    EXPECT_EQ(out.find(jt + "torque (") != std::string::npos, tq > tl[i] * (1 + 1e-9)) << out;
+    EXPECT_EQ(out.find(jt + "speed (") != std::string::npos, sp > 600 * (1 + 1e-9)) << out;
+  }
+}
+
+// A speed-up that passes the speed limit and no torque limit says so: "raise ... joint 1's torque"
+// was printed whatever the needed figures passed (a spline stroke of the 12 kg robot needed 10.19 of
+// its 20 N m and 681 of its 600 deg/s).
+TEST_F(DesignLimitsTest, TheInfeasibleAnswerNamesTheLimitsThatBind) {
+  std::string out;
+  const fs::path p = dir_ / "spline.yaml";
+  std::ofstream(p) << "name: o\nkind: optimize\nbase: base.yaml\noptimize:\n  family: spline\n"
+                      "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: 20, dT_s: [0.05, 1.0], "
+                      "start_delay_s: 0.1, over_torque: slow_down}\n"
+                      "  islands: 1\n  population: 6\n  generations: 5\n  polish_evaluations: 20\n  seeds: [1]\n"
+                      "  mujoco_check: false\n";
+  ASSERT_EQ(runCommand(bin() + " optimize " + p.string() + " --out " + (dir_ / "sp").string() + " --quiet", out), 3) << out;
+  nlohmann::json t;
+  std::ifstream(dir_ / "sp/summary.json") >> t;
+  ASSERT_TRUE(t.contains("infeasible")) << t.dump(2);
+  EXPECT_LT(t["infeasible"]["torque_needed_Nm"].get<double>(), 20.0) << out;
+  EXPECT_GT(t["infeasible"]["speed_needed_dps"].get<double>(), 600.0) << out;
+  EXPECT_NE(out.find("speed (600 deg/s)"), std::string::npos) << out;
+  EXPECT_EQ(out.find("torque (20 N m)"), std::string::npos) << out;
 }
 
 // objective: {model: perfoot} searches the per-foot model itself; {model: mujoco} re-ranks the

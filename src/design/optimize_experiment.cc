@@ -321,12 +321,22 @@ Infeasibility analyseInfeasible(const StrokeProblem& p, const StrokeEvaluation& 
     for (std::size_t i = 0; i < r.torque_needed_per_joint_Nm.size(); ++i)
       per_joint += (i ? ", joint " : "; per joint: joint ") + std::to_string(i + 1) + " " +
                    fmt4(r.torque_needed_per_joint_Nm[i]) + " N m, " + fmt4(r.speed_needed_per_joint_dps[i]) + " deg/s";
+  // The limits the needed figures pass, joint by joint (a speed-up may pass the speed limit and
+  // not the torque limit): those are the ones to raise.
+  std::string passed;
+  for (std::size_t i = 0; i < r.torque_needed_per_joint_Nm.size(); ++i) {
+    const JointLimits J = L.joint(i);
+    const std::string joint = "joint " + std::to_string(i + 1) + "'s ";
+    if (J.torque_max_Nm > 0 && exceedsLimit(r.torque_needed_per_joint_Nm[i], J.torque_max_Nm))
+      passed += (passed.empty() ? "" : ", ") + joint + "torque (" + fmt4(J.torque_max_Nm) + " N m)";
+    if (exceedsLimit(r.speed_needed_per_joint_dps[i], J.thetadot_max_radps * kDegPerRad))
+      passed += (passed.empty() ? "" : ", ") + joint + "speed (" + fmt4(J.thetadot_max_radps * kDegPerRad) + " deg/s)";
+  }
   r.message = head + ". The same stroke shape, run " + fmt4(k) + " times faster, turns it " + fmt4(r.check_phi_net_deg) +
               " deg (" + objectiveModelName(p.search_model) + " model) at a peak joint torque of " + fmt4(r.torque_needed_Nm) +
               " N m and a peak joint speed of " + fmt4(r.speed_needed_dps) + " deg/s (now " + fmt4(r.peak_torque_Nm) +
               " N m, " + fmt4(r.peak_speed_dps) + " deg/s" + per_joint + "): raise the limits to at least these" +
-              (r.binding_joint >= 0 ? " (first joint " + std::to_string(r.binding_joint + 1) + "'s torque)" : std::string()) +
-              ", or change the robot";
+              (passed.empty() ? std::string() : " (it passes " + passed + ")") + ", or change the robot";
   return r;
 }
 
@@ -544,8 +554,10 @@ void writeHistory(const OptimizeSpec& spec, const std::string& out_dir, Optimize
   std::ostringstream b;
   b << "set datafile separator ','\nset key outside right\nset grid\n"
     << "set title " << gpQuote("Convergence of " + spec.name + " (" + familyName(prob.space.family) + ")")
-    << " noenhanced\nset xlabel 'analytic model runs'\nset ylabel "
-    << gpQuote("best " + std::string(objectiveName(prob.objective)) + " so far [" + objectiveUnit(prob.objective) + "]")
+    << " noenhanced\nset xlabel " << gpQuote(std::string(objectiveModelName(prob.search_model)) + " model runs")
+    << "\nset ylabel "
+    // Signed: the best stroke so far (ranked by |objective|) may turn the body the other way.
+    << gpQuote(std::string(objectiveName(prob.objective)) + " of the best stroke so far, signed [" + objectiveUnit(prob.objective) + "]")
     << " noenhanced\nplot ";
   const std::string data = gpFileName("../history.csv");
   for (std::size_t i = 0; i < spec.seeds.size(); ++i)

@@ -27,7 +27,7 @@
 namespace tailsim {
 
 double StrokeEvaluation::fitness() const {
-  if (!ok) return 10.0;
+  if (!ok) return kFailedFitness;
   if (violation > 0.0) return violation;
   return -score();
 }

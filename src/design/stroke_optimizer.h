@@ -77,7 +77,10 @@ struct StrokeEvaluation {
   double score() const {
     return objective > 0.0 ? kStuckBand + objective : kStuckBand * std::min(stiction_ratio, 1.0);
   }
-  // Minimised by CMA-ES and DE: -score() when feasible; else the violation (> any feasible), 10 when failed.
+  // Minimised by CMA-ES and DE: -score() when feasible; else the violation (> any feasible);
+  // kFailedFitness when the run failed (worse than any violation: a torque 11 times its limit is a
+  // violation of 10, which used to rank below a failed run).
+  static constexpr double kFailedFitness = 1e12;
   double fitness() const;
   // Better than o in the tracker's order: feasible first, then objective, then stiction_ratio.
   bool betterThan(const StrokeEvaluation& o) const {
