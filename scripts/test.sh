@@ -3,5 +3,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-build/tailsim run configs/default.yaml --out results/default
+build/tailsim run configs/default.yaml --out "$PWD/results/default" --fresh
 ctest --test-dir build --output-on-failure -j"$(nproc)" "$@"
