@@ -20,6 +20,9 @@
 #include "experiments/robot_compare.h"
 #include "experiments/robot_model_cases.h"
 #include "models/mujoco/robot_import.h"
+#include "plotting/plots.h"
+#include "plotting/result_folder.h"
+#include "plotting/style.h"
 #include "menagerie_models.h"
 
 using namespace tailsim;
@@ -380,6 +383,40 @@ TEST(RobotModelExperiment, ThreeFeetRunArticulatedAndFeetAreOnePerBody) {
   const std::string shown = describeDerivedRobot(*c.robot_derived);
   EXPECT_NE(shown.find("feet (front to back): "), std::string::npos) << shown;
   EXPECT_NE(shown.find("only the articulated MuJoCo model runs on it"), std::string::npos) << shown;
+}
+
+// The figures and the result page of an experiment that names a model file call its MuJoCo run
+// what it is, the articulated robot ("MuJoCo (contact)" named the rigid-box contact model there too);
+// an experiment of tailsim's own robot keeps "MuJoCo (contact)".
+TEST(RobotModelExperiment, FiguresNameTheArticulatedRobot) {
+  Scratch t("robot_model_exp");
+  t.write("box.xml", boxRobot(kHome));
+  const std::string f = t.write("e.yaml", "name: box_fig\nrobot: {mjcf: box.xml}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, "
+                                          "links: 1}\ntrajectory: {rule: eq25, thetadot_max_dps: 600}\n"
+                                          "models: [analytic, mujoco]\noutput: {settle_s: 0.3, sample_dt_s: 0.01}\n");
+  std::vector<Experiment> s = loadExperimentSuite(f);
+  resolveRobotModels(s);
+  RunOptions o;
+  o.out_dir = (t.dir / "out").string();
+  o.threads = 1;
+  o.progress = false;
+  runSuite(s, o);
+  const ExperimentResults r = loadResults(o.out_dir);
+  EXPECT_TRUE(r.articulated);
+  EXPECT_EQ(r.modelTitle("mujoco"), "MuJoCo (articulated robot)");
+  EXPECT_EQ(r.modelTitle("analytic"), modelTitle("analytic"));
+  plotExperiment(r);
+  int scripts = 0;
+  for (const auto& e : fs::directory_iterator(t.dir / "out" / "plots")) {
+    if (e.path().extension() != ".gp") continue;
+    std::ifstream in(e.path());
+    std::stringstream gp;
+    gp << in.rdbuf();
+    EXPECT_EQ(gp.str().find("MuJoCo (contact)"), std::string::npos) << e.path();
+    scripts += gp.str().find("MuJoCo (articulated robot)") != std::string::npos;
+  }
+  EXPECT_GT(scripts, 0);
+  EXPECT_EQ(modelTitle("mujoco", false), "MuJoCo (contact)");
 }
 
 // A robot that falls is a failed run, never a turn: a 10 kg box with a 15 kg, 1 m tail held out to

@@ -102,6 +102,7 @@ std::deque<ModelEntry>& registry() {
     ModelEntry mujoco;
     mujoco.name = kMujocoModel;
     mujoco.title = "MuJoCo (contact)";
+    mujoco.articulated_title = "MuJoCo (articulated robot)";  // simulateRobotModel: the model file's own robot
     mujoco.color = kMujocoColor;
     mujoco.glossary = "MuJoCo = the contact model";
     mujoco.long_running = true;

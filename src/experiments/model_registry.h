@@ -47,6 +47,9 @@ struct WorkExcess {
 struct ModelEntry {
   std::string name;      // "analytic": YAML models: value, cases/<dir>/<name>.csv, runs.<name>
   std::string title;     // legend and report text, "short name (what it is)"
+  // The title in an experiment that names a model file (`robot: {mjcf: ...}`), whose run of this
+  // model is the user's articulated robot; empty: `title` there too.
+  std::string articulated_title;
   std::string color;     // plot colour, "#RRGGBB"
   std::string glossary;  // a figure caption's sentence saying what the model is
   bool long_running = false;  // scheduled first (the short cases fill the gaps at the end)

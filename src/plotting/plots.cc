@@ -339,18 +339,18 @@ CaseSeries loadCaseSeries(const ExperimentResults& r, const CaseRecord& c) {
 }
 
 // The title's ": analytic vs MuJoCo" or ": <model>", when the figure shows those.
-Txt modelsInTitle(const CaseSeries& cs) {
+Txt modelsInTitle(const ExperimentResults& r, const CaseSeries& cs) {
   if (cs.models.size() == 2 && cs.ts.count(kAnalyticModel) && cs.ts.count(kMujocoModel)) {
     const std::string v = ": " + modelShortTitle(kAnalyticModel) + " vs " + modelShortTitle(kMujocoModel);
     return {v, v};
   }
-  if (cs.models.size() == 1) return {": " + gpText(modelTitle(cs.models[0])), ": " + modelTitle(cs.models[0])};
+  if (cs.models.size() == 1) return {": " + gpText(r.modelTitle(cs.models[0])), ": " + r.modelTitle(cs.models[0])};
   return {"", ""};
 }
 
 // Stage 2: phi(t), all models overlaid (Figs. 6, 7a).
 void plotPhiOfTime(Ctx& ctx, const CaseRecord& c, const CaseSeries& cs, const std::string& stem_prefix) {
-  const Txt phi_title = ctx.title(W("body yaw phi(t)") + ctx.tail + modelsInTitle(cs));
+  const Txt phi_title = ctx.title(W("body yaw phi(t)") + ctx.tail + modelsInTitle(ctx.r, cs));
   std::ostringstream body;
   body << header(ctx, phi_title, "t [s]", "φ [deg]") << range("x", 0, cs.t_end) << phaseObjects(cs.phases, cs.t_end);
   body << "set key bottom right box opaque\nplot ";  // phi rises from 0 and settles: bottom right is free
@@ -359,7 +359,7 @@ void plotPhiOfTime(Ctx& ctx, const CaseRecord& c, const CaseSeries& cs, const st
     const std::string stem = stem_prefix + "_phi_" + m;
     writePhiData(ctx, stem, cs.ts.at(m));
     const double net = ctx.r.phiNet(c, m);
-    std::string title = gpText(modelTitle(m));
+    std::string title = gpText(ctx.r.modelTitle(m));
     if (std::isfinite(net)) title += ", φ_{net} = " + fmt("%.2f", net) + "°";
     body << (i ? ", \\\n     " : "") << gpFileName(stem + ".dat") << " using 1:2 with lines lw 2.5 lc rgb "
          << gpQuote(modelColor(m)) << " title " << gpQuote(title);
@@ -400,7 +400,7 @@ std::string momentsPanel(const Ctx& ctx, const TimeSeries& s, const std::string&
     rows.push_back(row);
   }
   writeDataFile(ctx.data(stem), names, rows);
-  std::string panel = gpText(modelTitle(m));
+  std::string panel = gpText(ctx.r.modelTitle(m));
   if (const ModelEntry* e = findModel(m); e && !e->moments_note.empty()) panel += ": " + e->moments_note;
   // the legend beside the panel: inside, it hid curves wherever it was put
   mb << "set grid\nset key outside right top vertical box\nset title " << gpTitle(panel, 1000)
@@ -677,13 +677,13 @@ void plotPhiNetOverKey(Ctx& ctx) {
       << indexTics(a) << "\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
       b << (j ? ", " : "") << gpFileName(stem + ".dat") << " using " << j + 2 << " lc rgb "
-        << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(modelTitle(r.models[j])));
+        << gpQuote(modelColor(r.models[j])) << " title " << gpQuote(gpText(ctx.r.modelTitle(r.models[j])));
   } else {
     b << "set xzeroaxis lt -1\nplot ";
     for (size_t j = 0; j < r.models.size(); ++j)
       b << (j ? ", " : "") << gpFileName(stem + ".dat") << " using 1:" << j + 2
         << " with linespoints lw 2.5 pt " << seriesPoint(j) << " ps 1.3 lc rgb " << gpQuote(modelColor(r.models[j]))
-        << " title " << gpQuote(gpText(modelTitle(r.models[j])));
+        << " title " << gpQuote(gpText(ctx.r.modelTitle(r.models[j])));
   }
   b << "\n";
   ctx.render(stem, b.str(), title,
@@ -1060,7 +1060,7 @@ Txt facetTitle(const Ctx& ctx, const std::string& m, const FacetKeys& fk, const 
   std::string unused;
   for (const SweepAxis& a : r.axes)
     if (!modelReads(m, a.key)) unused += (unused.empty() ? "" : ", ") + keyDisplay(a.key).plain;
-  Txt who{gpText(modelTitle(m)), modelTitle(m)};
+  Txt who{gpText(ctx.r.modelTitle(m)), ctx.r.modelTitle(m)};
   if (!unused.empty()) who = who + Txt{gpText(" (" + unused + " not used)"), " (" + unused + " not used)"};
   return ctx.title(W("phi_net over ") + K(r.axes[fk.x].key) + W(", one curve per ") + K(r.axes[fk.series].key) +
                    Txt{", one panel per " + gpText(facet_words), ", one panel per " + facet_words} + ctx.tail +
@@ -1138,7 +1138,7 @@ void plotManyKeys(Ctx& ctx) {
     for (size_t p = 0; p < combos.size(); ++p) b << facetPanel(r, fk, g, p, combos[p], dats[p], right, top);
     b << "unset multiplot\n";
     ctx.render(r.name + "_phi_net_facets_" + m, b.str(), title,
-               title.plain + ". φ_net of " + modelTitle(m) + " over " + K(ax.key).plain + ", one curve per value of " +
+               title.plain + ". φ_net of " + ctx.r.modelTitle(m) + " over " + K(ax.key).plain + ", one curve per value of " +
                    K(as.key).plain + ", one panel per value of " + facet_words +
                    "; every panel has the same axes. A missing point is a case that was not run or failed.",
                g.fig_w, g.fig_h);
@@ -1210,7 +1210,7 @@ void plotPoseOneKey(Ctx& ctx) {
     b << "unset multiplot\n";
     ctx.render(stem, b.str(), title,
                title.plain + ": (a) " + parts[0].plain + " and (b) " + parts[1].plain + " over " + kd.plain + " (" +
-                   modelTitle(model) + ").",
+                   ctx.r.modelTitle(model) + ").",
                1600, 690);
   }
   if (probe.has(col::kLF)) {
@@ -1223,7 +1223,7 @@ void plotPoseOneKey(Ctx& ctx) {
     std::ostringstream b;
     b << header(ctx, title, gpAxisLabel(a.key), "L_F [mm]") << "unset key\nplot " << gpFileName(stem + ".dat")
       << " using 1:2 with linespoints lw 2.5 pt 7 lc rgb " << gpQuote(modelColor(model)) << "\n";
-    ctx.render(stem, b.str(), title, title.plain + " (Eqs. 17-19, " + modelTitle(model) + ").");
+    ctx.render(stem, b.str(), title, title.plain + " (Eqs. 17-19, " + ctx.r.modelTitle(model) + ").");
   }
 }
 

@@ -1,4 +1,5 @@
 #include "plotting/result_folder.h"
+#include "plotting/style.h"
 
 
 #include <algorithm>
@@ -314,7 +315,10 @@ void resolveCases(const fs::path& root, ExperimentResults& r) {
   try {
     Experiment e = loadExperiment((root / "experiment.yaml").string());
     resolveRobotModels(e);  // a robot from its model file: the values the run used
-    for (const ExperimentCase& c : e.cases) r.resolved.emplace(c.name, c);
+    for (const ExperimentCase& c : e.cases) {
+      r.resolved.emplace(c.name, c);
+      r.articulated = r.articulated || static_cast<bool>(c.robot_model);
+    }
     if (!kind_given && !e.cases.empty()) r.kind = name(e.cases.front().kind);
     if (r.description.empty()) r.description = e.description;
     if (r.name.empty()) r.name = e.name;
@@ -428,6 +432,10 @@ std::vector<std::string> allModels(const std::vector<ExperimentResults>& results
     for (const std::string& m : r.models)
       if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
   return out;
+}
+
+std::string ExperimentResults::modelTitle(const std::string& model) const {
+  return tailsim::modelTitle(model, articulated);
 }
 
 }  // namespace tailsim

@@ -67,6 +67,10 @@ struct ExperimentResults {
   // an older tailsim without its robot copy): resolve_error says why.
   std::map<std::string, ExperimentCase> resolved;
   std::string resolve_error;
+  // A resolved case names a model file (`robot: {mjcf: ...}`): its MuJoCo run is the articulated robot.
+  bool articulated = false;
+  // A model's title in these results' figures and pages (modelTitle(model, articulated)).
+  std::string modelTitle(const std::string& model) const;
 
   // DIR/cases/<case.dir>/<model>.csv; throws std::runtime_error if unreadable.
   std::string csvPath(const CaseRecord& c, const std::string& model) const;

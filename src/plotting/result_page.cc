@@ -243,10 +243,10 @@ std::string indexHtml(bool three) {
   return o.str();
 }
 
-std::string modelsJson(const std::vector<std::string>& models) {
-  return array(models, [](const std::string& name) {
+std::string modelsJson(const ExperimentResults& r) {
+  return array(r.models, [&r](const std::string& name) {
     const ModelEntry* e = findModel(name);
-    return "{\"name\":" + jsString(name) + ",\"title\":" + jsString(e ? e->title : name) +
+    return "{\"name\":" + jsString(name) + ",\"title\":" + jsString(r.modelTitle(name)) +
            ",\"color\":" + jsString(e ? e->color : std::string("#000000")) + "}";
   });
 }
@@ -375,7 +375,7 @@ std::string experimentJson(const ExperimentResults& r, int index, const fs::path
   std::ostringstream o;
   o << "{\"name\":" << jsString(r.name) << ",\"description\":" << jsString(r.description)
     << ",\"kind\":" << jsString(r.kind) << ",\"dir\":" << jsString(relUrl(r.dir, root.string()))
-    << ",\"models\":" << modelsJson(r.models) << ",\"notes\":" << strArray(notes)
+    << ",\"models\":" << modelsJson(r) << ",\"notes\":" << strArray(notes)
     << ",\"figures\":" << strArray(figuresOf(r, root)) << ",\"axes\":[" << joined(axesJson(r, axis_index), ",")
     << "],\"cases\":{\"name\":" << strArray(names) << ",\"replay\":" << array(replay, [](const std::string& s) { return s; })
     << ",\"runs\":{" << runsJson(r.models, runs) << "}}}";

@@ -28,6 +28,12 @@ std::string modelTitle(const std::string& model) {
   return m ? m->title : model;
 }
 
+std::string modelTitle(const std::string& model, bool articulated) {
+  const ModelEntry* m = findModel(model);
+  if (m && articulated && !m->articulated_title.empty()) return m->articulated_title;
+  return modelTitle(model);
+}
+
 std::string modelShortTitle(const std::string& model) {
   const std::string t = modelTitle(model);
   const size_t open = t.find(" (");

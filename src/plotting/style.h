@@ -20,6 +20,9 @@ namespace tailsim {
 std::string modelColor(const std::string& model);
 // Legend / panel name of a model: "analytic (stiction)", "MuJoCo (contact)".
 std::string modelTitle(const std::string& model);
+// The same in an experiment whose cases name a model file (articulated: its MuJoCo run is the user's
+// articulated robot, ModelEntry::articulated_title).
+std::string modelTitle(const std::string& model, bool articulated);
 // Its title without the parenthesis ("MuJoCo", "analytic"): for panels that compare models over a
 // swept key the parenthesis may name ("analytic (stiction)" when the friction law is swept), and
 // for the keys of a model's own section ("MuJoCo foot shape").

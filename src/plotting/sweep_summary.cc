@@ -30,7 +30,7 @@ std::string where(const ExperimentResults& r, const CaseRecord& c) {
   return s.empty() ? "the single case" : s;
 }
 
-std::string modelName(const std::string& m) { return modelTitle(m); }
+std::string modelName(const ExperimentResults& r, const std::string& m) { return r.modelTitle(m); }
 
 void trends(const ExperimentResults& r, const std::string& m, std::vector<std::string>& out) {
   for (const SweepAxis& a : r.axes) {
@@ -57,7 +57,7 @@ void trends(const ExperimentResults& r, const std::string& m, std::vector<std::s
       if (mean[i] < mean[imin]) imin = i;
     }
     const double spread = mean[imax] - mean[imin];
-    std::string s = modelName(m) + ": φ_net ";
+    std::string s = modelName(r, m) + ": φ_net ";
     if (spread < std::max(0.01, 0.01 * std::max(std::fabs(mean[imax]), std::fabs(mean[imin])))) {
       s += "does not change with " + key + " (" + deg(mean[idx[0]]) + " throughout)";
     } else if (!a.numeric) {
@@ -99,10 +99,10 @@ SweepSummary summarizeSweep(const ExperimentResults& r) {
         if (!best || v > r.phiNet(*best, m)) best = &c;
       }
       if (!best) {
-        s.best.push_back(modelName(m) + ": no successful run.");
+        s.best.push_back(modelName(r, m) + ": no successful run.");
         continue;
       }
-      std::string line = modelName(m) + ": largest φ_net " + deg(r.phiNet(*best, m)) + " at " + where(r, *best);
+      std::string line = modelName(r, m) + ": largest φ_net " + deg(r.phiNet(*best, m)) + " at " + where(r, *best);
       if (ok < static_cast<int>(r.cases.size()))
         line += " (" + std::to_string(ok) + " of " + std::to_string(r.cases.size()) + " runs succeeded)";
       s.best.push_back(line + ".");
@@ -123,7 +123,7 @@ SweepSummary summarizeSweep(const ExperimentResults& r) {
         if (!worst || std::fabs(d) > std::fabs(worst_d)) worst = &c, worst_d = d;
       }
       if (!worst) continue;
-      std::string line = modelName(m1) + " − " + modelName(m0) + ": largest difference " + deg(worst_d) + " (" +
+      std::string line = modelName(r, m1) + " − " + modelName(r, m0) + ": largest difference " + deg(worst_d) + " (" +
                          deg(r.phiNet(*worst, m1)) + " vs " + deg(r.phiNet(*worst, m0)) + ") at " + where(r, *worst);
       if (n > 1) line += "; mean |difference| " + deg(sum / n, "%.2f") + " over " + std::to_string(n) + " cases";
       if (opposite > 0) line += "; opposite signs in " + std::to_string(opposite) + " case" + (opposite > 1 ? "s" : "");
@@ -144,7 +144,7 @@ SweepSummary summarizeSweep(const ExperimentResults& r) {
         ++groups[it->second].runs;
       }
   for (const Group& g : groups)
-    s.warnings.push_back(modelName(g.model) + ", " + std::to_string(g.runs) + " run" + (g.runs > 1 ? "s" : "") +
+    s.warnings.push_back(modelName(r, g.model) + ", " + std::to_string(g.runs) + " run" + (g.runs > 1 ? "s" : "") +
                          " (first: " + g.first + (g.runs > 1 ? "; each run's numbers in results.csv" : "") + "): " +
                          g.text);
   return s;
