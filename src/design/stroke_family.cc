@@ -99,11 +99,9 @@ TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const Str
     return t;
   }
   double s_max = std::numeric_limits<double>::infinity();  // where a duration or delay reaches its range's end
-  for (const JointProfile& j : t.joints) {
-    const double dT = j.isSpline() ? j.spline().dT_s : j.params().dT_s;
-    const double t0 = j.isSpline() ? j.spline().t0_s : j.params().t0_s;
-    if (dT > 0.0) s_max = std::min(s_max, L.dT_max_s / dT);
-    if (t0 > 0.0) s_max = std::min(s_max, L.t0_max_s / t0);
+  for (const JointProfile& j : t.joints) {  // params(): a spline's envelope holds its dT and t0 too
+    if (j.params().dT_s > 0.0) s_max = std::min(s_max, L.dT_max_s / j.params().dT_s);
+    if (j.params().t0_s > 0.0) s_max = std::min(s_max, L.t0_max_s / j.params().t0_s);
   }
   // Torques scale with 1/s^2 up to the figures' fixed 0.5 ms sampling grid, which samples the slowed
   // motion at other phases: a few corrections s <- s sqrt(peak / limit), each from the slowed
