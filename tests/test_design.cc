@@ -21,6 +21,7 @@
 #include "design/optimize_config.h"
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"
+#include "random_robots.h"
 
 namespace tailsim {
 namespace {
@@ -320,6 +321,48 @@ TEST(StrokeDesign, SlowDownMeetsTheTorqueLimitWithTheSameMotion) {
   EXPECT_GT(untouched, 5);
   EXPECT_GT(on_limit, 20);
   EXPECT_GT(capped, 5);
+}
+
+// The same on 60 seeded random robots and their own strokes (tests/random_robots.h: 1-6 link tails
+// of 0.3-18 kg, Eq. 25, sweeps and flicks), each joint limited to half its peak torque (or none
+// for every third joint): the slowed stroke is the same motion s times slower, every torque
+// tau(t) / s^2, and its peak meets the limit unless a duration reached the range's end.
+TEST(StrokeDesign, SlowDownOnRandomRobotsAndStrokes) {
+  int on_limit = 0;
+  for (int k = 0; k < 60; ++k) {
+    const testing::RandomRobotCase rc = testing::randomRobotCase(35, k);
+    const std::vector<TailLink>& tail = rc.robot.tail;
+    const StrokeFigures raw = strokeFigures(tail, rc.trajectory);
+    StrokeLimits L;
+    L.dT_max_s = 5.0;
+    L.t0_max_s = 1.0;
+    for (std::size_t i = 0; i < tail.size(); ++i)
+      L.joints.push_back({-10.0, 10.0, 1e6, i % 3 == 2 ? 0.0 : 0.5 * raw.joints[i].peak_torque_Nm});
+    StrokeFigures f;
+    const TailTrajectory b = slowedToTorqueLimit(tail, L, rc.trajectory, &f);
+    const StrokeFigures fb = strokeFigures(tail, b);
+    EXPECT_EQ(f.peak_torque_Nm, fb.peak_torque_Nm) << "the figures handed back are the slowed stroke's";
+    const double s = b.joints[0].params().dT_s / rc.trajectory.joints[0].params().dT_s;
+    EXPECT_GT(s, 1.3) << testing::describe(rc);  // half the torque: about sqrt(2)
+    double after = 0.0;
+    for (std::size_t i = 0; i < tail.size(); ++i) {
+      EXPECT_NEAR(b.joints[i].params().dT_s, s * rc.trajectory.joints[i].params().dT_s, 1e-12 * s);
+      if (L.joints[i].torque_max_Nm > 0) after = std::max(after, fb.joints[i].peak_torque_Nm / L.joints[i].torque_max_Nm);
+    }
+    std::vector<JointState> ja, jb;
+    const double t = rc.trajectory.startTime() + 0.37 * (rc.trajectory.endTime() - rc.trajectory.startTime());
+    rc.trajectory.evaluate(t, ja);
+    b.evaluate(s * t, jb);
+    const std::vector<double> ta = jointTorques(tail, ja), tb = jointTorques(tail, jb);
+    for (std::size_t i = 0; i < tail.size(); ++i) {
+      EXPECT_NEAR(jb[i].theta, ja[i].theta, 1e-9);
+      EXPECT_NEAR(tb[i], ta[i] / (s * s), 1e-9 * std::max(1.0, std::abs(ta[i])));
+    }
+    EXPECT_LE(after, 1.0 + 1e-9) << testing::describe(rc);
+    EXPECT_GT(after, 0.99) << testing::describe(rc);
+    ++on_limit;
+  }
+  EXPECT_EQ(on_limit, 60);
 }
 
 // Stuck strokes (the body does not turn) rank by how close they come to breaking away, in a band
