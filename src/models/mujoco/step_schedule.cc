@@ -1,5 +1,6 @@
 #include "models/mujoco/step_schedule.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/work_limits.h"
@@ -31,12 +32,29 @@ bool speedsAtRest(const mjModel* m, const mjData* d) {
   return true;
 }
 
+double shortestSolrefS(const mjModel* m) {
+  if (m->opt.enableflags & mjENBL_OVERRIDE) return std::max(0.0, static_cast<double>(m->opt.o_solref[0]));
+  double tc = HUGE_VAL;
+  auto take = [&tc](const mjtNum* solref) { tc = std::min(tc, std::max(0.0, static_cast<double>(solref[0]))); };
+  for (int g = 0; g < m->ngeom; ++g)
+    if (m->geom_contype[g] || m->geom_conaffinity[g]) take(m->geom_solref + mjNREF * g);
+  for (int p = 0; p < m->npair; ++p) take(m->pair_solref + mjNREF * p);
+  for (int e = 0; e < m->neq; ++e)
+    if (m->eq_active[e]) take(m->eq_solref + mjNREF * e);
+  for (int j = 0; j < m->njnt; ++j)
+    if (m->jnt_limited[j]) take(m->jnt_solref + mjNREF * j);
+  for (int v = 0; v < m->nv; ++v)
+    if (m->dof_frictionloss[v] > 0.0) take(m->dof_solref + mjNREF * v);
+  return tc;
+}
+
 StepSchedule::StepSchedule(double h, int factor, double tail_end_s, double duration_s, double sample_dt_s,
                            double solref_s, double servo_wn_radps, bool allowed)
     : h_(h), H_(h * factor), tail_end_(tail_end_s), end_(duration_s) {
   const double per_two = sample_dt_s / (2.0 * H_);
-  allowed_ = allowed && factor > 1 && per_two >= 1.0 - 1e-9 &&
-             std::abs(per_two - std::round(per_two)) < 1e-9 * per_two && solref_s >= 2.0 * H_ * (1.0 - 1e-9) &&
+  const bool rows_on_grid =
+      sample_dt_s <= 0.0 || (per_two >= 1.0 - 1e-9 && std::abs(per_two - std::round(per_two)) < 1e-9 * per_two);
+  allowed_ = allowed && factor > 1 && rows_on_grid && solref_s >= 2.0 * H_ * (1.0 - 1e-9) &&
              servo_wn_radps * H_ <= 1.0 + 1e-9;
 }
 
