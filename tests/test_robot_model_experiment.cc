@@ -8,7 +8,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -435,6 +437,58 @@ TEST(RobotModelExperiment, ARobotThatFallsIsAFailedRun) {
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.error.find("the robot fell over"), std::string::npos) << r.error;
   EXPECT_TRUE(std::isnan(r.phi_net_deg));
+}
+
+// The articulated robot's rest step schedule (docs/mujoco-model.md "Step schedule"): once the body
+// rests after the stroke it steps at rest_step_factor times the model's timestep, with the same
+// answer. The box robot on the implicit integrator (the schedule's guard) at a 1 ms step, rows every
+// 10 ms (two 5 ms rest steps). Its check run stops once the body rests. (At the default 2 ms step,
+// 10 ms rest steps, phi_net moves by 1.3e-5 deg: the box still settles on its soft contacts,
+// below the rest thresholds, when the coarse steps begin; docs/mujoco-model.md "Step schedule".)
+TEST(RobotModelExperiment, ArticulatedRobotStepsCoarserAtRestWithTheSameAnswer) {
+  Scratch t("robot_model_exp");
+  std::string xml = boxRobot(kHome);
+  xml.replace(xml.find("<worldbody>"), 0, "<option integrator=\"implicit\" timestep=\"0.001\"/>\n  ");
+  t.write("box.xml", xml);
+  auto run = [&](int factor) {
+    const std::string f = t.write(
+        "e.yaml", "name: box_rest\nrobot: {mjcf: box.xml}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, links: 1}\n"
+                  "trajectory: {rule: eq25, thetadot_max_dps: 600}\nmodels: [mujoco]\n"
+                  "mujoco: {rest_step_factor: " + std::to_string(factor) + "}\n"
+                  "output: {settle_s: 1.0, sample_dt_s: 0.01}\n");
+    std::vector<Experiment> s = loadExperimentSuite(f);
+    resolveRobotModels(s);
+    return runCase(s.front().cases.front(), nullptr).front();
+  };
+  const RunResult a = run(1), b = run(5);
+  ASSERT_TRUE(a.summary.ok) << a.summary.error;
+  ASSERT_TRUE(b.summary.ok) << b.summary.error;
+  std::printf("box robot: phi_net %+.9f / %+.9f deg, steps %ld -> %ld, check run steps %g -> %g\n",
+              a.summary.phi_net_deg, b.summary.phi_net_deg, a.summary.solver_steps, b.summary.solver_steps,
+              a.summary.extra.at("uncertainty_solver_steps"), b.summary.extra.at("uncertainty_solver_steps"));
+  EXPECT_NEAR(b.summary.phi_net_deg, a.summary.phi_net_deg, 1e-6);
+  // 2 s standing at 1 ms in both; most of the 1 s after the stroke at 5 ms.
+  EXPECT_LT(b.summary.solver_steps, a.summary.solver_steps - 600)
+      << a.summary.solver_steps << " -> " << b.summary.solver_steps;
+  EXPECT_TRUE(b.summary.at_rest);
+  ASSERT_EQ(a.series.names(), b.series.names());
+  for (const std::string& name : a.series.names()) {
+    const std::vector<double>& x = a.series.values(name);
+    const std::vector<double>& y = b.series.values(name);
+    ASSERT_EQ(x.size(), y.size()) << name;
+    double scale = 1e-9, diff = 0.0;
+    for (size_t k = 0; k < x.size(); ++k) {
+      scale = std::max(scale, std::abs(x[k]));
+      diff = std::max(diff, std::abs(x[k] - y[k]));
+    }
+    if (name == "t_s") {
+      EXPECT_EQ(diff, 0.0);
+    }
+    EXPECT_LE(diff, 1e-4 * scale) << name;
+  }
+  // The check run at 2 ms stops once the body rests: fewer than half the run's steps, the same phi_2h.
+  EXPECT_LT(a.summary.extra.at("uncertainty_solver_steps"), 0.5 * a.summary.solver_steps - 100);
+  EXPECT_NEAR(b.summary.extra.at("phi_net_check_deg"), a.summary.extra.at("phi_net_check_deg"), 1e-6);
 }
 
 // In a scene with two free bodies the robot is the tree of the tail mount's body; with no mount body

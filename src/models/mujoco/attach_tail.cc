@@ -2,6 +2,7 @@
 
 #include <tinyxml2.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "results/columns.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/run_uncertainty.h"
+#include "models/mujoco/step_schedule.h"
 #include "common/units.h"
 
 namespace tailsim {
@@ -401,10 +403,37 @@ class StrokeRecorder {
   std::vector<JointState> ref_;
 };
 
+// The servos' largest natural frequency [rad/s]: the tail's (servo_wn_dt / h; unknown, so infinite,
+// when kp is given) and each held leg joint's, sqrt(kp / M_ii) with its joint-space stiffness (a
+// position actuator's -biasprm[1] gear^2, or tailsim's kStancePdKp) and the diagonal of the mass
+// matrix at the state (armature included).
+double stiffestServoWn(const ArticulatedSim& a, const MujocoSettings& s) {
+  const mjModel* m = a.m;
+  double wn = s.kp == 0.0 ? s.servo_wn_dt / s.timestep_s : HUGE_VAL;
+  auto joint = [&](int dof, double kp) { wn = std::max(wn, std::sqrt(kp / a.d->qM[m->dof_Madr[dof]])); };
+  for (const int u : a.servoAct) {
+    const double gear = m->actuator_gear[6 * u];
+    joint(m->jnt_dofadr[m->actuator_trnid[2 * u]], -m->actuator_biasprm[mjNBIAS * u + 1] * gear * gear);
+  }
+  for (const int v : a.pdv) joint(v, kStancePdKp);
+  return wn;
+}
+
+// The stroke's rest step schedule (step_schedule.h) by the rigid box's guards, read from the model:
+// its own integrator (implicit only), its shortest solref, the stiffest servo. row_dt_s: the rows'
+// spacing inside the run (0: none).
+StepSchedule restSchedule(const ArticulatedSim& a, const MujocoSettings& s, double tail_end_s, double end_s,
+                          double row_dt_s) {
+  return StepSchedule(a.m->opt.timestep, s.rest_step_factor, tail_end_s, end_s, row_dt_s, shortestSolrefS(a.m),
+                      stiffestServoWn(a, s), a.m->opt.integrator == mjINT_IMPLICIT);
+}
+
 // Stage: the stroke and settle_after_s after it: phi_net (the root body's heading change, unwrapped
-// step by step), the tilt during it, the rows, and whether the body is at rest at the end.
-void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& trajectory, double settle_after_s,
-               double sample_dt_s, ArticulatedRun& out) {
+// step by step), the tilt during it, the rows, and whether the body is at rest at the end. Once the
+// body rests after the stroke the steps are rest_step_factor times longer (restSchedule); with
+// `stop_at_rest` (the check run: only phi_net is wanted) the run ends there.
+void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& trajectory, const MujocoSettings& s,
+               double settle_after_s, double sample_dt_s, bool stop_at_rest, ArticulatedRun& out) {
   const mjData* d = a.d;
   const int body = a.body;
   const double dt = a.m->opt.timestep;
@@ -413,19 +442,26 @@ void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& tr
   const double t_end = trajectory.endTime() + settle_after_s;
   const long runSteps = std::lround(t_end / dt);
   StrokeRecorder rec(a, trajectory, out.series, sample_dt_s, t_end);
+  const double row_dt = sample_dt_s > 0.0 && sample_dt_s < t_end ? sample_dt_s : 0.0;  // rows inside the run
+  StepSchedule schedule = restSchedule(a, s, trajectory.endTime(), runSteps * dt, row_dt);
   rec.record(0.0, phi);
-  for (long k = 0; k < runSteps && out.ok; ++k) {
-    stepArticulated(a, ctrl, (k + 1) * dt, out.steps);
+  long k = 0;  // the run's time in steps of dt (a coarse step is rest_step_factor of them)
+  while (k < runSteps && out.ok) {
+    k += std::lround(a.m->opt.timestep / dt);
+    stepArticulated(a, ctrl, k * dt, out.steps);
     const double y = yaw();
     phi += std::remainder(y - prev, 2 * kPi);
     prev = y;
-    rec.record((k + 1) * dt, phi);
+    rec.record(k * dt, phi);
     out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
     out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
     if (out.ok && fell(out.max_rel_tilt_deg, "during the stroke", out.error)) out.ok = false;
+    a.m->opt.timestep = schedule.next(k * dt, speedsAtRest(a.m, a.d));
+    if (stop_at_rest && schedule.rested(k * dt)) break;
   }
-  out.run_s = t_end;
+  a.m->opt.timestep = dt;
+  out.run_s = stop_at_rest ? k * dt : t_end;
   out.phi_net_deg = units::degrees(phi);
   const double* v = d->cvel + 6 * body;  // [angular; linear] at the subtree COM, world frame
   out.at_rest = units::degrees(std::abs(v[2])) < 0.1 && std::hypot(v[3], v[4]) < 1e-3;
@@ -452,10 +488,11 @@ void judgeArticulated(ArticulatedRun& out) {
 
 // The articulated run at s.timestep_s (the model's own, or the check run's twice that): the tail's
 // servo gains from s, the model's option timestep replaced by s.timestep_s. Stages: build, trim the
-// legs for the tail's weight, stand stand_s, the stroke and settle_after_s (sampled), judge.
+// legs for the tail's weight, stand stand_s, the stroke and settle_after_s (sampled; with
+// stop_at_rest only until the body rests after the stroke), judge.
 ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                                 const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
-                                double settle_after_s, double sample_dt_s) {
+                                double settle_after_s, double sample_dt_s, bool stop_at_rest = false) {
   ArticulatedRun out;
   MujocoMessages messages;
   ArticulatedSim a;
@@ -465,7 +502,7 @@ ArticulatedRun runArticulatedAt(const DerivedRobot& r, const TailMount& mount, c
   out.trim = trimStance(a, ctrl, r.legs_locked, out.steps, out.error);
   out.ok = out.error.empty();
   standWithTail(a, ctrl, r, stand_s, out);
-  runStroke(a, ctrl, trajectory, settle_after_s, sample_dt_s, out);
+  runStroke(a, ctrl, trajectory, s, settle_after_s, sample_dt_s, stop_at_rest, out);
   judgeArticulated(out);
   if (!messages.text().empty()) out.warnings.push_back(messages.text());
   return out;
@@ -523,8 +560,9 @@ RunResult simulateArticulated(const DerivedRobot& r, const TailMount& mount, con
     const MujocoSettings coarse = checkRunSettings(s);
     RunSummary check;
     try {
-      check = articulatedRunResult(runArticulatedAt(r, mount, tail, trajectory, coarse, stand_s, settle_after_s, 0.0),
-                                   model).summary;
+      // Only its phi_net is wanted: it ends once the body rests after the stroke.
+      const ArticulatedRun c = runArticulatedAt(r, mount, tail, trajectory, coarse, stand_s, settle_after_s, 0.0, true);
+      check = articulatedRunResult(c, model).summary;
     } catch (const std::exception& e) {
       check.ok = false;
       check.error = e.what();

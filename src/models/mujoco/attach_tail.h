@@ -74,7 +74,9 @@ inline constexpr double kFallTiltFromStanceDeg = 45.0;      // [deg]
 inline constexpr double kNearFallTiltFromStanceDeg = 20.0;  // [deg]
 
 // Stands stand_s with the tail held at theta(0), then runs the stroke and settle_after_s more, at
-// the model's own timestep; one run, without an uncertainty estimate (simulateArticulated).
+// the model's own timestep (once the body rests after the stroke, at s.rest_step_factor times it:
+// step_schedule.h, by the rigid box's guards read from the model); one run, without an uncertainty
+// estimate (simulateArticulated).
 ArticulatedRun runArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                               const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
                               double settle_after_s, double sample_dt_s = 0.0);
@@ -87,10 +89,11 @@ RunResult articulatedRunResult(const ArticulatedRun& a, const std::string& model
 // s.uncertainty, its own error estimate: the same robot run again at twice the model's timestep,
 // the tail servo's natural frequency kept and the legs on the model's own actuators, by the rule
 // of the rigid-box run (run_uncertainty.h: phi_net_uncertainty_deg, phi_net_check_deg,
-// uncertainty_solver_steps, the uncertain warning). Of s it reads the tail servo (kp, kv,
-// servo_wn_dt, velocity_feedforward, inverse_dynamics_feedforward), uncertainty and
-// uncertainty_warn_share; the step is the model's own. wall_time_s covers both runs. `run`:
-// optional, receives the run itself (its tilt figures).
+// uncertainty_solver_steps, the uncertain warning); the check run ends once the body rests after
+// the stroke. Of s it reads the tail servo (kp, kv, servo_wn_dt, velocity_feedforward,
+// inverse_dynamics_feedforward), rest_step_factor, uncertainty and uncertainty_warn_share; the step
+// is the model's own. wall_time_s covers both runs. `run`: optional, receives the run itself (its
+// tilt figures).
 RunResult simulateArticulated(const DerivedRobot& r, const TailMount& mount, const std::vector<TailLink>& tail,
                               const TailTrajectory& trajectory, const MujocoSettings& s, double stand_s,
                               double settle_after_s, double sample_dt_s, const std::string& model,

@@ -21,6 +21,7 @@
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_handles.h"
 #include "models/mujoco/run_uncertainty.h"
+#include "models/mujoco/step_schedule.h"
 #include "common/sha256.h"
 #include "common/work_limits.h"
 #include "robot/friction_law.h"
@@ -530,72 +531,6 @@ MujocoPlan planMujocoRun(const RobotParams& robot, const TailTrajectory& traject
                                 std::to_string(static_cast<long>(limits::kMaxMujocoSteps)));
   return {duration, static_cast<long>(rows)};
 }
-
-// Whether every speed of the state is below the rest thresholds (common/work_limits.h kRest*):
-// the quadruped's free, ball and slide joints by their linear and angular parts, the tail's hinges.
-bool speedsAtRest(const mjModel* m, const mjData* d) {
-  for (int j = 0; j < m->njnt; ++j) {
-    const mjtNum* v = d->qvel + m->jnt_dofadr[j];
-    auto below = [](const mjtNum* x, int n, double lim) {
-      double s = 0.0;
-      for (int i = 0; i < n; ++i) s += x[i] * x[i];
-      return s < lim * lim;
-    };
-    switch (m->jnt_type[j]) {
-      case mjJNT_FREE:
-        if (!below(v, 3, limits::kRestSpeedMps) || !below(v + 3, 3, limits::kRestAngularRadps)) return false;
-        break;
-      case mjJNT_BALL:
-        if (!below(v, 3, limits::kRestAngularRadps)) return false;
-        break;
-      case mjJNT_SLIDE:
-        if (!below(v, 1, limits::kRestSpeedMps)) return false;
-        break;
-      default:
-        if (!below(v, 1, limits::kRestJointRadps)) return false;
-    }
-  }
-  return true;
-}
-
-// The step schedule (docs/mujoco-model.md "Step schedule"): timestep_s h until the tail's motion has
-// ended and every speed has stayed at rest for kRestHoldS, then H = rest_step_factor h, back to h
-// the step anything moves again. A coarse step starts only on a multiple of H and ends within the
-// run, and only where H divides the output spacing, so that every row stays on its grid.
-class StepSchedule {
- public:
-  // `allowed`: the run may coarsen (no controller steering it, not RK4). The coarse step must also
-  // leave the contact as it is (solref's time constant at least 2 H, else MuJoCo raises it: a
-  // softer floor at rest) and keep the servo's explicit spring well inside its stable range
-  // (w_n H <= 1; its damper is implicit), and an even number of it must make an output row, so
-  // that each row's averaging window [t_k - dt/2, t_k + dt/2) stays made of whole steps.
-  StepSchedule(double h, int factor, double tail_end_s, double duration_s, double sample_dt_s, double solref_s,
-               double servo_wn_radps, bool allowed)
-      : h_(h), H_(h * factor), tail_end_(tail_end_s), end_(duration_s) {
-    const double per_two = sample_dt_s / (2.0 * H_);
-    allowed_ = allowed && factor > 1 && per_two >= 1.0 - 1e-9 &&
-               std::abs(per_two - std::round(per_two)) < 1e-9 * per_two && solref_s >= 2.0 * H_ * (1.0 - 1e-9) &&
-               servo_wn_radps * H_ <= 1.0 + 1e-9;
-  }
-  // After the step that ended at t: whether the state rests, and the length of the next step.
-  double next(double t, bool speeds_at_rest) {
-    if (!(t >= tail_end_ - 1e-6 * h_) || !speeds_at_rest) {
-      rest_since_ = -1.0;
-      return h_;
-    }
-    if (rest_since_ < 0.0) rest_since_ = t;
-    if (!rested(t) || !allowed_) return h_;
-    const bool on_grid = std::abs(t - std::round(t / H_) * H_) < 1e-6 * h_;
-    return on_grid && t + H_ <= end_ + 1e-6 * h_ ? H_ : h_;
-  }
-  // The body has rested for kRestHoldS after the tail's motion.
-  bool rested(double t) const { return rest_since_ >= 0.0 && t - rest_since_ >= limits::kRestHoldS - 1e-6 * h_; }
-
- private:
-  double h_, H_, tail_end_, end_;
-  bool allowed_ = false;
-  double rest_since_ = -1.0;
-};
 
 // One MuJoCo run, in named stages in the manner of mj_forward: build (the constructor: MJCF,
 // model, data, columns, start pose), settle (the pre-roll or its cached end state), stepLoop (the
