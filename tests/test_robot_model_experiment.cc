@@ -26,6 +26,7 @@
 #include "plotting/result_folder.h"
 #include "plotting/style.h"
 #include "menagerie_models.h"
+#include "series_compare.h"
 
 using namespace tailsim;
 namespace fs = std::filesystem;
@@ -471,21 +472,7 @@ TEST(RobotModelExperiment, ArticulatedRobotStepsCoarserAtRestWithTheSameAnswer) 
   EXPECT_LT(b.summary.solver_steps, a.summary.solver_steps - 600)
       << a.summary.solver_steps << " -> " << b.summary.solver_steps;
   EXPECT_TRUE(b.summary.at_rest);
-  ASSERT_EQ(a.series.names(), b.series.names());
-  for (const std::string& name : a.series.names()) {
-    const std::vector<double>& x = a.series.values(name);
-    const std::vector<double>& y = b.series.values(name);
-    ASSERT_EQ(x.size(), y.size()) << name;
-    double scale = 1e-9, diff = 0.0;
-    for (size_t k = 0; k < x.size(); ++k) {
-      scale = std::max(scale, std::abs(x[k]));
-      diff = std::max(diff, std::abs(x[k] - y[k]));
-    }
-    if (name == "t_s") {
-      EXPECT_EQ(diff, 0.0);
-    }
-    EXPECT_LE(diff, 1e-4 * scale) << name;
-  }
+  expectSameSeries(a.series, b.series, 1e-4);
   // The check run at 2 ms stops once the body rests: fewer than half the run's steps, the same phi_2h.
   EXPECT_LT(a.summary.extra.at("uncertainty_solver_steps"), 0.5 * a.summary.solver_steps - 100);
   EXPECT_NEAR(b.summary.extra.at("phi_net_check_deg"), a.summary.extra.at("phi_net_check_deg"), 1e-6);
