@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <random>
 #include <set>
@@ -323,6 +324,18 @@ TEST(StrokeDesign, SlowDownMeetsTheTorqueLimitWithTheSameMotion) {
   EXPECT_GT(capped, 5);
 }
 
+// A random robot's limits for the slow-down tests: each joint's torque limit `share` of the stroke's
+// peak there, every third joint without one; durations up to 5 s, delays up to 1 s.
+StrokeLimits sharedTorqueLimits(const std::vector<TailLink>& tail, const TailTrajectory& t, double share) {
+  const StrokeFigures raw = strokeFigures(tail, t);
+  StrokeLimits L;
+  L.dT_max_s = 5.0;
+  L.t0_max_s = 1.0;
+  for (std::size_t i = 0; i < tail.size(); ++i)
+    L.joints.push_back({-10.0, 10.0, 1e6, i % 3 == 2 ? 0.0 : share * raw.joints[i].peak_torque_Nm});
+  return L;
+}
+
 // The same on 60 seeded random robots and their own strokes (tests/random_robots.h: 1-6 link tails
 // of 0.3-18 kg, Eq. 25, sweeps and flicks), each joint limited to half its peak torque (or none
 // for every third joint): the slowed stroke is the same motion s times slower, every torque
@@ -332,12 +345,7 @@ TEST(StrokeDesign, SlowDownOnRandomRobotsAndStrokes) {
   for (int k = 0; k < 60; ++k) {
     const testing::RandomRobotCase rc = testing::randomRobotCase(35, k);
     const std::vector<TailLink>& tail = rc.robot.tail;
-    const StrokeFigures raw = strokeFigures(tail, rc.trajectory);
-    StrokeLimits L;
-    L.dT_max_s = 5.0;
-    L.t0_max_s = 1.0;
-    for (std::size_t i = 0; i < tail.size(); ++i)
-      L.joints.push_back({-10.0, 10.0, 1e6, i % 3 == 2 ? 0.0 : 0.5 * raw.joints[i].peak_torque_Nm});
+    const StrokeLimits L = sharedTorqueLimits(tail, rc.trajectory, 0.5);
     StrokeFigures f;
     const TailTrajectory b = slowedToTorqueLimit(tail, L, rc.trajectory, &f);
     const StrokeFigures fb = strokeFigures(tail, b);
@@ -363,6 +371,56 @@ TEST(StrokeDesign, SlowDownOnRandomRobotsAndStrokes) {
     ++on_limit;
   }
   EXPECT_EQ(on_limit, 60);
+}
+
+// slowedToTorqueLimit reads the slowed strokes' torques only near the raw stroke's peak (its
+// corrections) and then samples the answer in full. slowedToTorqueLimitOnFullSamples makes the same
+// corrections on full samples every time (the algorithm before the windows): the same stroke, bit for
+// bit, and the same figures, on 60 random robots with their own strokes and on 400 random strokes of both
+// families on the paper robot, whose many humps (a 6-link tail's, a spline's) are where a window
+// could miss the peak.
+TEST(StrokeDesign, SlowDownDecidesOnTheSameSamplesAsFullSampling) {
+  int slowed = 0, compared = 0;
+  auto expectSame = [&](const std::vector<TailLink>& tail, const StrokeLimits& L, const TailTrajectory& t,
+                        const std::string& what) {
+    StrokeFigures f;
+    const TailTrajectory a = slowedToTorqueLimit(tail, L, t, &f), b = slowedToTorqueLimitOnFullSamples(tail, L, t);
+    ++compared;
+    if (a.joints[0].params().dT_s != t.joints[0].params().dT_s) ++slowed;
+    for (std::size_t i = 0; i < t.joints.size(); ++i) {
+      EXPECT_EQ(a.joints[i].params().dT_s, b.joints[i].params().dT_s) << what << " joint " << i;
+      EXPECT_EQ(a.joints[i].params().t0_s, b.joints[i].params().t0_s) << what << " joint " << i;
+    }
+    const StrokeFigures fb = strokeFigures(tail, b);
+    EXPECT_EQ(f.peak_torque_Nm, fb.peak_torque_Nm) << what;
+    EXPECT_EQ(f.peak_speed_radps, fb.peak_speed_radps) << what;
+    EXPECT_EQ(f.energy_J, fb.energy_J) << what;
+  };
+  for (int k = 0; k < 60; ++k) {
+    const testing::RandomRobotCase rc = testing::randomRobotCase(36, k);
+    const std::vector<TailLink>& tail = rc.robot.tail;
+    const StrokeLimits L = sharedTorqueLimits(tail, rc.trajectory, 0.3 + 0.01 * k);
+    expectSame(tail, L, rc.trajectory, testing::describe(rc));
+  }
+  const ExperimentCase base = baseCase(3);
+  std::mt19937 rng(36);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (const StrokeFamily family : {StrokeFamily::kSplitCycle, StrokeFamily::kSpline}) {
+    StrokeSpace space;
+    space.family = family;
+    space.n_links = 3;
+    space.knots = 4;
+    space.limits.t0_max_s = 0.1;
+    space.limits.joints = {{-M_PI / 2, M_PI / 2, 600 * kDeg, 8.0}, {-M_PI / 2, M_PI / 2, 600 * kDeg, 3.0},
+                           {-M_PI / 2, M_PI / 2, 600 * kDeg, 1.0}};
+    for (int k = 0; k < 200; ++k) {
+      std::vector<double> x(static_cast<std::size_t>(space.dim()));
+      for (double& v : x) v = u01(rng);
+      expectSame(base.robot.tail, space.limits, space.trajectory(x), std::string(familyName(family)) + " stroke " + std::to_string(k));
+    }
+  }
+  EXPECT_EQ(compared, 460);
+  EXPECT_GT(slowed, 300) << "most strokes must be over a limit, or the comparison shows little";
 }
 
 // Stuck strokes (the body does not turn) rank by how close they come to breaking away, in a band

@@ -80,32 +80,125 @@ TailTrajectory timeScaled(const TailTrajectory& traj, double k) {
   return out;
 }
 
-TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t,
-                                   StrokeFigures* figures) {
-  StrokeFigures f, f_best;  // the last stroke's figures, the best kept one's
-  auto peakOverLimit = [&](const TailTrajectory& u) {  // the largest peak torque / its limit (0: no limit)
-    f = strokeFigures(links, u);
+namespace {
+// strokeFigures' sample times of traj: the grid t = k dt covering the stroke, plus every breakpoint, sorted.
+std::vector<double> sampleTimes(const TailTrajectory& traj, double dt) {
+  const double t_a = traj.startTime(), t_b = traj.endTime();
+  std::vector<double> ts;
+  for (long k = static_cast<long>(std::floor(t_a / dt)); k * dt <= t_b + dt; ++k) ts.push_back(k * dt);
+  for (double b : traj.breakpoints()) ts.push_back(b);
+  std::sort(ts.begin(), ts.end());
+  return ts;
+}
+
+// strokeFigures, with onSample(t, tau) called at every sample (the joint torques there).
+template <typename OnSample>
+StrokeFigures sampledFigures(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt, OnSample onSample) {
+  StrokeFigures f;
+  const double t_a = traj.startTime(), t_b = traj.endTime();
+  const std::vector<double> ts = sampleTimes(traj, dt);
+  std::vector<JointState> js, js0, js1;
+  traj.evaluate(t_a - 1.0, js0);
+  traj.evaluate(t_b + 1.0, js1);
+  f.theta_min_rad = f.theta_max_rad = js0.empty() ? 0.0 : js0[0].theta;
+  f.joints.resize(js0.size());
+  for (std::size_t i = 0; i < js0.size(); ++i) f.joints[i].theta_min_rad = f.joints[i].theta_max_rad = js0[i].theta;
+  double prev_t = ts.empty() ? 0.0 : ts.front(), prev_p = 0.0;
+  TailKinematics kin;       // scratch: no allocation per sample
+  std::vector<double> tau;
+  for (double t : ts) {
+    traj.evaluate(t, js);
+    jointTorques(links, js, kin, tau);
+    f.addSample(js, tau);
+    onSample(t, tau);
+    double p = 0.0;
+    for (std::size_t i = 0; i < js.size(); ++i) p += std::abs(tau[i] * js[i].theta_dot);
+    f.energy_J += 0.5 * (p + prev_p) * (t - prev_t);  // trapezoid
+    prev_t = t;
+    prev_p = p;
+  }
+  for (std::size_t i = 0; i < js0.size(); ++i) f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js1[i].theta - js0[i].theta));
+  for (std::size_t i = 0; i < traj.joints.size(); ++i)
+    if (traj.joints[i].isSpline()) {
+      const double v = std::abs(traj.joints[i].peakSpeed());
+      f.peak_speed_radps = std::max(f.peak_speed_radps, v);
+      if (i < f.joints.size()) f.joints[i].peak_speed_radps = std::max(f.joints[i].peak_speed_radps, v);
+    }
+  return f;
+}
+
+// The largest peak torque / its limit over the joints with a torque limit (0: none), from figures.
+double peakOverLimit(const StrokeFigures& f, const StrokeLimits& L) {
+  double ratio = 0.0;
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    const JointLimits J = L.joint(i);
+    if (J.torque_max_Nm > 0.0) ratio = std::max(ratio, f.joints[i].peak_torque_Nm / J.torque_max_Nm);
+  }
+  return ratio;
+}
+
+// The same ratio at one sample's torques.
+double ratioAt(const std::vector<double>& tau, const StrokeLimits& L) {
+  double ratio = 0.0;
+  for (std::size_t i = 0; i < tau.size(); ++i) {
+    const JointLimits J = L.joint(i);
+    if (J.torque_max_Nm > 0.0) ratio = std::max(ratio, std::abs(tau[i]) / J.torque_max_Nm);
+  }
+  return ratio;
+}
+
+// Where a stroke's torque peaks: the raw stroke's time intervals around its samples within kNearPeak of
+// its peak ratio. Slowed by s (times x s) they hold the slowed stroke's peak sample, unless another
+// hump, lower on the raw grid, comes out higher on the slowed one (peakIn's caller checks).
+struct PeakWindows {
+  static constexpr double kNearPeak = 0.02, kPad = 2.0;  // share of the peak; padding in samples
+  std::vector<std::pair<double, double>> raw;            // [a, b] in the raw stroke's time, merged
+
+  // From the raw stroke's samples (time, ratio) and its peak ratio.
+  PeakWindows(const std::vector<std::pair<double, double>>& samples, double peak, double dt) {
+    for (const auto& [time, r] : samples) {
+      if (r < (1.0 - kNearPeak) * peak) continue;
+      const double a = time - kPad * dt, b = time + kPad * dt;
+      if (!raw.empty() && a <= raw.back().second) raw.back().second = b;
+      else raw.emplace_back(a, b);
+    }
+  }
+
+  // The largest ratio over u's own sample times (sampleTimes(u), the same doubles strokeFigures
+  // evaluates) inside the windows slowed by s: u = t slowed by s.
+  double peakIn(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& u, double s,
+                double dt) const {
+    std::vector<JointState> js;
+    TailKinematics kin;
+    std::vector<double> tau;
     double ratio = 0.0;
-    for (std::size_t i = 0; i < f.joints.size(); ++i) {
-      const JointLimits J = L.joint(i);
-      if (J.torque_max_Nm > 0.0) ratio = std::max(ratio, f.joints[i].peak_torque_Nm / J.torque_max_Nm);
+    const std::vector<double> ts = sampleTimes(u, dt);
+    for (const auto& w : raw) {
+      auto it = std::lower_bound(ts.begin(), ts.end(), w.first * s);
+      for (; it != ts.end() && *it <= w.second * s; ++it) {
+        u.evaluate(*it, js);
+        jointTorques(links, js, kin, tau);
+        ratio = std::max(ratio, ratioAt(tau, L));
+      }
     }
     return ratio;
-  };
-  auto kept = [](double ratio) { return !exceedsLimit(ratio, 1.0); };
-  double ratio = peakOverLimit(t);
-  if (kept(ratio)) {
-    if (figures) *figures = f;
-    return t;
   }
+};
+
+// slowedToTorqueLimit's corrections, ratio(u, s) the peak ratio of u = t slowed by s: from the
+// raw stroke's ratio, a few corrections s <- s sqrt(ratio) (torques scale with 1/s^2 up to the
+// sampling grid, which samples the slowed motion at other phases), each from the slowed stroke's own
+// ratio, ending on the smallest factor seen that keeps the limit (or the last, when none does).
+// *s_out: the factor of the stroke returned.
+template <typename Ratio>
+TailTrajectory correctedSlowDown(const TailTrajectory& t, const StrokeLimits& L, double ratio, Ratio ratioOf,
+                                 double* s_out) {
+  auto kept = [](double r) { return !exceedsLimit(r, 1.0); };
   double s_max = std::numeric_limits<double>::infinity();  // where a duration or delay reaches its range's end
   for (const JointProfile& j : t.joints) {  // params(): a spline's envelope holds its dT and t0 too
     if (j.params().dT_s > 0.0) s_max = std::min(s_max, L.dT_max_s / j.params().dT_s);
     if (j.params().t0_s > 0.0) s_max = std::min(s_max, L.t0_max_s / j.params().t0_s);
   }
-  // Torques scale with 1/s^2 up to the figures' fixed 0.5 ms sampling grid, which samples the slowed
-  // motion at other phases: a few corrections s <- s sqrt(peak / limit), each from the slowed
-  // stroke's own figures, ending on the smallest factor seen that keeps the limit.
   s_max = std::max(1.0, s_max);
   double s = 1.0, s_kept = std::numeric_limits<double>::infinity();
   TailTrajectory out = t, best;
@@ -113,7 +206,6 @@ TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const Str
     if (kept(ratio) && s < s_kept) {
       s_kept = s;
       best = out;
-      f_best = f;
       if (ratio > 1.0 - 1e-7) break;
     }
     // A margin over the limit's rounding, grown from the 4th correction on (the grid can keep a
@@ -123,11 +215,53 @@ TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const Str
     if (next == s) break;
     s = next;
     out = timeScaled(t, 1.0 / s);
-    ratio = peakOverLimit(out);
+    ratio = ratioOf(out, s);
   }
   const bool last = !std::isfinite(s_kept) || (kept(ratio) && s < s_kept);  // else the best kept one
-  if (figures) *figures = last ? f : f_best;
+  *s_out = last ? s : s_kept;
   return last ? out : best;  // none kept: capped by the ranges, still over
+}
+}  // namespace
+
+TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t,
+                                   StrokeFigures* figures) {
+  constexpr double dt = 5e-4;  // strokeFigures' grid
+  std::vector<std::pair<double, double>> samples;  // (time, torque ratio) of the raw stroke
+  StrokeFigures f = sampledFigures(links, t, dt, [&](double time, const std::vector<double>& tau) {
+    samples.emplace_back(time, ratioAt(tau, L));
+  });
+  const double ratio = peakOverLimit(f, L);
+  if (!exceedsLimit(ratio, 1.0)) {
+    if (figures) *figures = f;
+    return t;
+  }
+  // The corrections read the slowed strokes' torques only where the raw stroke peaks (PeakWindows),
+  // a few dozen samples instead of the whole stroke; the answer's figures are then sampled in full,
+  // and where their peak is not the windows' (another hump came out higher) the corrections run
+  // again on full samples. Either way the same samples as strokeFigures decide.
+  const PeakWindows windows(samples, ratio, dt);
+  double s = 1.0;
+  const TailTrajectory fast = correctedSlowDown(
+      t, L, ratio, [&](const TailTrajectory& u, double k) { return windows.peakIn(links, L, u, k, dt); }, &s);
+  f = strokeFigures(links, fast, dt);
+  if (peakOverLimit(f, L) == windows.peakIn(links, L, fast, s, dt)) {
+    if (figures) *figures = f;
+    return fast;
+  }
+  return slowedToTorqueLimitOnFullSamples(links, L, t, figures);
+}
+
+TailTrajectory slowedToTorqueLimitOnFullSamples(const std::vector<TailLink>& links, const StrokeLimits& L,
+                                                const TailTrajectory& t, StrokeFigures* figures) {
+  constexpr double dt = 5e-4;  // strokeFigures' grid
+  auto ratioOf = [&](const TailTrajectory& u) { return peakOverLimit(strokeFigures(links, u, dt), L); };
+  const double ratio = ratioOf(t);
+  double s = 1.0;
+  const TailTrajectory out = exceedsLimit(ratio, 1.0)
+                                 ? correctedSlowDown(t, L, ratio, [&](const TailTrajectory& u, double) { return ratioOf(u); }, &s)
+                                 : t;
+  if (figures) *figures = strokeFigures(links, out, dt);
+  return out;
 }
 
 std::vector<double> StrokeSpace::pointOf(const std::vector<SplitCycleParams>& joints) const {
@@ -196,39 +330,7 @@ void StrokeFigures::addSample(const std::vector<JointState>& js, const std::vect
 }
 
 StrokeFigures strokeFigures(const std::vector<TailLink>& links, const TailTrajectory& traj, double dt) {
-  StrokeFigures f;
-  const double t_a = traj.startTime(), t_b = traj.endTime();
-  std::vector<double> ts;
-  for (long k = static_cast<long>(std::floor(t_a / dt)); k * dt <= t_b + dt; ++k) ts.push_back(k * dt);
-  for (double b : traj.breakpoints()) ts.push_back(b);
-  std::sort(ts.begin(), ts.end());
-  std::vector<JointState> js, js0, js1;
-  traj.evaluate(t_a - 1.0, js0);
-  traj.evaluate(t_b + 1.0, js1);
-  f.theta_min_rad = f.theta_max_rad = js0.empty() ? 0.0 : js0[0].theta;
-  f.joints.resize(js0.size());
-  for (std::size_t i = 0; i < js0.size(); ++i) f.joints[i].theta_min_rad = f.joints[i].theta_max_rad = js0[i].theta;
-  double prev_t = ts.empty() ? 0.0 : ts.front(), prev_p = 0.0;
-  TailKinematics kin;       // scratch: no allocation per sample
-  std::vector<double> tau;
-  for (double t : ts) {
-    traj.evaluate(t, js);
-    jointTorques(links, js, kin, tau);
-    f.addSample(js, tau);
-    double p = 0.0;
-    for (std::size_t i = 0; i < js.size(); ++i) p += std::abs(tau[i] * js[i].theta_dot);
-    f.energy_J += 0.5 * (p + prev_p) * (t - prev_t);  // trapezoid
-    prev_t = t;
-    prev_p = p;
-  }
-  for (std::size_t i = 0; i < js0.size(); ++i) f.end_offset_rad = std::max(f.end_offset_rad, std::abs(js1[i].theta - js0[i].theta));
-  for (std::size_t i = 0; i < traj.joints.size(); ++i)
-    if (traj.joints[i].isSpline()) {
-      const double v = std::abs(traj.joints[i].peakSpeed());
-      f.peak_speed_radps = std::max(f.peak_speed_radps, v);
-      if (i < f.joints.size()) f.joints[i].peak_speed_radps = std::max(f.joints[i].peak_speed_radps, v);
-    }
-  return f;
+  return sampledFigures(links, traj, dt, [](double, const std::vector<double>&) {});
 }
 
 double limitViolation(const StrokeFigures& f, const StrokeLimits& L) {

@@ -89,6 +89,11 @@ TailTrajectory timeScaled(const TailTrajectory& traj, double k);
 TailTrajectory slowedToTorqueLimit(const std::vector<TailLink>& links, const StrokeLimits& L, const TailTrajectory& t,
                                    StrokeFigures* figures = nullptr);
 
+// slowedToTorqueLimit with every correction read from the slowed stroke's full samples: what its
+// windowed corrections must match (tests), and its fallback where they do not.
+TailTrajectory slowedToTorqueLimitOnFullSamples(const std::vector<TailLink>& links, const StrokeLimits& L,
+                                                const TailTrajectory& t, StrokeFigures* figures = nullptr);
+
 // Joint torques tau_i = M_J,i (the Newton-Euler recursion of Eqs. 5-7, tail base held still).
 std::vector<double> jointTorques(const std::vector<TailLink>& links, const std::vector<JointState>& joints);
 // The same into tau, with kin as scratch (no allocation once sized): for sampling loops.
