@@ -172,14 +172,21 @@ struct PeakWindows {
     TailKinematics kin;
     std::vector<double> tau;
     double ratio = 0.0;
-    const std::vector<double> ts = sampleTimes(u, dt);
+    auto at = [&](double time) {
+      u.evaluate(time, js);
+      jointTorques(links, js, kin, tau);
+      ratio = std::max(ratio, ratioAt(tau, L));
+    };
+    // sampleTimes(u) inside each window, without building the whole list: its grid times k dt
+    // (k from floor(t_a / dt), k dt <= t_b + dt) and its breakpoints.
+    const long k_first = static_cast<long>(std::floor(u.startTime() / dt));
+    const double t_last = u.endTime() + dt;
+    const std::vector<double> breaks = u.breakpoints();
     for (const auto& w : raw) {
-      auto it = std::lower_bound(ts.begin(), ts.end(), w.first * s);
-      for (; it != ts.end() && *it <= w.second * s; ++it) {
-        u.evaluate(*it, js);
-        jointTorques(links, js, kin, tau);
-        ratio = std::max(ratio, ratioAt(tau, L));
-      }
+      const double a = w.first * s, b = w.second * s;
+      for (long k = std::max(k_first, static_cast<long>(std::floor(a / dt))); k * dt <= b && k * dt <= t_last; ++k)
+        if (k * dt >= a) at(k * dt);
+      for (auto it = std::lower_bound(breaks.begin(), breaks.end(), a); it != breaks.end() && *it <= b; ++it) at(*it);
     }
     return ratio;
   }
