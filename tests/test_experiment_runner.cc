@@ -22,18 +22,13 @@
 #include "common/atomic_file.h"
 #include "results/csv.h"
 #include "tailsim_version.h"
+#include "scratch_dir.h"
 
 using namespace tailsim;
+using tailsim::testing::ScratchDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("tailsim_runner_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
 // Fig. 11's sweep (9 cases), analytic only.
 fs::path writeSweep(const fs::path& dir, const std::string& wss = "{range: [0.1, 0.9, 0.1]}") {
@@ -52,7 +47,7 @@ nlohmann::json readJson(const fs::path& p) {
 }  // namespace
 
 TEST(ExperimentRunner, InterruptedSweepResumesWithEveryCaseOnce) {
-  const fs::path dir = tempDir("resume");
+  const ScratchDir dir("runner_resume");
   const Experiment e = loadExperiment(writeSweep(dir).string());
   ASSERT_EQ(e.cases.size(), 9u);
   RunOptions o;
@@ -83,7 +78,7 @@ TEST(ExperimentRunner, InterruptedSweepResumesWithEveryCaseOnce) {
 }
 
 TEST(ExperimentRunner, ResultsDoNotDependOnThreadCount) {
-  const fs::path dir = tempDir("threads");
+  const ScratchDir dir("runner_threads");
   const Experiment e = loadExperiment(writeSweep(dir).string());
   std::vector<double> phi[2];
   for (int k = 0; k < 2; ++k) {
@@ -103,7 +98,7 @@ TEST(ExperimentRunner, ResultsDoNotDependOnThreadCount) {
 }
 
 TEST(ExperimentRunner, ChangedExperimentIsRecomputedNotResumed) {
-  const fs::path dir = tempDir("changed");
+  const ScratchDir dir("runner_changed");
   RunOptions o;
   o.out_dir = (dir / "out").string();
   o.progress = false;
@@ -116,7 +111,7 @@ TEST(ExperimentRunner, ChangedExperimentIsRecomputedNotResumed) {
 }
 
 TEST(ExperimentRunner, InvalidSweepValueFailsBeforeAnythingRuns) {
-  const fs::path dir = tempDir("invalid");
+  const ScratchDir dir("runner_invalid");
   const fs::path f = writeSweep(dir, "{sweep: [0.2, 1.5, 0.3]}");
   try {
     loadExperiment(f.string());
@@ -173,7 +168,7 @@ Experiment onlyModels(Experiment e, const std::vector<std::string>& models) {
 
 // Editing the second robot file of a robot sweep must recompute its cases.
 TEST(ExperimentRunner, Finding1_EditedSweptRobotFileInvalidatesItsCases) {
-  const fs::path dir = tempDir("f1robot");
+  const ScratchDir dir("runner_f1robot");
   writeRobot(dir / "robotA.yaml", 8.458);
   writeRobot(dir / "robotB.yaml", 8.458);
   const fs::path f = writeExperiment(dir, "robots.yaml",
@@ -197,7 +192,7 @@ TEST(ExperimentRunner, Finding1_EditedSweptRobotFileInvalidatesItsCases) {
 
 // `run X --models analytic` then `run X` must compute MuJoCo.
 TEST(ExperimentRunner, Finding1_ModelsFilterIsPartOfTheResumeKey) {
-  const fs::path dir = tempDir("f1models");
+  const ScratchDir dir("runner_f1models");
   const fs::path f = writeExperiment(dir, "both.yaml",
                                      std::string("name: both\nrobot: paper\n") + kShortTrajectory +
                                          "models: [analytic, mujoco]\noutput: {settle_s: 0.05, sample_dt_s: 0.01}\n");
@@ -217,7 +212,7 @@ TEST(ExperimentRunner, Finding1_ModelsFilterIsPartOfTheResumeKey) {
 
 // Rendering on/off, the version and every resolved setting are in the key.
 TEST(ExperimentRunner, Finding1_ResumeKeyCoversRenderVersionAndSettings) {
-  const fs::path dir = tempDir("f1key");
+  const ScratchDir dir("runner_f1key");
   const Experiment e = loadExperiment(
       writeExperiment(dir, "k.yaml", std::string("name: k\nrobot: paper\n") + kShortTrajectory + "models: [analytic]\n")
           .string());
@@ -258,7 +253,7 @@ TEST(ExperimentRunner, Finding2_CaseFoldersAreUniqueByConstruction) {
     EXPECT_LE(d.size(), 100u) << d;
     EXPECT_NE(d[0], '.');
   }
-  const fs::path dir = tempDir("f2dirs");
+  const ScratchDir dir("runner_f2dirs");
   writeRobot(dir / "r a.yaml", 4.0);
   writeRobot(dir / "r_a.yaml", 8.458);
   const fs::path f = writeExperiment(dir, "names.yaml",
@@ -289,7 +284,7 @@ TEST(ExperimentRunner, Finding2_CaseFoldersAreUniqueByConstruction) {
 
 // Two threads writing one path atomically never share a temporary file.
 TEST(ExperimentRunner, Finding2_ConcurrentAtomicWritesNeverTear) {
-  const fs::path dir = tempDir("f2atomic");
+  const ScratchDir dir("runner_f2atomic");
   const std::string path = (dir / "same.csv").string();
   const std::string a(300000, 'a'), b(300000, 'b');
   std::atomic<int> errors{0};
@@ -313,7 +308,7 @@ TEST(ExperimentRunner, Finding2_ConcurrentAtomicWritesNeverTear) {
 
 // A second experiment into the same --out is refused, nothing written.
 TEST(ExperimentRunner, Finding3_OtherExperimentInSameOutIsRefused) {
-  const fs::path dir = tempDir("f3other");
+  const ScratchDir dir("runner_f3other");
   RunOptions o;
   o.out_dir = (dir / "out").string();
   o.progress = false;
@@ -345,7 +340,7 @@ TEST(ExperimentRunner, Finding3_OtherExperimentInSameOutIsRefused) {
 
 // A run into a folder another run holds fails at once, naming its pid.
 TEST(ExperimentRunner, Finding3_ConcurrentRunIntoSameOutFails) {
-  const fs::path dir = tempDir("f3lock");
+  const ScratchDir dir("runner_f3lock");
   fs::create_directories(dir / "out");
   const int fd = ::open((dir / "out" / ".tailsim.lock").c_str(), O_RDWR | O_CREAT, 0644);
   ASSERT_GE(fd, 0);
@@ -368,7 +363,7 @@ TEST(ExperimentRunner, Finding3_ConcurrentRunIntoSameOutFails) {
 // Temporaries a killed run left are removed by the next run of the folder;
 // those of a live process and files not named like tailsim's temporaries stay.
 TEST(ExperimentRunner, Finding11_KilledRunTemporariesAreCleaned) {
-  const fs::path dir = tempDir("f11");
+  const ScratchDir dir("runner_f11");
   RunOptions o;
   o.out_dir = (dir / "out").string();
   o.progress = false;
@@ -395,7 +390,7 @@ TEST(ExperimentRunner, Finding11_KilledRunTemporariesAreCleaned) {
 // case's part and then deleted by the join, without a word: it is refused before any work, unchanged,
 // whatever it is (a regular file, a symlink, a FIFO). tailsim's own parts still resume.
 TEST(UserFiles, AFileAtAPartsPathIsRefused) {
-  const fs::path dir = tempDir("a1");
+  const ScratchDir dir("runner_a1");
   std::ofstream(dir / "h5.yaml") << "name: h5\nrobot: paper\ntail: {links: 1}\n"
                                  << "trajectory: {theta0_deg: 45, dtheta_deg: -90, dT_s: 0.25, w_ss: {sweep: [0.2, 0.3]}}\n"
                                  << "models: [analytic]\noutput: {time_series: thin, time_series_file: hdf5}\n";
@@ -434,7 +429,7 @@ TEST(UserFiles, AFileAtAPartsPathIsRefused) {
 // `tailsim accuracy --out DIR` wrote accuracy.md and accuracy.csv over the user's files: refused
 // (checkAccuracyTables, before the study; writeAccuracyTables itself), unchanged; its own replaced.
 TEST(UserFiles, AccuracyTablesReplaceOnlyTailsimsOwn) {
-  const fs::path dir = tempDir("a4");
+  const ScratchDir dir("runner_a4");
   for (const std::string name : {"accuracy.md", "accuracy.csv"}) {
     std::ofstream(dir / name) << "mine";
     EXPECT_THROW(checkAccuracyTables(dir.string()), std::runtime_error) << name;
@@ -457,7 +452,7 @@ TEST(UserFiles, AccuracyTablesReplaceOnlyTailsimsOwn) {
 // A user's file named like a temporary of a dead process but without tailsim's infix
 // ("<name>.tmp.<pid>...") is not tailsim's: a run keeps it.
 TEST(UserFiles, TempLookalikesOfDeadPidsAreKept) {
-  const fs::path dir = tempDir("f19");
+  const ScratchDir dir("runner_f19");
   RunOptions o;
   o.out_dir = (dir / "out").string();
   o.progress = false;

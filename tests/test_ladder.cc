@@ -16,18 +16,13 @@
 #include "plotting/ladder.h"
 #include "plotting/result_folder.h"
 #include "results/columns.h"
+#include "scratch_dir.h"
 
 using namespace tailsim;
+using tailsim::testing::ScratchDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("tailsim_ladder_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
 // Fig. 7's case with the given extra lines.
 fs::path writeCase(const fs::path& dir, const std::string& extra, const std::string& quadruped = "{d_Q2B_m: 0.125}") {
@@ -48,7 +43,7 @@ std::string slurp(const fs::path& p) {
 }  // namespace
 
 TEST(PerFootRegistered, YamlRunsTheSameModelAsTheLibraryCall) {
-  const fs::path dir = tempDir("yaml");
+  const ScratchDir dir("ladder_yaml");
   const Experiment e = loadExperiment(
       writeCase(dir, "models: [analytic, perfoot]\nperfoot: {normal_loads: load_transfer}\n",
                "{d_Q2B_m: 0.125, com_height_m: 0.2}")
@@ -83,7 +78,7 @@ TEST(PerFootRegistered, YamlRunsTheSameModelAsTheLibraryCall) {
 }
 
 TEST(PerFootRegistered, BadPerfootKeyNamesFileLineAndKey) {
-  const fs::path dir = tempDir("bad");
+  const ScratchDir dir("ladder_bad");
   const fs::path f = writeCase(dir, "models: [perfoot]\nperfoot: {normal_loads: sideways}\n");
   try {
     loadExperiment(f.string());
@@ -100,7 +95,7 @@ TEST(PerFootRegistered, BadPerfootKeyNamesFileLineAndKey) {
 
 // configs/ladder/fig07_loading.yaml run and read back: one figure case, four ladder cases.
 TEST(GapLadder, Fig7RungsAreTheRunsPhiNetAndTheReportIsWritten) {
-  const fs::path out = tempDir("fig7");
+  const ScratchDir out("ladder_fig7");
   const Experiment e = loadExperiment(std::string(TAILSIM_SOURCE_DIR) + "/configs/ladder/fig07_loading.yaml");
   ASSERT_EQ(e.cases.size(), 4u);  // coupling x friction law
   RunOptions o;
@@ -151,7 +146,7 @@ TEST(GapLadder, Fig7RungsAreTheRunsPhiNetAndTheReportIsWritten) {
 }
 
 TEST(GapLadder, AFolderWithoutTheLadderAxesIsRefused) {
-  const fs::path dir = tempDir("notladder");
+  const ScratchDir dir("ladder_notladder");
   const Experiment e = loadExperiment(writeCase(dir, "models: [analytic]\n").string());
   RunOptions o;
   o.out_dir = (dir / "out").string();
@@ -170,7 +165,7 @@ TEST(GapLadder, AFolderWithoutTheLadderAxesIsRefused) {
 // anything is written, naming the file; tailsim's own (and an earlier tailsim's, by its first line)
 // are replaced.
 TEST(UserFiles, LadderTablesReplaceOnlyTailsimsOwn) {
-  const fs::path out = tempDir("userfiles");
+  const ScratchDir out("ladder_userfiles");
   RunOptions o;
   o.out_dir = out.string();
   o.progress = false;

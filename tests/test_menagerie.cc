@@ -18,8 +18,10 @@
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_handles.h"
 #include "trajectory/split_cycle_profile.h"
+#include "scratch_dir.h"
 
 using namespace tailsim;
+using tailsim::testing::ScratchDir;
 namespace fs = std::filesystem;
 
 namespace {
@@ -43,23 +45,6 @@ std::vector<fs::path> scenes() {
   std::sort(out.begin(), out.end());
   return out;
 }
-
-// A fresh folder under the test temp dir, removed at scope exit (per process: other builds may run
-// this test at the same time).
-struct ScratchDir {
-  fs::path path;
-  explicit ScratchDir(const std::string& name)
-      : path(fs::path(::testing::TempDir()) / ("menagerie_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-};
 
 std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
   for (size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) s.replace(i, from.size(), to);
@@ -218,8 +203,8 @@ TEST(Menagerie, FeetGiveThePaperMuOnAnyFloor) {
       f.robot_xml = replaceAll(f.robot_xml, R"( priority="1")", "");
     }
     if (!c.floor.empty()) f.scene_xml = replaceAll(f.scene_xml, R"(material="groundplane"/>)", R"(material="groundplane")" + c.floor + "/>");
-    const ScratchDir dir("friction");
-    const std::vector<std::string> paths = writeMenagerie(f, dir.path.string());
+    const ScratchDir dir("menagerie_friction");
+    const std::vector<std::string> paths = writeMenagerie(f, dir.string());
     ModelPtr model = loadModelFromFile(paths[1]);
     const mjModel* m = model.get();
     const int floor = mj_name2id(m, mjOBJ_GEOM, mjcf::kFloorGeom);
@@ -289,8 +274,8 @@ TEST(Menagerie, CustomRobotsAndEffectsCompile) {
   Effects e;
   e.friction = FrictionLaw::kContinuous;  // simulated from mu(0) = 0; the file carries the stiction value
   const MenagerieFiles f = generateMenagerie(p, MujocoSettings{}, e, "custom");
-  const ScratchDir dir("custom"), dir2("noeffects");
-  ModelPtr model = loadModelFromFile(writeMenagerie(f, dir.path.string())[1]);
+  const ScratchDir dir("menagerie_custom"), dir2("menagerie_noeffects");
+  ModelPtr model = loadModelFromFile(writeMenagerie(f, dir.string())[1]);
   const mjModel* m = model.get();
   EXPECT_EQ(m->nu, 3);
   EXPECT_EQ(m->body_mass[mj_name2id(m, mjOBJ_BODY, mjcf::tailBodyName(2).c_str())], 0.7);
@@ -304,7 +289,7 @@ TEST(Menagerie, CustomRobotsAndEffectsCompile) {
   e.ground_contact = false;
   e.gravity = false;
   ModelPtr m2 = loadModelFromFile(writeMenagerie(generateMenagerie(p, MujocoSettings{}, e, "noeffects"),
-                                                 dir2.path.string())[1]);
+                                                 dir2.string())[1]);
   EXPECT_TRUE(m2->opt.disableflags & mjDSBL_CONTACT);
   EXPECT_TRUE(m2->opt.disableflags & mjDSBL_GRAVITY);
   EXPECT_EQ(m2->nv, 4 + 3);

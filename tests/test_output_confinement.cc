@@ -12,18 +12,13 @@
 #include "experiments/experiment_runner.h"
 #include "models/mujoco/mujoco_handles.h"
 #include "rendering/ffmpeg_writer.h"
+#include "scratch_dir.h"
 
 using namespace tailsim;
+using tailsim::testing::ScratchDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("tailsim_confine_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
 // Runs f with the current directory set to dir.
 template <class F>
@@ -46,7 +41,7 @@ const char* kBody =
 }  // namespace
 
 TEST(OutputConfinement, Finding9_SuiteMemberNamesMustBeOneSafePathComponent) {
-  const fs::path dir = tempDir("names");
+  const ScratchDir dir("confine_names");
   const std::vector<std::string> bad = {"..", ".", "a/b", "a\\\\b", "-rf", "\"tab\\there\"", std::string(101, 'n')};
   for (const std::string& name : bad) {
     std::ofstream(dir / "member.yaml") << "name: " << name << "\n" << kBody;
@@ -67,7 +62,7 @@ TEST(OutputConfinement, Finding9_SuiteMemberNamesMustBeOneSafePathComponent) {
 }
 
 TEST(OutputConfinement, Finding9_MujocoWarningWritesNoLogFile) {
-  const fs::path dir = tempDir("mjlog");
+  const ScratchDir dir("confine_mjlog");
   std::string captured;
   inDirectory(dir, [&] {
     ModelPtr m = loadModelFromXml(
@@ -84,7 +79,7 @@ TEST(OutputConfinement, Finding9_MujocoWarningWritesNoLogFile) {
 }
 
 TEST(OutputConfinement, Finding9_MujocoErrorIsAnExceptionNotAnExit) {
-  const fs::path dir = tempDir("mjerr");
+  const ScratchDir dir("confine_mjerr");
   inDirectory(dir, [&] {
     installMujocoMessageHandlers();
     try {
@@ -102,10 +97,10 @@ TEST(OutputConfinement, Finding9_MujocoErrorIsAnExceptionNotAnExit) {
 TEST(OutputConfinement, Finding11_FfmpegLogLeavesNoFileInTmp) {
   const std::string exe = findExecutable("ffmpeg");
   if (exe.empty()) GTEST_SKIP() << "ffmpeg not installed";
-  const fs::path tmp = tempDir("ffmpeglog"), out = tempDir("ffmpegout");
+  const ScratchDir tmp("confine_ffmpeglog"), out("confine_ffmpegout");
   const char* old = std::getenv("TMPDIR");
   const std::string old_value = old ? old : "";
-  ::setenv("TMPDIR", tmp.c_str(), 1);
+  ::setenv("TMPDIR", tmp.string().c_str(), 1);
   {
     FfmpegSink sink(exe, 64, 48, VideoEncoding{}, {{FfmpegOutput::Kind::kMp4, (out / "v.mp4").string(), 0}});
     EXPECT_TRUE(fs::is_empty(tmp));  // while ffmpeg runs: this is what a kill -9 would leave

@@ -11,19 +11,14 @@
 #include "experiments/experiment_runner.h"
 #include "experiments/settings_json.h"
 #include "experiments/settings_schema.h"
+#include "scratch_dir.h"
 
 using namespace tailsim;
+using tailsim::testing::ScratchDir;
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 namespace {
-
-fs::path tempDir(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("tailsim_settings_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
 
 std::string loadError(const fs::path& dir, const std::string& yaml) {
   const fs::path f = dir / "e.yaml";
@@ -115,7 +110,7 @@ TEST(ResolvedCase, RoundTripsEveryPaperCase) {
 }
 
 TEST(ResolvedCase, ReaderNamesAMissingKey) {
-  const fs::path dir = tempDir("missing");
+  const ScratchDir dir("settings_missing");
   std::ofstream(dir / "e.yaml") << kBase;
   json j = resolvedJson(loadExperiment((dir / "e.yaml").string()).cases.at(0));
   j["mujoco"].erase("timestep_s");
@@ -129,7 +124,7 @@ TEST(ResolvedCase, ReaderNamesAMissingKey) {
 
 // result.json holds the resolved case: defaults, tail links, per-joint trajectory, version.
 TEST(ResolvedCase, ResultJsonHoldsEverySettingTheRunUsed) {
-  const fs::path dir = tempDir("result");
+  const ScratchDir dir("settings_result");
   std::ofstream(dir / "e.yaml") << "name: r\nrobot: paper\ntail: {links: 2}\n"
                                    "trajectory: {theta0_deg: [10, 20], dtheta_deg: -30, dT_s: 0.2}\n";
   const Experiment e = loadExperiment((dir / "e.yaml").string());
@@ -161,7 +156,7 @@ TEST(ResolvedCase, ResultJsonHoldsEverySettingTheRunUsed) {
 
 // A setting is in the resume key by being declared: each declared field changes the key.
 TEST(ResumeKey, EveryDeclaredFieldIsInTheKey) {
-  const fs::path dir = tempDir("key");
+  const ScratchDir dir("settings_key");
   std::ofstream(dir / "e.yaml") << kBase << "render: {}\n";
   const ExperimentCase c = loadExperiment((dir / "e.yaml").string()).cases.at(0);
   expectEveryFieldInKey(c, true, [](ExperimentCase& d) -> QuadrupedParams& { return d.robot.quadruped; }, "quadruped");
@@ -183,7 +178,7 @@ TEST(ResumeKey, EveryDeclaredFieldIsInTheKey) {
 // The loader refuses, at file:line:col, every render value the renderer would refuse (the same
 // declared limits): fps above 240, odd or tiny sizes, msaa, crf, preset.
 TEST(DeclaredLimits, LoaderRefusesWhatTheRendererRefuses) {
-  const fs::path dir = tempDir("render");
+  const ScratchDir dir("settings_render");
   const std::string f = (dir / "e.yaml").string();
   for (const auto& [yaml, key] : std::vector<std::pair<std::string, std::string>>{
            {"{fps: 1000}", "render.fps"},
