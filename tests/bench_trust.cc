@@ -3,11 +3,12 @@
 // the rule and its evidence"). Plain main, one thread; prints one Markdown row per rule:
 //   nice build/tests/bench_trust [--cases N=120] [--seed S=31] [--rules "today;set:imp=100,ns=3;.."]
 //                                [--ref-cache FILE] [--check16 K=10] [--csv FILE] [--jitter-check]
-//                                [--corpus mixed|tippy] [--falls]
+//                                [--corpus mixed|tippy] [--falls] [--ref-rule NAME]
 // Reference of a rule: the rule's settings at timestep / 8 (servo w_n kept), impratio >= 100,
 // noslip >= 3 (for "today": the old defaults' reference); every K-th case also at timestep / 16, to
 // show the reference itself has converged. --ref-cache keeps the reference runs (keyed by seed,
-// case and settings) so rules can be compared without re-running them.
+// case and settings) so rules can be compared without re-running them. --ref-rule NAME: every rule
+// against NAME's reference instead of its own (a candidate default against today's default's).
 // Columns (cases where both the rule and its reference stand):
 //  * err median / p90 / max: |phi_net - phi_net,ref| / max(|phi_net,ref|, 0.5 deg);
 //  * vs today ref: the same against today's reference (what a rule's physics moves);
@@ -155,20 +156,22 @@ std::map<std::string, Rule> rules() {
   return m;
 }
 
-// "set:key=value,..": today's rule with these changes (keys: h = timestep_s (servo w_n kept),
+// "set:key=value,..": today's rule with these changes; "dset:key=value,..": MujocoSettings'
+// defaults with these changes (keys: h = timestep_s (servo w_n kept),
 // imp = impratio, ns = noslip_iterations, tau, zeta = solref, dmin, dmax, width, mid, power =
 // solimp, foot = sphere|capsule|box, r = foot_radius_m, settle = settle_s).
 Rule parseRule(const std::string& spec) {
+  const bool from_defaults = spec.rfind("dset:", 0) == 0;
   std::vector<std::pair<std::string, std::string>> kv;
-  for (std::stringstream ss(spec.substr(4)); ss.good();) {
+  for (std::stringstream ss(spec.substr(spec.find(':') + 1)); ss.good();) {
     std::string item;
     std::getline(ss, item, ',');
     const size_t eq = item.find('=');
     if (eq == std::string::npos) throw std::invalid_argument("rule item without '=': " + item);
     kv.emplace_back(item.substr(0, eq), item.substr(eq + 1));
   }
-  return [kv](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
-    today(r, t, s);
+  return [kv, from_defaults](const RobotParams& r, const TailTrajectory& t, MujocoSettings& s) {
+    if (!from_defaults) today(r, t, s);
     for (const auto& [k, v] : kv) {
       const double x = std::atof(v.c_str());
       if (k == "h") refine(s, s.timestep_s / x);
@@ -459,7 +462,7 @@ int main(int argc, char** argv) {
   bool jitter_check = false, falls = false;
   RandomCorpus corpus = RandomCorpus::kMixed;  // --jitter-check: the jitter run has its own check run (check_jitter_phi_deg)
   unsigned seed = 31;
-  std::string rule_list = "today", cache_path, csv_path;
+  std::string rule_list = "today", cache_path, csv_path, ref_rule;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -475,6 +478,7 @@ int main(int argc, char** argv) {
     else if (a == "--ref-cache") cache_path = next();
     else if (a == "--check16") check16 = std::atoi(next().c_str());
     else if (a == "--csv") csv_path = next();
+    else if (a == "--ref-rule") ref_rule = next();
     else if (a == "--jitter-check") jitter_check = true;
     else if (a == "--falls") falls = true;
     else if (a == "--corpus") {
@@ -495,7 +499,7 @@ int main(int argc, char** argv) {
   for (std::stringstream ss(rule_list); ss.good();) {
     std::string n;
     std::getline(ss, n, ';');
-    if (n.rfind("set:", 0) == 0) all[n] = parseRule(n);
+    if (n.rfind("set:", 0) == 0 || n.rfind("dset:", 0) == 0) all[n] = parseRule(n);
     if (!all.count(n)) {
       std::fprintf(stderr, "unknown rule %s; known:", n.c_str());
       for (const auto& [k, v] : all) std::fprintf(stderr, " %s", k.c_str());
@@ -503,6 +507,10 @@ int main(int argc, char** argv) {
       return 2;
     }
     names.push_back(n);
+  }
+  if (!ref_rule.empty() && !all.count(ref_rule)) {
+    std::fprintf(stderr, "unknown --ref-rule %s\n", ref_rule.c_str());
+    return 2;
   }
   RefCache cache(cache_path);
   std::ofstream csv;
@@ -566,11 +574,12 @@ int main(int argc, char** argv) {
       MujocoSettings sj = s;
       sj.uncertainty = jitter_check && s.uncertainty;  // the jitter run needs phi_net only
       const Run j = runOnce(c.robot, jittered(c.trajectory, 1e-6), sj);
-      const Run f = refRun(rule, k, 8.0, 0.0);
-      const Run fj = refRun(rule, k, 8.0, 1e-6);
+      const Rule& ref_of = ref_rule.empty() ? rule : all.at(ref_rule);
+      const Run f = refRun(ref_of, k, 8.0, 0.0);
+      const Run fj = refRun(ref_of, k, 8.0, 1e-6);
       const Run ft = refRun(all.at("today"), k, 8.0, 0.0);
       Run f16;
-      if (check16 > 0 && k % check16 == 0) f16 = refRun(rule, k, 16.0, 0.0);
+      if (check16 > 0 && k % check16 == 0) f16 = refRun(ref_of, k, 16.0, 0.0);
       steps.push_back(r.steps);
       wall.push_back(r.wall_s);
       if (csv.is_open())

@@ -112,7 +112,7 @@ rc=0
 [ -L /dev/stdout ] || fail "/dev/stdout is no longer a symlink"
 [ "$(head -n 1 appended.txt)" = "kept line" ] || fail "mjcf --out /dev/stdout >> file truncated the file"
 cmp -s <(tail -n +2 appended.txt) expected2.xml || fail "mjcf --out /dev/stdout >> file: not the XML appended"
-echo old >target.xml
+: >target.xml
 ln -s target.xml link.xml
 run 0 "$tailsim" mjcf --links 2 --out link.xml
 [ -L link.xml ] || fail "mjcf --out link.xml replaced the symlink"
@@ -122,7 +122,17 @@ cmp -s plain.xml expected2.xml || fail "mjcf --out plain.xml differs from the st
 mkdir adir
 run 1 "$tailsim" mjcf --links 2 --out adir
 [ -d adir ] || fail "mjcf --out DIR replaced the folder"
-ok "mjcf --out: - (XML only), /dev/null, /dev/stdout >> file (appended), symlink (kept, target written), folder (error)"
+run 0 "$tailsim" mjcf --links 1 --out plain.xml
+grep -q 'model="tailsim_quadruped_tail1"' plain.xml || fail "mjcf --out plain.xml did not replace tailsim's own file"
+printf '<mujoco model="mine"/>\n' >mine.xml
+cp mine.xml mine.orig
+ln -s mine.xml minelink.xml
+for target in mine.xml minelink.xml; do
+  run 1 "$tailsim" mjcf --links 2 --out $target
+  grep -q "was not written by tailsim: not replaced" err.txt || fail "mjcf --out over a user's file $target: $(cat err.txt)"
+  cmp -s mine.xml mine.orig || fail "mjcf --out $target replaced the user's model file"
+done
+ok "mjcf --out: - (XML only), /dev/null, /dev/stdout >> file (appended), symlink (kept, target written), folder (error), tailsim's own file replaced, a user's file (or its link) refused and kept"
 
 echo "== mjcf of an experiment: a custom tail as one file (= the result folder's model) and in Menagerie form"
 printf 'name: custom3\nrobot: %s\n' "$robot" >custom3.yaml

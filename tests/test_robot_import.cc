@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "common/atomic_file.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/robot_compare.h"
 #include "models/mujoco/robot_import.h"
@@ -342,6 +343,26 @@ TEST(RobotImport, DerivedRobotFileLoadsBackExactly) {
   ASSERT_EQ(f.tails.size(), 6u);
   EXPECT_NEAR(f.tails.at(1).mass_kg, 0.1 * r.quadruped.mass_kg, 1e-12);
   EXPECT_NEAR(f.tails.at(3).length_m * 3, r.quadruped.l_F_m, 1e-12);
+
+  // `--write-robot FILE` (writeUserFile with the robot file's marker) replaces a robot file it
+  // wrote, never the user's model: `tailsim robot box.xml --write-robot box.xml` once turned the
+  // model into YAML.
+  const std::string text = derivedRobotFile(r, c);
+  EXPECT_FALSE(writeUserFile(path, text, kDerivedRobotFileMarker));
+  std::string before;
+  {
+    std::ifstream in(s.file);
+    before.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  try {
+    writeUserFile(s.file, text, kDerivedRobotFileMarker);
+    ADD_FAILURE() << "the model file was replaced";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("box.xml exists and was not written by tailsim: not replaced"), std::string::npos)
+        << e.what();
+  }
+  std::ifstream in(s.file);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), before);
 }
 
 }  // namespace
@@ -626,3 +647,216 @@ TEST(RobotImport, UrdfCollisionMeshMissingNamesTheLinkAndFile) {
         << e.what();
   }
 }
+
+// Models in styles nobody here wrote (an outside review's findings, each a wrong number or a
+// misleading error before): the helpers below build small robots in those styles.
+namespace {
+
+// A URDF quadruped: `base` (given by `base_link`), four legs on hinges `<leg>_j` at 0 (the stance),
+// each a 0.5 kg link with a collision sphere 0.2 m below the hip.
+std::string urdfQuadruped(const std::string& base_link) {
+  std::string legs;
+  const struct {
+    const char* name;
+    double x, y;
+  } leg[] = {{"FL", 0.2, 0.12}, {"FR", 0.2, -0.12}, {"RR", -0.2, -0.12}, {"RL", -0.2, 0.12}};
+  for (const auto& l : leg) {
+    char b[1200];
+    std::snprintf(b, sizeof b,
+                  "<link name=\"%s\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/>"
+                  "<inertia ixx=\"0.002\" iyy=\"0.002\" izz=\"0.0003\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
+                  "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
+                  "<joint name=\"%s_j\" type=\"revolute\"><parent link=\"base\"/><child link=\"%s\"/>"
+                  "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
+                  "<limit lower=\"-1\" upper=\"1\" effort=\"50\" velocity=\"10\"/></joint>\n",
+                  l.name, l.name, l.name, l.x, l.y);
+    legs += b;
+  }
+  return "<robot name=\"bot\">\n" + base_link + legs + "</robot>\n";
+}
+
+RobotModelSpec urdfSpec(const std::string& file) {
+  RobotModelSpec s;
+  s.file = file;
+  for (const char* j : {"FL_j", "FR_j", "RR_j", "RL_j"}) s.joint_angles_rad[j] = 0.0;
+  s.settle_s = 0.3;
+  return s;
+}
+
+const char* kAutolimits = "<compiler autolimits=\"true\"/>";
+
+// An MJCF box robot whose four legs hang on hinges j1..j4 held by `actuators` (%J% = the joint).
+std::string mjcfLegRobot(const std::string& compiler, const std::string& actuator, double stance_rad) {
+  std::string legs, acts;
+  const double xy[4][2] = {{0.2, 0.12}, {0.2, -0.12}, {-0.2, -0.12}, {-0.2, 0.12}};
+  for (int i = 0; i < 4; ++i) {
+    char b[700];
+    std::snprintf(b, sizeof b,
+                  "<body name=\"leg%d\" pos=\"%g %g -0.05\"><joint name=\"j%d\" axis=\"0 1 0\" range=\"-1 1\"/>"
+                  "<inertial pos=\"0 0 -0.1\" mass=\"0.5\" diaginertia=\"0.002 0.002 0.0003\"/>"
+                  "<geom name=\"f%d\" type=\"sphere\" size=\"0.02\" pos=\"0 0 -0.22\"/></body>\n",
+                  i + 1, xy[i][0], xy[i][1], i + 1, i + 1);
+    legs += b;
+    std::string a = actuator;
+    for (std::size_t p = a.find("%J%"); p != std::string::npos; p = a.find("%J%")) a.replace(p, 3, "j" + std::to_string(i + 1));
+    acts += a;
+  }
+  char key[200];
+  std::snprintf(key, sizeof key, "<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0 %g %g %g %g\"/></keyframe>",
+                stance_rad, stance_rad, stance_rad, stance_rad);
+  return "<mujoco model=\"legbot\">\n" + compiler + R"(
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <body name="trunk" pos="0 0 0.3">
+      <freejoint/>
+      <inertial pos="0 0 0" mass="10" diaginertia="0.1 0.2 0.25"/>
+      <geom name="body_box" type="box" size="0.25 0.15 0.05"/>
+)" + legs + "    </body>\n  </worldbody>\n  <actuator>" + acts + "</actuator>\n" + key + "\n</mujoco>\n";
+}
+
+// A URDF link without <inertial> weighs nothing (URDF's rule), not its collision geoms' mass at
+// density 1000 (MuJoCo's default): the ANYmal pattern, a `base` link holding only a collision box,
+// its 10 kg on a link fixed to it. Before: 15 kg more (the 0.5 x 0.3 x 0.1 m box).
+TEST(RobotImport, UrdfLinkWithoutInertialWeighsNothing) {
+  Scratch t("robot_import");
+  const std::string base = R"(<link name="base"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
+<link name="base_inertia"><inertial><origin xyz="0.01 0 0"/><mass value="10"/>
+  <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial></link>
+<joint name="base_to_inertia" type="fixed"><parent link="base"/><child link="base_inertia"/></joint>
+)";
+  const DerivedRobot r = deriveRobot(urdfSpec(t.write("bot.urdf", urdfQuadruped(base))));
+  EXPECT_EQ(r.root_body, "base");
+  expectMujocoFigures(r, 10.0 + 4 * 0.5);
+  // The URDF's own setting wins: mass from the collision geoms when it asks for it.
+  std::string asked = urdfQuadruped(base);
+  asked.replace(asked.find('\n') + 1, 0, "<mujoco><compiler inertiafromgeom=\"auto\"/></mujoco>\n");
+  const DerivedRobot a = deriveRobot(urdfSpec(t.write("asked.urdf", asked)));
+  EXPECT_NEAR(a.quadruped.mass_kg, 10.0 + 4 * 0.5 + 1000 * 0.5 * 0.3 * 0.1, 1e-6);
+}
+
+// A URDF's collision geoms have no names: its feet are named by their links (bodies).
+TEST(RobotImport, FeetNamedByTheirBodies) {
+  Scratch t("robot_import");
+  const std::string base = R"(<link name="base"><inertial><mass value="10"/>
+  <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
+  <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
+)";
+  RobotModelSpec s = urdfSpec(t.write("bot.urdf", urdfQuadruped(base)));
+  s.feet = {"RL", "FL", "FR", "RR"};
+  const DerivedRobot r = deriveRobot(s);
+  ASSERT_EQ(r.feet.size(), 4u);
+  EXPECT_NE(r.feet[0].find("of body 'FL'"), std::string::npos) << r.feet[0];  // ordered FL, FR, RR, RL
+  EXPECT_NEAR(r.quadruped.l_F_m, 0.4, 1e-3);
+  s.feet = {"RL", "FL", "FR", "nobody"};
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a foot named after nothing was taken";
+  } catch (const RobotImportError& e) {
+    EXPECT_EQ(e.key(), "robot.feet");
+    EXPECT_NE(std::string(e.what()).find("feet: no geom or body named 'nobody'"), std::string::npos) << e.what();
+  }
+}
+
+// A <position> servo with gear 2 holds its joint where ctrl = 2 q: given ctrl = q it held the legs
+// at half the stance angle (a robot that stood at gear 1 fell over at gear 2). A stance whose ctrl
+// is outside the ctrlrange is an error naming the actuator (MuJoCo would clamp it silently).
+TEST(RobotImport, PositionServosHoldTheStanceThroughTheirGearAndRange) {
+  Scratch t("robot_import");
+  RobotModelSpec s;
+  s.settle_s = 0.3;
+  // gear 2 at kp 400 is the joint stiffness of gear 1 at kp 1600: the same stance, the same settling.
+  s.file = t.write("gear1.xml", mjcfLegRobot(kAutolimits, "<position joint=\"%J%\" kp=\"1600\"/>", 0.3));
+  const DerivedRobot r1 = deriveRobot(s);
+  s.file = t.write("gear2.xml", mjcfLegRobot(kAutolimits, "<position joint=\"%J%\" kp=\"400\" gear=\"2\"/>", 0.3));
+  const DerivedRobot r = deriveRobot(s);
+  EXPECT_LT(r.tilt_deg, 1.0);
+  for (const char* j : {"j1", "j2", "j3", "j4"}) {
+    EXPECT_NEAR(r.settled_qpos.at(j).at(0), r1.settled_qpos.at(j).at(0), 1e-9) << j;
+    EXPECT_NEAR(r.settled_qpos.at(j).at(0), 0.3, 0.06) << j;  // ctrl = q held it near 0.15
+  }
+  s.file = t.write("clamp.xml", mjcfLegRobot(kAutolimits, "<position name=\"a_%J%\" joint=\"%J%\" kp=\"400\" ctrlrange=\"-0.2 0.2\"/>", 0.3));
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a stance outside the ctrlrange was taken";
+  } catch (const RobotImportError& e) {
+    EXPECT_EQ(e.key(), "robot.stance");
+    EXPECT_NE(std::string(e.what()).find("actuator 'a_j1' cannot hold joint 'j1' at its stance angle 17.1887 deg: that "
+                                         "needs ctrl 0.3, outside its ctrlrange [-0.2, 0.2]"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+// The compiler's settings as MuJoCo applies them: global coordinates are refused (the tail is
+// attached in local ones: before, it hung at the world origin); a joint MuJoCo 2.2 refuses is named
+// at its line in the user's file, with the hint for files written for MuJoCo >= 2.3.
+TEST(RobotImport, CompilerSettingsAsMujocoAppliesThem) {
+  Scratch t("robot_import");
+  RobotModelSpec s;
+  s.file = t.write("global.xml", mjcfLegRobot("<compiler coordinate=\"global\" autolimits=\"true\"/>",
+                                              "<position joint=\"%J%\" kp=\"400\"/>", 0.0));
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a model in global coordinates was taken";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("global.xml: the model is written in global coordinates"), std::string::npos)
+        << e.what();
+  }
+  const std::string text = mjcfLegRobot("", "<position joint=\"%J%\" kp=\"400\"/>", 0.0);
+  s.file = t.write("nolimits.xml", text);
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + text.find("name=\"j1\""), '\n'));
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a range without limited was taken by MuJoCo 2.2";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("nolimits.xml:" + std::to_string(line) + ": MuJoCo 2.2 refuses the model"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("add <compiler autolimits=\"true\"/>"), std::string::npos) << e.what();
+  }
+}
+
+// A binary STL tetrahedron (MuJoCo 2.2 reads binary STL).
+void writeTetrahedronStl(const fs::path& file) {
+  const float v[4][3] = {{0, 0, 0}, {0.05f, 0, 0}, {0, 0.05f, 0}, {0, 0, 0.05f}};
+  const int f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  std::ofstream out(file, std::ios::binary);
+  const std::string header(80, ' ');
+  out.write(header.data(), 80);
+  const uint32_t n = 4;
+  out.write(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& tri : f) {
+    const float normal[3] = {0, 0, 0};
+    out.write(reinterpret_cast<const char*>(normal), 12);
+    for (int k : tri) out.write(reinterpret_cast<const char*>(v[k]), 12);
+    const uint16_t attr = 0;
+    out.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+}
+
+// A scene with its own <compiler> before it includes the robot, whose <compiler meshdir> names the
+// mesh folder: the last setting wins, as in MuJoCo (before, the scene's compiler was the only one
+// read, and the robot's colliding mesh was looked for beside the scene).
+TEST(RobotImport, TheLastCompilerSettingWins) {
+  Scratch t("robot_import");
+  fs::create_directories(t.dir / "assets");
+  writeTetrahedronStl(t.dir / "assets" / "shell.stl");
+  std::string robot = mjcfLegRobot("<compiler meshdir=\"assets\" autolimits=\"true\"/>\n  <asset><mesh name=\"shell\" file=\"shell.stl\"/></asset>",
+                                   "<position joint=\"%J%\" kp=\"400\"/>", 0.0);
+  robot.replace(robot.find("<geom name=\"body_box\""), 0, "<geom name=\"shell\" type=\"mesh\" mesh=\"shell\" pos=\"0 0 0.05\"/>\n      ");
+  robot.replace(robot.find("<geom name=\"floor\" type=\"plane\" size=\"0 0 1\"/>"), 45, "");
+  t.write("bot.xml", robot);
+  RobotModelSpec s;
+  s.settle_s = 0.3;
+  s.file = t.write("scene.xml", R"(<mujoco model="scene">
+  <compiler autolimits="true"/>
+  <include file="bot.xml"/>
+  <worldbody><geom name="floor" type="plane" size="0 0 1"/></worldbody>
+</mujoco>
+)");
+  const DerivedRobot r = deriveRobot(s);
+  EXPECT_EQ(r.model.dropped_geoms, 0);
+  EXPECT_EQ(r.feet.size(), 4u);
+}
+
+}  // namespace

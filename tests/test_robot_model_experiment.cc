@@ -192,7 +192,7 @@ TEST(RobotModelExperiment, ErrorsNameFileLineAndKey) {
   EXPECT_NE(m.find("(models: [mujoco])"), std::string::npos) << m;
   m = run("{mjcf: box.xml, feet: [f1, f2, f3, toe]}");
   expectAt(m, f, 2, "robot.feet");
-  EXPECT_NE(m.find("no geom named 'toe'"), std::string::npos) << m;
+  EXPECT_NE(m.find("no geom or body named 'toe'"), std::string::npos) << m;
   // Commands whose MuJoCo run is the rigid box or changes its settings refuse it (trust, accuracy, mjcf).
   t.write("e.yaml", experiment("{mjcf: box.xml}"));
   try {

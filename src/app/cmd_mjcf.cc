@@ -82,7 +82,7 @@ int writeExperimentMjcf(const std::string& exp_path, const std::string& only_cas
                                " distinct MuJoCo models (cases " + names + (models.size() > 5 ? ", ..." : "") +
                                "); pick one with --case NAME, or write them all with --menagerie DIR");
     }
-    const bool to_stream = writeUserFile(out, models[0].xml);
+    const bool to_stream = writeUserFile(out, models[0].xml, kGeneratedMjcfMarker);
     std::fprintf(to_stream ? stderr : stdout, "wrote %s (case %s)\n", out == "-" ? "the MJCF to stdout" : out.c_str(),
                  models[0].c->name.c_str());
     return kExitOk;

@@ -105,13 +105,13 @@ void runRobot(const RobotOptions& o) {
     const RobotComparison c = compareRobotModels(spec, o.tail);
     std::fputs(describeDerivedRobot(c.robot).c_str(), stdout);
     std::fputs(("\n" + describeComparison(c)).c_str(), stdout);
-    if (!o.write_robot.empty() && !writeUserFile(o.write_robot, derivedRobotFile(c.robot, o.tail)))
+    if (!o.write_robot.empty() && !writeUserFile(o.write_robot, derivedRobotFile(c.robot, o.tail), kDerivedRobotFileMarker))
       std::printf("wrote %s\n", o.write_robot.c_str());
   } else {
     const DerivedRobot r = deriveRobot(spec);
     std::fputs(describeDerivedRobot(r).c_str(), stdout);
     if (!o.write_robot.empty()) {
-      if (!writeUserFile(o.write_robot, derivedRobotFile(r, o.tail)))
+      if (!writeUserFile(o.write_robot, derivedRobotFile(r, o.tail), kDerivedRobotFileMarker))
         std::printf("wrote %s\n", o.write_robot.c_str());
     }
   }

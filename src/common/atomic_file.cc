@@ -291,8 +291,23 @@ void writeAllTo(int fd, const std::string& path, const std::string& contents) {
 
 }  // namespace
 
-bool writeUserFile(const std::string& path, const std::string& contents) {
+// Refuses to replace a non-empty regular file at path (or a symlink's) that does not hold `marker`
+// near its start.
+static void refuseForeignFile(const std::string& path, const std::string& marker) {
+  struct stat st;
+  if (marker.empty() || ::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size == 0) return;
+  std::ifstream in(path, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  if (head.find(marker) == std::string::npos)
+    throw std::runtime_error(path + " exists and was not written by tailsim: not replaced (remove it, or choose "
+                                    "another name)");
+}
+
+bool writeUserFile(const std::string& path, const std::string& contents, const std::string& own_marker) {
   if (path.empty()) throw std::runtime_error("empty output path");
+  if (ownDescriptor(path) < 0) refuseForeignFile(path, own_marker);
   if (const int fd = ownDescriptor(path); fd >= 0) {
     writeAllTo(fd, path, contents);
     return true;

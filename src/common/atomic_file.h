@@ -27,7 +27,10 @@ bool processGone(long pid);
 //  - anything else (a regular file or a new name) atomically, as writeFileAtomic.
 // Returns true when the contents went to a stream (descriptor, device, FIFO, socket) rather than
 // to a file, so callers can keep their messages off stdout. Throws std::runtime_error naming PATH.
-bool writeUserFile(const std::string& path, const std::string& contents);
+// `own_marker`: a non-empty regular file at PATH (a symlink's target included) is replaced only when
+// its first 4 KiB hold this text, i.e. tailsim wrote it (e.g. "# Written by `tailsim robot`");
+// anything else, the user's model file among them, is refused with std::runtime_error and left as it is.
+bool writeUserFile(const std::string& path, const std::string& contents, const std::string& own_marker = "");
 
 // Reads a file tailsim wrote into a result folder (cases.jsonl, result.json, summary.json, ...)
 // only if it is what it should be: std::nullopt when absent; std::runtime_error naming the path

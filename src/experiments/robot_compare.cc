@@ -116,7 +116,7 @@ std::string derivedRobotFile(const DerivedRobot& r, const RobotTailChoice& c) {
     return std::string(b);
   };
   const QuadrupedParams& q = r.quadruped;
-  std::string t = "# Written by `tailsim robot` from " + r.model.source + "\n# stance: " + r.stance +
+  std::string t = std::string(kDerivedRobotFileMarker) + " from " + r.model.source + "\n# stance: " + r.stance +
                   "\n# feet (FL, FR, RR, RL):";
   for (const std::string& f : r.feet) t += " " + f;
   t += "\n# tail base: body '" + r.mount_body + "' (d_Q2B_m); docs/your-robot.md\n";

@@ -56,6 +56,8 @@ std::string describeYamlRobot(const std::string& path);
 // mu_s = mu_d = the derived mu, and tails.1..6 from tailFor (the choice's mass and length split
 // over n links): `tailsim robot FILE --write-robot OUT.yaml`, for experiments.
 std::string derivedRobotFile(const DerivedRobot& r, const RobotTailChoice& c);
+// Its first line starts with this: `tailsim robot --write-robot` replaces only a file that does.
+inline constexpr const char* kDerivedRobotFileMarker = "# Written by `tailsim robot`";
 
 // The comparison as a Markdown table plus each run's warnings; a MuJoCo row's phi_net with its
 // "+- U" (docs/your-robot.md).

@@ -208,7 +208,7 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
     const char* jn = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * u]);
     const auto t = jn ? r.hold_target_rad.find(jn) : r.hold_target_rad.end();
     if (t == r.hold_target_rad.end()) continue;
-    d->ctrl[u] = t->second;
+    d->ctrl[u] = servoCtrlFor(m, u, t->second);
     a.servoAct.push_back(u);
     a.servoQ.push_back(m->jnt_qposadr[m->actuator_trnid[2 * u]]);
     a.servoStance.push_back(r.settled_qpos.at(jn).at(0));
@@ -312,14 +312,16 @@ StanceTrim trimStance(ArticulatedSim& a, TailController& ctrl, bool legs_locked,
     prevPd = a.pdTarget;
     for (std::size_t k = 0; k < a.servoAct.size(); ++k) {
       const int u = a.servoAct[k];
-      double c = a.d->ctrl[u] + kTrimGain * (a.servoStance[k] - a.d->qpos[a.servoQ[k]]);
+      double c = a.d->ctrl[u] + kTrimGain * servoCtrlPerRad(a.m, u) * (a.servoStance[k] - a.d->qpos[a.servoQ[k]]);
       if (a.m->actuator_ctrllimited[u]) c = std::clamp(c, a.m->actuator_ctrlrange[2 * u], a.m->actuator_ctrlrange[2 * u + 1]);
       a.d->ctrl[u] = c;
     }
     for (std::size_t k = 0; k < a.pdq.size(); ++k) a.pdTarget[k] += kTrimGain * (a.pdStance[k] - a.d->qpos[a.pdq[k]]);
   }
   for (std::size_t k = 0; k < a.servoAct.size(); ++k)
-    t.max_offset_deg = std::max(t.max_offset_deg, units::degrees(std::abs(a.d->ctrl[a.servoAct[k]] - a.servoHold[k])));
+    t.max_offset_deg =
+        std::max(t.max_offset_deg, units::degrees(std::abs(a.d->ctrl[a.servoAct[k]] - servoCtrlFor(a.m, a.servoAct[k], a.servoHold[k])) /
+                                                  std::abs(servoCtrlPerRad(a.m, a.servoAct[k]))));
   for (std::size_t k = 0; k < a.pdq.size(); ++k)
     t.max_offset_deg = std::max(t.max_offset_deg, units::degrees(std::abs(a.pdTarget[k] - a.pdHold[k])));
   t.residual_deg = units::degrees(jointError());

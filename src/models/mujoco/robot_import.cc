@@ -207,6 +207,11 @@ std::string urdfToMjcf(const std::string& file) {
     ext->InsertFirstChild(compiler);
   }
   compiler->SetAttribute("fusestatic", "false");
+  // A link without <inertial> weighs nothing in URDF; MuJoCo's default (inertiafromgeom "auto")
+  // would give it its collision geoms' mass at density 1000. The URDF's own setting wins.
+  const bool massless_links = !compiler->Attribute("inertiafromgeom");
+  if (massless_links) compiler->SetAttribute("inertiafromgeom", "false");
+  const std::string inertia_from_geom = compiler->Attribute("inertiafromgeom");
   const fs::path dir = fs::path(file).parent_path();
   for (const char* attr : {"meshdir", "texturedir"}) {
     const char* v = compiler->Attribute(attr);
@@ -222,7 +227,14 @@ std::string urdfToMjcf(const std::string& file) {
   installMujocoMessageHandlers();
   char err[1000] = "";
   ModelPtr m(mj_loadXML(in.path().c_str(), nullptr, err, sizeof err));
-  if (!m) fail(file, std::string("MuJoCo cannot load this URDF: ") + err);
+  if (!m) {
+    std::string why = std::string("MuJoCo cannot load this URDF: ") + err;
+    if (massless_links && why.find("mass and inertia") != std::string::npos)
+      why += " (a link without <inertial> has no mass in URDF, and tailsim reads it so: give the moving links "
+             "an <inertial>, or add <mujoco><compiler inertiafromgeom=\"auto\"/></mujoco> to take their mass "
+             "from their collision geoms)";
+    fail(file, why);
+  }
   TempFile out("urdf", ".xml", file);
   const bool ok = mj_saveLastXML(out.path().c_str(), m.get(), err, sizeof err);
   if (!ok) fail(file, std::string("MuJoCo cannot write this URDF as MJCF: ") + err);
@@ -235,6 +247,14 @@ std::string urdfToMjcf(const std::string& file) {
     fail(file, "the URDF has more than one root link (MuJoCo's MJCF has several bodies in the world)");
   const bool hasJoint = base->FirstChildElement("freejoint") || base->FirstChildElement("joint");
   if (!hasJoint) base->InsertFirstChild(mjcf.NewElement("freejoint"));
+  // MuJoCo writes the inertials the URDF gave; a body it wrote without one must read back as the
+  // URDF reader compiled it (massless, unless the URDF asked for mass from geoms).
+  XMLElement* mjcf_compiler = mjcf.RootElement()->FirstChildElement("compiler");
+  if (!mjcf_compiler) {
+    mjcf_compiler = mjcf.NewElement("compiler");
+    mjcf.RootElement()->InsertFirstChild(mjcf_compiler);
+  }
+  mjcf_compiler->SetAttribute("inertiafromgeom", inertia_from_geom.c_str());
   tinyxml2::XMLPrinter printer;
   mjcf.Print(&printer);
   return printer.CStr();
@@ -250,8 +270,8 @@ XMLElement* loadModelXml(XMLDocument& doc, const std::string& file, PreparedMode
     const std::string mjcf = urdfToMjcf(file);
     doc.Clear();
     if (doc.Parse(mjcf.c_str()) != tinyxml2::XML_SUCCESS) fail(file, "MuJoCo's MJCF of this URDF does not parse");
-    out.notes.push_back("URDF read by MuJoCo's URDF reader (fusestatic off, visual elements discarded), written "
-                        "back as MJCF, its root link given a free joint");
+    out.notes.push_back("URDF read by MuJoCo's URDF reader (fusestatic off, links without <inertial> massless, "
+                        "visual elements discarded), written back as MJCF, its root link given a free joint");
   } else if (std::string(doc.RootElement()->Name()) != "mujoco") {
     fail(file, "neither MJCF (<mujoco>) nor URDF (<robot>)");
   }
@@ -268,12 +288,25 @@ struct AssetDirs {
 
 // Stage 2: the compiler's asset folders made absolute, so the compiled text finds the files the
 // user's file names.
-AssetDirs absoluteAssetDirs(XMLDocument& doc, XMLElement* root, const fs::path& dir) {
-  XMLElement* compiler = root->FirstChildElement("compiler");
-  if (!compiler) {
-    compiler = doc.NewElement("compiler");
-    root->InsertFirstChild(compiler);
+// A model may have several <compiler> elements (a scene's and its included robot's); MuJoCo applies
+// them in order, so the last one to set an attribute wins. They are merged into the last.
+AssetDirs absoluteAssetDirs(XMLDocument& doc, XMLElement* root, const fs::path& dir, const std::string& file) {
+  std::vector<XMLElement*> compilers;
+  for (XMLElement* c = root->FirstChildElement("compiler"); c; c = c->NextSiblingElement("compiler")) compilers.push_back(c);
+  if (compilers.empty()) {
+    compilers.push_back(doc.NewElement("compiler"));
+    root->InsertFirstChild(compilers.back());
   }
+  XMLElement* compiler = compilers.back();
+  for (std::size_t i = compilers.size() - 1; i-- > 0;)
+    for (const tinyxml2::XMLAttribute* a = compilers[i]->FirstAttribute(); a; a = a->Next())
+      if (!compiler->Attribute(a->Name())) compiler->SetAttribute(a->Name(), a->Value());
+  for (std::size_t i = 0; i + 1 < compilers.size(); ++i) root->DeleteChild(compilers[i]);
+  if (const char* c = compiler->Attribute("coordinate"); c && std::string(c) == "global")
+    fail(file, "the model is written in global coordinates (<compiler coordinate=\"global\">), and tailsim attaches "
+               "the tail in a body's local frame: convert it to local coordinates first, e.g. with MuJoCo 2.2's sample "
+               "`mujoco-compile model.xml model_local.xml` (it writes the compiled model back as MJCF, in local "
+               "coordinates), and import that file");
   auto absDir = [&](const char* attr) {
     const char* v = compiler->Attribute(attr);
     const fs::path p = v ? fs::path(v) : fs::path();
@@ -436,7 +469,17 @@ void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLEleme
 
 bool isPositionServo(const mjModel* m, int a) {
   return m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_biastype[a] == mjBIAS_AFFINE &&
+         m->actuator_gaintype[a] == mjGAIN_FIXED && m->actuator_gainprm[mjNGAIN * a] > 0.0 &&
          m->actuator_biasprm[mjNBIAS * a + 1] < 0.0;
+}
+
+double servoCtrlPerRad(const mjModel* m, int a) {
+  // force = kp ctrl + b0 + b1 length + b2 velocity, length = gear q (a joint transmission)
+  return -m->actuator_biasprm[mjNBIAS * a + 1] * m->actuator_gear[6 * a] / m->actuator_gainprm[mjNGAIN * a];
+}
+
+double servoCtrlFor(const mjModel* m, int a, double q) {
+  return -m->actuator_biasprm[mjNBIAS * a] / m->actuator_gainprm[mjNGAIN * a] + servoCtrlPerRad(m, a) * q;
 }
 
 // The stages in order: parse, absolute asset folders, missing assets, geoms without their mesh,
@@ -450,7 +493,7 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
   if (!isFile(file)) fail(file, "model file not found");
   XMLDocument doc;
   XMLElement* root = loadModelXml(doc, file, out);
-  const AssetDirs dirs = absoluteAssetDirs(doc, root, fs::path(file).parent_path());
+  const AssetDirs dirs = absoluteAssetDirs(doc, root, fs::path(file).parent_path(), file);
   MissingAssets missing = findMissingAssets(root, dirs, file);
   const Defaults defaults(root);
   XMLElement* world = root->FirstChildElement("worldbody");
@@ -573,9 +616,11 @@ struct LegHold {
   int other_actuators = 0;       // joint actuators that are not position servos (motors): ctrl 0
 };
 
-// Legs held by the model's actuators: position actuators (bias -kp q) get the stance angle as
-// ctrl; a joint without one is held by a PD tailsim adds through qfrc_applied.
-LegHold holdLegs(const mjModel* m, const Stance& stance) {
+// Legs held by the model's actuators: position actuators (bias -kp q) get the ctrl that holds the
+// stance angle (servoCtrlFor: the angle times the gear for a <position>); a joint without one is
+// held by a PD tailsim adds through qfrc_applied. A ctrlrange that leaves out that ctrl is an error
+// (MuJoCo would clamp it, and the robot would fall for no reason the user could see).
+LegHold holdLegs(const mjModel* m, const Stance& stance, const std::string& file) {
   LegHold h;
   h.by_actuator.assign(m->njnt, 0);
   h.ctrl.assign(m->nu, 0.0);
@@ -586,7 +631,19 @@ LegHold holdLegs(const mjModel* m, const Stance& stance) {
       ++h.other_actuators;
       continue;
     }
-    h.ctrl[a] = stance.qpos[m->jnt_qposadr[j]];
+    const double q = stance.qpos[m->jnt_qposadr[j]];
+    h.ctrl[a] = servoCtrlFor(m, a, q);
+    if (m->actuator_ctrllimited[a] &&
+        (h.ctrl[a] < m->actuator_ctrlrange[2 * a] || h.ctrl[a] > m->actuator_ctrlrange[2 * a + 1])) {
+      const char* an = mj_id2name(m, mjOBJ_ACTUATOR, a);
+      const char* jn = mj_id2name(m, mjOBJ_JOINT, j);
+      fail(file, "actuator '" + clipped(an ? an : "#" + std::to_string(a)) + "' cannot hold joint '" +
+                     clipped(jn ? jn : "#" + std::to_string(j)) + "' at its stance angle " + g6(units::degrees(q)) +
+                     " deg: that needs ctrl " + g6(h.ctrl[a]) + ", outside its ctrlrange [" +
+                     g6(m->actuator_ctrlrange[2 * a]) + ", " + g6(m->actuator_ctrlrange[2 * a + 1]) +
+                     "]; choose a stance inside it (robot.stance, --joint NAME=DEG) or widen the ctrlrange",
+           "robot.stance");
+    }
     h.by_actuator[j] = 1;
     ++h.position_servos;
   }
@@ -688,8 +745,16 @@ std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpe
   if (!spec.feet.empty()) {
     std::vector<int> named;
     for (const std::string& n : spec.feet) {
-      const int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
-      if (g < 0) fail(file, "feet: no geom named '" + clipped(n) + "'", "robot.feet");
+      int g = mj_name2id(m, mjOBJ_GEOM, n.c_str());
+      // A body's name stands for its lowest colliding geom (a URDF's geoms have no names).
+      if (const int b = g < 0 ? mj_name2id(m, mjOBJ_BODY, n.c_str()) : -1; b >= 0) {
+        for (int k = 0; k < m->ngeom; ++k)
+          if (m->geom_bodyid[k] == b && (m->geom_contype[k] || m->geom_conaffinity[k]) &&
+              (g < 0 || lowestZ(m, d, k) < lowestZ(m, d, g)))
+            g = k;
+        if (g < 0) fail(file, "feet: body '" + clipped(n) + "' has no colliding geom", "robot.feet");
+      }
+      if (g < 0) fail(file, "feet: no geom or body named '" + clipped(n) + "'", "robot.feet");
       named.push_back(g);
     }
     if (named.size() < 3 || named.size() > 4)
@@ -705,7 +770,7 @@ std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpe
                    std::to_string(feet.size()) + " geom" + (feet.size() == 1 ? "" : "s") +
                    (names.empty() ? "" : " (" + names + ")") +
                    "; a quadruped stands on 3 or 4 feet: check the stance (tilt " + g6(r.tilt_deg) +
-                   " deg) or name the feet with feet: [...]",
+                   " deg) or name the feet with feet: [...] (geom names, or the names of the foot bodies)",
          "robot.feet");
   }
   return feet;
@@ -908,21 +973,24 @@ void settledJoints(const mjModel* m, const mjData* d, const Stance& stance, cons
   }
 }
 
-// "file:line" of the first <element> carrying attribute `attr` (any attribute when empty) in `file`
-// or the files it includes; "" when none.
-std::string findInUserFiles(const std::string& file, const std::string& element, const std::string& attr, int depth) {
+// "file:line" of the first <element> (any element when empty) carrying attribute `attr` (any
+// attribute when empty; equal to `value` when that is given) in `file` or the files it includes;
+// "" when none.
+std::string findInUserFiles(const std::string& file, const std::string& element, const std::string& attr, int depth,
+                            const char* value = nullptr) {
   XMLDocument doc;
   if (depth > 8 || doc.LoadFile(file.c_str()) != tinyxml2::XML_SUCCESS || !doc.RootElement()) return "";
   std::string found;
   forEachElement(doc.RootElement(), [&](XMLElement* e) {
     if (!found.empty()) return;
     const std::string name = e->Name();
-    if (name == element && (attr.empty() || e->Attribute(attr.c_str())))
+    const char* a = attr.empty() ? nullptr : e->Attribute(attr.c_str());
+    if ((element.empty() || name == element) && (attr.empty() || (a && (!value || std::string(a) == value))))
       found = file + ":" + std::to_string(e->GetLineNum());
     else if (name == "include" && e->Attribute("file")) {
       const fs::path f = e->Attribute("file");
       found = findInUserFiles((f.is_absolute() ? f : fs::path(file).parent_path() / f).string(), element, attr,
-                              depth + 1);
+                              depth + 1, value);
     }
   });
   return found;
@@ -958,8 +1026,16 @@ ModelPtr compileUserModel(const PreparedModel& pm) {
                              "made for MuJoCo 2.2");
     }
     const std::string prefix = "MuJoCo could not compile the generated MJCF: ";
-    fail(pm.source, "MuJoCo 2.2 refuses the model (line numbers are of tailsim's copy, includes inlined): " +
-                        (msg.rfind(prefix, 0) == 0 ? msg.substr(prefix.size()) : msg));
+    // MuJoCo names the object; its line in the user's own file says where to look.
+    const std::string object = between(msg, "Object name = ", ",");
+    const std::string where = object.empty() ? "" : findInUserFiles(pm.source, "", "name", 0, object.c_str());
+    std::string why = (where.empty() ? pm.source : where) +
+                      ": MuJoCo 2.2 refuses the model (MuJoCo's line numbers are of tailsim's copy, includes inlined): " +
+                      (msg.rfind(prefix, 0) == 0 ? msg.substr(prefix.size()) : msg);
+    if (msg.find("has `range` but not `limited`") != std::string::npos)
+      why += " (MuJoCo 2.3 and later set `limited` from `range` by themselves: the file is likely written for a newer "
+             "MuJoCo; add <compiler autolimits=\"true\"/> to it for MuJoCo 2.2)";
+    throw RobotImportError(why);
   }
 }
 
@@ -986,7 +1062,7 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   if (spec.legs != "servos" && spec.legs != "locked")
     fail(file, "legs: '" + spec.legs + "' is neither servos nor locked", "robot.legs");
   r.legs_locked = spec.legs == "locked";
-  const LegHold hold = holdLegs(m, stance);
+  const LegHold hold = holdLegs(m, stance, file);
   r.stance += ", legs held by " + std::to_string(hold.position_servos) + " position actuator" +
               (hold.position_servos == 1 ? "" : "s") + " of the model" +
               (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints") +

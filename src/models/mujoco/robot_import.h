@@ -36,6 +36,11 @@ PreparedModel prepareRobotModel(const std::string& file);
 // <motor>, ctrl a torque) are not.
 bool isPositionServo(const mjModel* m, int a);
 
+// A position servo's ctrl per radian of its joint (its gear for a <position>), and the ctrl at
+// which it holds the joint at q with no force.
+double servoCtrlPerRad(const mjModel* m, int a);
+double servoCtrlFor(const mjModel* m, int a, double q);
+
 class RobotImportError : public std::runtime_error {
  public:
   // key: the experiment key the error is about (robot.mjcf, robot.stance, robot.feet,
