@@ -860,3 +860,26 @@ TEST(RobotImport, TheLastCompilerSettingWins) {
 }
 
 }  // namespace
+
+namespace {
+
+// A ground that is a box, not a plane: an error saying so (before, tailsim added its plane at z = 0
+// as well, and the robot stood on either, or inside the box).
+TEST(RobotImport, AGroundThatIsNotAPlaneIsNamed) {
+  Scratch t("robot_import");
+  std::string xml = mjcfLegRobot(kAutolimits, "<position joint=\"%J%\" kp=\"400\"/>", 0.0);
+  xml.replace(xml.find("<geom name=\"floor\" type=\"plane\" size=\"0 0 1\"/>"), 45,
+              "<geom name=\"ground\" type=\"box\" size=\"3 3 0.05\" pos=\"0 0 -0.05\"/>");
+  RobotModelSpec s;
+  s.file = t.write("boxground.xml", xml);
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a box ground was taken";
+  } catch (const RobotImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("the model has no plane to stand on, but a static colliding geom 'ground' (box, line 4)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace

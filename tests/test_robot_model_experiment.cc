@@ -15,6 +15,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <set>
 #include <string>
 
 #include "experiments/experiment_loader.h"
@@ -496,4 +497,33 @@ TEST(RobotModelExperiment, TwoFreeBodiesTheMountBodyChoosesTheRobot) {
   std::vector<Experiment> s = loadExperimentSuite(f);
   resolveRobotModels(s);
   EXPECT_NEAR(s.front().cases.front().robot.quadruped.mass_kg, 10.0, 1e-12);  // the trunk's tree, not the crate
+}
+
+// `tailsim run e.yaml --out .` in the folder that holds the user's robot.xml: the run refuses to
+// replace it (its own copy of the model is robot.xml) and leaves the folder as it was: before, it
+// had already written experiment.yaml and cases/ when it refused.
+TEST(RobotModelExperiment, ARefusedRunLeavesTheFolderAsItWas) {
+  Scratch t("robot_model_exp");
+  t.write("robot.xml", boxRobot(kHome));
+  const std::string f = t.write("e.yaml", experiment("{mjcf: robot.xml}"));
+  std::vector<Experiment> suite = loadExperimentSuite(f);
+  resolveRobotModels(suite);
+  std::set<std::string> before;
+  for (const auto& p : std::filesystem::directory_iterator(t.dir)) before.insert(p.path().filename().string());
+  RunOptions o;
+  o.out_dir = t.dir.string();
+  o.threads = 1;
+  o.progress = false;
+  try {
+    runSuite(suite, o);
+    ADD_FAILURE() << "the user's robot.xml was replaced";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("robot.xml was not written by tailsim"), std::string::npos) << e.what();
+  }
+  std::set<std::string> after;
+  for (const auto& p : std::filesystem::directory_iterator(t.dir)) after.insert(p.path().filename().string());
+  after.erase(".tailsim.lock");  // the folder's lock (docs/ARCHITECTURE.md), taken before anything is judged
+  EXPECT_EQ(after, before);
+  std::ifstream in(t.dir / "robot.xml");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), boxRobot(kHome));
 }

@@ -154,6 +154,13 @@ bool ownFile(const fs::path& root, const std::string& name) {
 
 }  // namespace
 
+void refuseForeignFiles(const fs::path& root, const std::vector<std::string>& names) {
+  for (const std::string& name : names)
+    if (!ownFile(root, name))
+      throw std::runtime_error((root / name).string() + " was not written by tailsim (or was changed since): not "
+                               "replaced; move it out of " + root.string() + " or choose another --out");
+}
+
 // Writes DIR/<name> (a top-level file of the folder) when what is there is tailsim's; else refuses.
 // The first write into a folder without a manifest records its files recognised as tailsim's first.
 void writeOwnFile(const fs::path& root, const std::string& name, const std::string& text) {
@@ -168,9 +175,7 @@ void writeOwnFile(const fs::path& root, const std::string& name, const std::stri
         own.emplace_back(n, *there);
     for (const auto& [n, there] : own) recordInManifest(root.string(), n, there);
   }
-  if (!ownFile(root, name))
-    throw std::runtime_error((root / name).string() + " was not written by tailsim (or was changed since): not "
-                             "replaced; move it out of " + root.string() + " or choose another --out");
+  refuseForeignFiles(root, {name});
   recordInManifest(root.string(), name, text);
   writeFileAtomic((root / name).string(), text);
 }

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "experiments/experiment_loader.h"
@@ -24,6 +25,9 @@ bool isRegularFile(const std::filesystem::path& p);
 
 // Writes DIR/<name> (a top-level file of the folder) when what is there is tailsim's; else refuses.
 void writeOwnFile(const std::filesystem::path& root, const std::string& name, const std::string& text);
+// Refuses (std::runtime_error, as writeOwnFile) when any of DIR/<names> is there and not tailsim's:
+// checked before a run writes anything, so a refused run leaves the folder as it was.
+void refuseForeignFiles(const std::filesystem::path& root, const std::vector<std::string>& names);
 // Deletes the entries tailsim writes into a result folder, and in them only what tailsim writes;
 // anything else stays (named on stderr).
 void clearResultFolder(const std::filesystem::path& root);

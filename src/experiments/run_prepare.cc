@@ -147,6 +147,10 @@ Job planJob(const Experiment& e, const RunOptions& opt, const fs::path& root, co
 void readyFolder(const Job& job, const RunOptions& opt, const std::vector<size_t>& todo_all) {
   const Experiment& e = *job.e;
   const fs::path& root = job.root;
+  const std::map<std::string, std::string> inputs = folderInputs(e);
+  std::vector<std::string> input_names;
+  for (const auto& [name, text] : inputs) input_names.push_back(name);
+  refuseForeignFiles(root, input_names);  // before anything is written
   claimFolder(e, root, !opt.resume);
   if (!opt.resume && opt.only_case.empty()) clearResultFolder(root);  // --fresh: no stale case folders
   removeStaleTemps(root);
@@ -166,7 +170,7 @@ void readyFolder(const Job& job, const RunOptions& opt, const std::vector<size_t
   if (any_folder) makeResultDir((root / "cases").string());
   // The inputs, so that the folder runs again on its own: experiment.yaml naming robot.yaml.
   compactManifest(root.string());
-  for (const auto& [name, text] : folderInputs(e)) writeOwnFile(root, name, text);
+  for (const auto& [name, text] : inputs) writeOwnFile(root, name, text);
   if (job.render) checkRenderPrerequisites(e.cases.front().render, (root / "renders").string());
 }
 

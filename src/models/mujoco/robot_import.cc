@@ -445,7 +445,7 @@ void mergeWorldbodies(XMLElement* world) {
 // Stage 6: a floor when the model has none (a robot file without its scene), or a name for its
 // unnamed plane; out.floor_geom names it.
 void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLElement*>& geoms, const Defaults& defaults,
-                 bool hasPlane, PreparedModel& out) {
+                 bool hasPlane, const std::string& file, PreparedModel& out) {
   if (hasPlane && !out.floor_geom.empty()) return;
   if (hasPlane) {
     // The model's plane has no name: name it.
@@ -455,6 +455,21 @@ void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLEleme
         break;
       }
   } else {
+    // A ground that is not a plane (a box, a height field) would sit beside or above the added
+    // plane: the robot would stand on either, or inside the box, with no sign of it.
+    for (XMLElement* gm : geoms) {
+      if (gm->Parent() != world) continue;  // a geom of the world body: static scenery
+      const char* ct = defaults.geomAttr(gm, "contype");
+      const char* ca = defaults.geomAttr(gm, "conaffinity");
+      if ((ct ? std::atoi(ct) : 1) == 0 && (ca ? std::atoi(ca) : 1) == 0) continue;
+      const char* type = defaults.geomAttr(gm, "type");
+      fail(file, "the model has no plane to stand on, but a static colliding geom " +
+                     (gm->Attribute("name") ? "'" + clipped(gm->Attribute("name")) + "'" : std::string("(unnamed)")) +
+                     " (" + (type ? type : "sphere") +
+                     (gm->GetLineNum() > 0 ? ", line " + std::to_string(gm->GetLineNum()) : std::string()) +
+                     "): tailsim stands the robot on a plane; make the ground a plane (<geom type=\"plane\" size=\"0 0 "
+                     "1\"/> at its top), or remove it to stand the robot on the plane tailsim adds at z = 0");
+    }
     XMLElement* floor = doc.NewElement("geom");
     floor->SetAttribute("name", "tailsim_floor");
     floor->SetAttribute("type", "plane");
@@ -515,7 +530,7 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
                         std::to_string(out.dropped_textures) + " texture" + (out.dropped_textures == 1 ? "" : "s") +
                         " whose file is missing (their materials keep their colour)");
   nameJoints(world);
-  ensureFloor(doc, world, geoms, defaults, hasPlane, out);
+  ensureFloor(doc, world, geoms, defaults, hasPlane, file, out);
   tinyxml2::XMLPrinter printer;
   doc.Print(&printer);
   out.xml = printer.CStr();
