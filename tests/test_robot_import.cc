@@ -654,7 +654,7 @@ namespace {
 
 // A URDF quadruped: `base` (given by `base_link`), four legs on hinges `<leg>_j` at 0 (the stance),
 // each a 0.5 kg link with a collision sphere 0.2 m below the hip.
-std::string urdfQuadruped(const std::string& base_link) {
+std::string urdfQuadruped(const std::string& base_link, double effort_Nm = 50.0) {
   std::string legs;
   const struct {
     const char* name;
@@ -668,8 +668,8 @@ std::string urdfQuadruped(const std::string& base_link) {
                   "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
                   "<joint name=\"%s_j\" type=\"revolute\"><parent link=\"base\"/><child link=\"%s\"/>"
                   "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
-                  "<limit lower=\"-1\" upper=\"1\" effort=\"50\" velocity=\"10\"/></joint>\n",
-                  l.name, l.name, l.name, l.x, l.y);
+                  "<limit lower=\"-1\" upper=\"1\" effort=\"%g\" velocity=\"10\"/></joint>\n",
+                  l.name, l.name, l.name, l.x, l.y, effort_Nm);
     legs += b;
   }
   return "<robot name=\"bot\">\n" + base_link + legs + "</robot>\n";
@@ -880,6 +880,38 @@ TEST(RobotImport, AGroundThatIsNotAPlaneIsNamed) {
               std::string::npos)
         << e.what();
   }
+}
+
+}  // namespace
+
+namespace {
+
+// Legs held by tailsim's PD stay within the joint's own torque limit (the URDF's effort, a motor's
+// ctrlrange x gear): a robot too weak to hold its stance sags and says so; before, the PD's 200 N
+// m/rad held any robot up.
+TEST(RobotImport, ThePdKeepsWithinTheJointsTorqueLimit) {
+  Scratch t("robot_import");
+  const std::string base = R"(<link name="base"><inertial><mass value="10"/>
+  <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
+  <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
+)";
+  RobotModelSpec s = urdfSpec(t.write("strong.urdf", urdfQuadruped(base, 50.0)));
+  for (auto& [j, q] : s.joint_angles_rad) q = 0.4;
+  const DerivedRobot r = deriveRobot(s);
+  EXPECT_EQ(r.pd_torque_limit_Nm.at("FL_j"), 50.0);
+  EXPECT_NE(r.stance.find("its torque kept within the joint's own limit on 4 of them: 50 N m"), std::string::npos) << r.stance;
+  EXPECT_EQ(r.stance.find("at their torque limit"), std::string::npos) << r.stance;
+  s.file = t.write("weak.urdf", urdfQuadruped(base, 0.2));  // 2.6 kg a leg at ~0.08 m needs ~2 N m
+  std::string what;
+  try {
+    const DerivedRobot w = deriveRobot(s);
+    what = w.stance;
+  } catch (const RobotImportError& e) {
+    what = e.what();
+  }
+  EXPECT_NE(what.find("4 of them at their torque limit (FL_j, FR_j, RR_j, RL_j): the legs cannot hold the stance"),
+            std::string::npos)
+      << what;
 }
 
 }  // namespace

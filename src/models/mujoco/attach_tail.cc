@@ -182,6 +182,7 @@ struct ArticulatedSim {
   std::vector<int> qadr, vadr, act;       // the tail's joints and actuators
   std::vector<int> pdq, pdv;              // joints held by tailsim's PD
   std::vector<double> pdTarget;           // their set-points [rad]
+  std::vector<double> pdLimit;            // their torque limits (HUGE_VAL: none) [N m]
   std::vector<double> pdStance;           // their angles in the settled stance [rad]
   std::vector<int> servoAct, servoQ;      // leg joints held by the model's position actuators
   std::vector<double> servoStance;        // their angles in the settled stance [rad]
@@ -227,6 +228,8 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
     a.pdq.push_back(m->jnt_qposadr[j]);
     a.pdv.push_back(m->jnt_dofadr[j]);
     a.pdTarget.push_back(r.hold_target_rad.at(name));
+    const auto lim = r.pd_torque_limit_Nm.find(name);
+    a.pdLimit.push_back(lim == r.pd_torque_limit_Nm.end() ? HUGE_VAL : lim->second);
     a.pdStance.push_back(r.settled_qpos.at(name).at(0));
     a.pdHold.push_back(a.pdTarget.back());
   }
@@ -256,7 +259,7 @@ bool fell(double tilt_deg, const char* phase, std::string& error) {
 void stepArticulated(ArticulatedSim& a, TailController& ctrl, double t_ref, long& steps) {
   mj_step1(a.m, a.d);
   for (std::size_t k = 0; k < a.pdq.size(); ++k)
-    a.d->qfrc_applied[a.pdv[k]] = kStancePdKp * (a.pdTarget[k] - a.d->qpos[a.pdq[k]]);  // its damper: dof_damping
+    a.d->qfrc_applied[a.pdv[k]] = stancePdTorque(a.pdTarget[k], a.d->qpos[a.pdq[k]], a.pdLimit[k]);  // its damper: dof_damping
   ctrl.apply(a.m, a.d, t_ref, false);
   mj_step2(a.m, a.d);
   ++steps;

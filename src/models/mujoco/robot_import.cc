@@ -192,7 +192,7 @@ void missingUrdfCollisionMeshes(const XMLElement* robot, const char* meshdir, co
                  "), or remove those <collision> elements");
 }
 
-std::string urdfToMjcf(const std::string& file) {
+std::string urdfToMjcf(const std::string& file, std::map<std::string, double>& efforts) {
   XMLDocument urdf;
   loadXmlFile(urdf, file);
   XMLElement* robot = urdf.RootElement();
@@ -221,6 +221,11 @@ std::string urdfToMjcf(const std::string& file) {
     compiler->SetAttribute(attr, a.c_str());
   }
   missingUrdfCollisionMeshes(robot, compiler->Attribute("meshdir"), file);
+  for (XMLElement* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint")) {
+    const XMLElement* limit = j->FirstChildElement("limit");
+    const char* name = j->Attribute("name");
+    if (name && limit && limit->DoubleAttribute("effort", 0.0) > 0.0) efforts[name] = limit->DoubleAttribute("effort");
+  }
   TempFile in("urdf", ".urdf", file);
   if (urdf.SaveFile(in.path().c_str()) != tinyxml2::XML_SUCCESS) fail(file, "cannot write a temporary copy of the URDF");
 
@@ -267,7 +272,7 @@ XMLElement* loadModelXml(XMLDocument& doc, const std::string& file, PreparedMode
   if (!doc.RootElement()) fail(file, "empty XML file");
   if (std::string(doc.RootElement()->Name()) == "robot") {
     out.from_urdf = true;
-    const std::string mjcf = urdfToMjcf(file);
+    const std::string mjcf = urdfToMjcf(file, out.urdf_effort_Nm);
     doc.Clear();
     if (doc.Parse(mjcf.c_str()) != tinyxml2::XML_SUCCESS) fail(file, "MuJoCo's MJCF of this URDF does not parse");
     out.notes.push_back("URDF read by MuJoCo's URDF reader (fusestatic off, links without <inertial> massless, "
@@ -622,20 +627,52 @@ int rootBody(const mjModel* m, const RobotModelSpec& spec, const std::string& fi
        "tail.mount.body");
 }
 
+// The torque limit of joint j when tailsim's PD holds it: the smallest of its joint actuators'
+// (motors: |gear| times the larger |end| of ctrlrange or forcerange, where limited) and the URDF's
+// effort; HUGE_VAL when it has none.
+double pdTorqueLimit(const mjModel* m, int j, const std::map<std::string, double>& efforts) {
+  double limit = HUGE_VAL;
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_trnid[2 * a] != j) continue;
+    const double gear = std::abs(m->actuator_gear[6 * a]);
+    if (m->actuator_ctrllimited[a] && m->actuator_gaintype[a] == mjGAIN_FIXED && m->actuator_biastype[a] == mjBIAS_NONE)
+      limit = std::min(limit, gear * std::abs(m->actuator_gainprm[mjNGAIN * a]) *
+                                  std::max(std::abs(m->actuator_ctrlrange[2 * a]), std::abs(m->actuator_ctrlrange[2 * a + 1])));
+    if (m->actuator_forcelimited[a])
+      limit = std::min(limit, gear * std::max(std::abs(m->actuator_forcerange[2 * a]), std::abs(m->actuator_forcerange[2 * a + 1])));
+  }
+  const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+  if (const auto e = name ? efforts.find(name) : efforts.end(); e != efforts.end()) limit = std::min(limit, e->second);
+  return limit;
+}
+
 // How the legs are held in the stance.
 struct LegHold {
   std::vector<int> by_actuator;  // per joint: 1 when a position actuator of the model holds it
   std::vector<double> ctrl;      // the actuators' ctrl: the stance angle for position actuators
   std::vector<int> pd;           // hinge and slide joints held by tailsim's PD
+  std::vector<double> pd_limit;  // their torque limits (HUGE_VAL: none) [N m]
   int position_servos = 0;
   int other_actuators = 0;       // joint actuators that are not position servos (motors): ctrl 0
 };
+
+// " (within the model's torque limits on k of them: ...)" for the stance line, "" when none has one.
+std::string pdLimitWords(const LegHold& h) {
+  int n = 0;
+  double lo = HUGE_VAL, hi = 0.0;
+  for (double l : h.pd_limit)
+    if (std::isfinite(l)) ++n, lo = std::min(lo, l), hi = std::max(hi, l);
+  if (n == 0) return "";
+  return " (its torque kept within the joint's own limit on " + std::to_string(n) + " of them: " + g6(lo) +
+         (hi > lo ? " to " + g6(hi) : std::string()) + " N m, from the model's motors or the URDF's effort)";
+}
 
 // Legs held by the model's actuators: position actuators (bias -kp q) get the ctrl that holds the
 // stance angle (servoCtrlFor: the angle times the gear for a <position>); a joint without one is
 // held by a PD tailsim adds through qfrc_applied. A ctrlrange that leaves out that ctrl is an error
 // (MuJoCo would clamp it, and the robot would fall for no reason the user could see).
-LegHold holdLegs(const mjModel* m, const Stance& stance, const std::string& file) {
+LegHold holdLegs(const mjModel* m, const Stance& stance, const std::string& file,
+                 const std::map<std::string, double>& efforts) {
   LegHold h;
   h.by_actuator.assign(m->njnt, 0);
   h.ctrl.assign(m->nu, 0.0);
@@ -663,7 +700,10 @@ LegHold holdLegs(const mjModel* m, const Stance& stance, const std::string& file
     ++h.position_servos;
   }
   for (int j = 0; j < m->njnt; ++j)
-    if ((m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) && !h.by_actuator[j]) h.pd.push_back(j);
+    if ((m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) && !h.by_actuator[j]) {
+      h.pd.push_back(j);
+      h.pd_limit.push_back(pdTorqueLimit(m, j, efforts));
+    }
   return h;
 }
 
@@ -694,14 +734,25 @@ void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stan
   addStancePdDamping(m, hold.pd);
   const int steps = static_cast<int>(std::ceil(spec.settle_s / m->opt.timestep));
   for (int i = 0; i < steps; ++i) {
-    for (int j : hold.pd) {
-      const int qa = m->jnt_qposadr[j], va = m->jnt_dofadr[j];
-      d->qfrc_applied[va] = kStancePdKp * (stance.qpos[qa] - d->qpos[qa]);
+    for (std::size_t k = 0; k < hold.pd.size(); ++k) {
+      const int qa = m->jnt_qposadr[hold.pd[k]], va = m->jnt_dofadr[hold.pd[k]];
+      d->qfrc_applied[va] = stancePdTorque(stance.qpos[qa], d->qpos[qa], hold.pd_limit[k]);
     }
     mj_step(m, d);
   }
   mj_forward(m, d);
   if (warningCount(d) > 0) fail(file, "MuJoCo warnings while standing: " + describeWarnings(d));
+  std::string saturated;  // PD-held joints whose torque limit holds them back at the end
+  int n_saturated = 0;
+  for (std::size_t k = 0; k < hold.pd.size(); ++k) {
+    const int qa = m->jnt_qposadr[hold.pd[k]];
+    if (std::abs(kStancePdKp * (stance.qpos[qa] - d->qpos[qa])) < hold.pd_limit[k]) continue;
+    const char* n = mj_id2name(m, mjOBJ_JOINT, hold.pd[k]);
+    if (n_saturated++ < 4) saturated += (saturated.empty() ? "" : ", ") + clipped(n ? n : "?");
+  }
+  if (n_saturated > 0)
+    r.stance += "; after standing, " + std::to_string(n_saturated) + " of them at their torque limit (" + saturated +
+                (n_saturated > 4 ? ", ..." : "") + "): the legs cannot hold the stance";
   const double* Rroot = d->xmat + 9 * root;
   r.tilt_deg = units::degrees(std::acos(std::clamp(Rroot[8], -1.0, 1.0)));
 }
@@ -983,7 +1034,11 @@ void settledJoints(const mjModel* m, const mjData* d, const Stance& stance, cons
     r.settled_qpos[name].assign(d->qpos + m->jnt_qposadr[j], d->qpos + m->jnt_qposadr[j] + n);
     if (m->jnt_type[j] == mjJNT_HINGE || m->jnt_type[j] == mjJNT_SLIDE) {
       r.hold_target_rad[name] = stance.qpos[m->jnt_qposadr[j]];
-      if (!hold.by_actuator[j]) r.pd_joints.push_back(name);
+      if (!hold.by_actuator[j]) {
+        r.pd_joints.push_back(name);
+        const auto k = std::find(hold.pd.begin(), hold.pd.end(), j) - hold.pd.begin();
+        if (std::isfinite(hold.pd_limit[k])) r.pd_torque_limit_Nm[name] = hold.pd_limit[k];
+      }
     }
   }
 }
@@ -1077,10 +1132,11 @@ DerivedRobot deriveRobot(const RobotModelSpec& spec) {
   if (spec.legs != "servos" && spec.legs != "locked")
     fail(file, "legs: '" + spec.legs + "' is neither servos nor locked", "robot.legs");
   r.legs_locked = spec.legs == "locked";
-  const LegHold hold = holdLegs(m, stance, file);
+  const LegHold hold = holdLegs(m, stance, file, r.model.urdf_effort_Nm);
   r.stance += ", legs held by " + std::to_string(hold.position_servos) + " position actuator" +
               (hold.position_servos == 1 ? "" : "s") + " of the model" +
               (hold.pd.empty() ? "" : " and a PD added by tailsim on " + std::to_string(hold.pd.size()) + " joints") +
+              pdLimitWords(hold) +
               (hold.other_actuators == 0
                    ? ""
                    : " (the model's " + std::to_string(hold.other_actuators) + " other joint actuator" +

@@ -24,6 +24,7 @@ struct PreparedModel {
   int dropped_geoms = 0;       // non-colliding geoms whose mesh file is missing
   int dropped_textures = 0;    // textures whose file is missing (their materials keep their colour)
   std::string floor_geom;      // the floor's geom name
+  std::map<std::string, double> urdf_effort_Nm;  // a URDF's joint <limit effort> (> 0) by joint name
   std::vector<std::string> notes;  // one line each, for the user
 };
 
@@ -87,6 +88,9 @@ struct DerivedRobot {
   std::map<std::string, std::vector<double>> settled_qpos;
   std::map<std::string, double> hold_target_rad;
   std::vector<std::string> pd_joints;
+  // The torque limit of each PD-held joint that has one (its motor's ctrlrange or forcerange times
+  // the gear, or the URDF's effort; the smallest): tailsim's PD never exceeds it. [N m]
+  std::map<std::string, double> pd_torque_limit_Nm;
   // Each foot as (body name, index of the geom among its body's geoms): unnamed geoms found again
   // in a model with more bodies.
   std::vector<std::pair<std::string, int>> foot_geoms;
@@ -99,6 +103,11 @@ inline constexpr double kStancePdKp = 200.0;  // [N m/rad]
 inline constexpr double kStancePdKv = 5.0;    // [N m s/rad]
 // Adds kStancePdKv to the damping of each of these joints' dofs.
 void addStancePdDamping(mjModel* m, const std::vector<int>& joints);
+// The PD's spring torque towards `target`, within +-limit (the joint's own actuator limit; HUGE_VAL: none).
+inline double stancePdTorque(double target, double q, double limit) {
+  const double t = kStancePdKp * (target - q);
+  return t > limit ? limit : t < -limit ? -limit : t;
+}
 
 // Loads, stands (settle_s with the legs held) and measures the robot. Throws RobotImportError with
 // a message for the user (no stance, not on 3-4 feet, an attribute MuJoCo 2.2 does not know at its
