@@ -28,6 +28,7 @@
 #include "plotting/result_folder.h"
 #include "settings/optimize_section.h"
 #include "settings/trajectory_section.h"
+#include "scratch_dir.h"
 
 namespace tailsim {
 namespace {
@@ -569,4 +570,39 @@ TEST(OptimizeSectionDeclaration, UnknownKeysListTheDeclaredKeys) {
 }
 
 }  // namespace
+}  // namespace tailsim
+
+namespace tailsim {
+using testing::ScratchDir;
+
+// A design file whose base experiment takes its robot from a model file: refused at the base line
+// with the way that works (before: after the limits, "cannot copy into the result folder: the
+// robot was not derived", with a lock and an empty plots/ left in --out).
+TEST(DesignInputsRobot, DesignCommandsNameTheWayToAnImportedRobot) {
+  const ScratchDir t("design_model_base");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(t / name) << text;
+    return (t / name).string();
+  };
+  write("box.xml", "<mujoco/>\n");  // the loader reads the keys only: nothing is derived
+  write("base.yaml", "name: b\nrobot: {mjcf: box.xml}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, links: 1}\n"
+                     "trajectory: {rule: eq25, thetadot_max_dps: 600}\n");
+  const std::string opt = write(
+      "opt.yaml",
+      "name: o\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n  objective: phi_net\n"
+      "  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: none, dT_s: [0.05, 1.0], start_delay_s: 0.1}\n");
+  const std::string man = write("man.yaml", "name: m\nkind: maneuver\nbase: base.yaml\nmaneuver: {heading_deg: 90}\n");
+  for (const auto& [file, load] : std::vector<std::pair<std::string, std::function<void()>>>{
+           {opt, [&] { loadOptimizeSpec(opt); }}, {man, [&] { loadManeuverSpec(man); }}}) {
+    try {
+      load();
+      ADD_FAILURE() << file << " was taken";
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(file + ":3:7: base: the base experiment takes its robot from a model file", 0), 0u) << m;
+      EXPECT_NE(m.find("tailsim robot MODEL --write-robot ROBOT.yaml"), std::string::npos) << m;
+    }
+  }
+}
+
 }  // namespace tailsim

@@ -915,3 +915,65 @@ TEST(RobotImport, ThePdKeepsWithinTheJointsTorqueLimit) {
 }
 
 }  // namespace
+
+namespace {
+
+// A fall of the articulated robot whose leg servos are too stiff for the model's step (w_n h > 1)
+// says the step may be the cause: the same file at a quarter of the step stands and turns.
+TEST(RobotImport, AFallAtATooCoarseStepSaysSo) {
+  Scratch t("robot_import");
+  std::ifstream in(fs::path(TAILSIM_SOURCE_DIR) / "tests" / "data" / "light_quadruped.xml");
+  const std::string xml(std::istreambuf_iterator<char>(in), {});
+  RobotModelSpec s;
+  s.file = t.write("light.xml", xml);
+  s.mount.pos_m = {-0.3, 0.0, 0.0};
+  RobotTailChoice tail;
+  const RobotComparison coarse = compareRobotModels(s, tail);
+  EXPECT_FALSE(coarse.articulated.ok);
+  EXPECT_NE(coarse.articulated.error.find("its stiffest leg servo has w_n h = 1.32 > 1 at the model's timestep (0.002 s)"),
+            std::string::npos)
+      << coarse.articulated.error;
+  std::string fine = xml;
+  fine.replace(fine.find("<worldbody>"), 0, "<option timestep=\"0.0005\"/>\n  ");
+  s.file = t.write("light_fine.xml", fine);
+  const RobotComparison ok = compareRobotModels(s, tail);
+  EXPECT_TRUE(ok.articulated.ok) << ok.articulated.error;
+}
+
+}  // namespace
+
+namespace {
+
+// A robot whose legs give way is not measured lying on its body (an outside review's 200 kg robot
+// on kp 100 servos had its trunk and thighs taken as feet); one that still rocks after settle_s
+// stands on until it rests, or says that it has not.
+TEST(RobotImport, ARobotMustStandAndRestBeforeItIsMeasured) {
+  Scratch t("robot_import");
+  RobotModelSpec s;
+  s.settle_s = 0.3;
+  // tests/data/light_quadruped.xml at 200 kg: its kp 100 servos cannot carry it.
+  std::ifstream in(fs::path(TAILSIM_SOURCE_DIR) / "tests" / "data" / "light_quadruped.xml");
+  std::string heavy(std::istreambuf_iterator<char>(in), {});
+  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
+           {"mass=\"0.3\" diaginertia=\"0.003 0.006 0.0075\"", "mass=\"176\" diaginertia=\"1.76 3.52 4.4\""},
+           {"mass=\"0.033\" diaginertia=\"0.000132 0.000132 3.3e-05\"", "mass=\"4\" diaginertia=\"0.016 0.016 0.004\""},
+           {"mass=\"0.0165\" diaginertia=\"6.6e-05 6.6e-05 1.65e-05\"", "mass=\"2\" diaginertia=\"0.008 0.008 0.002\""}})
+    for (std::size_t p = heavy.find(from); p != std::string::npos; p = heavy.find(from)) heavy.replace(p, from.size(), to);
+  s.file = t.write("heavy.xml", heavy);
+  try {
+    deriveRobot(s);
+    ADD_FAILURE() << "a robot whose legs gave way was measured";
+  } catch (const RobotImportError& e) {
+    EXPECT_EQ(e.key(), "robot.stance");
+    EXPECT_NE(std::string(e.what()).find("its legs do not hold the stance"), std::string::npos) << e.what();
+  }
+  s.file = t.write("firm.xml", mjcfLegRobot(kAutolimits, "<position joint=\"%J%\" kp=\"400\"/>", 0.3));
+  const DerivedRobot r = deriveRobot(s);
+  const auto noted = [&](const DerivedRobot& d, const std::string& text) {
+    return std::any_of(d.notes.begin(), d.notes.end(), [&](const std::string& n) { return n.find(text) != std::string::npos; });
+  };
+  EXPECT_FALSE(noted(r, "the body still moves")) << describeDerivedRobot(r);
+  EXPECT_TRUE(noted(r, "then stood ")) << describeDerivedRobot(r);
+}
+
+}  // namespace

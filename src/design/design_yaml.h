@@ -175,6 +175,17 @@ struct DesignFile {
 };
 // max_name_chars: shorter than an experiment's kMaxNameChars when the command derives a longer
 // name from it (optimize's best.yaml is named <name>_best).
+// A design file's base experiment must give its robot by numbers: one from a model file (robot:
+// {mjcf: ...}) runs as the articulated robot, which the design commands do not search on.
+inline void refuseModelFileBase(const Reader& r, const Val& base, bool from_model_file, const char* command) {
+  if (from_model_file)
+    r.fail(base, std::string("the base experiment takes its robot from a model file (robot: {mjcf: ...}); `tailsim ") +
+                     command +
+                     "` works on the robot's numbers: write them once with `tailsim robot MODEL --write-robot "
+                     "ROBOT.yaml` (docs/your-robot.md), give its tail entry the joints' limits, and name ROBOT.yaml as "
+                     "the base's robot");
+}
+
 inline DesignFile openDesignFile(const Reader& r, const std::string& source_file, const char* kind, const char* section,
                                  std::size_t max_name_chars = kMaxNameChars) {
   DesignFile f{Val{loadBoundedYaml(source_file), "", YAML::Mark()}, {}, {}, section};

@@ -149,6 +149,7 @@ ManeuverSpec loadManeuverSpec(const std::string& path) {
   if (e.cases.size() != 1)
     r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
   s.base = e.cases.front();
+  design_yaml::refuseModelFileBase(r, base, s.base.robot_model.has_value(), "maneuver");
   if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
   if (from) {
     // stroke_from: base (the base experiment's trajectory) or the path of a one-case experiment

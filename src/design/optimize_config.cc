@@ -281,6 +281,7 @@ void readBase(const Reader& r, const Val& base, OptimizeSpec& s) {
   if (e.cases.size() != 1)
     r.fail(base, "the base experiment must have exactly one case (no sweeps), it has " + std::to_string(e.cases.size()));
   s.base = e.cases.front();
+  design_yaml::refuseModelFileBase(r, base, s.base.robot_model.has_value(), "optimize");
   if (s.base.kind != CaseKind::kSimulate) r.fail(base, "the base experiment must be kind: simulate");
   if (!s.base.splines.empty())
     r.fail(base, "the base experiment's trajectory is the search's start and must be split-cycle (not family: spline)");

@@ -246,12 +246,23 @@ void buildArticulated(ArticulatedSim& a, const DerivedRobot& r, const TailMount&
   }
 }
 
+double legServoWnH(const ArticulatedSim& a);
+
 // A fall: the body tilted more than kFallTiltFromStanceDeg from its stance. Sets the run's error
-// (phase: while what) and returns true.
-bool fell(double tilt_deg, const char* phase, std::string& error) {
+// (phase: while what) and returns true. Where a leg servo is too stiff for the step (w_n h > 1, the
+// rest schedule's guard), the explicit spring may have thrown the body over: the message says so.
+bool fell(const ArticulatedSim& a, double tilt_deg, const char* phase, std::string& error) {
   if (tilt_deg <= kFallTiltFromStanceDeg) return false;
   error = "the robot fell over: its body tilted " + std::to_string(tilt_deg) + " deg from its stance (limit " +
           std::to_string(kFallTiltFromStanceDeg) + " deg) " + phase;
+  if (const double wh = legServoWnH(a); wh > 1.0) {
+    char b[320];
+    std::snprintf(b, sizeof b,
+                  "; its stiffest leg servo has w_n h = %.3g > 1 at the model's timestep (%g s), so the step, not the "
+                  "robot's balance, may be what threw it: run it again with a smaller <option timestep>",
+                  wh, a.m->opt.timestep);
+    error += b;
+  }
   return true;
 }
 
@@ -293,7 +304,7 @@ StanceTrim trimStance(ArticulatedSim& a, TailController& ctrl, bool legs_locked,
     for (long k = 0; k < roundSteps; ++k) {
       stepArticulated(a, ctrl, 0.0, steps);
       t.max_rel_tilt_deg = std::max(t.max_rel_tilt_deg, tiltFromDeg(a.d, a.body, a.stanceZ));
-      if (fell(t.max_rel_tilt_deg, "while its legs were trimmed for the tail's weight", error)) return t;
+      if (fell(a, t.max_rel_tilt_deg, "while its legs were trimmed for the tail's weight", error)) return t;
       if (warningCount(a.d)) {
         error = "MuJoCo warnings while trimming the legs' set-points for the tail: " + describeWarnings(a.d);
         return t;
@@ -341,7 +352,7 @@ void standWithTail(ArticulatedSim& a, TailController& ctrl, const DerivedRobot& 
     out.stand_max_tilt_deg = std::max(out.stand_max_tilt_deg, tiltDeg(d, a.body));
     out.stand_max_rel_tilt_deg = std::max(out.stand_max_rel_tilt_deg, tiltFromDeg(d, a.body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings while standing: " + describeWarnings(d);
-    if (out.ok && fell(out.stand_max_rel_tilt_deg, "while standing with the tail", out.error)) out.ok = false;
+    if (out.ok && fell(a, out.stand_max_rel_tilt_deg, "while standing with the tail", out.error)) out.ok = false;
   }
   out.stand_s = stand_s;
   out.stand_end_tilt_deg = tiltDeg(d, a.body);
@@ -413,15 +424,22 @@ class StrokeRecorder {
 // position actuator's -biasprm[1] gear^2, or tailsim's kStancePdKp) and the diagonal of the mass
 // matrix at the state (armature included).
 double stiffestServoWn(const ArticulatedSim& a, const MujocoSettings& s) {
+  const double tail = s.kp == 0.0 ? s.servo_wn_dt / s.timestep_s : HUGE_VAL;
+  return std::max(tail, legServoWnH(a) / a.m->opt.timestep);
+}
+
+// The stiffest held leg joint's w_n h at the model's step (its joint-space stiffness: a position
+// actuator's -biasprm[1] gear^2, or tailsim's kStancePdKp; M_ii at the state, armature included).
+double legServoWnH(const ArticulatedSim& a) {
   const mjModel* m = a.m;
-  double wn = s.kp == 0.0 ? s.servo_wn_dt / s.timestep_s : HUGE_VAL;
+  double wn = 0.0;
   auto joint = [&](int dof, double kp) { wn = std::max(wn, std::sqrt(kp / a.d->qM[m->dof_Madr[dof]])); };
   for (const int u : a.servoAct) {
     const double gear = m->actuator_gear[6 * u];
     joint(m->jnt_dofadr[m->actuator_trnid[2 * u]], -m->actuator_biasprm[mjNBIAS * u + 1] * gear * gear);
   }
   for (const int v : a.pdv) joint(v, kStancePdKp);
-  return wn;
+  return wn * m->opt.timestep;
 }
 
 // The stroke's rest step schedule (step_schedule.h) by the rigid box's guards, read from the model:
@@ -461,7 +479,7 @@ void runStroke(ArticulatedSim& a, TailController& ctrl, const TailTrajectory& tr
     out.max_tilt_deg = std::max(out.max_tilt_deg, tiltDeg(d, body));
     out.max_rel_tilt_deg = std::max(out.max_rel_tilt_deg, tiltFromDeg(d, body, a.stanceZ));
     if (warningCount(d)) out.ok = false, out.error = "MuJoCo warnings during the stroke: " + describeWarnings(d);
-    if (out.ok && fell(out.max_rel_tilt_deg, "during the stroke", out.error)) out.ok = false;
+    if (out.ok && fell(a, out.max_rel_tilt_deg, "during the stroke", out.error)) out.ok = false;
     a.m->opt.timestep = schedule.next(k * dt, speedsAtRest(a.m, a.d));
     if (stop_at_rest && schedule.rested(k * dt)) break;
   }

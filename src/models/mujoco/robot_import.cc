@@ -234,6 +234,9 @@ std::string urdfToMjcf(const std::string& file, std::map<std::string, double>& e
   ModelPtr m(mj_loadXML(in.path().c_str(), nullptr, err, sizeof err));
   if (!m) {
     std::string why = std::string("MuJoCo cannot load this URDF: ") + err;
+    if (why.find("Unknown mesh file type") != std::string::npos)
+      why += " (MuJoCo 2.2 reads STL, OBJ and MSH meshes: convert that mesh, or let the visual elements be discarded "
+             "(no discardvisual=\"false\"))";
     if (massless_links && why.find("mass and inertia") != std::string::npos)
       why += " (a link without <inertial> has no mass in URDF, and tailsim reads it so: give the moving links "
              "an <inertial>, or add <mujoco><compiler inertiafromgeom=\"auto\"/></mujoco> to take their mass "
@@ -715,6 +718,13 @@ void addStancePdDamping(mjModel* m, const std::vector<int>& joints) {
 
 namespace {
 
+constexpr double kStandRestSpeedMps = 1e-3;   // a body at rest moves slower than this [m/s]
+constexpr double kStandRestTurnRadps = 0.01;  // ... and turns slower than this [rad/s]
+constexpr double kStandMoreS = 0.25;          // standing goes on in steps of this while the body moves [s]
+constexpr double kStandMaxExtraS = 3.0;       // ... for at most this beyond settle_s [s]
+constexpr double kStandMaxTiltDeg = 30.0;     // a robot tilted further after standing does not stand [deg]
+constexpr double kStandMaxSinkShare = 0.3;    // nor one whose body sank more than this share of its start height
+
 // Stage: the stance lifted (or lowered) until the lowest colliding geom is 1 mm above the floor, then
 // settled for spec.settle_s with the legs held; r.tilt_deg is the root body's tilt afterwards.
 void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stance, const LegHold& hold, int root,
@@ -728,20 +738,42 @@ void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stan
   const int freeq = m->jnt_qposadr[m->body_jntadr[root]];
   const double lift = floorZ + 1e-3 - low;
   d->qpos[freeq + 2] += lift;
-  r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
-                    g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(spec.settle_s) + " s");
+  const double z0 = d->qpos[freeq + 2];  // the root body's height at the start, 1 mm above the floor
   mju_copy(d->ctrl, hold.ctrl.data(), m->nu);
   addStancePdDamping(m, hold.pd);
-  const int steps = static_cast<int>(std::ceil(spec.settle_s / m->opt.timestep));
-  for (int i = 0; i < steps; ++i) {
-    for (std::size_t k = 0; k < hold.pd.size(); ++k) {
-      const int qa = m->jnt_qposadr[hold.pd[k]], va = m->jnt_dofadr[hold.pd[k]];
-      d->qfrc_applied[va] = stancePdTorque(stance.qpos[qa], d->qpos[qa], hold.pd_limit[k]);
+  const auto standFor = [&](double seconds) {
+    const int steps = static_cast<int>(std::ceil(seconds / m->opt.timestep - 1e-9));
+    for (int i = 0; i < steps; ++i) {
+      for (std::size_t k = 0; k < hold.pd.size(); ++k) {
+        const int qa = m->jnt_qposadr[hold.pd[k]], va = m->jnt_dofadr[hold.pd[k]];
+        d->qfrc_applied[va] = stancePdTorque(stance.qpos[qa], d->qpos[qa], hold.pd_limit[k]);
+      }
+      mj_step(m, d);
     }
-    mj_step(m, d);
+  };
+  // settle_s, then on in kStandMoreS steps while the body still moves (up to kStandMaxExtraS more):
+  // a robot measured while it still rocks gives values that depend on when it was measured.
+  const int freev = m->jnt_dofadr[m->body_jntadr[root]];
+  const auto speed = [&] { return std::hypot(d->qvel[freev], d->qvel[freev + 1], d->qvel[freev + 2]); };
+  const auto turnRate = [&] { return std::hypot(d->qvel[freev + 3], d->qvel[freev + 4], d->qvel[freev + 5]); };
+  const auto moving = [&] { return speed() > kStandRestSpeedMps || turnRate() > kStandRestTurnRadps; };
+  standFor(spec.settle_s);
+  double stood = spec.settle_s;
+  while (moving() && stood < spec.settle_s + kStandMaxExtraS - 1e-9) {
+    standFor(kStandMoreS);
+    stood += kStandMoreS;
   }
+  r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
+                    g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(stood) + " s" +
+                    (stood > spec.settle_s ? " (settle_s " + g6(spec.settle_s) + " s, then on until the body rested)" : ""));
+  if (moving())
+    r.notes.push_back("the body still moves after standing " + g6(stood) + " s (" + g6(1e3 * speed()) + " mm/s, " +
+                      g6(units::degrees(turnRate())) + " deg/s): the values below are of a robot that has not come to "
+                      "rest (its legs' servos may be undamped)");
   mj_forward(m, d);
-  if (warningCount(d) > 0) fail(file, "MuJoCo warnings while standing: " + describeWarnings(d));
+  if (warningCount(d) > 0)
+    fail(file, "MuJoCo warnings while standing: " + describeWarnings(d) + " (the robot's servos or contacts are too "
+               "stiff for the model's timestep, " + g6(m->opt.timestep) + " s: lower <option timestep> or the actuators' kp)");
   std::string saturated;  // PD-held joints whose torque limit holds them back at the end
   int n_saturated = 0;
   for (std::size_t k = 0; k < hold.pd.size(); ++k) {
@@ -755,6 +787,16 @@ void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stan
                 (n_saturated > 4 ? ", ..." : "") + "): the legs cannot hold the stance";
   const double* Rroot = d->xmat + 9 * root;
   r.tilt_deg = units::degrees(std::acos(std::clamp(Rroot[8], -1.0, 1.0)));
+  // A robot that collapsed (its legs gave way, or the stance cannot be stood in) lies on its body:
+  // what touches the floor then is not its feet.
+  const double sank = z0 - d->qpos[freeq + 2], start_h = z0 - floorZ;
+  if (r.tilt_deg > kStandMaxTiltDeg || (start_h > 0.0 && sank > kStandMaxSinkShare * start_h))
+    fail(file, "the robot does not stand in " + r.stance + ": after " + g6(stood) + " s its body has sunk " +
+                   g6(1e3 * sank) + " mm of the " + g6(1e3 * start_h) + " mm it started above the floor and is tilted " +
+                   g6(r.tilt_deg) + " deg (limits " + g6(100 * kStandMaxSinkShare) + " % and " + g6(kStandMaxTiltDeg) +
+                   " deg): its legs do not hold the stance (servos too weak or too soft for its weight, or a stance "
+                   "it cannot stand in)",
+         "robot.stance");
 }
 
 // A geom's name, or "geom #k of body 'b'" for an unnamed one.
