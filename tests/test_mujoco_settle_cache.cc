@@ -13,6 +13,7 @@
 #include "experiments/experiment_runner.h"
 #include "models/mujoco/mjcf_generator.h"
 #include "models/mujoco/mujoco_simulation.h"
+#include "scratch_dir.h"
 
 using namespace tailsim;
 
@@ -147,7 +148,8 @@ TEST(MujocoSettleCache, KeyedByModelStartPoseAndSettings) {
 
 TEST(MujocoSettleCache, ASweepSettlesOncePerModelAndMatchesRunsWithoutIt) {
   // The paper's Fig. 12 style sweep: many strokes, one model and start pose.
-  const std::string path = ::testing::TempDir() + "settle_cache_sweep.yaml";
+  const tailsim::testing::ScratchDir dir("settle_cache");
+  const std::string path = (dir / "settle_cache_sweep.yaml").string();
   {
     std::ofstream f(path);
     f << "name: settle_cache_sweep\nrobot: paper\nkind: simulate\nmodels: [mujoco]\ntail: {links: 1}\n"

@@ -964,12 +964,26 @@ TEST(SweepSummary, BestTrendsDifferencesAndWarningsForAnyExperiment) {
   EXPECT_FALSE(isPaperFigure(r));
   const SweepSummary s = summarizeSweep(r);
   ASSERT_EQ(s.best.size(), 2u);
-  EXPECT_NE(s.best[0].find("largest φ_net +6.00° at ΔT = 0.6 s, w_ss = 0.25"), std::string::npos) << s.best[0];
+  EXPECT_NE(s.best[0].find("largest |φ_net| +6.00° at ΔT = 0.6 s, w_ss = 0.25"), std::string::npos) << s.best[0];
   bool rises = false;
   for (const std::string& t : s.trends) rises = rises || t.find("rises with ΔT, from +2.") != std::string::npos;
   EXPECT_TRUE(rises) << s.trends[0];
   ASSERT_EQ(s.disagree.size(), 1u);
   EXPECT_NE(s.disagree[0].find("largest difference +1.00°"), std::string::npos) << s.disagree[0];
+  EXPECT_NE(s.disagree[0].find("(No uncertainty is recorded for these results.)"), std::string::npos) << s.disagree[0];
+  {
+    // The largest turn either way (a turn of -6 deg is larger than one of +2), and the runs' own
+    // uncertainties beside the largest difference where they have them.
+    ExperimentResults neg = r;
+    for (CaseRecord& c : neg.cases) {
+      c.runs["analytic"].phi_net_deg = -c.runs["analytic"].phi_net_deg;
+      c.runs["mujoco"].phi_net_uncertainty_deg = 0.25;
+    }
+    const SweepSummary n = summarizeSweep(neg);
+    EXPECT_NE(n.best[0].find("largest |φ_net| -6.00° at ΔT = 0.6 s"), std::string::npos) << n.best[0];
+    EXPECT_NE(n.disagree[0].find("uncertainty there ±0.250°)"), std::string::npos) << n.disagree[0];
+    EXPECT_EQ(n.disagree[0].find("No uncertainty"), std::string::npos) << n.disagree[0];
+  }
   const std::string md = reportMarkdown({r}, computeFindings({r}), {}, root.string());
   EXPECT_EQ(md.find("Paper claims"), std::string::npos);
   EXPECT_EQ(md.find("Rone"), std::string::npos);

@@ -96,13 +96,13 @@ SweepSummary summarizeSweep(const ExperimentResults& r) {
         const double v = r.phiNet(c, m);
         if (!std::isfinite(v)) continue;
         ++ok;
-        if (!best || v > r.phiNet(*best, m)) best = &c;
+        if (!best || std::fabs(v) > std::fabs(r.phiNet(*best, m))) best = &c;  // the largest turn, either way
       }
       if (!best) {
         s.best.push_back(modelName(r, m) + ": no successful run.");
         continue;
       }
-      std::string line = modelName(r, m) + ": largest φ_net " + deg(r.phiNet(*best, m)) + " at " + where(r, *best);
+      std::string line = modelName(r, m) + ": largest |φ_net| " + deg(r.phiNet(*best, m)) + " at " + where(r, *best);
       if (ok < static_cast<int>(r.cases.size()))
         line += " (" + std::to_string(ok) + " of " + std::to_string(r.cases.size()) + " runs succeeded)";
       s.best.push_back(line + ".");
@@ -127,7 +127,15 @@ SweepSummary summarizeSweep(const ExperimentResults& r) {
                          deg(r.phiNet(*worst, m1)) + " vs " + deg(r.phiNet(*worst, m0)) + ") at " + where(r, *worst);
       if (n > 1) line += "; mean |difference| " + deg(sum / n, "%.2f") + " over " + std::to_string(n) + " cases";
       if (opposite > 0) line += "; opposite signs in " + std::to_string(opposite) + " case" + (opposite > 1 ? "s" : "");
-      s.disagree.push_back(line + ". (No uncertainty is recorded for these results.)");
+      // The runs' own uncertainties where they have one (MuJoCo's phi_net_uncertainty_deg).
+      std::string u;
+      for (const std::string& m : {m0, m1}) {
+        const auto run = worst->runs.find(m);
+        if (run != worst->runs.end() && std::isfinite(run->second.phi_net_uncertainty_deg))
+          u += (u.empty() ? "" : "; ") + modelName(r, m) + "'s uncertainty there ±" +
+               deg(run->second.phi_net_uncertainty_deg, "%.3f");
+      }
+      s.disagree.push_back(line + (u.empty() ? ". (No uncertainty is recorded for these results.)" : " (" + u + ")."));
     }
   }
   struct Group {

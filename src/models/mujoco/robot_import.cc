@@ -763,7 +763,8 @@ void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stan
     standFor(kStandMoreS);
     stood += kStandMoreS;
   }
-  r.notes.push_back("stance started " + g6(1e3 * (low - floorZ)) + " mm above the floor (lowest colliding geom); moved " +
+  r.notes.push_back("stance started " + g6(1e3 * std::abs(low - floorZ)) +
+                    (low >= floorZ ? " mm above" : " mm below") + " the floor (lowest colliding geom); moved " +
                     g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(stood) + " s" +
                     (stood > spec.settle_s ? " (settle_s " + g6(spec.settle_s) + " s, then on until the body rested)" : ""));
   if (moving())
@@ -809,6 +810,12 @@ std::string geomName(const mjModel* m, int g) {
 // Stage: the feet: the named geoms, or the robot's geoms touching the floor (a foot body's geoms within
 // kFootMergeM of each other count once, its lowest); 3 or 4 of them.
 constexpr double kFootMergeM = 0.05;  // [m] horizontal, between geom centres
+// A geom as a message names it: 'name', or geom #k of body 'b' for an unnamed one (no quotes around).
+std::string quotedGeom(const mjModel* m, int g) {
+  const char* n = mj_id2name(m, mjOBJ_GEOM, g);
+  return n ? "'" + clipped(n) + "'" : clipped(geomName(m, g));
+}
+
 // Geoms g and h are one foot: the same geom, or two of one body within kFootMergeM of each other.
 bool sameFoot(const mjModel* m, const mjData* d, int g, int h) {
   const double* a = d->geom_xpos + 3 * g;
@@ -837,12 +844,12 @@ void checkNamedFeet(const mjModel* m, const mjData* d, const std::vector<int>& n
                     const std::string& file) {
   for (int g : named)
     if (std::none_of(touching.begin(), touching.end(), [&](int t) { return sameFoot(m, d, g, t); }))
-      fail(file, "feet: '" + clipped(geomName(m, g)) + "' does not touch the floor after standing: name the geoms the robot "
+      fail(file, "feet: " + quotedGeom(m, g) + " does not touch the floor after standing: name the geoms the robot "
                  "stands on (or leave feet: out to take the touching ones)",
            "robot.feet");
   for (int t : touching)
     if (std::none_of(named.begin(), named.end(), [&](int g) { return sameFoot(m, d, g, t); }))
-      fail(file, "feet: '" + clipped(geomName(m, t)) + "' also touches the floor after standing but is not named: name "
+      fail(file, "feet: " + quotedGeom(m, t) + " also touches the floor after standing but is not named: name "
                  "every foot the robot stands on",
            "robot.feet");
 }
