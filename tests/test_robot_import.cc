@@ -467,6 +467,74 @@ TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
   EXPECT_NEAR(r.quadruped.w_F_m, 0.24, 1e-9);
 }
 
+// Models in styles nobody here wrote (an outside review's findings, each a wrong number or a
+// misleading error before): the helpers below build small robots in those styles.
+namespace {
+
+// A URDF quadruped: `base` (given by `base_link`), four legs on hinges `<leg>_j` at 0 (the stance),
+// each a 0.5 kg link with a collision sphere 0.2 m below the hip.
+std::string urdfQuadruped(const std::string& base_link, double effort_Nm = 50.0) {
+  std::string legs;
+  const struct {
+    const char* name;
+    double x, y;
+  } leg[] = {{"FL", 0.2, 0.12}, {"FR", 0.2, -0.12}, {"RR", -0.2, -0.12}, {"RL", -0.2, 0.12}};
+  for (const auto& l : leg) {
+    char b[1200];
+    std::snprintf(b, sizeof b,
+                  "<link name=\"%s\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/>"
+                  "<inertia ixx=\"0.002\" iyy=\"0.002\" izz=\"0.0003\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
+                  "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
+                  "<joint name=\"%s_j\" type=\"revolute\"><parent link=\"base\"/><child link=\"%s\"/>"
+                  "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
+                  "<limit lower=\"-1\" upper=\"1\" effort=\"%g\" velocity=\"10\"/></joint>\n",
+                  l.name, l.name, l.name, l.x, l.y, effort_Nm);
+    legs += b;
+  }
+  return "<robot name=\"bot\">\n" + base_link + legs + "</robot>\n";
+}
+
+RobotModelSpec urdfSpec(const std::string& file) {
+  RobotModelSpec s;
+  s.file = file;
+  for (const char* j : {"FL_j", "FR_j", "RR_j", "RL_j"}) s.joint_angles_rad[j] = 0.0;
+  s.settle_s = 0.3;
+  return s;
+}
+
+const char* kAutolimits = "<compiler autolimits=\"true\"/>";
+
+// An MJCF box robot whose four legs hang on hinges j1..j4 held by `actuators` (%J% = the joint).
+std::string mjcfLegRobot(const std::string& compiler, const std::string& actuator, double stance_rad) {
+  std::string legs, acts;
+  const double xy[4][2] = {{0.2, 0.12}, {0.2, -0.12}, {-0.2, -0.12}, {-0.2, 0.12}};
+  for (int i = 0; i < 4; ++i) {
+    char b[700];
+    std::snprintf(b, sizeof b,
+                  "<body name=\"leg%d\" pos=\"%g %g -0.05\"><joint name=\"j%d\" axis=\"0 1 0\" range=\"-1 1\"/>"
+                  "<inertial pos=\"0 0 -0.1\" mass=\"0.5\" diaginertia=\"0.002 0.002 0.0003\"/>"
+                  "<geom name=\"f%d\" type=\"sphere\" size=\"0.02\" pos=\"0 0 -0.22\"/></body>\n",
+                  i + 1, xy[i][0], xy[i][1], i + 1, i + 1);
+    legs += b;
+    std::string a = actuator;
+    for (std::size_t p = a.find("%J%"); p != std::string::npos; p = a.find("%J%")) a.replace(p, 3, "j" + std::to_string(i + 1));
+    acts += a;
+  }
+  char key[200];
+  std::snprintf(key, sizeof key, "<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0 %g %g %g %g\"/></keyframe>",
+                stance_rad, stance_rad, stance_rad, stance_rad);
+  return "<mujoco model=\"legbot\">\n" + compiler + R"(
+  <worldbody>
+    <geom name="floor" type="plane" size="0 0 1"/>
+    <body name="trunk" pos="0 0 0.3">
+      <freejoint/>
+      <inertial pos="0 0 0" mass="10" diaginertia="0.1 0.2 0.25"/>
+      <geom name="body_box" type="box" size="0.25 0.15 0.05"/>
+)" + legs + "    </body>\n  </worldbody>\n  <actuator>" + acts + "</actuator>\n" + key + "\n</mujoco>\n";
+}
+
+}  // namespace
+
 // Standing with the tail: the tilt that counts is the one from the robot's own settled stance. A
 // rigid box robot whose front feet are 40 mm shorter stands pitched by atan(0.04 / 0.4) = 5.7 deg
 // with or without a tail; holding the tail must not tilt it further, and no tilt warning is given.
@@ -476,32 +544,9 @@ TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
 // gear x angle (here 50 x 0.3 = 15 N m) away from the stance.
 TEST(RobotImport, MotorLegsAreHeldByThePdAndTheirCtrlStaysZero) {
   Scratch t("robot_import");
-  std::string legs, motors;
-  const double xy[4][2] = {{0.2, 0.12}, {0.2, -0.12}, {-0.2, -0.12}, {-0.2, 0.12}};
-  for (int i = 0; i < 4; ++i) {
-    char b[600];
-    std::snprintf(b, sizeof b,
-                  "<body name=\"leg%d\" pos=\"%g %g -0.05\"><joint name=\"j%d\" axis=\"0 1 0\"/>"
-                  "<inertial pos=\"0 0 -0.1\" mass=\"0.5\" diaginertia=\"0.002 0.002 0.0003\"/>"
-                  "<geom type=\"capsule\" fromto=\"0 0 0 0 0 -0.2\" size=\"0.015\" contype=\"0\" conaffinity=\"0\"/>"
-                  "<geom name=\"f%d\" type=\"sphere\" size=\"0.02\" pos=\"0 0 -0.22\"/></body>\n",
-                  i + 1, xy[i][0], xy[i][1], i + 1, i + 1);
-    legs += b;
-    motors += "<motor joint=\"j" + std::to_string(i + 1) + "\" gear=\"50\"/>";
-  }
-  const std::string xml = R"(<mujoco model="motorbot">
-  <worldbody>
-    <geom name="floor" type="plane" size="0 0 1"/>
-    <body name="trunk" pos="0 0 0.3">
-      <freejoint/>
-      <inertial pos="0 0 0" mass="10" diaginertia="0.1 0.2 0.25"/>
-      <geom name="body_box" type="box" size="0.25 0.15 0.05"/>
-)" + legs + R"(    </body>
-  </worldbody>
-  <actuator>)" + motors + R"(</actuator>
-  <keyframe><key name="home" qpos="0 0 0.3 1 0 0 0 0.3 0.3 0.3 0.3" ctrl="0.3 0.3 0.3 0.3"/></keyframe>
-</mujoco>
-)";
+  // The motors' keyframe ctrl are the stance angles (Go2's are).
+  std::string xml = mjcfLegRobot(kAutolimits, "<motor joint=\"%J%\" gear=\"50\"/>", 0.3);
+  xml.replace(xml.find("0.3 0.3 0.3 0.3\"/>"), 18, "0.3 0.3 0.3 0.3\" ctrl=\"0.3 0.3 0.3 0.3\"/>");
   RobotModelSpec s;
   s.file = t.write("motorbot.xml", xml);
   s.mount.pos_m = {-0.25, 0.0, 0.0};
@@ -648,71 +693,7 @@ TEST(RobotImport, UrdfCollisionMeshMissingNamesTheLinkAndFile) {
   }
 }
 
-// Models in styles nobody here wrote (an outside review's findings, each a wrong number or a
-// misleading error before): the helpers below build small robots in those styles.
 namespace {
-
-// A URDF quadruped: `base` (given by `base_link`), four legs on hinges `<leg>_j` at 0 (the stance),
-// each a 0.5 kg link with a collision sphere 0.2 m below the hip.
-std::string urdfQuadruped(const std::string& base_link, double effort_Nm = 50.0) {
-  std::string legs;
-  const struct {
-    const char* name;
-    double x, y;
-  } leg[] = {{"FL", 0.2, 0.12}, {"FR", 0.2, -0.12}, {"RR", -0.2, -0.12}, {"RL", -0.2, 0.12}};
-  for (const auto& l : leg) {
-    char b[1200];
-    std::snprintf(b, sizeof b,
-                  "<link name=\"%s\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/>"
-                  "<inertia ixx=\"0.002\" iyy=\"0.002\" izz=\"0.0003\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
-                  "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
-                  "<joint name=\"%s_j\" type=\"revolute\"><parent link=\"base\"/><child link=\"%s\"/>"
-                  "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
-                  "<limit lower=\"-1\" upper=\"1\" effort=\"%g\" velocity=\"10\"/></joint>\n",
-                  l.name, l.name, l.name, l.x, l.y, effort_Nm);
-    legs += b;
-  }
-  return "<robot name=\"bot\">\n" + base_link + legs + "</robot>\n";
-}
-
-RobotModelSpec urdfSpec(const std::string& file) {
-  RobotModelSpec s;
-  s.file = file;
-  for (const char* j : {"FL_j", "FR_j", "RR_j", "RL_j"}) s.joint_angles_rad[j] = 0.0;
-  s.settle_s = 0.3;
-  return s;
-}
-
-const char* kAutolimits = "<compiler autolimits=\"true\"/>";
-
-// An MJCF box robot whose four legs hang on hinges j1..j4 held by `actuators` (%J% = the joint).
-std::string mjcfLegRobot(const std::string& compiler, const std::string& actuator, double stance_rad) {
-  std::string legs, acts;
-  const double xy[4][2] = {{0.2, 0.12}, {0.2, -0.12}, {-0.2, -0.12}, {-0.2, 0.12}};
-  for (int i = 0; i < 4; ++i) {
-    char b[700];
-    std::snprintf(b, sizeof b,
-                  "<body name=\"leg%d\" pos=\"%g %g -0.05\"><joint name=\"j%d\" axis=\"0 1 0\" range=\"-1 1\"/>"
-                  "<inertial pos=\"0 0 -0.1\" mass=\"0.5\" diaginertia=\"0.002 0.002 0.0003\"/>"
-                  "<geom name=\"f%d\" type=\"sphere\" size=\"0.02\" pos=\"0 0 -0.22\"/></body>\n",
-                  i + 1, xy[i][0], xy[i][1], i + 1, i + 1);
-    legs += b;
-    std::string a = actuator;
-    for (std::size_t p = a.find("%J%"); p != std::string::npos; p = a.find("%J%")) a.replace(p, 3, "j" + std::to_string(i + 1));
-    acts += a;
-  }
-  char key[200];
-  std::snprintf(key, sizeof key, "<keyframe><key name=\"home\" qpos=\"0 0 0.3 1 0 0 0 %g %g %g %g\"/></keyframe>",
-                stance_rad, stance_rad, stance_rad, stance_rad);
-  return "<mujoco model=\"legbot\">\n" + compiler + R"(
-  <worldbody>
-    <geom name="floor" type="plane" size="0 0 1"/>
-    <body name="trunk" pos="0 0 0.3">
-      <freejoint/>
-      <inertial pos="0 0 0" mass="10" diaginertia="0.1 0.2 0.25"/>
-      <geom name="body_box" type="box" size="0.25 0.15 0.05"/>
-)" + legs + "    </body>\n  </worldbody>\n  <actuator>" + acts + "</actuator>\n" + key + "\n</mujoco>\n";
-}
 
 // A URDF link without <inertial> weighs nothing (URDF's rule), not its collision geoms' mass at
 // density 1000 (MuJoCo's default): the ANYmal pattern, a `base` link holding only a collision box,
