@@ -420,16 +420,27 @@ TEST(RobotImport, AnymalWithLockedLegsTurnsLikeTheRigidBoxWhicheverWayItFaces) {
 // A URDF robot: MuJoCo 2.2's URDF reader would fuse the root link into the world (no free joint);
 // tailsim keeps it a body (fusestatic off) and gives it the free joint. A 10 kg box base and four
 // 0.5 kg legs, two on revolute joints (held by tailsim's PD), two on fixed joints (their own bodies).
-TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
-  Scratch t("robot_import");
+// Models in styles nobody here wrote (an outside review's findings, each a wrong number or a
+// misleading error before): the helpers below build small robots in those styles.
+namespace {
+
+// A URDF quadruped: `base` (given by `base_link`), four legs on hinges `<leg>_j` at 0 (the stance),
+// each a 0.5 kg link with a collision sphere 0.2 m below the hip.
+struct UrdfLeg {
+  const char* name;
+  double x, y;
+};
+// A 10 kg base link with its collision box.
+const char* kUrdfBoxBase = R"(<link name="base"><inertial><mass value="10"/>
+  <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
+  <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
+)";
+constexpr UrdfLeg kUrdfLegs[] = {{"FL", 0.2, 0.12}, {"FR", 0.2, -0.12}, {"RR", -0.2, -0.12}, {"RL", -0.2, 0.12}};
+
+// rear_joint: the rear legs' joint type ("fixed": welded, not held).
+std::string urdfQuadruped(const std::string& base_link, double effort_Nm = 50.0, const char* rear_joint = "revolute") {
   std::string legs;
-  const struct {
-    const char* name;
-    double x, y;
-    const char* type;
-  } leg[] = {{"FL", 0.2, 0.12, "revolute"}, {"FR", 0.2, -0.12, "revolute"}, {"RR", -0.2, -0.12, "fixed"},
-             {"RL", -0.2, 0.12, "fixed"}};
-  for (const auto& l : leg) {
+  for (const UrdfLeg& l : kUrdfLegs) {
     char b[1200];
     std::snprintf(b, sizeof b,
                   "<link name=\"%s\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/>"
@@ -437,58 +448,8 @@ TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
                   "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
                   "<joint name=\"%s_j\" type=\"%s\"><parent link=\"base\"/><child link=\"%s\"/>"
                   "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
-                  "<limit lower=\"-1\" upper=\"1\" effort=\"50\" velocity=\"10\"/></joint>\n",
-                  l.name, l.name, l.type, l.name, l.x, l.y);
-    legs += b;
-  }
-  const std::string urdf = std::string(R"(<robot name="boxbot">
-  <link name="base">
-    <inertial><origin xyz="0.01 0 0"/><mass value="10"/>
-      <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
-    <visual><geometry><mesh filename="package://boxbot/meshes/shell.stl"/></geometry></visual>
-    <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision>
-  </link>
-)") + legs + "</robot>\n";
-  RobotModelSpec s;
-  s.file = t.write("boxbot.urdf", urdf);
-  s.joint_angles_rad = {{"FL_j", 0.0}, {"FR_j", 0.0}};
-  const DerivedRobot r = deriveRobot(s);
-  std::printf("%s", describeDerivedRobot(r).c_str());
-  EXPECT_TRUE(r.model.from_urdf);
-  EXPECT_EQ(r.root_body, "base");
-  EXPECT_EQ(r.pd_joints.size(), 2u);
-  expectMujocoFigures(r, 10.0 + 4 * 0.5);
-  // By hand: I_zz of the base and legs about the COM (x_c = 0.1 / 12), legs upright.
-  const double xc = (10 * 0.01 + 0.5 * (0.2 + 0.2 - 0.2 - 0.2)) / 12.0;
-  double izz = 0.25 + 10 * (0.01 - xc) * (0.01 - xc) + 4 * 0.0003;
-  for (const auto& l : leg) izz += 0.5 * ((l.x - xc) * (l.x - xc) + l.y * l.y);
-  EXPECT_NEAR(r.quadruped.izz_kgm2, izz, 1e-4 * izz);
-  EXPECT_NEAR(r.quadruped.l_F_m, 0.4, 1e-3);
-  EXPECT_NEAR(r.quadruped.w_F_m, 0.24, 1e-9);
-}
-
-// Models in styles nobody here wrote (an outside review's findings, each a wrong number or a
-// misleading error before): the helpers below build small robots in those styles.
-namespace {
-
-// A URDF quadruped: `base` (given by `base_link`), four legs on hinges `<leg>_j` at 0 (the stance),
-// each a 0.5 kg link with a collision sphere 0.2 m below the hip.
-std::string urdfQuadruped(const std::string& base_link, double effort_Nm = 50.0) {
-  std::string legs;
-  const struct {
-    const char* name;
-    double x, y;
-  } leg[] = {{"FL", 0.2, 0.12}, {"FR", 0.2, -0.12}, {"RR", -0.2, -0.12}, {"RL", -0.2, 0.12}};
-  for (const auto& l : leg) {
-    char b[1200];
-    std::snprintf(b, sizeof b,
-                  "<link name=\"%s\"><inertial><origin xyz=\"0 0 -0.1\"/><mass value=\"0.5\"/>"
-                  "<inertia ixx=\"0.002\" iyy=\"0.002\" izz=\"0.0003\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
-                  "<collision><origin xyz=\"0 0 -0.2\"/><geometry><sphere radius=\"0.02\"/></geometry></collision></link>\n"
-                  "<joint name=\"%s_j\" type=\"revolute\"><parent link=\"base\"/><child link=\"%s\"/>"
-                  "<origin xyz=\"%g %g -0.05\"/><axis xyz=\"0 1 0\"/>"
                   "<limit lower=\"-1\" upper=\"1\" effort=\"%g\" velocity=\"10\"/></joint>\n",
-                  l.name, l.name, l.name, l.x, l.y, effort_Nm);
+                  l.name, l.name, l.x < 0 ? rear_joint : "revolute", l.name, l.x, l.y, effort_Nm);
     legs += b;
   }
   return "<robot name=\"bot\">\n" + base_link + legs + "</robot>\n";
@@ -534,6 +495,33 @@ std::string mjcfLegRobot(const std::string& compiler, const std::string& actuato
 }
 
 }  // namespace
+
+TEST(RobotImport, UrdfRobotKeepsItsRootLinkAndStands) {
+  Scratch t("robot_import");
+  const std::string urdf = urdfQuadruped(R"(<link name="base">
+    <inertial><origin xyz="0.01 0 0"/><mass value="10"/>
+      <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
+    <visual><geometry><mesh filename="package://boxbot/meshes/shell.stl"/></geometry></visual>
+    <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision>
+  </link>
+)", 50.0, "fixed");
+  RobotModelSpec s;
+  s.file = t.write("boxbot.urdf", urdf);
+  s.joint_angles_rad = {{"FL_j", 0.0}, {"FR_j", 0.0}};
+  const DerivedRobot r = deriveRobot(s);
+  std::printf("%s", describeDerivedRobot(r).c_str());
+  EXPECT_TRUE(r.model.from_urdf);
+  EXPECT_EQ(r.root_body, "base");
+  EXPECT_EQ(r.pd_joints.size(), 2u);
+  expectMujocoFigures(r, 10.0 + 4 * 0.5);
+  // By hand: I_zz of the base and legs about the COM (x_c = 0.1 / 12), legs upright.
+  const double xc = (10 * 0.01 + 0.5 * (0.2 + 0.2 - 0.2 - 0.2)) / 12.0;
+  double izz = 0.25 + 10 * (0.01 - xc) * (0.01 - xc) + 4 * 0.0003;
+  for (const UrdfLeg& l : kUrdfLegs) izz += 0.5 * ((l.x - xc) * (l.x - xc) + l.y * l.y);
+  EXPECT_NEAR(r.quadruped.izz_kgm2, izz, 1e-4 * izz);
+  EXPECT_NEAR(r.quadruped.l_F_m, 0.4, 1e-3);
+  EXPECT_NEAR(r.quadruped.w_F_m, 0.24, 1e-9);
+}
 
 // Standing with the tail: the tilt that counts is the one from the robot's own settled stance. A
 // rigid box robot whose front feet are 40 mm shorter stands pitched by atan(0.04 / 0.4) = 5.7 deg
@@ -718,10 +706,7 @@ TEST(RobotImport, UrdfLinkWithoutInertialWeighsNothing) {
 // A URDF's collision geoms have no names: its feet are named by their links (bodies).
 TEST(RobotImport, FeetNamedByTheirBodies) {
   Scratch t("robot_import");
-  const std::string base = R"(<link name="base"><inertial><mass value="10"/>
-  <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
-  <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
-)";
+  const std::string base = kUrdfBoxBase;
   RobotModelSpec s = urdfSpec(t.write("bot.urdf", urdfQuadruped(base)));
   s.feet = {"RL", "FL", "FR", "RR"};
   const DerivedRobot r = deriveRobot(s);
@@ -872,10 +857,7 @@ namespace {
 // m/rad held any robot up.
 TEST(RobotImport, ThePdKeepsWithinTheJointsTorqueLimit) {
   Scratch t("robot_import");
-  const std::string base = R"(<link name="base"><inertial><mass value="10"/>
-  <inertia ixx="0.1" iyy="0.2" izz="0.25" ixy="0" ixz="0" iyz="0"/></inertial>
-  <collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
-)";
+  const std::string base = kUrdfBoxBase;
   RobotModelSpec s = urdfSpec(t.write("strong.urdf", urdfQuadruped(base, 50.0)));
   for (auto& [j, q] : s.joint_angles_rad) q = 0.4;
   const DerivedRobot r = deriveRobot(s);
