@@ -269,6 +269,13 @@ def main():
         # an arrow for each foot the ground pushes (foot<k>_Fn_N); the CSV row must have some
         loaded = sum(float(row["foot%d_Fn_N" % k]) > 1e-3 for k in range(1, 5))
         assert s["force_arrows"]["normal"] == loaded, (s["force_arrows"], loaded)
+        # The table gives MuJoCo's phi_net with its own uncertainty, and the verdict across the models.
+        driver.execute_script("const f = document.getElementById('filter'); f.value = ''; f.dispatchEvent(new Event('input'))")
+        heads = driver.execute_script("return Array.from(document.querySelectorAll('#thead .cell')).map(c => c.textContent)")
+        cells = driver.execute_script("return Array.from(document.querySelector('.row').children).map(c => c.textContent)")
+        mj_col = next(i for i, h in enumerate(heads) if h.startswith("MuJoCo") and "φ_net" in h)
+        assert " ± " in cells[mj_col], (heads, cells)
+        assert heads[-1] == "verdict" and cells[-1], (heads, cells)
         if SHOTS:
             driver.save_screenshot(os.path.join(SHOTS, "result-page-mujoco.png"))
 

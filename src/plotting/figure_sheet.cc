@@ -14,6 +14,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A description's text after its head (figureName: the text before the first ':'), trimmed; ""
+// when the head is all of it (the heading already shows it).
+std::string afterHead(const std::string& description) {
+  const std::size_t colon = description.find(':');
+  if (colon == std::string::npos) return "";
+  const std::size_t b = description.find_first_not_of(" \t", colon + 1);
+  return b == std::string::npos ? "" : description.substr(b);
+}
+
 std::string html(const std::string& s) {
   std::string o;
   for (char c : s) {
@@ -87,7 +96,7 @@ std::string figureSheetHtml(const std::string& dir, const std::vector<Experiment
   for (const ExperimentResults* r : order) {
     ++section;
     o << "<li><a href=\"#s" << section << "\">" << html(figureName(r->description, r->name)) << "</a>";
-    if (!r->description.empty()) o << ": " << html(plainSymbols(r->description));
+    if (const std::string rest = afterHead(r->description); !rest.empty()) o << ": " << html(plainSymbols(rest));
     o << "</li>\n";
   }
   o << "</ul></nav>\n";
@@ -96,7 +105,7 @@ std::string figureSheetHtml(const std::string& dir, const std::vector<Experiment
   for (const ExperimentResults* r : order) {
     ++section;
     o << "<h2 id=\"s" << section << "\">" << html(figureName(r->description, r->name)) << "</h2>\n";
-    if (!r->description.empty()) o << "<p>" << html(plainSymbols(r->description)) << "</p>\n";
+    if (const std::string rest = afterHead(r->description); !rest.empty()) o << "<p>" << html(plainSymbols(rest)) << "</p>\n";
     const SweepSummary sum = summarizeSweep(*r);
     auto list = [&](const char* what, const std::vector<std::string>& lines) {
       if (lines.empty()) return;

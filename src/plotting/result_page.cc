@@ -274,7 +274,7 @@ void writePageFile(const fs::path& dir, const std::string& name, const std::stri
 
 // One model's per-case columns of data.js, in case order; ok/warnings/error as JS literals.
 struct RunColumns {
-  std::vector<double> phi, tstop, events, wall;
+  std::vector<double> phi, u, tstop, events, wall;
   std::vector<std::string> ok, warn, err;
 };
 
@@ -283,6 +283,7 @@ void addRun(RunColumns& cols, const CaseRecord& c, const std::string& m) {
   const auto run = c.runs.find(m);
   const bool has = run != c.runs.end();
   cols.phi.push_back(has ? run->second.phi_net_deg : NAN);
+  cols.u.push_back(has ? run->second.phi_net_uncertainty_deg : NAN);
   cols.tstop.push_back(has ? run->second.t_stop_s : NAN);
   cols.events.push_back(has ? run->second.stick_slip_events : NAN);
   cols.wall.push_back(has ? run->second.wall_time_s : NAN);
@@ -347,7 +348,8 @@ std::string runsJson(const std::vector<std::string>& models, std::map<std::strin
   for (size_t i = 0; i < models.size(); ++i) {
     const std::string& m = models[i];
     const RunColumns& c = runs[m];
-    o << (i ? "," : "") << jsString(m) << ":{\"phi_net_deg\":" << numArray(c.phi) << ",\"t_stop_s\":" << numArray(c.tstop)
+    o << (i ? "," : "") << jsString(m) << ":{\"phi_net_deg\":" << numArray(c.phi)
+      << ",\"phi_net_uncertainty_deg\":" << numArray(c.u) << ",\"t_stop_s\":" << numArray(c.tstop)
       << ",\"stick_slip_events\":" << numArray(c.events) << ",\"wall_time_s\":" << numArray(c.wall)
       << ",\"ok\":" << array(c.ok, raw) << ",\"warnings\":" << array(c.warn, raw) << ",\"error\":" << array(c.err, raw)
       << "}";
@@ -361,12 +363,13 @@ std::string experimentJson(const ExperimentResults& r, int index, const fs::path
   if (!r.resolve_error.empty()) notes.push_back(r.resolve_error);
   if (const std::string n = r.seriesNote(); !n.empty()) notes.push_back(n);
   const size_t n = r.cases.size();
-  std::vector<std::string> names, replay;
+  std::vector<std::string> names, replay, verdicts;
   std::vector<std::vector<int>> axis_index(r.axes.size(), std::vector<int>(n, -1));
   std::map<std::string, RunColumns> runs;
   for (size_t k = 0; k < n; ++k) {
     const CaseRecord& c = r.cases[k];
     names.push_back(c.name);
+    verdicts.push_back(c.verdict);
     for (size_t a = 0; a < r.axes.size(); ++a)
       if (auto it = c.sweep.find(r.axes[a].key); it != c.sweep.end()) axis_index[a][k] = r.axes[a].indexOf(it->second);
     for (const std::string& m : r.models) addRun(runs[m], c, m);
@@ -377,7 +380,7 @@ std::string experimentJson(const ExperimentResults& r, int index, const fs::path
     << ",\"kind\":" << jsString(r.kind) << ",\"dir\":" << jsString(relUrl(r.dir, root.string()))
     << ",\"models\":" << modelsJson(r) << ",\"notes\":" << strArray(notes)
     << ",\"figures\":" << strArray(figuresOf(r, root)) << ",\"axes\":[" << joined(axesJson(r, axis_index), ",")
-    << "],\"cases\":{\"name\":" << strArray(names) << ",\"replay\":" << array(replay, [](const std::string& s) { return s; })
+    << "],\"cases\":{\"name\":" << strArray(names) << ",\"verdict\":" << strArray(verdicts) << ",\"replay\":" << array(replay, [](const std::string& s) { return s; })
     << ",\"runs\":{" << runsJson(r.models, runs) << "}}}";
   return o.str();
 }

@@ -143,15 +143,16 @@ const char* const kResultPageJs = R"JS('use strict';
       grid = { kind: 'line', x: ax[0] };
       return;
     }
-    const nx = ax[0].values.length, ny = ax[1].values.length;
+    // As the figures' heat map (plots.cc): the first swept key up, the second across.
+    const nx = ax[1].values.length, ny = ax[0].values.length;
     const cell = new Int32Array(nx * ny).fill(-1);
     for (let k = 0; k < n; ++k) {
       let other = true;
       for (let a = 2; a < ax.length; ++a) if (ax[a].index[k] !== 0) other = false;
-      const ix = ax[0].index[k], iy = ax[1].index[k];
+      const ix = ax[1].index[k], iy = ax[0].index[k];
       if (other && ix >= 0 && iy >= 0 && cell[iy * nx + ix] < 0) cell[iy * nx + ix] = k;
     }
-    grid = { kind: 'map', x: ax[0], y: ax[1], nx: nx, ny: ny, cell: cell };
+    grid = { kind: 'map', x: ax[1], y: ax[0], nx: nx, ny: ny, cell: cell };
   }
   const MAP = { x0: 70, y0: 20, x1: 470, y1: 310 };
   // The figures' colour maps (style.h): sequential white - orange - dark orange when every value
@@ -305,7 +306,7 @@ const char* const kResultPageJs = R"JS('use strict';
   T.mapPoint = function (k) {
     const W = MAP.x1 - MAP.x0, H = MAP.y1 - MAP.y0;
     if (!grid || grid.kind !== 'map') return null;
-    const ix = exp.axes[0].index[k], iy = exp.axes[1].index[k];
+    const ix = exp.axes[1].index[k], iy = exp.axes[0].index[k];
     return { x: MAP.x0 + (ix + 0.5) * W / grid.nx, y: MAP.y1 - (iy + 0.5) * H / grid.ny };
   };
 
@@ -318,11 +319,17 @@ const char* const kResultPageJs = R"JS('use strict';
       show: (k) => (a.index[k] >= 0 ? a.values[a.index[k]] : '') }));
     exp.models.forEach((m) => {
       const r = exp.cases.runs[m.name];
-      columns.push({ title: m.title + ' φ_net [deg]', get: (k) => r.phi_net_deg[k], show: (k) => fmt(r.phi_net_deg[k], 3) });
+      // MuJoCo's phi_net with its own uncertainty, as the run's table prints it.
+      const u = r.phi_net_uncertainty_deg || [];
+      columns.push({ title: m.title + ' φ_net [deg]', get: (k) => r.phi_net_deg[k],
+        show: (k) => fmt(r.phi_net_deg[k], 3) + (Number.isFinite(u[k]) ? ' ± ' + fmt(u[k], 3) : '') });
       columns.push({ title: m.title + ' t_stop [s]', get: (k) => r.t_stop_s[k], show: (k) => fmt(r.t_stop_s[k], 3) });
       columns.push({ title: m.title + ' status', text: true, get: (k) => (r.ok[k] === 0 ? 'failed: ' + r.error[k] : r.warnings[k] ? 'warning: ' + r.warnings[k] : r.ok[k] === 1 ? 'ok' : ''),
         cls: (k) => (r.ok[k] === 0 ? 'bad' : r.warnings[k] ? 'warn' : '') });
     });
+    // The verdict across the models (experiments/verdict.h), where the run gave one.
+    const verdict = exp.cases.verdict || [];
+    if (verdict.some((v) => v)) columns.push({ title: 'verdict', text: true, get: (k) => verdict[k] || '' });
     const head = $('thead'); clear(head);
     columns.forEach((c, i) => {
       const h = el('div', { class: 'cell' + (c.cls === 'name' ? ' name' : '') }, c.title);
