@@ -501,6 +501,29 @@ double since(Clock::time_point& t0) {
   return s;
 }
 
+// Width in pixels of `text` in MuJoCo's normal font (a byte outside its table counts as 'M').
+int textWidthPx(const mjrContext& con, const std::string& text) {
+  int w = 0;
+  for (const char ch : text) {
+    const unsigned char u = static_cast<unsigned char>(ch);
+    w += con.charWidth[u > 32 && u < 127 ? u : 'M'];
+  }
+  return w;
+}
+
+// `text` cut to fit `width_px` in the normal font, ending in "..." when cut (a long swept case's
+// title ran under the slow-motion factor on the same strip).
+std::string fitText(const mjrContext& con, const std::string& text, int width_px) {
+  if (textWidthPx(con, text) <= width_px) return text;
+  std::string cut = text;
+  while (!cut.empty() && textWidthPx(con, cut + "...") > width_px) {
+    cut.pop_back();
+    while (!cut.empty() && (static_cast<unsigned char>(cut.back()) & 0xC0) == 0x80) cut.pop_back();  // whole UTF-8
+    if (!cut.empty() && static_cast<unsigned char>(cut.back()) >= 0xC0) cut.pop_back();
+  }
+  return cut + "...";
+}
+
 // The 2-D parts of a frame: title strip, text, colour key and the phi(t) inset with its cursor.
 void drawPanel(RenderRig& r, const RenderInputs& in, const RenderSettings& s, double t, const PlanarState& st,
                const std::optional<PlanarState>& ghost) {
@@ -510,7 +533,14 @@ void drawPanel(RenderRig& r, const RenderInputs& in, const RenderSettings& s, do
   mjr_rectangle(L.panel, 0.10f, 0.10f, 0.12f, 1.0f);
   mjr_rectangle(L.title, 0.10f, 0.10f, 0.12f, 1.0f);
   std::snprintf(buf, sizeof buf, "%gx slow motion", s.slowmo);
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.title, in.title.c_str(), nullptr, &con);
+  // The title gets the strip less the factor and a gap of four widths of 'M' (the overlay's margins).
+  // A title "experiment case" too long for it keeps the case, which tells the frames apart.
+  const int title_px = L.title.width - textWidthPx(con, buf) - 4 * con.charWidth['M'];
+  const std::size_t space = in.title.find(' ');
+  const std::string title =
+      fitText(con, textWidthPx(con, in.title) > title_px && space != std::string::npos ? in.title.substr(space + 1) : in.title,
+              title_px);
+  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, L.title, title.c_str(), nullptr, &con);
   mjr_overlay(mjFONT_NORMAL, mjGRID_TOPRIGHT, L.title, buf, nullptr, &con);
   std::string text = "t = ";
   std::snprintf(buf, sizeof buf, "%.3f s", t);
