@@ -605,4 +605,32 @@ TEST(DesignInputsRobot, DesignCommandsNameTheWayToAnImportedRobot) {
   }
 }
 
+
+// A limit in the design file that differs from the robot file's is noted (a start_here preset
+// copied for one's own robot kept the paper's limits over the robot's 6 N m, silently); one that
+// equals it, or that the robot file does not give, is not.
+TEST(DesignInputsRobot, ADesignLimitReplacingTheRobotFilesIsNoted) {
+  const ScratchDir t("design_overrides");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(t / name) << text;
+    return (t / name).string();
+  };
+  write("robot.yaml", "quadruped: {mass_kg: 8, size_m: [0.45, 0.25, 0.18]}\nfriction: {mu_s: 0.5, mu_d: 0.45}\n"
+                      "gravity_mps2: 9.81\ntails:\n  2: {mass_kg: 0.25, izz_kgm2: 4.7e-4, length_m: 0.15, torque_max_Nm: 6, "
+                      "thetadot_max_dps: 500, theta_min_deg: -80, theta_max_deg: 80}\n");
+  write("base.yaml", "name: b\nrobot: robot.yaml\ntail: {links: 2}\ntrajectory: {rule: eq25, thetadot_max_dps: 500, w_ss: 0.25}\n");
+  const auto spec = [&](const std::string& limits) {
+    return loadOptimizeSpec(write("o.yaml", "name: o\nkind: optimize\nbase: base.yaml\noptimize:\n  family: split_cycle\n"
+                                            "  objective: phi_net\n  limits: " + limits + "\n"));
+  };
+  const OptimizeSpec over = spec("{theta_deg: [-90, 90], thetadot_max_dps: 500, torque_max_Nm: none}");
+  ASSERT_EQ(over.limit_overrides.size(), 4u);
+  EXPECT_NE(over.limit_overrides[0].find("joint 1 theta_deg: [-90, 90] deg from "), std::string::npos) << over.limit_overrides[0];
+  EXPECT_NE(over.limit_overrides[0].find("o.yaml replaces the robot file's [-80, 80] deg"), std::string::npos);
+  EXPECT_NE(over.limit_overrides[1].find("joint 1 torque_max_Nm: none from "), std::string::npos) << over.limit_overrides[1];
+  EXPECT_NE(over.limit_overrides[1].find("replaces the robot file's 6 N m"), std::string::npos);
+  EXPECT_TRUE(spec("{}").limit_overrides.empty());
+  EXPECT_TRUE(spec("{thetadot_max_dps: 500, torque_max_Nm: 6}").limit_overrides.empty());
+}
+
 }  // namespace tailsim

@@ -66,6 +66,19 @@ TEST(Maneuver, OpenLoopPlanLandsOnTargetInTheAnalyticModel) {
   EXPECT_GE(r.t_within_s, 0.0);
 }
 
+// A heading a hair past whole cycles takes no extra cycle: the smallest cycle would overshoot by far
+// more than the hair (an outside review: 10 deg by cycles of 1.995 ended at 10.977, not 9.975).
+TEST(Maneuver, ARemainderSmallerThanTheSmallestCycleAddsNone) {
+  ManeuverSpec s = spec90();
+  const YawMap map = analyticYawMap(s.base, s.settings);
+  s.settings.heading_deg = 3 * std::abs(map.full()) / kDeg + 0.02;
+  const std::vector<StrokeCommand> plan = planOpenLoop(s.base, s.settings, map);
+  ASSERT_EQ(plan.size(), 3u);
+  const ManeuverRun r = runAnalyticOpenLoop(s.base, s.settings, plan);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_NEAR(std::abs(r.final_error_rad), 0.02 * kDeg, 1e-6);
+}
+
 TEST(Maneuver, MinusNinetyIsTheMirrorOfPlusNinety) {
   ManeuverSpec s = spec90();
   const YawMap map = analyticYawMap(s.base, s.settings);

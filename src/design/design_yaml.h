@@ -36,6 +36,7 @@ struct Val {
 class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
+  const std::string& file() const { return file_; }
   [[noreturn]] void fail(const YAML::Mark& m, const std::string& key, const std::string& what) const {
     std::string s = file_;
     if (!m.is_null()) s += ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1);

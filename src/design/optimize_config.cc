@@ -36,7 +36,8 @@ struct FileLimit {
 // with what to add (torque: `none` keeps no torque limit). When every joint ends with the same
 // limits, the scalars of StrokeLimits hold them (joints empty); else StrokeLimits::joints does.
 void resolveJointLimits(const Reader& r, const Val& lv, const ExperimentCase& base, const FileLimit& theta,
-                        const FileLimit& speed, const FileLimit& torque, bool torque_given_as_word, StrokeLimits& L) {
+                        const FileLimit& speed, const FileLimit& torque, bool torque_given_as_word, StrokeLimits& L,
+                        std::vector<std::string>& overrides) {
   const std::vector<TailLink>& tail = base.robot.tail;
   const std::size_t n = tail.size();
   const std::string where = base.robot_file.empty() ? std::string("the base experiment's tail")
@@ -55,12 +56,23 @@ void resolveJointLimits(const Reader& r, const Val& lv, const ExperimentCase& ba
     return f.values[(f.per_joint ? i * stride : 0) + k];
   };
   std::vector<JointLimits> js(n);
+  // This file's value where the robot gives another: noted (a preset copied for one's own robot).
+  auto overridden = [&](std::size_t joint, const std::string& what, const std::string& here, const std::string& robot) {
+    if (here != robot)
+      overrides.push_back("joint " + std::to_string(joint + 1) + " " + what + ": " + here + " from " + r.file() +
+                          " replaces the robot file's " + robot);
+  };
+  const auto deg = [](double rad) { return fmtG(rad / kRadPerDeg); };
+  const auto torqueText = [](double t) { return t > 0.0 ? fmtG(t) + " N m" : std::string("none"); };
   for (std::size_t i = 0; i < n; ++i) {
     JointLimits& J = js[i];
     const TailLink& k = tail[i];
     if (theta.at) {
       J.theta_min_rad = fileValue(theta, i, 2, 0);
       J.theta_max_rad = fileValue(theta, i, 2, 1);
+      if (k.hasRange())
+        overridden(i, "theta_deg", "[" + deg(J.theta_min_rad) + ", " + deg(J.theta_max_rad) + "] deg",
+                   "[" + deg(k.theta_min_rad) + ", " + deg(k.theta_max_rad) + "] deg");
     } else {
       if (!k.hasRange())
         missing("theta_deg", "theta_min_deg and theta_max_deg to the robot's tail entry, or theta_deg: [low, high] here", i);
@@ -69,6 +81,8 @@ void resolveJointLimits(const Reader& r, const Val& lv, const ExperimentCase& ba
     }
     if (speed.at) {
       J.thetadot_max_radps = fileValue(speed, i, 1, 0);
+      if (k.thetadot_max_radps > 0.0)
+        overridden(i, "thetadot_max_dps", deg(J.thetadot_max_radps) + " deg/s", deg(k.thetadot_max_radps) + " deg/s");
     } else {
       if (!(k.thetadot_max_radps > 0.0))
         missing("thetadot_max_dps", "thetadot_max_dps (the actuator's peak speed) to the robot's tail entry or here", i);
@@ -76,6 +90,7 @@ void resolveJointLimits(const Reader& r, const Val& lv, const ExperimentCase& ba
     }
     if (torque.at || torque_given_as_word) {
       J.torque_max_Nm = torque.at ? fileValue(torque, i, 1, 0) : L.torque_max_Nm;
+      if (k.torque_max_Nm > 0.0) overridden(i, "torque_max_Nm", torqueText(J.torque_max_Nm), torqueText(k.torque_max_Nm));
     } else {
       if (!(k.torque_max_Nm > 0.0))
         missing("torque_max_Nm", "torque_max_Nm (the actuator's peak torque) to the robot's tail entry or here, or "
@@ -439,7 +454,7 @@ OptimizeSpec loadOptimizeSpec(const std::string& path) {
     L.torque_max_Nm = strokeFigures(s.base.robot.tail, s.base.trajectory()).peak_torque_Nm;
     if (!(L.torque_max_Nm > 0.0)) r.fail(*lk.torque_key, "base: the base stroke has no joint torque to keep");
   }
-  resolveJointLimits(r, lv, s.base, lk.theta, lk.speed, lk.torque, lk.torque_word, L);
+  resolveJointLimits(r, lv, s.base, lk.theta, lk.speed, lk.torque, lk.torque_word, L, s.limit_overrides);
   requireSearchableLimits(r, lv, s);
   sp.tail = s.base.robot.tail;
   s.problem.base = s.base;

@@ -31,6 +31,9 @@ struct OptimizeSpec {
   int pareto_points = 0;                // > 0: phi_net vs peak torque front with this many points
   bool mujoco_check = true;             // re-simulate the optimum in MuJoCo
   double min_turn_deg = 0.1;            // a best stroke turning the body less is no answer (exit 3, what would)
+  // Where this file's limits replace different ones the robot file gives (a copied preset's keep
+  // their values over the user's robot): one line each, printed and in summary.json.
+  std::vector<std::string> limit_overrides;
   // The objective's model (objective: {model: ...}); with mujoco the search runs
   // problem.search_model and MuJoCo re-ranks its best problem.keep_candidates points.
   ObjectiveModel objective_model = ObjectiveModel::kAnalytic;

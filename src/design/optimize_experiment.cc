@@ -620,6 +620,7 @@ void summarizeSettings(const OptimizeSpec& spec, nlohmann::json& j) {
   j["experiment"] = spec.name;
   j["source"] = spec.source_file;
   j["base"] = spec.base_file;
+  j["limit_overrides"] = spec.limit_overrides;
   j["family"] = familyName(prob.space.family);
   j["objective"] = objectiveName(prob.objective);
   j["objective_model"] = objectiveModelName(spec.objective_model);
@@ -789,6 +790,7 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
     writeOwnedFile(out_dir, name, text);
     rep.files.push_back(name);
   }
+  for (const std::string& o : spec.limit_overrides) std::fprintf(stderr, "note: %s\n", o.c_str());
   searchSeeds(spec, progress, t0, rep);
   OptimizeResult best = pickBestSeed(rep);
   if (spec.objective_model == ObjectiveModel::kMujoco) rerankWithMujoco(spec, progress, best, rep);
