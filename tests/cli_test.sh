@@ -193,6 +193,37 @@ run 0 "$tailsim" run sweep.yaml --out int_run --threads 2 --quiet
 grep -q "^$total cases: $((total - saved)) run, $saved resumed, 0 failed" out.txt || fail "rerun: $(head -n 1 out.txt)"
 ok "Ctrl-C after the first case: exit 130, '$said', rerun resumed $saved"
 
+echo "== SIGTERM during optimize: the seeds that finished are the result, exit 143"
+cat >opt_sig.yaml <<EOF
+name: opt_sig
+kind: optimize
+base: $src/configs/design/base/eq25_n1.yaml
+optimize:
+  family: split_cycle
+  objective: phi_net
+  limits: {theta_deg: [-90, 90], thetadot_max_dps: 600, torque_max_Nm: none}
+  islands: 1
+  population: 8
+  generations: 200
+  seeds: [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12]
+  mujoco_check: false
+EOF
+"$tailsim" optimize opt_sig.yaml --out opt_sig >out.txt 2>err.txt &
+pid=$!
+for _ in $(seq 1 600); do  # until the first seed has finished, at most 60 s
+  grep -q "^seed 1: " err.txt && break
+  sleep 0.1
+done
+kill -TERM "$pid"
+rc=0
+wait "$pid" || rc=$?
+[ $rc -eq 143 ] || fail "optimize: exit $rc after SIGTERM (want 143)\n$(tail -n 3 err.txt)"
+grep -Eq "^optimize opt_sig: stopped by SIGTERM after [0-9]+ of 12 seeds: the best of those is written" err.txt ||
+  fail "optimize: no stop message: $(tail -n 3 err.txt)"
+grep -q '"stopped_by": "SIGTERM"' opt_sig/summary.json || fail "optimize: summary.json does not say it was stopped"
+[ -f opt_sig/best.yaml ] || fail "optimize: no best.yaml after SIGTERM"
+ok "optimize: SIGTERM after the first seed: exit 143, $(grep -o 'after [0-9]* of 12 seeds' err.txt), summary.json stopped_by"
+
 echo "== Ctrl-C twice with every series in one HDF5 file: the finished cases stay resumable"
 sed 's/^name: wss_sweep/name: wss_sweep_h5/' sweep.yaml >sweep_h5.yaml
 # 4 s simulated per case: the case running at the first Ctrl-C is still running at the second.

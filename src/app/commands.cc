@@ -62,6 +62,7 @@ void* optimiserEntry(const char* what, const char* entry) {
 int optimiserExitCode(int rc, const char* err) {
   if (rc == -1) throw ConfigError(err);
   if (rc < 0) throw std::runtime_error(err);
+  if (rc >= 128) return rc;  // stopped by a signal: 128 + the signal, as `run`
   return rc == 0 ? kExitOk : kExitRunsFailed;
 }
 

@@ -32,6 +32,7 @@ constexpr const char* kExitCodes =
     "       maneuver: a run failed or the closed loop missed the heading\n"
     "  130  run: interrupted by Ctrl-C (SIGINT; finished cases are saved; run again to resume)\n"
     "  143  run: stopped by SIGTERM (a batch system's time limit), likewise\n"
+    "       optimize, maneuver: the same codes; optimize keeps the seeds that finished, maneuver only its inputs\n"
     "  129  run: stopped by SIGHUP (the terminal closed), likewise";
 
 std::string versionString() {

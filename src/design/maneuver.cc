@@ -370,11 +370,14 @@ ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettin
 namespace {
 
 // Stage 2: the runs: the analytic open loop, and with maneuver.mujoco MuJoCo's open and closed loops.
-void runManeuverModels(const ExperimentCase& base, const ManeuverSettings& s, bool progress, ManeuverReport& rep) {
+void runManeuverModels(const ExperimentCase& base, const ManeuverSettings& s, bool progress,
+                       const std::function<int()>& stopped, ManeuverReport& rep) {
+  const auto stop = [&] { return stopped && (rep.stop_signal = stopped()) != 0; };
   rep.runs.push_back(runAnalyticOpenLoop(base, s, rep.plan));
-  if (!s.mujoco) return;
+  if (!s.mujoco || stop()) return;
   rep.runs.push_back(runMujocoOpenLoop(base, s, rep.plan));
   if (progress) std::fprintf(stderr, "MuJoCo open loop done\n");
+  if (stop()) return;
   // Closed loop: time for twice the plan's cycles plus two (MuJoCo turns less per cycle), at most max_strokes.
   const int cycles = std::min(s.max_strokes, 2 * static_cast<int>(rep.plan.size()) + 2);
   const double dur = cycles * (cycleDuration(s, 1.0) + 0.2) + 0.5;
@@ -538,7 +541,8 @@ void writeManeuverSummary(const ManeuverSpec& spec, const ManeuverSettings& s, c
 
 // The stages in order: the plan (before anything is written), the folder's inputs, the runs, the CSV
 // files, the heading plot, the video, the summary.
-ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress) {
+ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress,
+                           const std::function<int()>& stopped) {
   const auto w0 = std::chrono::steady_clock::now();
   ManeuverSettings s = spec.settings;
   const ExperimentCase& base = spec.base;
@@ -560,7 +564,8 @@ ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir,
     std::fprintf(stderr, "analytic cycle: stroke %+.4f deg, return %+.4f deg; plan: %zu cycles (last scale %.4f)\n",
                  rep.full_cycle.fast_rad * kDegPerRad, rep.full_cycle.back_rad * kDegPerRad, rep.plan.size(),
                  rep.plan.empty() ? 0.0 : rep.plan.back().scale);
-  runManeuverModels(base, s, progress, rep);
+  runManeuverModels(base, s, progress, stopped, rep);
+  if (rep.stop_signal || (stopped && (rep.stop_signal = stopped()) != 0)) return rep;  // results whole or not at all
   writeHeadings(base, out_dir, rep);
   writeStrokes(s, n, out_dir, rep);
   writeYawMap(out_dir, rep);

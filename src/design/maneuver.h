@@ -7,6 +7,7 @@
 // optimize file, and holds a `maneuver:` section (ManeuverSettings, declared once).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,7 @@ ManeuverRun runMujocoOpenLoop(const ExperimentCase& base, const ManeuverSettings
 ManeuverRun runMujocoClosedLoop(const ExperimentCase& base, const ManeuverSettings& s, const YawMap& map, double duration_s);
 
 struct ManeuverReport {
+  int stop_signal = 0;   // a stop signal ended it between runs: no results written (0: none)
   double min_scale = 0;  // used (given, or derived from the tolerance)
   YawMap map;
   CycleYaw full_cycle;
@@ -96,6 +98,9 @@ struct ManeuverReport {
 
 // Runs everything and writes DIR/maneuver.csv, strokes.csv, yaw_map.csv, summary.json,
 // plots/heading.{gp,png,svg} and, with `video`, renders/<name>.mp4 (closed loop, analytic ghost).
-ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress);
+// `stopped`: polled between the runs, the stop signal received (0: none): then the report's
+// stop_signal is set and nothing but the inputs is written.
+ManeuverReport runManeuver(const ManeuverSpec& spec, const std::string& out_dir, bool video, bool progress,
+                           const std::function<int()>& stopped = {});
 
 }  // namespace tailsim

@@ -1,4 +1,5 @@
 #include "design/optimize_experiment.h"
+#include "common/stop_signals.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -400,9 +401,11 @@ class SeedProgress {
 };
 
 // Stage 1: one search per seed, into rep.per_seed and rep.evaluations.
-void searchSeeds(const OptimizeSpec& spec, bool progress, std::chrono::steady_clock::time_point t0, OptimizeReport& rep) {
+void searchSeeds(const OptimizeSpec& spec, bool progress, std::chrono::steady_clock::time_point t0,
+                 const std::function<int()>& stopped, OptimizeReport& rep) {
   SeedProgress line(spec, t0);
   for (std::size_t i = 0; i < spec.seeds.size(); ++i) {
+    if (stopped && (rep.stop_signal = stopped()) != 0) return;
     OptimizerSettings os = spec.optimizer;
     os.seed = spec.seeds[i];
     ProgressFn show;
@@ -770,6 +773,10 @@ void writeSummary(const OptimizeSpec& spec, const OptimizeReport& rep, const Opt
   summarizeResimulation(spec, rep, j);
   if (!pareto.empty()) j["pareto"] = pareto;
   summarizeRerankAndInfeasible(spec, rep, j);
+  if (rep.stop_signal) {
+    j["stopped_by"] = StopSignals::name(rep.stop_signal);
+    j["seeds_finished"] = rep.per_seed.size();
+  }
   j["evaluations"] = rep.evaluations;
   j["wall_s"] = rep.wall_s;
   j["files"] = rep.files;
@@ -781,7 +788,8 @@ void writeSummary(const OptimizeSpec& spec, const OptimizeReport& rep, const Opt
 
 // The stages in order: the folder's inputs, the seeds' searches, the best seed, the MuJoCo re-rank,
 // the infeasibility diagnosis, the read-back and re-simulation, the history, the Pareto front, the summary.
-OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress) {
+OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress,
+                           const std::function<int()>& stopped) {
   const auto t0 = std::chrono::steady_clock::now();
   OptimizeReport rep;
   fs::create_directories(fs::path(out_dir) / "plots");
@@ -791,7 +799,8 @@ OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir,
     rep.files.push_back(name);
   }
   for (const std::string& o : spec.limit_overrides) std::fprintf(stderr, "note: %s\n", o.c_str());
-  searchSeeds(spec, progress, t0, rep);
+  searchSeeds(spec, progress, t0, stopped, rep);
+  if (rep.per_seed.empty()) return rep;  // stopped before a seed finished: the inputs only
   OptimizeResult best = pickBestSeed(rep);
   if (spec.objective_model == ObjectiveModel::kMujoco) rerankWithMujoco(spec, progress, best, rep);
   rep.infeasible = analyseInfeasible(spec.problem, best.best, best.trajectory, units::radians(spec.min_turn_deg));

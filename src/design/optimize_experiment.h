@@ -10,6 +10,7 @@
 //   DIR/summary.json         everything the note needs (objective per seed, spread, MuJoCo difference)
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -82,6 +83,9 @@ struct OptimizeReport {
   // base never met on this stroke): the re-runs then use the search's own trajectory, and
   // `tailsim run best.yaml` gives this error instead of their results.
   std::string best_yaml_error;
+  // A stop signal (stopped() returned it) ended the search before all seeds ran: the best of the
+  // seeds that finished is the result (0: none); with no seed finished nothing but the inputs is written.
+  int stop_signal = 0;
 };
 
 // The inputs a design folder keeps so that it runs again on its own after a move: the design file
@@ -92,7 +96,9 @@ struct OptimizeReport {
 std::map<std::string, std::string> designFolderInputs(const std::string& design_file, const std::string& design_copy,
                                                       const std::string& base_file, const std::string& stroke_file = "");
 
-OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress);
+// `stopped`: polled between seeds, the stop signal received (0: none); empty: never stops.
+OptimizeReport runOptimize(const OptimizeSpec& spec, const std::string& out_dir, bool progress,
+                           const std::function<int()>& stopped = {});
 
 // The ready-to-run experiment YAML of a split-cycle stroke on the spec's base experiment.
 std::string bestExperimentYaml(const OptimizeSpec& spec, const TailTrajectory& traj);

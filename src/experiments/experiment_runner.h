@@ -80,6 +80,9 @@ void refuseRunResults(const std::string& dir, const std::string& command);
 // then each of `outputs` (names relative to DIR, e.g. "plots/history.png") must be tailsim's
 // (ownedFile), else std::runtime_error naming it, before any work.
 void claimDesignFolder(const std::string& dir, const std::vector<std::string>& outputs);
+// Removes those of `outputs` (files relative to dir) that are there, after claimDesignFolder
+// has judged them tailsim's; a file a manifest no longer names stays.
+void removeDesignOutputs(const std::string& dir, const std::vector<std::string>& outputs);
 
 // Keeps only the models named in `only` in every case (none given: all). Throws ConfigError naming
 // `file` for an unknown model name, or when the names select no model of any simulated case (the run

@@ -70,6 +70,14 @@ void claimDesignFolder(const std::string& dir, const std::vector<std::string>& o
   }
 }
 
+void removeDesignOutputs(const std::string& dir, const std::vector<std::string>& outputs) {
+  claimDesignFolder(dir, outputs);  // every one of them tailsim's (or absent), judged again
+  for (const std::string& o : outputs) {
+    std::error_code ec;
+    fs::remove(fs::path(dir) / o, ec);
+  }
+}
+
 namespace runner {
 
 // A JSON file of the folder (discarded, not an exception, when absent or not JSON; an error when

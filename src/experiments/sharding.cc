@@ -1,4 +1,5 @@
 #include "experiments/sharding.h"
+#include "common/stop_signals.h"
 #include "experiments/time_series_h5.h"
 
 #include <algorithm>
@@ -161,41 +162,6 @@ namespace {
 // The file that marks a folder as a merge's staging folder, named in its manifest with this content.
 const char* const kStageMarker = ".tailsim-merge-stage";
 const char* const kStageMarkerText = "tailsim merge staging folder\n";
-
-// SIGINT, SIGTERM and SIGHUP blocked for the merge (its worker threads and children inherit the
-// mask) and read between files: the merge stops cleanly and removes its staging folder. The
-// caller's mask is restored on exit, and a signal still pending is taken so it does not kill the
-// process after the merge has answered for it.
-class StopSignals {
- public:
-  StopSignals() {
-    sigemptyset(&set_);
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&set_, sig);
-    pthread_sigmask(SIG_BLOCK, &set_, &old_);
-  }
-  ~StopSignals() {
-    pending();
-    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-  // The first stop signal received so far (0: none).
-  int pending() {
-    const timespec zero{0, 0};
-    for (;;) {
-      const int sig = ::sigtimedwait(&set_, nullptr, &zero);
-      if (sig > 0) {
-        if (first_ == 0) first_ = sig;
-        continue;
-      }
-      if (errno != EINTR) return first_;
-    }
-  }
-
- private:
-  sigset_t set_{}, old_{};
-  int first_ = 0;
-};
 
 struct MergeStopped {
   int sig;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/stop_signals.h"
 #include "design/maneuver.h"
 #include "design/optimize_experiment.h"
 #include "experiments/experiment_loader.h"
@@ -15,6 +16,20 @@
 #include "common/units.h"
 
 namespace {
+// The files a design folder holds: its inputs (replaced by the next run's), and its results (the
+// previous run's removed before a new one starts, so a stopped or failed run never leaves an old
+// summary beside new inputs, nor an old pareto.csv beside a run without one).
+const std::vector<std::string> kOptimizeInputs = {"optimize.yaml", "base.yaml", "robot.yaml"};
+const std::vector<std::string> kOptimizeOutputs = {
+    "summary.json",     "best.yaml",         "best_analytic.csv", "best_perfoot.csv",  "best_mujoco.csv",
+    "best_trajectory.csv", "history.csv",    "pareto.csv",        "plots/history.png", "plots/history.svg",
+    "plots/history.gp", "plots/pareto.png",  "plots/pareto.svg",  "plots/pareto.gp"};
+const std::vector<std::string> kManeuverInputs = {"maneuver.yaml", "base.yaml", "robot.yaml", "stroke.yaml",
+                                                  "stroke_robot.yaml"};
+const std::vector<std::string> kManeuverOutputs = {"summary.json",      "maneuver.csv",      "strokes.csv",
+                                                   "yaw_map.csv",       "plots/heading.png", "plots/heading.svg",
+                                                   "plots/heading.gp"};
+
 void copyMessage(const char* what, char* err, size_t err_len) {
   if (!err || err_len == 0) return;
   std::strncpy(err, what, err_len - 1);
@@ -46,11 +61,16 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
     const OptimizeSpec spec = loadOptimizeSpec(exp_path);  // all errors before any work
     const FolderLock lock(out_dir);
     refuseRunResults(out_dir, "optimize");
-    claimDesignFolder(out_dir, {"summary.json", "best.yaml", "optimize.yaml", "base.yaml", "robot.yaml", "best_analytic.csv", "best_perfoot.csv", "best_mujoco.csv",
-                                "best_trajectory.csv", "history.csv", "pareto.csv", "plots/history.png",
-                                "plots/history.svg", "plots/history.gp", "plots/pareto.png", "plots/pareto.svg",
-                                "plots/pareto.gp"});
-    const OptimizeReport r = runOptimize(spec, out_dir, quiet == 0);
+    claimDesignFolder(out_dir, kOptimizeInputs);
+    claimDesignFolder(out_dir, kOptimizeOutputs);
+    removeDesignOutputs(out_dir, kOptimizeOutputs);  // an old summary never sits beside new inputs
+    StopSignals signals;  // before the search's threads start: they inherit the mask
+    const OptimizeReport r = runOptimize(spec, out_dir, quiet == 0, [&signals] { return signals.pending(); });
+    if (r.per_seed.empty()) {
+      std::fprintf(stderr, "optimize %s: stopped by %s before a seed finished: nothing written but the inputs; run it "
+                   "again\n", spec.name.c_str(), StopSignals::name(r.stop_signal));
+      return 128 + r.stop_signal;
+    }
     // One line in signed degrees: the search's optimum, the three models' re-runs, the limits.
     const StrokeEvaluation& b = r.per_seed[r.best_seed_index].best;
     const StrokeLimits& L = spec.problem.space.limits;
@@ -91,6 +111,12 @@ extern "C" __attribute__((visibility("default"))) int tailsim_optimize_main(cons
     if (!r.best_yaml_error.empty())
       std::fprintf(stderr, "warning: %s/best.yaml does not load back (%s): the re-runs used the search's trajectory\n",
                    out_dir, r.best_yaml_error.c_str());
+    if (r.stop_signal) {
+      std::fprintf(stderr, "optimize %s: stopped by %s after %zu of %zu seeds: the best of those is written (summary.json "
+                   "\"stopped_by\"); run it again for all\n", spec.name.c_str(), StopSignals::name(r.stop_signal),
+                   r.per_seed.size(), spec.seeds.size());
+      return 128 + r.stop_signal;
+    }
     if (r.infeasible.infeasible) {
       std::fprintf(stderr, "error: %s: %s (summary.json \"infeasible\")\n", spec.name.c_str(), r.infeasible.message.c_str());
       return 3;
@@ -112,10 +138,16 @@ extern "C" __attribute__((visibility("default"))) int tailsim_maneuver_main(cons
     const ManeuverSpec spec = loadManeuverSpec(exp_path);  // all errors before any work
     const FolderLock lock(out_dir);
     refuseRunResults(out_dir, "maneuver");
-    claimDesignFolder(out_dir, {"summary.json", "maneuver.yaml", "base.yaml", "robot.yaml", "stroke.yaml",
-                                "stroke_robot.yaml", "maneuver.csv", "strokes.csv", "yaw_map.csv", "plots/heading.png",
-                                "plots/heading.svg", "plots/heading.gp"});
-    const ManeuverReport r = runManeuver(spec, out_dir, video != 0, quiet == 0);
+    claimDesignFolder(out_dir, kManeuverInputs);
+    claimDesignFolder(out_dir, kManeuverOutputs);
+    removeDesignOutputs(out_dir, kManeuverOutputs);
+    StopSignals signals;
+    const ManeuverReport r = runManeuver(spec, out_dir, video != 0, quiet == 0, [&signals] { return signals.pending(); });
+    if (r.stop_signal) {
+      std::fprintf(stderr, "maneuver %s: stopped by %s: nothing written but the inputs (its results are whole or not "
+                   "at all); run it again\n", spec.name.c_str(), StopSignals::name(r.stop_signal));
+      return 128 + r.stop_signal;
+    }
     bool all_ok = true;
     std::vector<std::string> reasons;  // why the exit is not 0, one line each
     std::printf("%s: target %.4g deg, tolerance %.4g deg, min_scale %.4g (%s); analytic cycle %+.4f deg (stroke %+.4f, return %+.4f)\n",
