@@ -633,4 +633,30 @@ TEST(DesignInputsRobot, ADesignLimitReplacingTheRobotFilesIsNoted) {
   EXPECT_TRUE(spec("{thetadot_max_dps: 500, torque_max_Nm: 6}").limit_overrides.empty());
 }
 
+
+// A base that is a folder, or a design file (the optimize file itself), is named as such at the
+// base key (before: "no such experiment file", or "run it with tailsim optimize" without a line).
+TEST(DesignInputsRobot, ABaseThatIsAFolderOrADesignFileIsNamedAtItsKey) {
+  const ScratchDir t("design_base_kinds");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(t / name) << text;
+    return (t / name).string();
+  };
+  fs::create_directories(t / "afolder");
+  const std::string head = "kind: optimize\noptimize: {family: split_cycle, objective: phi_net, limits: {}}\n";
+  const std::string folder = write("folder.yaml", "name: a\nbase: afolder\n" + head);
+  const std::string self = write("self.yaml", "name: b\nbase: self.yaml\n" + head);
+  for (const auto& [file, want] : {std::make_pair(folder, "afolder is a folder: base names a one-case experiment file"),
+                                   std::make_pair(self, "self.yaml is a kind: optimize file: base names a one-case")}) {
+    try {
+      loadOptimizeSpec(file);
+      ADD_FAILURE() << file;
+    } catch (const ConfigError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(file + ":2:7: base: ", 0), 0u) << m;
+      EXPECT_NE(m.find(want), std::string::npos) << m;
+    }
+  }
+}
+
 }  // namespace tailsim

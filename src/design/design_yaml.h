@@ -159,8 +159,22 @@ inline DesignHead readDesignHead(const Reader& r, const Val& root, const Map& to
   const Val& base = need(r, top, root, "base");
   h.base_file = (fs::path(source_file).parent_path() / r.text(base)).lexically_normal().string();
   std::error_code ec;  // a name too long for the file system is an error here, not an exception
+  if (fs::is_directory(h.base_file, ec))
+    r.fail(base, h.base_file + " is a folder: base names a one-case experiment file (kind: simulate)");
   if (!fs::is_regular_file(h.base_file, ec))
     r.fail(base, "no such experiment file: " + h.base_file + (ec ? " (" + ec.message() + ")" : std::string()));
+  // A design file as the base (e.g. the optimize file itself): said here, at this key.
+  std::string base_kind;
+  try {
+    const YAML::Node doc = loadBoundedYaml(h.base_file);
+    if (doc.IsMap() && doc["kind"] && doc["kind"].IsScalar()) base_kind = doc["kind"].Scalar();
+  } catch (const std::exception&) {
+    // the experiment loader names the file's own error at its line
+  }
+  if (base_kind == "optimize" || base_kind == "maneuver")
+    r.fail(base, h.base_file + " is a kind: " + base_kind +
+                     " file: base names a one-case experiment file (kind: simulate), e.g. a best.yaml of tailsim "
+                     "optimize or the experiment your design starts from");
   return h;
 }
 
