@@ -659,4 +659,32 @@ TEST(DesignInputsRobot, ABaseThatIsAFolderOrADesignFileIsNamedAtItsKey) {
   }
 }
 
+
+// A maneuver's fast stroke beyond the robot file's actuator limits is refused at its key (an outside
+// review ran a 95 N m stroke on a 6 N m robot with no warning); within them it loads.
+TEST(DesignInputsRobot, AManeuverStrokeBeyondTheRobotsLimitsIsRefused) {
+  const ScratchDir t("design_maneuver_limits");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(t / name) << text;
+    return (t / name).string();
+  };
+  write("robot.yaml", "quadruped: {mass_kg: 8, size_m: [0.45, 0.25, 0.18]}\nfriction: {mu_s: 0.5, mu_d: 0.45}\n"
+                      "gravity_mps2: 9.81\ntails:\n  2: {mass_kg: 0.25, izz_kgm2: 4.7e-4, length_m: 0.15, torque_max_Nm: 6, "
+                      "thetadot_max_dps: 2000, theta_min_deg: -80, theta_max_deg: 80}\n");
+  write("base.yaml", "name: b\nrobot: robot.yaml\ntail: {links: 2}\ntrajectory: {rule: eq25, thetadot_max_dps: 500, w_ss: 0.25}\n"
+                     "models: [analytic]\n");
+  const std::string fast = write("fast.yaml", "name: m\nkind: maneuver\nbase: base.yaml\n"
+                                              "maneuver: {heading_deg: 20, stroke_deg: 120, stroke_dT_s: 0.08, mujoco: false}\n");
+  try {
+    loadManeuverSpec(fast);
+    ADD_FAILURE() << "a stroke over the robot's 6 N m was taken";
+  } catch (const ConfigError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(fast + ":4:", 0), 0u) << m;
+    EXPECT_NE(m.find("over its 6 N m at joint 1 (the robot file's tail entry"), std::string::npos) << m;
+  }
+  EXPECT_NO_THROW(loadManeuverSpec(write("slow.yaml", "name: m\nkind: maneuver\nbase: base.yaml\n"
+                                                      "maneuver: {heading_deg: 20, stroke_deg: 120, stroke_dT_s: 0.6, mujoco: false}\n")));
+}
+
 }  // namespace tailsim

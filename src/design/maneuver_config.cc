@@ -9,8 +9,10 @@
 
 #include "design/design_yaml.h"
 #include "design/maneuver.h"
+#include "design/stroke_family.h"
 #include "experiments/experiment_loader.h"
 #include "experiments/work_estimate.h"
+#include "common/units.h"
 #include "common/work_limits.h"
 
 namespace tailsim {
@@ -90,6 +92,27 @@ void checkStrokes(const Reader& r, const Val& mv, const std::vector<std::pair<st
                std::string("the ") + (part == 0 ? "fast stroke" : "return") + " at scale " + fmtG(scale) +
                    " asks too much of the analytic model: " + x.what);
     }
+  }
+  // The fast stroke at full scale within the robot's own actuator limits, where its tail entry gives
+  // them (tail base held still, as the optimiser's figures): a stroke the robot cannot make is no plan.
+  // 1 % is allowed over: a stroke searched onto a limit, sampled on another 0.5 ms grid once shifted
+  // to start at 0, peaks a little apart (a best.yaml at 6 N m showed 6.0009 here).
+  constexpr double kAllowed = 1.01;
+  const StrokeFigures f = strokeFigures(spec.base.robot.tail, shiftedToZero(cycleStrokes(s, n, {1.0, 1}, 0.0).fast));
+  for (int i = 0; i < n && i < static_cast<int>(f.joints.size()); ++i) {
+    const TailLink& k = spec.base.robot.tail[i];
+    const JointFigures& j = f.joints[i];
+    std::string over;
+    if (k.torque_max_Nm > 0.0 && j.peak_torque_Nm > kAllowed * k.torque_max_Nm)
+      over = "a peak torque of " + fmtG(j.peak_torque_Nm) + " N m, over its " + fmtG(k.torque_max_Nm) + " N m";
+    else if (k.thetadot_max_radps > 0.0 && j.peak_speed_radps > kAllowed * k.thetadot_max_radps)
+      over = "a peak speed of " + fmtG(units::degrees(j.peak_speed_radps)) + " deg/s, over its " +
+             fmtG(units::degrees(k.thetadot_max_radps)) + " deg/s";
+    if (!over.empty())
+      r.fail(firstSet(mv, m, {"stroke_from", "stroke_dT_s", "stroke_deg"}),
+             "the fast stroke needs " + over + " at joint " + std::to_string(i + 1) +
+                 " (the robot file's tail entry; 1 % over is allowed): the robot cannot make it; use a slower stroke (stroke_dT_s, or a "
+                 "tailsim optimize best.yaml searched within these limits)");
   }
   // The MuJoCo closed loop: at most max_strokes cycles (runManeuver's duration), one run.
   if (s.mujoco) {
