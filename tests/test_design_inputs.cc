@@ -575,15 +575,18 @@ TEST(OptimizeSectionDeclaration, UnknownKeysListTheDeclaredKeys) {
 namespace tailsim {
 using testing::ScratchDir;
 
+// Writes DIR/name; returns its path.
+std::string writeIn(const ScratchDir& dir, const std::string& name, const std::string& text) {
+  std::ofstream(dir / name) << text;
+  return (dir / name).string();
+}
+
 // A design file whose base experiment takes its robot from a model file: refused at the base line
 // with the way that works (before: after the limits, "cannot copy into the result folder: the
 // robot was not derived", with a lock and an empty plots/ left in --out).
 TEST(DesignInputsRobot, DesignCommandsNameTheWayToAnImportedRobot) {
   const ScratchDir t("design_model_base");
-  const auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(t / name) << text;
-    return (t / name).string();
-  };
+  const auto write = [&](const std::string& name, const std::string& text) { return writeIn(t, name, text); };
   write("box.xml", "<mujoco/>\n");  // the loader reads the keys only: nothing is derived
   write("base.yaml", "name: b\nrobot: {mjcf: box.xml}\ntail: {mount: {pos_m: [-0.25, 0, 0]}, links: 1}\n"
                      "trajectory: {rule: eq25, thetadot_max_dps: 600}\n");
@@ -611,10 +614,7 @@ TEST(DesignInputsRobot, DesignCommandsNameTheWayToAnImportedRobot) {
 // equals it, or that the robot file does not give, is not.
 TEST(DesignInputsRobot, ADesignLimitReplacingTheRobotFilesIsNoted) {
   const ScratchDir t("design_overrides");
-  const auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(t / name) << text;
-    return (t / name).string();
-  };
+  const auto write = [&](const std::string& name, const std::string& text) { return writeIn(t, name, text); };
   write("robot.yaml", "quadruped: {mass_kg: 8, size_m: [0.45, 0.25, 0.18]}\nfriction: {mu_s: 0.5, mu_d: 0.45}\n"
                       "gravity_mps2: 9.81\ntails:\n  2: {mass_kg: 0.25, izz_kgm2: 4.7e-4, length_m: 0.15, torque_max_Nm: 6, "
                       "thetadot_max_dps: 500, theta_min_deg: -80, theta_max_deg: 80}\n");
@@ -638,10 +638,7 @@ TEST(DesignInputsRobot, ADesignLimitReplacingTheRobotFilesIsNoted) {
 // base key (before: "no such experiment file", or "run it with tailsim optimize" without a line).
 TEST(DesignInputsRobot, ABaseThatIsAFolderOrADesignFileIsNamedAtItsKey) {
   const ScratchDir t("design_base_kinds");
-  const auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(t / name) << text;
-    return (t / name).string();
-  };
+  const auto write = [&](const std::string& name, const std::string& text) { return writeIn(t, name, text); };
   fs::create_directories(t / "afolder");
   const std::string head = "kind: optimize\noptimize: {family: split_cycle, objective: phi_net, limits: {}}\n";
   const std::string folder = write("folder.yaml", "name: a\nbase: afolder\n" + head);
@@ -664,10 +661,7 @@ TEST(DesignInputsRobot, ABaseThatIsAFolderOrADesignFileIsNamedAtItsKey) {
 // review ran a 95 N m stroke on a 6 N m robot with no warning); within them it loads.
 TEST(DesignInputsRobot, AManeuverStrokeBeyondTheRobotsLimitsIsRefused) {
   const ScratchDir t("design_maneuver_limits");
-  const auto write = [&](const std::string& name, const std::string& text) {
-    std::ofstream(t / name) << text;
-    return (t / name).string();
-  };
+  const auto write = [&](const std::string& name, const std::string& text) { return writeIn(t, name, text); };
   write("robot.yaml", "quadruped: {mass_kg: 8, size_m: [0.45, 0.25, 0.18]}\nfriction: {mu_s: 0.5, mu_d: 0.45}\n"
                       "gravity_mps2: 9.81\ntails:\n  2: {mass_kg: 0.25, izz_kgm2: 4.7e-4, length_m: 0.15, torque_max_Nm: 6, "
                       "thetadot_max_dps: 2000, theta_min_deg: -80, theta_max_deg: 80}\n");
