@@ -763,6 +763,7 @@ void stand(mjModel* m, mjData* d, const RobotModelSpec& spec, const Stance& stan
     standFor(kStandMoreS);
     stood += kStandMoreS;
   }
+  r.stood_s = stood;
   r.notes.push_back("stance started " + g6(1e3 * std::abs(low - floorZ)) +
                     (low >= floorZ ? " mm above" : " mm below") + " the floor (lowest colliding geom); moved " +
                     g6(1e3 * lift) + " mm to start 1 mm above it, then stood " + g6(stood) + " s" +
@@ -881,7 +882,7 @@ std::vector<int> findFeet(const mjModel* m, const mjData* d, const RobotModelSpe
   if (feet.size() < 3 || feet.size() > 4) {
     std::string names;
     for (int g : feet) names += (names.empty() ? "" : ", ") + geomName(m, g);
-    fail(file, "after standing " + g6(spec.settle_s) + " s in " + r.stance + ", the robot touches the floor with " +
+    fail(file, "after standing " + g6(r.stood_s) + " s in " + r.stance + ", the robot touches the floor with " +
                    std::to_string(feet.size()) + " geom" + (feet.size() == 1 ? "" : "s") +
                    (names.empty() ? "" : " (" + names + ")") +
                    "; a quadruped stands on 3 or 4 feet: check the stance (tilt " + g6(r.tilt_deg) +
@@ -1058,7 +1059,7 @@ std::string footFriction(const mjModel* m, const mjData* d, const RobotModelSpec
 // Stage: r.values, the derived settings with the source of each.
 void listValues(const RobotModelSpec& spec, const std::string& muSource, DerivedRobot& r) {
   const QuadrupedParams& q = r.quadruped;
-  const std::string stood = " (stance after standing " + g6(spec.settle_s) + " s)";
+  const std::string stood = " (stance after standing " + g6(r.stood_s) + " s)";
   const std::string frame = "planar frame: body '" + r.mount_body + "' x" +
                             (spec.mount.yaw_rad != 0.0 ? " turned by " + g6(units::degrees(spec.mount.yaw_rad)) + " deg" : "");
   r.values = {

@@ -75,6 +75,7 @@ struct DerivedRobot {
   std::string stance;                   // how the stance was set, in words
   bool legs_locked = false;             // the spec's legs: locked (attachTail adds the joint equalities)
   double tilt_deg = 0.0;                // root body tilt after settling [deg]
+  double stood_s = 0.0;                 // how long it stood before it was measured: settle_s, or longer until at rest [s]
   double lateral_com_to_feet_m = 0.0;   // y of the foot centroid in the planar frame (the planar models take 0) [m]
   double lateral_mount_m = 0.0;         // y of the tail base in the planar frame [m]
   // MuJoCo's own figures, for checking: body_subtreemass of the root body and the z-z entry of the
