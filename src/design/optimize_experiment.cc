@@ -687,7 +687,10 @@ void summarizeSearch(const OptimizeSpec& spec, const OptimizeReport& rep, const 
                {"phi_net_deg", b.phi_net_rad * kDegPerRad},
                {"peak_speed_dps", b.figures.peak_speed_radps * kDegPerRad}, {"peak_torque_Nm", b.figures.peak_torque_Nm},
                {"energy_J", b.figures.energy_J}, {"joints", joints}};
-  j["improvement_over_start"] = best.start.objective > 0 ? b.objective / best.start.objective - 1.0 : 0.0;
+  // The best's objective over the start's, less 1; null when the start scores nothing (a start that
+  // does not turn the body: any turn is an unbounded improvement, not 0).
+  j["improvement_over_start"] =
+      best.start.objective > 0 ? nlohmann::json(b.objective / best.start.objective - 1.0) : nlohmann::json(nullptr);
 }
 
 // summary.json's re-runs: the analytic re-run and its limits per joint, MuJoCo, the per-foot model.
