@@ -529,6 +529,10 @@ PreparedModel prepareRobotModel(const std::string& file_in) {
   const bool hasPlane = findFloor(geoms, defaults, out);
   const std::vector<XMLElement*> dropGeoms = geomsWithoutMesh(geoms, defaults, missing, dirs, file);
   for (XMLElement* gm : dropGeoms) gm->Parent()->DeleteChild(gm);
+  // The later stages read `geoms`: the deleted ones leave it (they would be freed elements).
+  geoms.erase(std::remove_if(geoms.begin(), geoms.end(),
+                             [&](XMLElement* gm) { return std::find(dropGeoms.begin(), dropGeoms.end(), gm) != dropGeoms.end(); }),
+              geoms.end());
   for (XMLElement* a : missing.elements) a->Parent()->DeleteChild(a);
   out.dropped_geoms = static_cast<int>(dropGeoms.size());
   out.dropped_textures = static_cast<int>(missing.texture.size());
