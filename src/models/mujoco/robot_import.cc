@@ -377,6 +377,13 @@ MissingAssets findMissingAssets(XMLElement* root, const AssetDirs& dirs, const s
   return m;
 }
 
+// Whether a geom can collide: contype or conaffinity (from the geom or its default classes) not 0.
+bool collides(const Defaults& defaults, XMLElement* gm) {
+  const char* ct = defaults.geomAttr(gm, "contype");
+  const char* ca = defaults.geomAttr(gm, "conaffinity");
+  return (ct ? std::atoi(ct) : 1) != 0 || (ca ? std::atoi(ca) : 1) != 0;
+}
+
 bool isPlane(const Defaults& defaults, XMLElement* gm) {
   const char* type = defaults.geomAttr(gm, "type");
   return type && std::string(type) == "plane";
@@ -391,14 +398,12 @@ std::vector<XMLElement*> geomsWithoutMesh(const std::vector<XMLElement*>& geoms,
   for (XMLElement* gm : geoms) {
     const char* mesh = defaults.geomAttr(gm, "mesh");
     if (!mesh || !missing.mesh.count(mesh)) continue;
-    const char* ct = defaults.geomAttr(gm, "contype");
-    const char* ca = defaults.geomAttr(gm, "conaffinity");
-    const bool collides = (ct ? std::atoi(ct) : 1) != 0 || (ca ? std::atoi(ca) : 1) != 0;
+    const bool can_collide = collides(defaults, gm);
     XMLElement* body = gm->Parent() ? gm->Parent()->ToElement() : nullptr;
     const std::string bodyName = body && body->Attribute("name") ? body->Attribute("name") : "world";
     const std::string geomName =
         gm->Attribute("name") ? "'" + std::string(gm->Attribute("name")) + "'" : "(unnamed, mesh '" + std::string(mesh) + "')";
-    if (collides) {
+    if (can_collide) {
       colliding.push_back("geom " + geomName + " in body '" + bodyName + "' collides but its mesh file " +
                           missing.mesh[mesh] + " is missing");
       continue;
@@ -467,9 +472,7 @@ void ensureFloor(XMLDocument& doc, XMLElement* world, const std::vector<XMLEleme
     // plane: the robot would stand on either, or inside the box, with no sign of it.
     for (XMLElement* gm : geoms) {
       if (gm->Parent() != world) continue;  // a geom of the world body: static scenery
-      const char* ct = defaults.geomAttr(gm, "contype");
-      const char* ca = defaults.geomAttr(gm, "conaffinity");
-      if ((ct ? std::atoi(ct) : 1) == 0 && (ca ? std::atoi(ca) : 1) == 0) continue;
+      if (!collides(defaults, gm)) continue;
       const char* type = defaults.geomAttr(gm, "type");
       fail(file, "the model has no plane to stand on, but a static colliding geom " +
                      (gm->Attribute("name") ? "'" + clipped(gm->Attribute("name")) + "'" : std::string("(unnamed)")) +
@@ -663,7 +666,8 @@ struct LegHold {
   int other_actuators = 0;       // joint actuators that are not position servos (motors): ctrl 0
 };
 
-// " (within the model's torque limits on k of them: ...)" for the stance line, "" when none has one.
+// " (its torque kept within the joint's own limit on k of them: ...)" for the stance line, "" when
+// none has a limit.
 std::string pdLimitWords(const LegHold& h) {
   int n = 0;
   double lo = HUGE_VAL, hi = 0.0;
